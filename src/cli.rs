@@ -1,0 +1,339 @@
+//! The command line: clap subcommands that call the library and print.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::mission::{self, Checked, Report};
+use crate::pipeline::{CancelToken, Completion, Event, Level, Observer};
+use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
+
+/// Terminal mission designer for multi-UAV formations.
+#[derive(Debug, Parser)]
+#[command(name = "skyform", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Validate mission files: print every error and warning with its line.
+    ///
+    /// Exits 0 when every file is valid, 1 when any has an error.
+    Check {
+        /// Mission TOML files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Treat warnings as errors.
+        #[arg(long)]
+        strict: bool,
+        /// Print the diagnostics as JSON (one object per file) instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Run a planning pipeline on a mission.
+    #[command(subcommand)]
+    Run(RunCommand),
+}
+
+#[derive(Debug, Subcommand)]
+pub enum RunCommand {
+    /// θ-PSO formation path planning with reconfiguration at intermediate waypoints.
+    ///
+    /// Progress goes to stderr, a summary to stdout. Exit status: 0 feasible
+    /// plan, 1 error, 2 infeasible plan, 130 cancelled (Ctrl-C).
+    ThetaPso {
+        /// Mission TOML file.
+        mission: PathBuf,
+        /// Seed of the swarm (default: the mission's `seed`).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Write the whole outcome as JSON to FILE, or to stdout with `-`
+        /// (the summary then goes to stderr).
+        #[arg(long, value_name = "FILE|-")]
+        json: Option<PathBuf>,
+        /// Evaluate the swarm on one thread (same result, slower).
+        #[arg(long)]
+        sequential: bool,
+    },
+}
+
+/// Exit status of a run, as the shell sees it.
+pub mod exit {
+    /// Success; for `run`, a feasible plan.
+    pub const OK: u8 = 0;
+    /// Invalid input or a failure.
+    pub const ERROR: u8 = 1;
+    /// The plan breaks a hard constraint.
+    pub const INFEASIBLE: u8 = 2;
+    /// Stopped by Ctrl-C (128 + SIGINT).
+    pub const CANCELLED: u8 = 130;
+}
+
+/// Entry point of the binary.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Check {
+            files,
+            strict,
+            json,
+        } => ExitCode::from(check(&files, strict, json)),
+        Command::Run(RunCommand::ThetaPso {
+            mission,
+            seed,
+            json,
+            sequential,
+        }) => ExitCode::from(run_theta_pso(&mission, seed, json.as_deref(), sequential)),
+    }
+}
+
+/// Ctrl-C sets the token (the pipeline stops at the next iteration and keeps
+/// its best); a second Ctrl-C exits at once.
+fn cancel_on_ctrl_c() -> CancelToken {
+    let token = CancelToken::new();
+    let handler = token.clone();
+    let installed = ctrlc::set_handler(move || {
+        if handler.is_cancelled() {
+            std::process::exit(i32::from(exit::CANCELLED));
+        }
+        eprintln!("\ncancelling… (Ctrl-C again to quit at once)");
+        handler.cancel();
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: Ctrl-C will not cancel cleanly: {e}");
+    }
+    token
+}
+
+/// Progress on stderr: a bar redrawn in place on a terminal, a line every
+/// 10 % otherwise (CI logs, pipes).
+struct StderrProgress {
+    terminal: bool,
+    last_decile: i32,
+    best: f64,
+    stage: String,
+}
+
+impl StderrProgress {
+    fn new() -> Self {
+        use std::io::IsTerminal;
+        StderrProgress {
+            terminal: std::io::stderr().is_terminal(),
+            last_decile: -1,
+            best: f64::NAN,
+            stage: String::new(),
+        }
+    }
+}
+
+impl Observer for StderrProgress {
+    fn on_event(&mut self, event: Event<'_>) {
+        match event {
+            Event::Stage(stage) => {
+                if self.terminal && !self.stage.is_empty() {
+                    eprintln!();
+                }
+                self.stage = stage.to_owned();
+                if !self.terminal {
+                    eprintln!("stage: {stage}");
+                }
+            }
+            Event::PathIteration { cost, .. } => self.best = cost.total,
+            Event::Progress(fraction) => {
+                let percent = (fraction * 100.0).round() as i32;
+                if self.terminal {
+                    let filled = (fraction * 30.0).round() as usize;
+                    eprint!(
+                        "\r{:<14} [{:<30}] {percent:>3}%  best J = {:.3}",
+                        self.stage,
+                        "#".repeat(filled.min(30)),
+                        self.best
+                    );
+                } else if percent / 10 > self.last_decile {
+                    self.last_decile = percent / 10;
+                    eprintln!("progress: {percent}% (best J = {:.3})", self.best);
+                }
+            }
+            Event::Log(level, message) => {
+                if self.terminal {
+                    eprint!("\r\x1b[K");
+                }
+                let tag = match level {
+                    Level::Info => "info",
+                    Level::Warn => "warning",
+                };
+                eprintln!("{tag}: {message}");
+            }
+        }
+    }
+}
+
+/// `skyform run theta-pso`.
+fn run_theta_pso(
+    path: &std::path::Path,
+    seed: Option<u64>,
+    json: Option<&std::path::Path>,
+    sequential: bool,
+) -> u8 {
+    let loaded = match mission::load(path) {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return exit::ERROR;
+        }
+    };
+    eprint!("{}", loaded.warnings);
+    let mission = loaded.mission;
+    let seed = seed.unwrap_or(mission.seed);
+    let cancel = cancel_on_ctrl_c();
+    let mut progress = StderrProgress::new();
+    let options = PlanOptions {
+        parallel: !sequential,
+    };
+    let outcome = match planner::plan(&mission, seed, options, &mut progress, &cancel) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("\nerror: {e}");
+            return exit::ERROR;
+        }
+    };
+    if progress.terminal {
+        eprintln!();
+    }
+    let json_to_stdout = json.is_some_and(|p| p.as_os_str() == "-");
+    let summary = theta_pso_summary(&outcome);
+    if json_to_stdout {
+        eprint!("{summary}");
+    } else {
+        print!("{summary}");
+    }
+    if let Some(target) = json {
+        let text = match serde_json::to_string_pretty(&outcome) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("error: cannot write the outcome as JSON: {e}");
+                return exit::ERROR;
+            }
+        };
+        if json_to_stdout {
+            println!("{text}");
+        } else if let Err(e) = mission::write_atomically(target, text.as_bytes()) {
+            eprintln!("error: cannot write {}: {e}", target.display());
+            return exit::ERROR;
+        }
+    }
+    if outcome.completion == Completion::Cancelled {
+        exit::CANCELLED
+    } else if outcome.feasible() {
+        exit::OK
+    } else {
+        exit::INFEASIBLE
+    }
+}
+
+/// The human summary of a θ-PSO outcome.
+pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(s, "θ-PSO plan for \"{}\" (seed {})", o.mission, o.seed);
+    let _ = writeln!(
+        s,
+        "  run          {:?} after {} iterations, {} cost evaluations",
+        o.completion, o.iterations, o.evaluations
+    );
+    let c = &o.cost;
+    let _ = writeln!(
+        s,
+        "  cost         J = {:.3}  (J1 length {:.2} m, J2 obstacles {:.5}, J3 altitude {:.3}, J_R waypoints {:.2} m)",
+        c.total, c.length, c.obstacle, c.altitude, c.waypoints
+    );
+    let _ = writeln!(
+        s,
+        "  path         {:.1} m in {:.1} s, {} free waypoints",
+        o.path_length,
+        o.duration,
+        o.waypoints.len()
+    );
+    let enabled = o.iwps.iter().filter(|i| i.enabled).count();
+    let _ = writeln!(s, "  IWPs         {} found, {enabled} enabled", o.iwps.len());
+    for r in &o.reconfigurations {
+        let _ = writeln!(
+            s,
+            "  reconfig     {} between '{}' and '{}': t1 {:.1} s, t2 {:.1} s, t3 {:.1} s, t4 {:.1} s",
+            r.shape.name(),
+            r.between[0],
+            r.between[1],
+            r.t1,
+            r.t2,
+            r.t3,
+            r.t4
+        );
+    }
+    let _ = writeln!(s, "  verification");
+    for check in &o.verification.checks {
+        let worst = check
+            .worst
+            .map_or_else(|| "n/a".to_owned(), |w| format!("{w:.3}"));
+        let at = check.at.as_ref().map_or_else(String::new, |a| {
+            let other = a.other.as_deref().map_or_else(String::new, |o| format!(" vs {o}"));
+            format!("  (UAV {} at t = {:.1} s{other})", a.uav, a.time)
+        });
+        let verdict = if check.ok { "ok  " } else { "FAIL" };
+        let _ = writeln!(
+            s,
+            "    {verdict} {:<32} worst {worst:>9} {} {}{at}",
+            check.name, check.relation, check.limit
+        );
+    }
+    let verdict = if o.feasible() { "FEASIBLE" } else { "INFEASIBLE" };
+    let _ = writeln!(s, "  result       {verdict}");
+    s
+}
+
+/// `skyform check`: one report per file, then a one-line verdict.
+fn check(files: &[PathBuf], strict: bool, json: bool) -> u8 {
+    let mut failed = false;
+    let mut json_reports = Vec::new();
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    for path in files {
+        let name = path.display().to_string();
+        let report = match mission::read(path) {
+            Ok(text) => {
+                let Checked { report, .. } = mission::check_str(&text, Some(&name));
+                report
+            }
+            Err(e) => Report::new(vec![
+                mission::Diagnostic::error(mission::FieldPath::root(), e.to_string())
+                    .locate(Some(&name), &mission::SourceMap::new("")),
+            ]),
+        };
+        let bad = report.has_errors() || (strict && report.warning_count() > 0);
+        failed |= bad;
+        if json {
+            json_reports.push(serde_json::json!({
+                "file": name,
+                "valid": !bad,
+                "diagnostics": report.diagnostics,
+            }));
+            continue;
+        }
+        let _ = write!(out, "{report}");
+        let verdict = if bad { "FAILED" } else { "ok" };
+        let _ = writeln!(
+            out,
+            "{name}: {verdict} ({} error(s), {} warning(s))",
+            report.error_count(),
+            report.warning_count()
+        );
+    }
+    if json {
+        let text = serde_json::to_string_pretty(&json_reports).unwrap_or_default();
+        let _ = writeln!(out, "{text}");
+    }
+    if failed { exit::ERROR } else { exit::OK }
+}

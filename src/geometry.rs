@@ -1,0 +1,91 @@
+//! Plain 3D geometry shared by validation, planners and verification.
+//!
+//! Metres, ENU (z up), ground at z = 0. This module is a leaf: it knows nothing
+//! of missions or pipelines.
+
+use nalgebra::{Point2, Point3};
+
+/// A vertical cylinder standing on the ground: axis through `center`, from
+/// z = 0 up to z = `height`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cylinder {
+    pub center: Point2<f64>,
+    pub radius: f64,
+    pub height: f64,
+}
+
+impl Cylinder {
+    /// Horizontal distance from `p` to the axis.
+    pub fn horizontal_distance(&self, p: &Point3<f64>) -> f64 {
+        (p.xy() - self.center).norm()
+    }
+
+    /// Distance from `p` to the cylinder's axis, extended over the top: below
+    /// the top it is the horizontal distance to the axis; above it, the radius
+    /// plus the distance to the top disc. Continuous at the top, and equal to
+    /// the radius exactly on the surface, so `1 - d / r_safe` measures how deep
+    /// a point is inside a safety margin around the whole solid (θ-PSO eq. 4).
+    pub fn axis_distance(&self, p: &Point3<f64>) -> f64 {
+        self.radius + self.clearance(p)
+    }
+
+    /// Signed distance from `p` to the solid cylinder: positive outside,
+    /// negative inside (as deep as the nearest side wall).
+    pub fn clearance(&self, p: &Point3<f64>) -> f64 {
+        let outward = self.horizontal_distance(p) - self.radius;
+        if p.z <= self.height {
+            outward
+        } else {
+            let above = p.z - self.height;
+            let sideways = outward.max(0.0);
+            (sideways * sideways + above * above).sqrt()
+        }
+    }
+}
+
+/// Length of the polyline through `points`.
+pub fn polyline_length(points: &[Point3<f64>]) -> f64 {
+    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const POLE: Cylinder = Cylinder {
+        center: Point2::new(0.0, 0.0),
+        radius: 1.0,
+        height: 10.0,
+    };
+
+    #[test]
+    fn clearance_beside_the_wall_is_horizontal() {
+        assert_eq!(POLE.clearance(&Point3::new(3.0, 0.0, 5.0)), 2.0);
+        assert_eq!(POLE.clearance(&Point3::new(0.5, 0.0, 5.0)), -0.5);
+    }
+
+    #[test]
+    fn clearance_above_the_top_is_to_the_top_disc() {
+        assert_eq!(POLE.clearance(&Point3::new(0.0, 0.0, 13.0)), 3.0);
+        let corner = POLE.clearance(&Point3::new(4.0, 0.0, 14.0));
+        assert!((corner - 5.0).abs() < 1e-12, "3-4-5 triangle, got {corner}");
+    }
+
+    #[test]
+    fn axis_distance_is_continuous_over_the_top() {
+        let below = POLE.axis_distance(&Point3::new(2.5, 0.0, 10.0));
+        let above = POLE.axis_distance(&Point3::new(2.5, 0.0, 10.0 + 1e-9));
+        assert!((below - above).abs() < 1e-6);
+        assert_eq!(below, 2.5);
+    }
+
+    #[test]
+    fn polyline_length_adds_segments() {
+        let pts = [
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(3.0, 4.0, 0.0),
+            Point3::new(3.0, 4.0, 2.0),
+        ];
+        assert_eq!(polyline_length(&pts), 7.0);
+    }
+}

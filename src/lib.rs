@@ -1,0 +1,12 @@
+//! skyform: a terminal mission designer for multi-UAV formations.
+//!
+//! Data flows one way: a mission file becomes a validated [`mission::Mission`],
+//! pipelines turn it into outcomes, and views (CLI, TUI, Rerun) show them.
+//! See `docs/architecture.md`.
+
+pub mod cli;
+pub mod geometry;
+pub mod mission;
+pub mod pipeline;
+pub mod planner;
+pub mod swarm;

@@ -1,0 +1,156 @@
+//! Reading, checking and atomically saving mission files.
+
+use std::fs;
+use std::io::{self, Write};
+use std::path::Path;
+
+use toml::de::DeTable;
+
+use super::diagnostic::{Diagnostic, Report};
+use super::model::Mission;
+use super::source::SourceMap;
+use super::validate::validate;
+
+/// What can go wrong between a mission file and a `Mission`.
+#[derive(Debug, thiserror::Error)]
+pub enum MissionError {
+    #[error("cannot read {path}: {source}")]
+    Read { path: String, source: io::Error },
+    #[error("{origin} is not a valid mission ({} error(s)):\n{report}", report.error_count())]
+    Invalid { origin: String, report: Report },
+    #[error("cannot save {path}: {source}")]
+    Write { path: String, source: io::Error },
+    #[error("cannot write the mission as TOML: {0}")]
+    Serialize(#[from] toml::ser::Error),
+}
+
+/// The result of checking a mission text: the mission when it could be read at
+/// all, and every problem found (syntax, unknown keys, validation rules).
+#[derive(Debug, Clone)]
+pub struct Checked {
+    pub mission: Option<Mission>,
+    pub report: Report,
+}
+
+/// Parses and validates `text`; `file` names it in the messages.
+/// Never panics, whatever the bytes.
+pub fn check_str(text: &str, file: Option<&str>) -> Checked {
+    let source = SourceMap::new(text);
+    let locate = |d: Diagnostic| d.locate(file, &source);
+
+    // The spanned parser recovers after a syntax error, so every syntax error
+    // of the file is reported at once, not only the first.
+    let (_, syntax_errors) = DeTable::parse_recoverable(text);
+    if !syntax_errors.is_empty() {
+        let diagnostics = syntax_errors
+            .iter()
+            .map(|e| locate_toml_error(e, &source))
+            .map(locate)
+            .collect();
+        return Checked {
+            mission: None,
+            report: Report::new(diagnostics),
+        };
+    }
+    match toml::from_str::<Mission>(text) {
+        Ok(mission) => {
+            let report = Report::new(validate(&mission).into_iter().map(locate).collect());
+            Checked {
+                mission: Some(mission),
+                report,
+            }
+        }
+        Err(e) => Checked {
+            mission: None,
+            report: Report::new(vec![locate(locate_toml_error(&e, &source))]),
+        },
+    }
+}
+
+/// A toml error as a diagnostic on the field under its span.
+fn locate_toml_error(e: &toml::de::Error, source: &SourceMap<'_>) -> Diagnostic {
+    let path = e
+        .span()
+        .map(|span| source.path_at(span.start))
+        .unwrap_or_default();
+    let mut d = Diagnostic::error(path, e.message().trim().to_owned());
+    d.location = e.span().map(|span| source.line_col(span.start));
+    d
+}
+
+/// A valid mission and the warnings it raised.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    pub mission: Mission,
+    pub warnings: Report,
+}
+
+/// Parses `text` into a valid mission, or fails with every error found.
+pub fn parse_str(text: &str, origin: &str) -> Result<Loaded, MissionError> {
+    let Checked { mission, report } = check_str(text, Some(origin));
+    match mission {
+        Some(mission) if !report.has_errors() => Ok(Loaded {
+            mission,
+            warnings: report,
+        }),
+        _ => Err(MissionError::Invalid {
+            origin: origin.to_owned(),
+            report,
+        }),
+    }
+}
+
+/// Reads a mission file; it must be valid.
+pub fn load(path: &Path) -> Result<Loaded, MissionError> {
+    let text = read(path)?;
+    parse_str(&text, &path.display().to_string())
+}
+
+/// Reads a file as UTF-8 text, naming it in the error.
+pub fn read(path: &Path) -> Result<String, MissionError> {
+    fs::read_to_string(path).map_err(|source| MissionError::Read {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// The mission as TOML text, the same shape as the shipped files.
+pub fn to_toml_string(mission: &Mission) -> Result<String, MissionError> {
+    let body = toml::to_string_pretty(mission)?;
+    Ok(format!(
+        "# skyform mission (format of skyform {}); see README.md for every field.\n\n{body}",
+        env!("CARGO_PKG_VERSION")
+    ))
+}
+
+/// Saves atomically: the text goes to a temporary file in the same directory,
+/// is flushed to disk, then renamed over `path`. A crash or a full disk leaves
+/// either the old file or the new one, never half of one.
+pub fn save(mission: &Mission, path: &Path) -> Result<(), MissionError> {
+    let text = to_toml_string(mission)?;
+    write_atomically(path, text.as_bytes()).map_err(|source| MissionError::Write {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// Writes `bytes` to `path` through a synced temporary file and a rename.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".skyform-save-")
+        .suffix(".tmp")
+        .tempfile_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    // Make the rename itself durable. Not every platform lets a directory be
+    // opened and synced; the data is already safe, so that failure is ignored.
+    if let Ok(d) = fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}

@@ -1,0 +1,19 @@
+//! Missions: the TOML model, loading with located diagnostics, validation and
+//! atomic saving. Everything downstream takes a `Mission` that passed `validate`.
+
+mod builtin;
+mod diagnostic;
+mod file;
+mod model;
+mod source;
+mod validate;
+
+pub use builtin::{BUILTIN, Builtin, default_mission};
+pub use diagnostic::{Diagnostic, Report, Severity};
+pub use file::{
+    Checked, Loaded, MissionError, check_str, load, parse_str, read, save, to_toml_string,
+    write_atomically,
+};
+pub use model::*;
+pub use source::{FieldPath, LineCol, PathSegment, SourceMap};
+pub use validate::validate;

@@ -1,0 +1,487 @@
+//! The mission as it is written in a TOML file.
+//!
+//! Frames and units: positions are metres in the local East-North-Up frame
+//! (x east, y north, z up), angles in the file are degrees, times seconds.
+//! Every parameter defaults to the value used in its paper, so a mission file
+//! only has to say what differs. Unknown keys are rejected (`deny_unknown_fields`)
+//! so that a typo is an error instead of a silently ignored setting.
+
+use nalgebra::{Point2, Point3, Vector2, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// A complete mission: the operating space, what is in it, the formation that
+/// flies it, and the parameters of the three planning pipelines.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mission {
+    /// Short human name, shown in the TUI and in recordings.
+    pub name: String,
+    /// Free text: what the mission is for.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub description: String,
+    /// Seed of every random number the pipelines draw; same mission + seed → same result.
+    #[serde(default)]
+    pub seed: u64,
+    /// Geodetic anchor of the local ENU frame, for export to real autopilots.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<GeoOrigin>,
+    pub bounds: Bounds,
+    pub route: Route,
+    #[serde(default)]
+    pub formation: Formation,
+    #[serde(default)]
+    pub reconfiguration: Reconfiguration,
+    #[serde(default)]
+    pub theta_pso: ThetaPsoParams,
+    #[serde(default)]
+    pub flatlo: FlatloParams,
+    #[serde(default)]
+    pub fleet: FleetParams,
+    /// Vertical cylinders standing on the ground (z = 0).
+    #[serde(default)]
+    pub obstacles: Vec<Obstacle>,
+}
+
+/// WGS-84 position of the ENU origin.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeoOrigin {
+    /// Degrees, positive north.
+    pub latitude: f64,
+    /// Degrees, positive east.
+    pub longitude: f64,
+    /// Metres above the WGS-84 ellipsoid.
+    #[serde(default)]
+    pub altitude: f64,
+}
+
+/// The operating box (θ-PSO eq. 1 decodes into it) and the altitude band
+/// [z_min, z_max] of θ-PSO eq. 5. Metres, ENU.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bounds {
+    /// [x_min, x_max]
+    pub x: [f64; 2],
+    /// [y_min, y_max]
+    pub y: [f64; 2],
+    /// Altitude band [z_min, z_max] above ground.
+    pub z: [f64; 2],
+}
+
+impl Bounds {
+    pub fn contains(&self, p: &Point3<f64>) -> bool {
+        self.contains_xy(&p.xy()) && (self.z[0]..=self.z[1]).contains(&p.z)
+    }
+
+    pub fn contains_xy(&self, p: &Point2<f64>) -> bool {
+        (self.x[0]..=self.x[1]).contains(&p.x) && (self.y[0]..=self.y[1]).contains(&p.y)
+    }
+}
+
+/// A vertical cylinder from the ground to `height`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Obstacle {
+    pub name: String,
+    /// Axis position, metres ENU.
+    pub center: Point2<f64>,
+    /// Metres.
+    pub radius: f64,
+    /// Metres above ground.
+    pub height: f64,
+    /// Free label ("pier", "pole", "tree", …), for display only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kind: Option<String>,
+}
+
+/// Where the formation centroid starts and ends. Metres ENU.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Route {
+    pub start: Point3<f64>,
+    pub goal: Point3<f64>,
+}
+
+/// The formation flown by the θ-PSO pipeline (θ-PSO paper, Section III).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Formation {
+    /// r_Q: safe radius of one UAV, metres (eq. 7).
+    pub uav_radius: f64,
+    /// d_com: communication range, metres (eq. 7).
+    pub comm_range: f64,
+    /// Constant ground speed of the centroid, m/s.
+    pub ground_speed: f64,
+    /// [d_min^s, d_max^s]: distance band to the inspected surface, metres (eq. 8).
+    pub surface_distance: [f64; 2],
+    /// Offsets of each UAV from the centroid in the formation frame
+    /// (x forward along the horizontal path tangent, y left, z up), metres.
+    pub slots: Vec<Vector3<f64>>,
+}
+
+impl Default for Formation {
+    /// The paper's experiment: a triangle ΔT1..ΔT3, 3 m/s, d^s ∈ [1, 5] m.
+    fn default() -> Self {
+        Formation {
+            uav_radius: 0.5,
+            comm_range: 20.0,
+            ground_speed: 3.0,
+            surface_distance: [1.0, 5.0],
+            slots: vec![
+                Vector3::new(0.0, 2.0, 0.0),
+                Vector3::new(-2.0, -1.0, 0.0),
+                Vector3::new(2.0, -1.0, 0.0),
+            ],
+        }
+    }
+}
+
+/// The shapes a formation can take at an intermediate waypoint (Fig. 2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeChoice {
+    /// The least change that fits the gap.
+    #[default]
+    Auto,
+    /// A single-file column along the direction of travel.
+    Alignment,
+    /// The shape turned rigidly into the vertical plane across the path.
+    Rotation,
+    /// The shape scaled toward the centroid by `shrink_scale`.
+    Shrink,
+}
+
+/// How the formation reconfigures at intermediate waypoints (Section III.B).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Reconfiguration {
+    /// Shape used at IWPs that have no entry in `waypoints`.
+    pub default_shape: ShapeChoice,
+    /// Scale of the shrink shape, in (0, 1].
+    pub shrink_scale: f64,
+    /// Path length over which the shape changes ([t1, t2] and [t3, t4]), metres.
+    /// The paper's rotation experiment takes 6 s at 3 m/s (Fig. 7).
+    pub transition_distance: f64,
+    /// The new shape is complete this far before the IWP and held until this
+    /// far after it, metres (1 m in the paper's experiment).
+    pub hold_distance: f64,
+    /// Choices for individual IWPs, named by the obstacle pair they lie between.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub waypoints: Vec<WaypointChoice>,
+}
+
+impl Default for Reconfiguration {
+    fn default() -> Self {
+        Reconfiguration {
+            default_shape: ShapeChoice::Auto,
+            shrink_scale: 0.5,
+            transition_distance: 18.0,
+            hold_distance: 1.0,
+            waypoints: Vec::new(),
+        }
+    }
+}
+
+/// The operator's choice for the IWP between two named obstacles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaypointChoice {
+    /// Names of the two obstacles whose gap holds the IWP (eq. 9).
+    pub between: [String; 2],
+    /// A disabled IWP takes no part in J_R (eq. 11) and causes no reconfiguration.
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    #[serde(default)]
+    pub shape: ShapeChoice,
+    /// Overrides `shrink_scale` for this IWP.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f64>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// θ-PSO parameters (θ-PSO paper, eqs. 1-5, 10-11, Section IV.A).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ThetaPsoParams {
+    /// N: number of particles (100 in the paper).
+    pub swarm_size: usize,
+    /// Number of free waypoints between start and goal (7 in the paper).
+    pub waypoints: usize,
+    /// Swarm iterations (150 in the paper).
+    pub iterations: usize,
+    /// w: inertia weight of eq. 1.
+    pub inertia: f64,
+    /// c1: cognitive gain of eq. 1.
+    pub cognitive: f64,
+    /// c2: social gain of eq. 1.
+    pub social: f64,
+    /// L: straight segments the path is split into for the cost (eqs. 3-5, 11).
+    pub segments: usize,
+    /// β1: weight of the path length J1 (eq. 2).
+    pub weight_length: f64,
+    /// β2: weight of the obstacle violation J2 (eq. 2).
+    pub weight_obstacle: f64,
+    /// β3: weight of the altitude violation J3 (eq. 2).
+    pub weight_altitude: f64,
+    /// Weight of J_R (eq. 10 adds it with weight 1).
+    pub weight_waypoints: f64,
+    /// δ_l for a segment at or below the ground. The paper's ∞ is replaced by
+    /// a large finite value so that costs stay comparable.
+    pub ground_penalty: f64,
+}
+
+impl Default for ThetaPsoParams {
+    fn default() -> Self {
+        ThetaPsoParams {
+            swarm_size: 100,
+            waypoints: 7,
+            iterations: 150,
+            inertia: 0.7298,
+            cognitive: 1.49618,
+            social: 1.49618,
+            segments: 64,
+            weight_length: 1.0,
+            weight_obstacle: 1000.0,
+            weight_altitude: 100.0,
+            weight_waypoints: 1.0,
+            ground_penalty: 1.0e6,
+        }
+    }
+}
+
+/// FLATLO parameters (FLATLO paper, Algorithms 1-2, eqs. 1-6, Section 3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FlatloParams {
+    /// N: aircraft in the squadron (4 in the paper).
+    pub aircraft: usize,
+    /// Δ_d: spacing between neighbours, before and after, metres (18,300 m).
+    pub spacing: f64,
+    /// Nominal airspeed, m/s (30.5 m/s).
+    pub airspeed: f64,
+    /// r: radius of the turn manoeuvres, metres (4,575 m).
+    pub turn_radius: f64,
+    /// Initial height, metres (3,050 m).
+    pub altitude: f64,
+    /// φ: initial heading, degrees from the x axis (east), counter-clockwise.
+    pub heading_deg: f64,
+    /// β: flight-path climb angle, degrees.
+    pub climb_deg: f64,
+    /// Position of aircraft 0 at the start (x, y), metres ENU; height is `altitude`.
+    pub start: Point2<f64>,
+    /// K_2: length of the final straight leg on the longitudinal line (Alg. 1 line 51), metres.
+    pub final_leg: f64,
+    /// T: sampling period of the references, s.
+    pub sample_period: f64,
+    /// Fixed RK4 step of the aircraft simulation, s.
+    pub sim_step: f64,
+    /// Aircraft mass, kg.
+    pub mass: f64,
+    /// Wing area, m².
+    pub wing_area: f64,
+    /// Air density at the flight altitude, kg/m³.
+    pub air_density: f64,
+    /// Zero-lift drag coefficient C_D0.
+    pub drag_cd0: f64,
+    /// Induced drag factor k in C_D = C_D0 + k C_L².
+    pub drag_k: f64,
+    /// Thrust limit, N.
+    pub max_thrust: f64,
+    /// Load factor limits [n_min, n_max].
+    pub load_factor: [f64; 2],
+    /// Bank angle limit |μ|, degrees.
+    pub max_bank_deg: f64,
+    /// Position-error PID gains [kp, ki, kd] of the tracking controller.
+    pub pid: [f64; 3],
+    /// Relative standard deviation of the multiplicative Gaussian noise on
+    /// airspeed, heading and flight-path angle (0.25 % in the paper; 0 = exact).
+    pub noise: f64,
+    /// Pass/fail threshold on the minimum pairwise distance, metres.
+    pub min_separation: f64,
+}
+
+impl Default for FlatloParams {
+    fn default() -> Self {
+        FlatloParams {
+            aircraft: 4,
+            spacing: 18_300.0,
+            airspeed: 30.5,
+            turn_radius: 4_575.0,
+            altitude: 3_050.0,
+            heading_deg: 0.0,
+            climb_deg: 0.0,
+            start: Point2::origin(),
+            final_leg: 20_000.0,
+            sample_period: 1.0,
+            sim_step: 0.1,
+            mass: 750.0,
+            wing_area: 10.0,
+            air_density: 0.905,
+            drag_cd0: 0.03,
+            drag_k: 0.05,
+            max_thrust: 3_000.0,
+            load_factor: [-1.0, 3.0],
+            max_bank_deg: 60.0,
+            pid: [0.02, 0.0002, 0.4],
+            noise: 0.0025,
+            min_separation: 1_000.0,
+        }
+    }
+}
+
+/// One target of the fleet's timed sequence.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FleetTarget {
+    /// When the target becomes active, s.
+    pub time: f64,
+    /// Target point P_d in the flight plane, metres ENU.
+    pub position: Point2<f64>,
+}
+
+/// A push on one agent, as in the disturbance experiment (fleet paper, 4.2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FleetPush {
+    /// Index of the agent pushed (0-based).
+    pub agent: usize,
+    /// When, s.
+    pub time: f64,
+    /// Impulse, N·s, in the flight plane.
+    pub impulse: Vector2<f64>,
+}
+
+/// Distributed-fleet parameters (fleet paper, eqs. 2-13, Table 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FleetParams {
+    /// n: number of quadrotors (3 in Section 4.4).
+    pub agents: usize,
+    /// ρ ≫ 1: weight of the distance to the target (eq. 6); 5 in Table 1.
+    pub rho: f64,
+    /// σ: steepness of a_ij and Obs_ik (eqs. 3, 9); 0.4 in Table 1.
+    pub sigma: f64,
+    /// c: safety distance between agents and to obstacles, metres (0.8 m).
+    pub safety_distance: f64,
+    /// d_obs: obstacle detection range, metres (3 m).
+    pub detection_range: f64,
+    /// l: neighbourhood radius of eq. 2, metres.
+    pub neighbourhood: f64,
+    /// h_max: each PSO searches h ∈ [-h_max, h_max]², metres (0.4 m).
+    pub step_max: f64,
+    /// τ: re-planning period, s (0.1 s).
+    pub replan_period: f64,
+    /// d_ip^d: desired distance of each agent to the target, metres (1 m → 1.732 m
+    /// between three agents).
+    pub target_distance: f64,
+    /// Desired inter-agent distances d_ij^d; empty = uniform polygon around the target.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub distances: Vec<Vec<f64>>,
+    /// Flight altitude of the plane the fleet moves in, metres.
+    pub altitude: f64,
+    /// Particles of each agent's PSO.
+    pub swarm_size: usize,
+    /// Iterations of each agent's PSO per re-plan.
+    pub iterations: usize,
+    /// PSO inertia w.
+    pub inertia: f64,
+    /// PSO cognitive gain c1.
+    pub cognitive: f64,
+    /// PSO social gain c2.
+    pub social: f64,
+    /// Simulation step of the quadrotor dynamics, s.
+    pub sim_step: f64,
+    /// Simulated duration, s.
+    pub duration: f64,
+    /// Quadrotor mass, kg (Parrot AR.Drone 2).
+    pub mass: f64,
+    /// Diagonal of the inertia matrix J, kg·m².
+    pub inertia_diag: Vector3<f64>,
+    /// K_pos (eq. 11): [position gain, velocity gain].
+    pub position_gains: [f64; 2],
+    /// K_att (eq. 13): [attitude gain, rate gain].
+    pub attitude_gains: [f64; 2],
+    /// Thrust limit, N.
+    pub max_thrust: f64,
+    /// Tilt limit, degrees.
+    pub max_tilt_deg: f64,
+    /// Convergence tolerance on every distance, as a fraction of its desired value.
+    pub tolerance: f64,
+    /// Initial positions (x, y); empty = seeded random inside the bounds.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub initial_positions: Vec<Point2<f64>>,
+    /// The timed sequence of targets.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub targets: Vec<FleetTarget>,
+    /// Disturbances.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pushes: Vec<FleetPush>,
+}
+
+impl Default for FleetParams {
+    fn default() -> Self {
+        FleetParams {
+            agents: 3,
+            rho: 5.0,
+            sigma: 0.4,
+            safety_distance: 0.8,
+            detection_range: 3.0,
+            neighbourhood: 5.0,
+            step_max: 0.4,
+            replan_period: 0.1,
+            target_distance: 1.0,
+            distances: Vec::new(),
+            altitude: 1.0,
+            swarm_size: 30,
+            iterations: 30,
+            inertia: 0.7298,
+            cognitive: 1.49618,
+            social: 1.49618,
+            sim_step: 0.005,
+            duration: 40.0,
+            mass: 0.42,
+            inertia_diag: Vector3::new(0.0022, 0.0029, 0.0048),
+            position_gains: [4.0, 3.0],
+            attitude_gains: [60.0, 12.0],
+            max_thrust: 8.0,
+            max_tilt_deg: 30.0,
+            tolerance: 0.05,
+            initial_positions: Vec::new(),
+            targets: Vec::new(),
+            pushes: Vec::new(),
+        }
+    }
+}
+
+impl Obstacle {
+    pub fn cylinder(&self) -> crate::geometry::Cylinder {
+        crate::geometry::Cylinder {
+            center: self.center,
+            radius: self.radius,
+            height: self.height,
+        }
+    }
+}
+
+impl Formation {
+    /// r_F = max_n ‖ΔT_n‖: distance of the farthest UAV from the centroid (eq. 6).
+    pub fn radius(&self) -> f64 {
+        self.slots.iter().map(|s| s.norm()).fold(0.0, f64::max)
+    }
+
+    /// Safe radius of the whole formation around its centroid, r_F + r_Q.
+    pub fn safe_radius(&self) -> f64 {
+        self.radius() + self.uav_radius
+    }
+
+    /// Centroid of the slots; eq. 6 puts it at the origin of the formation frame.
+    pub fn slot_centroid(&self) -> Vector3<f64> {
+        if self.slots.is_empty() {
+            return Vector3::zeros();
+        }
+        self.slots.iter().sum::<Vector3<f64>>() / self.slots.len() as f64
+    }
+}

@@ -1,0 +1,624 @@
+//! The rules a mission must follow, checked on the typed value.
+//!
+//! Every rule runs, so one pass reports every problem. Each finding names the
+//! field it concerns; `Diagnostic::locate` later adds the file and line.
+
+use nalgebra::Point3;
+
+use super::diagnostic::Diagnostic;
+use super::model::{
+    Bounds, FlatloParams, FleetParams, Formation, GeoOrigin, Mission, Obstacle, Reconfiguration,
+    Route, ThetaPsoParams,
+};
+use super::source::FieldPath;
+
+/// Standard gravity, m/s².
+const G: f64 = 9.81;
+
+/// Checks every rule; errors and warnings in the order of the file.
+pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
+    let mut c = Checker::default();
+    let root = FieldPath::root();
+    c.finite_everywhere(mission);
+    if mission.name.trim().is_empty() {
+        c.error(root.key("name"), "must not be empty");
+    }
+    if let Some(origin) = &mission.origin {
+        c.origin(&root.key("origin"), origin);
+    }
+    c.bounds(&root.key("bounds"), &mission.bounds);
+    c.route(&root.key("route"), mission);
+    c.formation(&root.key("formation"), &mission.formation);
+    c.reconfiguration(&root.key("reconfiguration"), &mission.reconfiguration, mission);
+    c.theta_pso(&root.key("theta_pso"), &mission.theta_pso);
+    c.flatlo(&root.key("flatlo"), &mission.flatlo);
+    c.fleet(&root.key("fleet"), &mission.fleet, &mission.bounds);
+    c.obstacles(&root.key("obstacles"), &mission.obstacles, &mission.bounds);
+    c.out
+}
+
+#[derive(Default)]
+struct Checker {
+    out: Vec<Diagnostic>,
+}
+
+impl Checker {
+    fn error(&mut self, path: FieldPath, message: impl Into<String>) {
+        self.out.push(Diagnostic::error(path, message));
+    }
+
+    fn warning(&mut self, path: FieldPath, message: impl Into<String>) {
+        self.out.push(Diagnostic::warning(path, message));
+    }
+
+    /// NaN and ±inf are legal TOML but never a legal length, time or gain.
+    /// Checked once over the serialised tree so no float field can be missed.
+    fn finite_everywhere(&mut self, mission: &Mission) {
+        if let Ok(tree) = toml::Value::try_from(mission) {
+            self.finite_in(&FieldPath::root(), &tree);
+        }
+    }
+
+    fn finite_in(&mut self, path: &FieldPath, value: &toml::Value) {
+        match value {
+            toml::Value::Float(x) if !x.is_finite() => {
+                self.error(path.clone(), format!("must be a finite number, got {x}"));
+            }
+            toml::Value::Array(items) => {
+                for (i, item) in items.iter().enumerate() {
+                    self.finite_in(&path.index(i), item);
+                }
+            }
+            toml::Value::Table(table) => {
+                for (key, item) in table {
+                    self.finite_in(&path.key(key), item);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// `value > 0`; non-finite values are reported once, by `finite_everywhere`.
+    fn positive(&mut self, path: FieldPath, value: f64, unit: &str) {
+        if value.is_finite() && value <= 0.0 {
+            self.error(path, format!("must be positive, got {value}{unit}"));
+        }
+    }
+
+    fn non_negative(&mut self, path: FieldPath, value: f64, unit: &str) {
+        if value.is_finite() && value < 0.0 {
+            self.error(path, format!("must not be negative, got {value}{unit}"));
+        }
+    }
+
+    fn at_least_one(&mut self, path: FieldPath, value: usize, what: &str) {
+        if value == 0 {
+            self.error(path, format!("needs at least one {what}, got 0"));
+        }
+    }
+
+    /// `[lo, hi]` with lo < hi.
+    fn range(&mut self, path: FieldPath, range: [f64; 2], unit: &str) -> bool {
+        let [lo, hi] = range;
+        if !(lo.is_finite() && hi.is_finite()) {
+            return false;
+        }
+        if lo > hi {
+            self.error(path, format!("is inverted: {lo}{unit} > {hi}{unit}"));
+            false
+        } else if lo == hi {
+            self.error(path, format!("is empty: both ends are {lo}{unit}"));
+            false
+        } else {
+            true
+        }
+    }
+
+    /// An open interval (lo, hi].
+    fn in_half_open(&mut self, path: FieldPath, value: f64, lo: f64, hi: f64) {
+        if value.is_finite() && !(value > lo && value <= hi) {
+            self.error(path, format!("must be in ({lo}, {hi}], got {value}"));
+        }
+    }
+
+    fn origin(&mut self, path: &FieldPath, origin: &GeoOrigin) {
+        if origin.latitude.abs() > 90.0 {
+            self.error(
+                path.key("latitude"),
+                format!("must be within ±90°, got {}", origin.latitude),
+            );
+        }
+        if origin.longitude.abs() > 180.0 {
+            self.error(
+                path.key("longitude"),
+                format!("must be within ±180°, got {}", origin.longitude),
+            );
+        }
+    }
+
+    fn bounds(&mut self, path: &FieldPath, b: &Bounds) {
+        self.range(path.key("x"), b.x, " m");
+        self.range(path.key("y"), b.y, " m");
+        if self.range(path.key("z"), b.z, " m") && b.z[0] < 0.0 {
+            self.error(
+                path.key("z"),
+                format!("z_min is below the ground: {} m < 0 m", b.z[0]),
+            );
+        }
+    }
+
+    fn route(&mut self, path: &FieldPath, mission: &Mission) {
+        let Route { start, goal } = &mission.route;
+        self.route_point(path.key("start"), "start", start, mission);
+        self.route_point(path.key("goal"), "goal", goal, mission);
+        if (goal - start).norm() < 1e-9 {
+            self.error(path.key("goal"), "is the same point as the start");
+        }
+    }
+
+    fn route_point(&mut self, path: FieldPath, what: &str, p: &Point3<f64>, mission: &Mission) {
+        if !p.iter().all(|v| v.is_finite()) {
+            return;
+        }
+        if !mission.bounds.contains(p) {
+            let b = &mission.bounds;
+            self.error(
+                path.clone(),
+                format!(
+                    "{what} ({}, {}, {}) is outside the bounds x {:?}, y {:?}, z {:?}",
+                    p.x, p.y, p.z, b.x, b.y, b.z
+                ),
+            );
+        }
+        let safe = mission.formation.safe_radius();
+        for o in &mission.obstacles {
+            let clearance = o.cylinder().clearance(p);
+            if clearance < safe {
+                self.error(
+                    path.clone(),
+                    format!(
+                        "{what} is within the formation's safe radius of obstacle '{}': \
+                         clearance {clearance:.2} m < r_F + r_Q = {safe:.2} m",
+                        o.name
+                    ),
+                );
+            }
+        }
+    }
+
+    fn formation(&mut self, path: &FieldPath, f: &Formation) {
+        self.positive(path.key("uav_radius"), f.uav_radius, " m");
+        self.positive(path.key("comm_range"), f.comm_range, " m");
+        self.positive(path.key("ground_speed"), f.ground_speed, " m/s");
+        if self.range(path.key("surface_distance"), f.surface_distance, " m") {
+            self.non_negative(path.key("surface_distance"), f.surface_distance[0], " m");
+        }
+        if f.comm_range.is_finite() && f.comm_range < 2.0 * f.uav_radius {
+            self.error(
+                path.key("comm_range"),
+                format!(
+                    "{} m is less than 2 r_Q = {} m: no two UAVs can satisfy eq. 7",
+                    f.comm_range,
+                    2.0 * f.uav_radius
+                ),
+            );
+        }
+        let slots = path.key("slots");
+        if f.slots.is_empty() {
+            self.error(slots.clone(), "needs at least one slot");
+        }
+        self.slot_spacing(&slots, f, 1.0, "slots");
+        let centroid = f.slot_centroid();
+        if centroid.norm() > 1e-6 {
+            self.warning(
+                slots,
+                format!(
+                    "the slots' centroid is at ({:.3}, {:.3}, {:.3}), not at the origin; \
+                     the planned path is for the centroid (eq. 6)",
+                    centroid.x, centroid.y, centroid.z
+                ),
+            );
+        }
+    }
+
+    /// Eq. 7 on every pair of slots scaled by `scale`: 2 r_Q ≤ d ≤ d_com.
+    fn slot_spacing(&mut self, path: &FieldPath, f: &Formation, scale: f64, what: &str) {
+        for i in 0..f.slots.len() {
+            for j in (i + 1)..f.slots.len() {
+                let d = scale * (f.slots[i] - f.slots[j]).norm();
+                if !d.is_finite() {
+                    continue;
+                }
+                let at = if what == "slots" {
+                    path.index(j)
+                } else {
+                    path.clone()
+                };
+                if d < 2.0 * f.uav_radius {
+                    self.error(
+                        at,
+                        format!(
+                            "{what}: slots {i} and {j} are {d:.3} m apart, closer than \
+                             2 r_Q = {:.3} m (eq. 7)",
+                            2.0 * f.uav_radius
+                        ),
+                    );
+                } else if d > f.comm_range {
+                    self.error(
+                        at,
+                        format!(
+                            "{what}: slots {i} and {j} are {d:.3} m apart, beyond the \
+                             communication range d_com = {} m (eq. 7)",
+                            f.comm_range
+                        ),
+                    );
+                }
+            }
+        }
+    }
+
+    fn reconfiguration(&mut self, path: &FieldPath, r: &Reconfiguration, mission: &Mission) {
+        self.in_half_open(path.key("shrink_scale"), r.shrink_scale, 0.0, 1.0);
+        if r.shrink_scale > 0.0 && r.shrink_scale < 1.0 {
+            self.slot_spacing(
+                &path.key("shrink_scale"),
+                &mission.formation,
+                r.shrink_scale,
+                "shrunk",
+            );
+        }
+        self.positive(path.key("transition_distance"), r.transition_distance, " m");
+        self.non_negative(path.key("hold_distance"), r.hold_distance, " m");
+        let names: Vec<&str> = mission.obstacles.iter().map(|o| o.name.as_str()).collect();
+        for (i, w) in r.waypoints.iter().enumerate() {
+            let at = path.key("waypoints").index(i);
+            for name in &w.between {
+                if !names.contains(&name.as_str()) {
+                    self.error(
+                        at.key("between"),
+                        format!("there is no obstacle named '{name}'"),
+                    );
+                }
+            }
+            if w.between[0] == w.between[1] {
+                self.error(
+                    at.key("between"),
+                    format!("names '{}' twice; an IWP lies between two obstacles", w.between[0]),
+                );
+            }
+            if let Some(scale) = w.scale {
+                self.in_half_open(at.key("scale"), scale, 0.0, 1.0);
+                if scale > 0.0 && scale < 1.0 {
+                    self.slot_spacing(&at.key("scale"), &mission.formation, scale, "shrunk");
+                }
+            }
+        }
+    }
+
+    fn theta_pso(&mut self, path: &FieldPath, p: &ThetaPsoParams) {
+        self.at_least_one(path.key("swarm_size"), p.swarm_size, "particle");
+        self.at_least_one(path.key("waypoints"), p.waypoints, "waypoint");
+        self.at_least_one(path.key("iterations"), p.iterations, "iteration");
+        if p.segments < p.waypoints + 1 {
+            self.error(
+                path.key("segments"),
+                format!(
+                    "{} segments cannot split a path through {} waypoints; \
+                     needs at least {}",
+                    p.segments,
+                    p.waypoints,
+                    p.waypoints + 1
+                ),
+            );
+        }
+        for (key, value) in [
+            ("inertia", p.inertia),
+            ("cognitive", p.cognitive),
+            ("social", p.social),
+            ("weight_length", p.weight_length),
+            ("weight_obstacle", p.weight_obstacle),
+            ("weight_altitude", p.weight_altitude),
+            ("weight_waypoints", p.weight_waypoints),
+        ] {
+            self.non_negative(path.key(key), value, "");
+        }
+        self.positive(path.key("ground_penalty"), p.ground_penalty, "");
+        if p.inertia >= 1.0 {
+            self.warning(
+                path.key("inertia"),
+                format!("w = {} ≥ 1 lets the swarm's velocities grow without bound", p.inertia),
+            );
+        }
+        if p.weight_obstacle == 0.0 {
+            self.warning(
+                path.key("weight_obstacle"),
+                "is 0: the planner will ignore obstacles (the result is still verified)",
+            );
+        }
+    }
+
+    fn flatlo(&mut self, path: &FieldPath, p: &FlatloParams) {
+        if p.aircraft < 2 {
+            self.error(
+                path.key("aircraft"),
+                format!("a squadron transition needs at least 2 aircraft, got {}", p.aircraft),
+            );
+        }
+        for (key, value, unit) in [
+            ("spacing", p.spacing, " m"),
+            ("airspeed", p.airspeed, " m/s"),
+            ("turn_radius", p.turn_radius, " m"),
+            ("altitude", p.altitude, " m"),
+            ("final_leg", p.final_leg, " m"),
+            ("sample_period", p.sample_period, " s"),
+            ("sim_step", p.sim_step, " s"),
+            ("mass", p.mass, " kg"),
+            ("wing_area", p.wing_area, " m²"),
+            ("air_density", p.air_density, " kg/m³"),
+            ("max_thrust", p.max_thrust, " N"),
+            ("max_bank_deg", p.max_bank_deg, "°"),
+        ] {
+            self.positive(path.key(key), value, unit);
+        }
+        for (key, value) in [
+            ("drag_cd0", p.drag_cd0),
+            ("drag_k", p.drag_k),
+            ("noise", p.noise),
+            ("min_separation", p.min_separation),
+        ] {
+            self.non_negative(path.key(key), value, "");
+        }
+        for (i, gain) in p.pid.iter().enumerate() {
+            self.non_negative(path.key("pid").index(i), *gain, "");
+        }
+        if self.range(path.key("load_factor"), p.load_factor, "") && p.load_factor[1] <= 1.0 {
+            self.error(
+                path.key("load_factor"),
+                format!(
+                    "n_max = {} cannot hold level flight (needs n > 1 to turn)",
+                    p.load_factor[1]
+                ),
+            );
+        }
+        if p.max_bank_deg >= 90.0 {
+            self.error(
+                path.key("max_bank_deg"),
+                format!("must be below 90°, got {}°", p.max_bank_deg),
+            );
+        }
+        if p.climb_deg.abs() >= 90.0 {
+            self.error(
+                path.key("climb_deg"),
+                format!("must be within ±90°, got {}°", p.climb_deg),
+            );
+        }
+        if p.sim_step > p.sample_period {
+            self.warning(
+                path.key("sim_step"),
+                format!(
+                    "the RK4 step {} s is longer than the reference period {} s",
+                    p.sim_step, p.sample_period
+                ),
+            );
+        }
+        // Algorithm 1, line 41: Δ2 = √2 (Δ − 2r(1 − cos π/4)) must not be
+        // negative for the smallest lateral offset Δ that is not zero.
+        let smallest_offset = if p.aircraft.is_multiple_of(2) {
+            p.spacing / 2.0
+        } else {
+            p.spacing
+        };
+        let needed = 2.0 * p.turn_radius * (1.0 - std::f64::consts::FRAC_PI_4.cos());
+        if smallest_offset < needed {
+            self.error(
+                path.key("turn_radius"),
+                format!(
+                    "a turn radius of {} m needs a lateral offset of at least {needed:.1} m \
+                     (Algorithm 1, line 41), but the innermost aircraft is {smallest_offset} m \
+                     from the longitudinal line",
+                    p.turn_radius
+                ),
+            );
+        }
+        if p.noise > 0.05 {
+            self.warning(
+                path.key("noise"),
+                format!("{} % noise is far above the paper's 0.25 %", p.noise * 100.0),
+            );
+        }
+    }
+
+    fn fleet(&mut self, path: &FieldPath, p: &FleetParams, bounds: &Bounds) {
+        self.at_least_one(path.key("agents"), p.agents, "agent");
+        self.at_least_one(path.key("swarm_size"), p.swarm_size, "particle");
+        self.at_least_one(path.key("iterations"), p.iterations, "iteration");
+        for (key, value, unit) in [
+            ("rho", p.rho, ""),
+            ("sigma", p.sigma, ""),
+            ("safety_distance", p.safety_distance, " m"),
+            ("detection_range", p.detection_range, " m"),
+            ("neighbourhood", p.neighbourhood, " m"),
+            ("step_max", p.step_max, " m"),
+            ("replan_period", p.replan_period, " s"),
+            ("altitude", p.altitude, " m"),
+            ("sim_step", p.sim_step, " s"),
+            ("duration", p.duration, " s"),
+            ("mass", p.mass, " kg"),
+            ("max_thrust", p.max_thrust, " N"),
+            ("max_tilt_deg", p.max_tilt_deg, "°"),
+            ("tolerance", p.tolerance, ""),
+        ] {
+            self.positive(path.key(key), value, unit);
+        }
+        self.non_negative(path.key("target_distance"), p.target_distance, " m");
+        for (i, v) in p.inertia_diag.iter().enumerate() {
+            self.positive(path.key("inertia_diag").index(i), *v, " kg·m²");
+        }
+        for (key, gains) in [
+            ("position_gains", p.position_gains),
+            ("attitude_gains", p.attitude_gains),
+        ] {
+            for (i, v) in gains.iter().enumerate() {
+                self.positive(path.key(key).index(i), *v, "");
+            }
+        }
+        if p.max_thrust.is_finite() && p.mass > 0.0 && p.max_thrust <= p.mass * G {
+            self.error(
+                path.key("max_thrust"),
+                format!(
+                    "{} N cannot lift {} kg (weight {:.2} N)",
+                    p.max_thrust,
+                    p.mass,
+                    p.mass * G
+                ),
+            );
+        }
+        if p.max_tilt_deg >= 90.0 {
+            self.error(
+                path.key("max_tilt_deg"),
+                format!("must be below 90°, got {}°", p.max_tilt_deg),
+            );
+        }
+        if p.replan_period < p.sim_step {
+            self.error(
+                path.key("replan_period"),
+                format!(
+                    "τ = {} s is shorter than the simulation step {} s",
+                    p.replan_period, p.sim_step
+                ),
+            );
+        }
+        self.fleet_distances(path, p);
+        if !p.initial_positions.is_empty() && p.initial_positions.len() != p.agents {
+            self.error(
+                path.key("initial_positions"),
+                format!(
+                    "gives {} positions for {} agents",
+                    p.initial_positions.len(),
+                    p.agents
+                ),
+            );
+        }
+        for (i, q) in p.initial_positions.iter().enumerate() {
+            if !bounds.contains_xy(q) {
+                self.error(
+                    path.key("initial_positions").index(i),
+                    format!("({}, {}) is outside the bounds", q.x, q.y),
+                );
+            }
+        }
+        let mut previous = f64::NEG_INFINITY;
+        for (i, t) in p.targets.iter().enumerate() {
+            let at = path.key("targets").index(i);
+            self.non_negative(at.key("time"), t.time, " s");
+            if t.time < previous {
+                self.error(
+                    at.key("time"),
+                    format!("targets must be in time order: {} s comes after {previous} s", t.time),
+                );
+            }
+            previous = t.time;
+            if !bounds.contains_xy(&t.position) {
+                self.error(
+                    at.key("position"),
+                    format!("({}, {}) is outside the bounds", t.position.x, t.position.y),
+                );
+            }
+        }
+        for (i, push) in p.pushes.iter().enumerate() {
+            let at = path.key("pushes").index(i);
+            if push.agent >= p.agents {
+                self.error(
+                    at.key("agent"),
+                    format!("there are only {} agents (0-based index {})", p.agents, push.agent),
+                );
+            }
+            self.non_negative(at.key("time"), push.time, " s");
+        }
+    }
+
+    /// The desired distances must be a symmetric n×n matrix that keeps every
+    /// pair at least the safety distance c apart (fleet paper, eq. 5).
+    fn fleet_distances(&mut self, path: &FieldPath, p: &FleetParams) {
+        let n = p.agents;
+        let at = path.key("distances");
+        if p.distances.is_empty() {
+            if n >= 2 {
+                let side = 2.0 * p.target_distance * (std::f64::consts::PI / n as f64).sin();
+                if side < p.safety_distance {
+                    self.error(
+                        path.key("target_distance"),
+                        format!(
+                            "{n} agents at {} m from the target are {side:.3} m apart, \
+                             closer than the safety distance c = {} m",
+                            p.target_distance, p.safety_distance
+                        ),
+                    );
+                }
+            }
+            return;
+        }
+        if p.distances.len() != n || p.distances.iter().any(|row| row.len() != n) {
+            self.error(at, format!("must be a {n}×{n} matrix (one row per agent)"));
+            return;
+        }
+        for i in 0..n {
+            if p.distances[i][i] != 0.0 {
+                self.error(at.index(i).index(i), "the diagonal must be 0");
+            }
+            for j in (i + 1)..n {
+                let (a, b) = (p.distances[i][j], p.distances[j][i]);
+                if a != b {
+                    self.error(
+                        at.index(i).index(j),
+                        format!("is {a} but distances[{j}][{i}] is {b}; must be symmetric"),
+                    );
+                } else if a < p.safety_distance {
+                    self.error(
+                        at.index(i).index(j),
+                        format!(
+                            "{a} m is below the safety distance c = {} m",
+                            p.safety_distance
+                        ),
+                    );
+                }
+            }
+        }
+    }
+
+    fn obstacles(&mut self, path: &FieldPath, obstacles: &[Obstacle], bounds: &Bounds) {
+        for (i, o) in obstacles.iter().enumerate() {
+            let at = path.index(i);
+            if o.name.trim().is_empty() {
+                self.error(at.key("name"), "must not be empty");
+            } else if obstacles[..i].iter().any(|p| p.name == o.name) {
+                self.error(
+                    at.key("name"),
+                    format!("'{}' is used by an earlier obstacle; names must be unique", o.name),
+                );
+            }
+            self.positive(at.key("radius"), o.radius, " m");
+            self.positive(at.key("height"), o.height, " m");
+            if !o.center.iter().all(|v| v.is_finite()) {
+                continue;
+            }
+            if !bounds.contains_xy(&o.center) {
+                self.error(
+                    at.key("center"),
+                    format!(
+                        "({}, {}) is outside the bounds x {:?}, y {:?}",
+                        o.center.x, o.center.y, bounds.x, bounds.y
+                    ),
+                );
+            } else if o.radius > 0.0 {
+                let inside = o.center.x - o.radius >= bounds.x[0]
+                    && o.center.x + o.radius <= bounds.x[1]
+                    && o.center.y - o.radius >= bounds.y[0]
+                    && o.center.y + o.radius <= bounds.y[1];
+                if !inside {
+                    self.warning(at.key("radius"), "the cylinder reaches outside the bounds");
+                }
+            }
+        }
+    }
+}

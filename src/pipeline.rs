@@ -1,0 +1,109 @@
+//! What every planning pipeline shares: progress reporting and cancellation.
+//!
+//! A pipeline is a plain function of a validated mission and a seed. It tells
+//! an [`Observer`] what it is doing and checks a [`CancelToken`] between
+//! iterations. It never touches a terminal, a file or Rerun: the CLI, the TUI,
+//! the recorder, the tests and the benchmarks are all observers.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use nalgebra::Point3;
+use serde::Serialize;
+
+/// Severity of a log event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Level {
+    Info,
+    Warn,
+}
+
+/// Cost terms of a θ-PSO path (eqs. 2-5, 10-11), unweighted, plus the weighted total.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct CostTerms {
+    /// J1, path length, metres (eq. 3).
+    pub length: f64,
+    /// J2, mean violation of the obstacles' safe radii (eq. 4).
+    pub obstacle: f64,
+    /// J3, summed altitude-band violation, metres (eq. 5).
+    pub altitude: f64,
+    /// J_R, mean horizontal distance of the path to the enabled IWPs, metres (eq. 11).
+    pub waypoints: f64,
+    /// J = β1 J1 + β2 J2 + β3 J3 + β_R J_R (eqs. 2, 10).
+    pub total: f64,
+}
+
+/// Something a pipeline reports while it runs.
+#[derive(Debug, Clone, Copy)]
+pub enum Event<'a> {
+    /// A new stage started ("planning", "trajectories", "verification", ...).
+    Stage(&'a str),
+    /// Overall progress in [0, 1].
+    Progress(f64),
+    /// θ-PSO: the best centroid path and its cost after an iteration.
+    PathIteration {
+        iteration: usize,
+        cost: &'a CostTerms,
+        path: &'a [Point3<f64>],
+    },
+    /// A message for the log.
+    Log(Level, &'a str),
+}
+
+/// Receives a pipeline's events on the pipeline's thread. Keep it cheap: it
+/// runs between iterations of the hot loop.
+pub trait Observer {
+    fn on_event(&mut self, event: Event<'_>);
+}
+
+/// An observer that ignores everything.
+#[derive(Debug, Default)]
+pub struct Silent;
+
+impl Observer for Silent {
+    fn on_event(&mut self, _: Event<'_>) {}
+}
+
+impl<F: FnMut(Event<'_>)> Observer for F {
+    fn on_event(&mut self, event: Event<'_>) {
+        self(event)
+    }
+}
+
+/// A shared flag to ask a running pipeline to stop. Cloning shares the flag.
+#[derive(Debug, Clone, Default)]
+pub struct CancelToken(Arc<AtomicBool>);
+
+impl CancelToken {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Completion {
+    /// Every iteration ran.
+    Finished,
+    /// Stopped by the cancel token; the outcome holds the best found so far.
+    Cancelled,
+}
+
+/// Why a pipeline could not produce an outcome at all.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PipelineError {
+    #[error("the mission is not valid:\n{0}")]
+    InvalidMission(String),
+    #[error("{0}")]
+    Unsupported(String),
+}

@@ -1,0 +1,156 @@
+//! Per-UAV timed trajectories from the centroid path (θ-PSO eqs. 12-15).
+//!
+//! The centroid moves along its path at the formation's ground speed. At each
+//! sample the slot offsets (formation frame: x along the horizontal direction
+//! of travel, y to its left, z up) of the current shape are turned into the
+//! inertial frame (eq. 13) and added to the centroid (eq. 14). Velocities are
+//! the time derivative of the sampled positions (eq. 15).
+
+use nalgebra::{Point3, Vector3};
+use serde::Serialize;
+
+use super::iwp::{Iwp, radius};
+use super::path::{ArcWalker, CentroidPath};
+use crate::mission::Formation;
+
+/// One sample of a UAV's trajectory. Seconds, metres ENU, m/s.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Sample {
+    pub t: f64,
+    pub position: Point3<f64>,
+    pub velocity: Vector3<f64>,
+}
+
+/// The timed trajectory T_n of one UAV (eq. 15).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trajectory {
+    /// 0-based slot index.
+    pub uav: usize,
+    pub samples: Vec<Sample>,
+}
+
+/// A reconfiguration as flown: which IWP, which shape, and when.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Reconfiguration {
+    pub iwp: usize,
+    pub between: [String; 2],
+    pub shape: super::iwp::Shape,
+    /// Centroid position at the IWP.
+    pub position: Point3<f64>,
+    /// t1 (start of transformation), t2 (shape complete), t3 (start of
+    /// return), t4 (back to nominal), seconds from the start.
+    pub t1: f64,
+    pub t2: f64,
+    pub t3: f64,
+    pub t4: f64,
+}
+
+/// Samples per second of the trajectories.
+pub const SAMPLE_PERIOD: f64 = 0.1;
+
+/// The per-UAV trajectories and the reconfiguration timetable.
+pub fn generate(
+    path: &CentroidPath,
+    iwps: &[Iwp],
+    formation: &Formation,
+) -> (Vec<Trajectory>, Vec<Reconfiguration>) {
+    let walker = ArcWalker::new(&path.points);
+    let speed = formation.ground_speed;
+    let duration = walker.length() / speed;
+    let steps = (duration / SAMPLE_PERIOD).ceil().max(1.0) as usize;
+    let span = radius(&formation.slots).max(1.0);
+    let times: Vec<f64> = (0..=steps)
+        .map(|k| (k as f64 * SAMPLE_PERIOD).min(duration))
+        .collect();
+
+    let n = formation.slots.len();
+    let mut positions = vec![Vec::with_capacity(times.len()); n];
+    let mut offsets = Vec::with_capacity(n);
+    for &t in &times {
+        let s = t * speed;
+        let centroid = walker.at(s);
+        let forward = walker.heading(s, span);
+        let left = Vector3::new(-forward.y, forward.x, 0.0);
+        current_offsets(path, &formation.slots, s, &mut offsets);
+        for (uav, o) in offsets.iter().enumerate() {
+            // Eq. 13: ΔP^I = R_IF ΔP with R_IF's columns the formation axes.
+            positions[uav].push(centroid + forward * o.x + left * o.y + Vector3::z() * o.z);
+        }
+    }
+
+    let trajectories = positions
+        .into_iter()
+        .enumerate()
+        .map(|(uav, p)| Trajectory {
+            uav,
+            samples: with_velocities(&times, &p),
+        })
+        .collect();
+
+    let reconfigurations = path
+        .zones
+        .iter()
+        .map(|z| {
+            let [a1, a2, a3, a4] = z.arcs();
+            let at = |s: f64| (s / speed).clamp(0.0, duration);
+            Reconfiguration {
+                iwp: z.iwp,
+                between: iwps
+                    .get(z.iwp)
+                    .map(|i| i.between.clone())
+                    .unwrap_or_default(),
+                shape: z.shape,
+                position: walker.at(z.arc),
+                t1: at(a1),
+                t2: at(a2),
+                t3: at(a3),
+                t4: at(a4),
+            }
+        })
+        .collect();
+    (trajectories, reconfigurations)
+}
+
+/// Offsets at arc length s: the nominal slots, or the shape of the zone that
+/// is furthest into its reconfiguration.
+fn current_offsets(
+    path: &CentroidPath,
+    nominal: &[Vector3<f64>],
+    s: f64,
+    out: &mut Vec<Vector3<f64>>,
+) {
+    let active = path
+        .zones
+        .iter()
+        .map(|z| (z, z.blend(s)))
+        .filter(|(_, b)| *b > 0.0)
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    match active {
+        Some((zone, b)) => zone.shape.offsets_into(nominal, b, out),
+        None => {
+            out.clear();
+            out.extend_from_slice(nominal);
+        }
+    }
+}
+
+/// Velocities by central differences (one-sided at the ends).
+fn with_velocities(times: &[f64], positions: &[Point3<f64>]) -> Vec<Sample> {
+    let n = positions.len();
+    (0..n)
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(1), (k + 1).min(n - 1));
+            let dt = times[b] - times[a];
+            let velocity = if dt > 0.0 {
+                (positions[b] - positions[a]) / dt
+            } else {
+                Vector3::zeros()
+            };
+            Sample {
+                t: times[k],
+                position: positions[k],
+                velocity,
+            }
+        })
+        .collect()
+}

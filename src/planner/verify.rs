@@ -1,0 +1,191 @@
+//! Checks the flown result against the hard constraints, sample by sample.
+//!
+//! The cost only penalises; this decides. For every UAV and every sample:
+//! clearance to every obstacle ≥ r_Q, every pair within [2 r_Q, d_com]
+//! (eq. 7), altitude inside the band (eq. 5), position inside the bounds.
+//! A plan that fails any of them is infeasible.
+
+use nalgebra::Point3;
+use serde::Serialize;
+
+use super::trajectory::Trajectory;
+use crate::mission::Mission;
+
+/// Where a worst value happens.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Location {
+    pub time: f64,
+    pub uav: usize,
+    /// The other UAV or the obstacle, when the check involves one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub other: Option<String>,
+    pub position: Point3<f64>,
+}
+
+/// One row of the verification table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Check {
+    pub name: &'static str,
+    /// "≥" or "≤": how `worst` must compare with `limit`.
+    pub relation: &'static str,
+    pub limit: f64,
+    /// The worst value over all UAVs and samples; `None` when nothing was
+    /// measured (no obstacles, a single UAV).
+    pub worst: Option<f64>,
+    pub ok: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub at: Option<Location>,
+}
+
+/// A sample that breaks a constraint.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Violation {
+    pub check: &'static str,
+    pub value: f64,
+    pub location: Location,
+}
+
+/// The verification table and the verdict.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verification {
+    pub feasible: bool,
+    pub checks: Vec<Check>,
+    /// The first violations found (at most `MAX_VIOLATIONS`), for display.
+    pub violations: Vec<Violation>,
+    /// How many samples broke a constraint in all.
+    pub violation_count: usize,
+}
+
+/// Violations kept in the outcome.
+pub const MAX_VIOLATIONS: usize = 200;
+
+/// Tracks the worst value of one check.
+struct Tracker {
+    check: Check,
+    at_least: bool,
+}
+
+impl Tracker {
+    fn new(name: &'static str, at_least: bool, limit: f64) -> Self {
+        Tracker {
+            check: Check {
+                name,
+                relation: if at_least { "≥" } else { "≤" },
+                limit,
+                worst: None,
+                ok: true,
+                at: None,
+            },
+            at_least,
+        }
+    }
+
+    /// Records a value; returns whether it breaks the limit.
+    fn observe(&mut self, value: f64, at: impl FnOnce() -> Location) -> bool {
+        let worse = match self.check.worst {
+            None => true,
+            Some(w) => {
+                if self.at_least {
+                    value < w
+                } else {
+                    value > w
+                }
+            }
+        };
+        if worse {
+            self.check.worst = Some(value);
+            self.check.at = Some(at());
+        }
+        let bad = if self.at_least {
+            value < self.check.limit
+        } else {
+            value > self.check.limit
+        };
+        if bad {
+            self.check.ok = false;
+        }
+        bad
+    }
+}
+
+/// Verifies trajectories sampled at common times.
+pub fn verify(mission: &Mission, trajectories: &[Trajectory]) -> Verification {
+    let f = &mission.formation;
+    let b = &mission.bounds;
+    let mut clearance = Tracker::new("obstacle clearance", true, f.uav_radius);
+    let mut closest = Tracker::new("inter-UAV distance (closest)", true, 2.0 * f.uav_radius);
+    let mut farthest = Tracker::new("inter-UAV distance (farthest)", false, f.comm_range);
+    let mut low = Tracker::new("altitude (lowest)", true, b.z[0]);
+    let mut high = Tracker::new("altitude (highest)", false, b.z[1]);
+    let mut inside = Tracker::new("distance inside the x-y bounds", true, 0.0);
+    let mut violations = Vec::new();
+    let mut count = 0usize;
+    let mut note = |check: &'static str, value: f64, location: Location| {
+        count += 1;
+        if violations.len() < MAX_VIOLATIONS {
+            violations.push(Violation {
+                check,
+                value,
+                location,
+            });
+        }
+    };
+    let cylinders: Vec<_> = mission.obstacles.iter().map(|o| o.cylinder()).collect();
+    let samples = trajectories
+        .iter()
+        .map(|t| t.samples.len())
+        .min()
+        .unwrap_or(0);
+
+    for k in 0..samples {
+        for (n, traj) in trajectories.iter().enumerate() {
+            let s = &traj.samples[k];
+            let p = s.position;
+            let here = |other: Option<String>| Location {
+                time: s.t,
+                uav: n,
+                other,
+                position: p,
+            };
+            for (o, c) in mission.obstacles.iter().zip(&cylinders) {
+                let d = c.clearance(&p);
+                if clearance.observe(d, || here(Some(o.name.clone()))) {
+                    note(clearance.check.name, d, here(Some(o.name.clone())));
+                }
+            }
+            if low.observe(p.z, || here(None)) {
+                note(low.check.name, p.z, here(None));
+            }
+            if high.observe(p.z, || here(None)) {
+                note(high.check.name, p.z, here(None));
+            }
+            let margin = (p.x - b.x[0])
+                .min(b.x[1] - p.x)
+                .min(p.y - b.y[0])
+                .min(b.y[1] - p.y);
+            if inside.observe(margin, || here(None)) {
+                note(inside.check.name, margin, here(None));
+            }
+            for (m, other) in trajectories.iter().enumerate().skip(n + 1) {
+                let d = (other.samples[k].position - p).norm();
+                let name = || Some(format!("UAV {m}"));
+                if closest.observe(d, || here(name())) {
+                    note(closest.check.name, d, here(name()));
+                }
+                if farthest.observe(d, || here(name())) {
+                    note(farthest.check.name, d, here(name()));
+                }
+            }
+        }
+    }
+    let checks: Vec<Check> = [clearance, closest, farthest, low, high, inside]
+        .into_iter()
+        .map(|t| t.check)
+        .collect();
+    Verification {
+        feasible: checks.iter().all(|c| c.ok),
+        checks,
+        violations,
+        violation_count: count,
+    }
+}

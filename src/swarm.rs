@@ -1,0 +1,320 @@
+//! One particle-swarm engine for every planner.
+//!
+//! The engine moves particles in a box of plain coordinates. Encodings live in
+//! the objective: θ-PSO searches angles θ ∈ [-π/2, π/2] and its cost decodes
+//! them with eq. 1; the fleet's PSO searches steps h directly. The update is
+//! eq. 1 of the θ-PSO paper (the standard inertia-weight PSO):
+//!
+//! Δθ ← w Δθ + c1 r1 (λ_i − θ) + c2 r2 (λ_g − θ),  θ ← θ + Δθ,
+//!
+//! with Δθ and θ clamped to the box, r1, r2 ~ U(0, 1) drawn once per particle
+//! and iteration (the paper's scalars r_{1i}^k, r_{2i}^k).
+//!
+//! Determinism: each particle draws from its own ChaCha8 stream (`set_stream`)
+//! and costs are evaluated before any best is updated, so the result depends on
+//! the seed only, not on how many threads evaluate the costs.
+
+use std::ops::ControlFlow;
+
+use rand::rngs::ChaCha8Rng;
+use rand::{RngExt, SeedableRng};
+use rayon::prelude::*;
+
+/// The swarm's hyper-parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SwarmConfig {
+    /// N, particles.
+    pub particles: usize,
+    /// Iterations after the initial evaluation.
+    pub iterations: usize,
+    /// w, inertia weight.
+    pub inertia: f64,
+    /// c1, pull toward the particle's own best.
+    pub cognitive: f64,
+    /// c2, pull toward the swarm's best.
+    pub social: f64,
+    /// Evaluate the particles' costs on the rayon pool. Same result either way.
+    pub parallel: bool,
+}
+
+/// The box the particles move in and the largest step per iteration, per dimension.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchSpace {
+    pub lower: Vec<f64>,
+    pub upper: Vec<f64>,
+    pub max_step: Vec<f64>,
+}
+
+impl SearchSpace {
+    /// `dims` dimensions, each in [lower, upper] with steps up to `max_step`.
+    pub fn uniform(dims: usize, lower: f64, upper: f64, max_step: f64) -> Self {
+        SearchSpace {
+            lower: vec![lower; dims],
+            upper: vec![upper; dims],
+            max_step: vec![max_step; dims],
+        }
+    }
+
+    pub fn dims(&self) -> usize {
+        self.lower.len()
+    }
+}
+
+/// A position and its cost.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Best {
+    pub position: Vec<f64>,
+    pub cost: f64,
+}
+
+/// What the engine tells its caller after each iteration.
+#[derive(Debug)]
+pub struct IterationReport<'a> {
+    /// 1-based; iteration 0 is the initial evaluation.
+    pub iteration: usize,
+    pub best: &'a Best,
+    /// The global best changed in this iteration.
+    pub improved: bool,
+}
+
+/// The outcome of a minimisation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SwarmResult {
+    pub best: Best,
+    /// Iterations completed (≤ the configured count when stopped early).
+    pub iterations: usize,
+    /// Cost evaluations made.
+    pub evaluations: usize,
+    /// The caller stopped the run (cancellation).
+    pub stopped: bool,
+}
+
+/// Minimises `cost` over `space`. `on_iteration` is called after the initial
+/// evaluation (iteration 0) and after each iteration; returning
+/// `ControlFlow::Break` stops the run, keeping the best found so far.
+/// A NaN cost counts as +∞, so it never becomes a best.
+pub fn minimize<F, C>(
+    space: &SearchSpace,
+    config: &SwarmConfig,
+    seed: u64,
+    cost: F,
+    mut on_iteration: C,
+) -> SwarmResult
+where
+    F: Fn(&[f64]) -> f64 + Sync,
+    C: FnMut(&IterationReport<'_>) -> ControlFlow<()>,
+{
+    let dims = space.dims();
+    let n = config.particles.max(1);
+    let mut rngs: Vec<ChaCha8Rng> = (0..n)
+        .map(|i| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            rng.set_stream(i as u64);
+            rng
+        })
+        .collect();
+
+    let mut positions: Vec<Vec<f64>> = rngs
+        .iter_mut()
+        .map(|rng| {
+            (0..dims)
+                .map(|d| sample(rng, space.lower[d], space.upper[d]))
+                .collect()
+        })
+        .collect();
+    let mut velocities = vec![vec![0.0; dims]; n];
+
+    let mut costs = evaluate(&positions, &cost, config.parallel);
+    let mut evaluations = n;
+    let mut personal: Vec<Best> = positions
+        .iter()
+        .zip(&costs)
+        .map(|(p, &c)| Best {
+            position: p.clone(),
+            cost: c,
+        })
+        .collect();
+    let mut global = best_of(&personal);
+
+    let report = IterationReport {
+        iteration: 0,
+        best: &global,
+        improved: true,
+    };
+    if on_iteration(&report).is_break() {
+        return SwarmResult {
+            best: global,
+            iterations: 0,
+            evaluations,
+            stopped: true,
+        };
+    }
+
+    for iteration in 1..=config.iterations {
+        for (i, rng) in rngs.iter_mut().enumerate() {
+            let r1: f64 = rng.random();
+            let r2: f64 = rng.random();
+            let (x, v) = (&mut positions[i], &mut velocities[i]);
+            for d in 0..dims {
+                let step = config.inertia * v[d]
+                    + config.cognitive * r1 * (personal[i].position[d] - x[d])
+                    + config.social * r2 * (global.position[d] - x[d]);
+                v[d] = step.clamp(-space.max_step[d], space.max_step[d]);
+                x[d] = (x[d] + v[d]).clamp(space.lower[d], space.upper[d]);
+            }
+        }
+        costs = evaluate(&positions, &cost, config.parallel);
+        evaluations += n;
+        for (i, &c) in costs.iter().enumerate() {
+            if c < personal[i].cost {
+                personal[i] = Best {
+                    position: positions[i].clone(),
+                    cost: c,
+                };
+            }
+        }
+        let candidate = best_of(&personal);
+        let improved = candidate.cost < global.cost;
+        if improved {
+            global = candidate;
+        }
+        let report = IterationReport {
+            iteration,
+            best: &global,
+            improved,
+        };
+        if on_iteration(&report).is_break() {
+            return SwarmResult {
+                best: global,
+                iterations: iteration,
+                evaluations,
+                stopped: true,
+            };
+        }
+    }
+    SwarmResult {
+        best: global,
+        iterations: config.iterations,
+        evaluations,
+        stopped: false,
+    }
+}
+
+fn sample(rng: &mut ChaCha8Rng, lower: f64, upper: f64) -> f64 {
+    if upper > lower {
+        rng.random_range(lower..=upper)
+    } else {
+        lower
+    }
+}
+
+fn evaluate<F>(positions: &[Vec<f64>], cost: &F, parallel: bool) -> Vec<f64>
+where
+    F: Fn(&[f64]) -> f64 + Sync,
+{
+    let guarded = |p: &Vec<f64>| {
+        let c = cost(p);
+        if c.is_nan() { f64::INFINITY } else { c }
+    };
+    if parallel {
+        positions.par_iter().map(guarded).collect()
+    } else {
+        positions.iter().map(guarded).collect()
+    }
+}
+
+/// The lowest cost; the first particle wins ties, so the choice is stable.
+fn best_of(personal: &[Best]) -> Best {
+    let mut best = &personal[0];
+    for b in &personal[1..] {
+        if b.cost < best.cost {
+            best = b;
+        }
+    }
+    best.clone()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config(parallel: bool) -> SwarmConfig {
+        SwarmConfig {
+            particles: 30,
+            iterations: 200,
+            inertia: 0.7298,
+            cognitive: 1.49618,
+            social: 1.49618,
+            parallel,
+        }
+    }
+
+    fn sphere(x: &[f64]) -> f64 {
+        x.iter().map(|v| (v - 0.3) * (v - 0.3)).sum()
+    }
+
+    #[test]
+    fn finds_the_minimum_of_a_sphere() {
+        let space = SearchSpace::uniform(4, -1.0, 1.0, 0.5);
+        let result = minimize(&space, &config(false), 1, sphere, |_| ControlFlow::Continue(()));
+        assert!(result.best.cost < 1e-8, "cost {}", result.best.cost);
+        assert!(result.best.position.iter().all(|v| (v - 0.3).abs() < 1e-3));
+        assert_eq!(result.evaluations, 30 * 201);
+    }
+
+    #[test]
+    fn parallel_and_sequential_runs_are_identical() {
+        let space = SearchSpace::uniform(6, -1.0, 1.0, 0.5);
+        let seq = minimize(&space, &config(false), 42, sphere, |_| ControlFlow::Continue(()));
+        let par = minimize(&space, &config(true), 42, sphere, |_| ControlFlow::Continue(()));
+        assert_eq!(seq, par);
+        let other = minimize(&space, &config(false), 43, sphere, |_| ControlFlow::Continue(()));
+        assert_ne!(seq.best.position, other.best.position, "the seed matters");
+    }
+
+    #[test]
+    fn positions_stay_in_the_box() {
+        // The minimum lies outside the box: the best must sit on the wall.
+        let space = SearchSpace::uniform(2, -1.0, 1.0, 2.0);
+        let result = minimize(
+            &space,
+            &config(false),
+            3,
+            |x| -x[0] - x[1],
+            |_| ControlFlow::Continue(()),
+        );
+        assert_eq!(result.best.position, vec![1.0, 1.0]);
+    }
+
+    #[test]
+    fn the_global_best_never_gets_worse_and_breaking_stops_at_once() {
+        let space = SearchSpace::uniform(3, -1.0, 1.0, 0.5);
+        let mut history = Vec::new();
+        let result = minimize(&space, &config(false), 5, sphere, |r| {
+            history.push(r.best.cost);
+            if r.iteration == 10 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
+        assert!(result.stopped);
+        assert_eq!(result.iterations, 10);
+        assert_eq!(history.len(), 11);
+        assert!(history.windows(2).all(|w| w[1] <= w[0]));
+    }
+
+    #[test]
+    fn nan_costs_never_become_the_best() {
+        let space = SearchSpace::uniform(1, -1.0, 1.0, 0.5);
+        let result = minimize(
+            &space,
+            &config(false),
+            9,
+            |x| if x[0] > 0.0 { f64::NAN } else { -x[0] },
+            |_| ControlFlow::Continue(()),
+        );
+        assert!(result.best.cost.is_finite());
+        assert!(result.best.position[0] <= 0.0);
+    }
+}

@@ -1,0 +1,298 @@
+//! Every validation rule on a small bad file: the diagnostic must name the
+//! file, the field path and the line the field is written on.
+
+use skyform::mission::{Diagnostic, Severity, check_str, parse_str};
+
+const FILE: &str = "bad.toml";
+
+/// A valid mission of 8 lines, plus whatever a test appends.
+fn mission_with(extra: &str) -> String {
+    format!(
+        "name = \"test\"\n\
+         [bounds]\n\
+         x = [0.0, 100.0]\n\
+         y = [0.0, 100.0]\n\
+         z = [5.0, 15.0]\n\
+         [route]\n\
+         start = [10.0, 10.0, 10.0]\n\
+         goal = [90.0, 90.0, 10.0]\n\
+         {extra}"
+    )
+}
+
+/// 1-based line of the first line of `text` that contains `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines()
+        .position(|l| l.contains(needle))
+        .map(|i| i + 1)
+        .unwrap_or_else(|| panic!("{needle:?} not in the test text"))
+}
+
+/// All diagnostics of `text`.
+fn diagnostics(text: &str) -> Vec<Diagnostic> {
+    check_str(text, Some(FILE)).report.diagnostics
+}
+
+/// The one error at `path`; fails the test with every diagnostic otherwise.
+fn error_at(text: &str, path: &str) -> Diagnostic {
+    let all = diagnostics(text);
+    let found: Vec<_> = all
+        .iter()
+        .filter(|d| d.severity == Severity::Error && d.path.to_string() == path)
+        .cloned()
+        .collect();
+    assert!(
+        !found.is_empty(),
+        "no error at {path}; diagnostics:\n{}",
+        all.iter()
+            .map(|d| d.to_string())
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+    found[0].clone()
+}
+
+/// Asserts an error at `path` on the line holding `needle`, mentioning `words`.
+fn assert_error(text: &str, path: &str, needle: &str, words: &str) {
+    let d = error_at(text, path);
+    let line = line_of(text, needle);
+    assert_eq!(d.file.as_deref(), Some(FILE));
+    assert_eq!(
+        d.location.map(|l| l.line),
+        Some(line),
+        "wrong line for {path}: {d}"
+    );
+    assert!(
+        d.message.contains(words),
+        "message of {path} should mention {words:?}: {d}"
+    );
+    let printed = d.to_string();
+    assert!(
+        printed.starts_with(&format!("{FILE}:{line}:")) && printed.contains(path),
+        "printed form must carry file:line and the path: {printed}"
+    );
+}
+
+#[test]
+fn the_minimal_mission_is_valid() {
+    let text = mission_with("");
+    let all = diagnostics(&text);
+    assert!(all.is_empty(), "{all:?}");
+}
+
+#[test]
+fn unknown_keys_are_errors_at_their_line() {
+    // Top-level keys must come before the tables, so put the typo first.
+    let text = format!("nmae = \"typo\"\n{}", mission_with(""));
+    assert_error(&text, "nmae", "nmae", "unknown field");
+
+    let text = mission_with("[formation]\nuav_radiuss = 0.5\n");
+    assert_error(&text, "formation.uav_radiuss", "uav_radiuss", "unknown field");
+
+    let text = mission_with(
+        "[[obstacles]]\nname = \"a\"\ncenter = [50.0, 50.0]\nradius = 1.0\nheight = 5.0\nheigth = 4.0\n",
+    );
+    assert_error(&text, "obstacles[0].heigth", "heigth", "unknown field");
+
+    let text = mission_with("[theta_pso]\nswarm = 10\n");
+    assert_error(&text, "theta_pso.swarm", "swarm = 10", "unknown field");
+}
+
+#[test]
+fn syntax_errors_are_reported_with_their_line() {
+    let text = mission_with("[formation\nuav_radius = 0.5\n");
+    let all = diagnostics(&text);
+    assert!(!all.is_empty());
+    assert!(all.iter().all(|d| d.is_error()));
+    assert_eq!(all[0].location.map(|l| l.line), Some(9), "{}", all[0]);
+}
+
+#[test]
+fn wrong_types_name_the_field() {
+    let text = mission_with("[formation]\nuav_radius = \"half a metre\"\n");
+    assert_error(&text, "formation.uav_radius", "half a metre", "invalid type");
+}
+
+#[test]
+fn non_finite_numbers_are_errors() {
+    let text = mission_with(
+        "[[obstacles]]\nname = \"a\"\ncenter = [50.0, 50.0]\nradius = nan\nheight = 5.0\n",
+    );
+    assert_error(&text, "obstacles[0].radius", "radius = nan", "finite");
+    let text = mission_with("[theta_pso]\ninertia = inf\n");
+    assert_error(&text, "theta_pso.inertia", "inertia = inf", "finite");
+    let text = mission_with("[formation]\nslots = [[0.0, 2.0, 0.0], [-inf, -1.0, 0.0]]\n");
+    assert_error(&text, "formation.slots[1][0]", "slots =", "finite");
+}
+
+#[test]
+fn non_positive_radius_height_and_speed_are_errors() {
+    let obstacle = |radius: &str, height: &str| {
+        mission_with(&format!(
+            "[[obstacles]]\nname = \"a\"\ncenter = [50.0, 50.0]\nradius = {radius}\nheight = {height}\n\
+             [[obstacles]]\nname = \"b\"\ncenter = [30.0, 60.0]\nradius = 1.0\nheight = 5.0\n"
+        ))
+    };
+    assert_error(&obstacle("-1.0", "5.0"), "obstacles[0].radius", "radius = -1.0", "positive");
+    assert_error(&obstacle("1.0", "0.0"), "obstacles[0].height", "height = 0.0", "positive");
+    let text = mission_with("[formation]\nground_speed = 0.0\n");
+    assert_error(&text, "formation.ground_speed", "ground_speed", "positive");
+    let text = mission_with("[formation]\nuav_radius = -0.5\n");
+    assert_error(&text, "formation.uav_radius", "uav_radius", "positive");
+}
+
+#[test]
+fn inverted_and_empty_ranges_are_errors() {
+    let text = mission_with("").replace("x = [0.0, 100.0]", "x = [100.0, 0.0]");
+    assert_error(&text, "bounds.x", "x = [100.0, 0.0]", "inverted");
+    // z_min ≥ z_max, both the equal and the inverted case.
+    let text = mission_with("").replace("z = [5.0, 15.0]", "z = [10.0, 10.0]");
+    assert_error(&text, "bounds.z", "z = [10.0, 10.0]", "empty");
+    let text = mission_with("").replace("z = [5.0, 15.0]", "z = [15.0, 5.0]");
+    assert_error(&text, "bounds.z", "z = [15.0, 5.0]", "inverted");
+    let text = mission_with("[formation]\nsurface_distance = [5.0, 1.0]\n");
+    assert_error(&text, "formation.surface_distance", "surface_distance", "inverted");
+}
+
+#[test]
+fn obstacles_outside_the_bounds_are_errors() {
+    let text = mission_with(
+        "[[obstacles]]\nname = \"far\"\ncenter = [150.0, 50.0]\nradius = 1.0\nheight = 5.0\n",
+    );
+    assert_error(&text, "obstacles[0].center", "[150.0, 50.0]", "outside the bounds");
+}
+
+#[test]
+fn start_and_goal_must_be_inside_the_bounds() {
+    let text = mission_with("").replace("start = [10.0, 10.0, 10.0]", "start = [-5.0, 10.0, 10.0]");
+    assert_error(&text, "route.start", "start =", "outside the bounds");
+    // Outside the altitude band counts too.
+    let text = mission_with("").replace("goal = [90.0, 90.0, 10.0]", "goal = [90.0, 90.0, 30.0]");
+    assert_error(&text, "route.goal", "goal =", "outside the bounds");
+}
+
+#[test]
+fn start_inside_an_obstacles_safe_radius_is_an_error() {
+    // Default triangle: r_F = √5 ≈ 2.236 m, r_Q = 0.5 m → needs 2.736 m of clearance.
+    let text = mission_with(
+        "[[obstacles]]\nname = \"pole\"\ncenter = [12.0, 10.0]\nradius = 0.5\nheight = 20.0\n",
+    );
+    let d = error_at(&text, "route.start");
+    assert!(d.message.contains("'pole'") && d.message.contains("safe radius"), "{d}");
+    assert_eq!(d.location.map(|l| l.line), Some(line_of(&text, "start =")));
+}
+
+#[test]
+fn slots_closer_than_two_uav_radii_or_beyond_comm_range_are_errors() {
+    let text = mission_with("[formation]\nslots = [[0.0, 0.3, 0.0], [0.0, -0.3, 0.0]]\n");
+    let d = error_at(&text, "formation.slots[1]");
+    assert!(d.message.contains("closer than 2 r_Q"), "{d}");
+    let text = mission_with(
+        "[formation]\ncomm_range = 5.0\nslots = [[0.0, 4.0, 0.0], [0.0, -4.0, 0.0]]\n",
+    );
+    let d = error_at(&text, "formation.slots[1]");
+    assert!(d.message.contains("beyond the communication range"), "{d}");
+}
+
+#[test]
+fn impossible_parameter_combinations_are_errors() {
+    let text = mission_with("[theta_pso]\nswarm_size = 0\n");
+    assert_error(&text, "theta_pso.swarm_size", "swarm_size = 0", "at least one");
+    let text = mission_with("[theta_pso]\nwaypoints = 9\nsegments = 5\n");
+    assert_error(&text, "theta_pso.segments", "segments = 5", "at least 10");
+    let text = mission_with("[flatlo]\naircraft = 1\n");
+    assert_error(&text, "flatlo.aircraft", "aircraft = 1", "at least 2");
+    let text = mission_with("[flatlo]\nspacing = 1000.0\nturn_radius = 4575.0\n");
+    assert_error(&text, "flatlo.turn_radius", "turn_radius", "Algorithm 1");
+    let text = mission_with("[fleet]\nmass = 1.0\nmax_thrust = 5.0\n");
+    assert_error(&text, "fleet.max_thrust", "max_thrust", "cannot lift");
+    let text = mission_with("[fleet]\nagents = 2\ndistances = [[0.0, 1.0], [2.0, 0.0]]\n");
+    assert_error(&text, "fleet.distances[0][1]", "distances", "symmetric");
+    let text = mission_with(
+        "[fleet]\nagents = 2\n[[fleet.pushes]]\nagent = 5\ntime = 1.0\nimpulse = [0.1, 0.0]\n",
+    );
+    assert_error(&text, "fleet.pushes[0].agent", "agent = 5", "only 2 agents");
+    let text = mission_with("[formation]\ncomm_range = 0.5\n");
+    assert_error(&text, "formation.comm_range", "comm_range", "2 r_Q");
+}
+
+#[test]
+fn reconfiguration_choices_must_name_existing_obstacles() {
+    let text = mission_with(
+        "[reconfiguration]\ndefault_shape = \"auto\"\nshrink_scale = 0.5\ntransition_distance = 5.0\n\
+         hold_distance = 1.0\n[[reconfiguration.waypoints]]\nbetween = [\"a\", \"ghost\"]\n\
+         [[obstacles]]\nname = \"a\"\ncenter = [50.0, 50.0]\nradius = 1.0\nheight = 5.0\n",
+    );
+    assert_error(&text, "reconfiguration.waypoints[0].between", "between", "'ghost'");
+    let text = mission_with("[reconfiguration]\ndefault_shape = \"squash\"\n");
+    assert_error(&text, "reconfiguration.default_shape", "squash", "unknown variant");
+}
+
+#[test]
+fn a_shrink_that_brings_uavs_too_close_is_an_error() {
+    // Triangle sides ≥ 3.6 m; scale 0.1 → 0.36 m < 2 r_Q = 1 m.
+    let text = mission_with(
+        "[reconfiguration]\ndefault_shape = \"shrink\"\nshrink_scale = 0.1\n\
+         transition_distance = 5.0\nhold_distance = 1.0\n",
+    );
+    assert_error(&text, "reconfiguration.shrink_scale", "shrink_scale", "closer than");
+}
+
+#[test]
+fn duplicate_obstacle_names_are_errors() {
+    let text = mission_with(
+        "[[obstacles]]\nname = \"a\"\ncenter = [50.0, 50.0]\nradius = 1.0\nheight = 5.0\n\
+         [[obstacles]]\nname = \"a\"\ncenter = [30.0, 60.0]\nradius = 1.0\nheight = 5.0\n",
+    );
+    let d = error_at(&text, "obstacles[1].name");
+    assert!(d.message.contains("unique"));
+    // The second obstacle's name line, not the first's.
+    let second = text.match_indices("name = \"a\"").nth(1).map(|(i, _)| i);
+    let line = second.map(|i| text[..i].matches('\n').count() + 1);
+    assert_eq!(d.location.map(|l| l.line), line);
+}
+
+#[test]
+fn all_problems_are_collected_in_one_pass() {
+    let text = mission_with(
+        "[formation]\nground_speed = -3.0\nuav_radius = 0.0\n[theta_pso]\niterations = 0\n\
+         [[obstacles]]\nname = \"x\"\ncenter = [500.0, 50.0]\nradius = -2.0\nheight = 5.0\n",
+    )
+    .replace("y = [0.0, 100.0]", "y = [100.0, 0.0]");
+    let errors: Vec<String> = diagnostics(&text)
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.path.to_string())
+        .collect();
+    for expected in [
+        "bounds.y",
+        "formation.ground_speed",
+        "formation.uav_radius",
+        "theta_pso.iterations",
+        "obstacles[0].center",
+        "obstacles[0].radius",
+    ] {
+        assert!(errors.iter().any(|p| p == expected), "missing {expected} in {errors:?}");
+    }
+}
+
+#[test]
+fn warnings_are_kept_apart_and_do_not_block_loading() {
+    let text = mission_with("[formation]\nslots = [[1.0, 2.0, 0.0], [1.0, -2.0, 0.0]]\n");
+    let checked = check_str(&text, Some(FILE));
+    assert!(!checked.report.has_errors(), "{}", checked.report);
+    let warnings: Vec<_> = checked.report.warnings().collect();
+    assert_eq!(warnings.len(), 1);
+    assert_eq!(warnings[0].path.to_string(), "formation.slots");
+    assert!(warnings[0].to_string().contains("warning:"));
+    let loaded = parse_str(&text, FILE).map_err(|e| e.to_string());
+    assert!(loaded.is_ok_and(|l| l.warnings.warning_count() == 1));
+}
+
+#[test]
+fn an_invalid_mission_does_not_load_and_the_error_lists_every_problem() {
+    let text = mission_with("[formation]\nground_speed = -3.0\nuav_radius = 0.0\n");
+    let err = parse_str(&text, FILE).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(err.contains("2 error(s)"), "{err}");
+    assert!(err.contains("formation.ground_speed") && err.contains("formation.uav_radius"));
+}
