@@ -259,7 +259,11 @@ pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
         o.waypoints.len()
     );
     let enabled = o.iwps.iter().filter(|i| i.enabled).count();
-    let _ = writeln!(s, "  IWPs         {} found, {enabled} enabled", o.iwps.len());
+    let _ = writeln!(
+        s,
+        "  IWPs         {} found, {enabled} enabled",
+        o.iwps.len()
+    );
     for r in &o.reconfigurations {
         let _ = writeln!(
             s,
@@ -279,7 +283,10 @@ pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
             .worst
             .map_or_else(|| "n/a".to_owned(), |w| format!("{w:.3}"));
         let at = check.at.as_ref().map_or_else(String::new, |a| {
-            let other = a.other.as_deref().map_or_else(String::new, |o| format!(" vs {o}"));
+            let other = a
+                .other
+                .as_deref()
+                .map_or_else(String::new, |o| format!(" vs {o}"));
             format!("  (UAV {} at t = {:.1} s{other})", a.uav, a.time)
         });
         let verdict = if check.ok { "ok  " } else { "FAIL" };
@@ -289,7 +296,11 @@ pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
             check.name, check.relation, check.limit
         );
     }
-    let verdict = if o.feasible() { "FEASIBLE" } else { "INFEASIBLE" };
+    let verdict = if o.feasible() {
+        "FEASIBLE"
+    } else {
+        "INFEASIBLE"
+    };
     let _ = writeln!(s, "  result       {verdict}");
     s
 }

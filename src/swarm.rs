@@ -256,7 +256,9 @@ mod tests {
     #[test]
     fn finds_the_minimum_of_a_sphere() {
         let space = SearchSpace::uniform(4, -1.0, 1.0, 0.5);
-        let result = minimize(&space, &config(false), 1, sphere, |_| ControlFlow::Continue(()));
+        let result = minimize(&space, &config(false), 1, sphere, |_| {
+            ControlFlow::Continue(())
+        });
         assert!(result.best.cost < 1e-8, "cost {}", result.best.cost);
         assert!(result.best.position.iter().all(|v| (v - 0.3).abs() < 1e-3));
         assert_eq!(result.evaluations, 30 * 201);
@@ -265,10 +267,16 @@ mod tests {
     #[test]
     fn parallel_and_sequential_runs_are_identical() {
         let space = SearchSpace::uniform(6, -1.0, 1.0, 0.5);
-        let seq = minimize(&space, &config(false), 42, sphere, |_| ControlFlow::Continue(()));
-        let par = minimize(&space, &config(true), 42, sphere, |_| ControlFlow::Continue(()));
+        let seq = minimize(&space, &config(false), 42, sphere, |_| {
+            ControlFlow::Continue(())
+        });
+        let par = minimize(&space, &config(true), 42, sphere, |_| {
+            ControlFlow::Continue(())
+        });
         assert_eq!(seq, par);
-        let other = minimize(&space, &config(false), 43, sphere, |_| ControlFlow::Continue(()));
+        let other = minimize(&space, &config(false), 43, sphere, |_| {
+            ControlFlow::Continue(())
+        });
         assert_ne!(seq.best.position, other.best.position, "the seed matters");
     }
 

@@ -32,7 +32,12 @@ fn every_shipped_mission_is_valid_without_errors() {
 fn the_compiled_in_missions_are_the_files_on_disk() {
     for builtin in BUILTIN {
         let on_disk = fs::read_to_string(missions_dir().join(builtin.file_name));
-        assert_eq!(on_disk.ok().as_deref(), Some(builtin.text), "{}", builtin.file_name);
+        assert_eq!(
+            on_disk.ok().as_deref(),
+            Some(builtin.text),
+            "{}",
+            builtin.file_name
+        );
     }
     let default = mission::default_mission();
     assert_eq!(default.mission.name, "Light-rail bridge inspection");
@@ -44,7 +49,11 @@ fn the_bridge_mission_carries_the_papers_settings() {
     // θ-PSO paper, Section IV.A: 100 particles, 7 waypoints, 150 iterations,
     // altitude band 7-15 m, 3 m/s, triangle ΔT1..ΔT3, d_s ∈ [1, 5] m.
     assert_eq!(
-        (m.theta_pso.swarm_size, m.theta_pso.waypoints, m.theta_pso.iterations),
+        (
+            m.theta_pso.swarm_size,
+            m.theta_pso.waypoints,
+            m.theta_pso.iterations
+        ),
         (100, 7, 150)
     );
     assert_eq!(m.bounds.z, [7.0, 15.0]);
@@ -92,6 +101,28 @@ fn save_replaces_the_file_and_leaves_no_temporary_behind() {
     assert_eq!(load(&path).map(|l| l.mission).ok(), Some(m));
 }
 
+#[cfg(unix)]
+#[test]
+fn save_keeps_the_permissions_of_the_file_it_replaces() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().ok();
+    let Some(dir) = dir else { return };
+    let path = dir.path().join("m.toml");
+    fs::write(&path, "old").ok();
+    fs::set_permissions(&path, fs::Permissions::from_mode(0o640)).ok();
+    assert!(save(&mission::default_mission().mission, &path).is_ok());
+    let mode = fs::metadata(&path)
+        .map(|m| m.permissions().mode() & 0o777)
+        .ok();
+    assert_eq!(mode, Some(0o640));
+    let fresh = dir.path().join("new.toml");
+    assert!(save(&mission::default_mission().mission, &fresh).is_ok());
+    let mode = fs::metadata(&fresh)
+        .map(|m| m.permissions().mode() & 0o777)
+        .ok();
+    assert_eq!(mode, Some(0o644));
+}
+
 #[test]
 fn a_failed_save_names_the_path_and_keeps_nothing() {
     let dir = tempfile::tempdir().ok();
@@ -101,7 +132,10 @@ fn a_failed_save_names_the_path_and_keeps_nothing() {
         .err()
         .map(|e| e.to_string())
         .unwrap_or_default();
-    assert!(err.contains("cannot save") && err.contains("no-such-dir"), "{err}");
+    assert!(
+        err.contains("cannot save") && err.contains("no-such-dir"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -110,13 +144,22 @@ fn a_missing_file_is_a_clear_error() {
         .err()
         .map(|e| e.to_string())
         .unwrap_or_default();
-    assert!(err.starts_with("cannot read /definitely/not/here.toml"), "{err}");
+    assert!(
+        err.starts_with("cannot read /definitely/not/here.toml"),
+        "{err}"
+    );
 }
 
 /// Random missions that pass validation: a box, a route inside it, obstacles
 /// away from the route, the default triangle.
 fn valid_mission() -> impl Strategy<Value = Mission> {
-    let obstacle = (0.2f64..0.8, 0.2f64..0.8, 0.1f64..3.0, 1.0f64..30.0, "[a-z ]{0,12}");
+    let obstacle = (
+        0.2f64..0.8,
+        0.2f64..0.8,
+        0.1f64..3.0,
+        1.0f64..30.0,
+        "[a-z ]{0,12}",
+    );
     (
         10.0f64..500.0,
         10.0f64..500.0,

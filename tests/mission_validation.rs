@@ -87,7 +87,12 @@ fn unknown_keys_are_errors_at_their_line() {
     assert_error(&text, "nmae", "nmae", "unknown field");
 
     let text = mission_with("[formation]\nuav_radiuss = 0.5\n");
-    assert_error(&text, "formation.uav_radiuss", "uav_radiuss", "unknown field");
+    assert_error(
+        &text,
+        "formation.uav_radiuss",
+        "uav_radiuss",
+        "unknown field",
+    );
 
     let text = mission_with(
         "[[obstacles]]\nname = \"a\"\ncenter = [50.0, 50.0]\nradius = 1.0\nheight = 5.0\nheigth = 4.0\n",
@@ -110,7 +115,12 @@ fn syntax_errors_are_reported_with_their_line() {
 #[test]
 fn wrong_types_name_the_field() {
     let text = mission_with("[formation]\nuav_radius = \"half a metre\"\n");
-    assert_error(&text, "formation.uav_radius", "half a metre", "invalid type");
+    assert_error(
+        &text,
+        "formation.uav_radius",
+        "half a metre",
+        "invalid type",
+    );
 }
 
 #[test]
@@ -133,8 +143,18 @@ fn non_positive_radius_height_and_speed_are_errors() {
              [[obstacles]]\nname = \"b\"\ncenter = [30.0, 60.0]\nradius = 1.0\nheight = 5.0\n"
         ))
     };
-    assert_error(&obstacle("-1.0", "5.0"), "obstacles[0].radius", "radius = -1.0", "positive");
-    assert_error(&obstacle("1.0", "0.0"), "obstacles[0].height", "height = 0.0", "positive");
+    assert_error(
+        &obstacle("-1.0", "5.0"),
+        "obstacles[0].radius",
+        "radius = -1.0",
+        "positive",
+    );
+    assert_error(
+        &obstacle("1.0", "0.0"),
+        "obstacles[0].height",
+        "height = 0.0",
+        "positive",
+    );
     let text = mission_with("[formation]\nground_speed = 0.0\n");
     assert_error(&text, "formation.ground_speed", "ground_speed", "positive");
     let text = mission_with("[formation]\nuav_radius = -0.5\n");
@@ -151,7 +171,12 @@ fn inverted_and_empty_ranges_are_errors() {
     let text = mission_with("").replace("z = [5.0, 15.0]", "z = [15.0, 5.0]");
     assert_error(&text, "bounds.z", "z = [15.0, 5.0]", "inverted");
     let text = mission_with("[formation]\nsurface_distance = [5.0, 1.0]\n");
-    assert_error(&text, "formation.surface_distance", "surface_distance", "inverted");
+    assert_error(
+        &text,
+        "formation.surface_distance",
+        "surface_distance",
+        "inverted",
+    );
 }
 
 #[test]
@@ -159,7 +184,12 @@ fn obstacles_outside_the_bounds_are_errors() {
     let text = mission_with(
         "[[obstacles]]\nname = \"far\"\ncenter = [150.0, 50.0]\nradius = 1.0\nheight = 5.0\n",
     );
-    assert_error(&text, "obstacles[0].center", "[150.0, 50.0]", "outside the bounds");
+    assert_error(
+        &text,
+        "obstacles[0].center",
+        "[150.0, 50.0]",
+        "outside the bounds",
+    );
 }
 
 #[test]
@@ -178,7 +208,10 @@ fn start_inside_an_obstacles_safe_radius_is_an_error() {
         "[[obstacles]]\nname = \"pole\"\ncenter = [12.0, 10.0]\nradius = 0.5\nheight = 20.0\n",
     );
     let d = error_at(&text, "route.start");
-    assert!(d.message.contains("'pole'") && d.message.contains("safe radius"), "{d}");
+    assert!(
+        d.message.contains("'pole'") && d.message.contains("safe radius"),
+        "{d}"
+    );
     assert_eq!(d.location.map(|l| l.line), Some(line_of(&text, "start =")));
 }
 
@@ -197,7 +230,12 @@ fn slots_closer_than_two_uav_radii_or_beyond_comm_range_are_errors() {
 #[test]
 fn impossible_parameter_combinations_are_errors() {
     let text = mission_with("[theta_pso]\nswarm_size = 0\n");
-    assert_error(&text, "theta_pso.swarm_size", "swarm_size = 0", "at least one");
+    assert_error(
+        &text,
+        "theta_pso.swarm_size",
+        "swarm_size = 0",
+        "at least one",
+    );
     let text = mission_with("[theta_pso]\nwaypoints = 9\nsegments = 5\n");
     assert_error(&text, "theta_pso.segments", "segments = 5", "at least 10");
     let text = mission_with("[flatlo]\naircraft = 1\n");
@@ -223,9 +261,19 @@ fn reconfiguration_choices_must_name_existing_obstacles() {
          hold_distance = 1.0\n[[reconfiguration.waypoints]]\nbetween = [\"a\", \"ghost\"]\n\
          [[obstacles]]\nname = \"a\"\ncenter = [50.0, 50.0]\nradius = 1.0\nheight = 5.0\n",
     );
-    assert_error(&text, "reconfiguration.waypoints[0].between", "between", "'ghost'");
+    assert_error(
+        &text,
+        "reconfiguration.waypoints[0].between",
+        "between",
+        "'ghost'",
+    );
     let text = mission_with("[reconfiguration]\ndefault_shape = \"squash\"\n");
-    assert_error(&text, "reconfiguration.default_shape", "squash", "unknown variant");
+    assert_error(
+        &text,
+        "reconfiguration.default_shape",
+        "squash",
+        "unknown variant",
+    );
 }
 
 #[test]
@@ -235,7 +283,12 @@ fn a_shrink_that_brings_uavs_too_close_is_an_error() {
         "[reconfiguration]\ndefault_shape = \"shrink\"\nshrink_scale = 0.1\n\
          transition_distance = 5.0\nhold_distance = 1.0\n",
     );
-    assert_error(&text, "reconfiguration.shrink_scale", "shrink_scale", "closer than");
+    assert_error(
+        &text,
+        "reconfiguration.shrink_scale",
+        "shrink_scale",
+        "closer than",
+    );
 }
 
 #[test]
@@ -272,7 +325,10 @@ fn all_problems_are_collected_in_one_pass() {
         "obstacles[0].center",
         "obstacles[0].radius",
     ] {
-        assert!(errors.iter().any(|p| p == expected), "missing {expected} in {errors:?}");
+        assert!(
+            errors.iter().any(|p| p == expected),
+            "missing {expected} in {errors:?}"
+        );
     }
 }
 
@@ -292,7 +348,10 @@ fn warnings_are_kept_apart_and_do_not_block_loading() {
 #[test]
 fn an_invalid_mission_does_not_load_and_the_error_lists_every_problem() {
     let text = mission_with("[formation]\nground_speed = -3.0\nuav_radius = 0.0\n");
-    let err = parse_str(&text, FILE).err().map(|e| e.to_string()).unwrap_or_default();
+    let err = parse_str(&text, FILE)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
     assert!(err.contains("2 error(s)"), "{err}");
     assert!(err.contains("formation.ground_speed") && err.contains("formation.uav_radius"));
 }

@@ -60,7 +60,10 @@ fn eq1_decodes_the_angle_range_onto_the_bounds() {
     assert!(close(decode_angle(-FRAC_PI_2, 7.0, 15.0), 7.0));
     assert!(close(decode_angle(FRAC_PI_2, 7.0, 15.0), 15.0));
     assert!(close(decode_angle(0.0, 7.0, 15.0), 11.0));
-    assert!(close(decode_angle(FRAC_PI_2 / 3.0, 0.0, 2.0), 1.5), "sin 30° = ½");
+    assert!(
+        close(decode_angle(FRAC_PI_2 / 3.0, 0.0, 2.0), 1.5),
+        "sin 30° = ½"
+    );
 }
 
 // ---- cost terms, eqs. 3, 4, 5, 11 --------------------------------------------
@@ -87,7 +90,10 @@ fn j2_is_the_mean_safe_radius_violation_eq4() {
     m.obstacles = vec![pole("p", 50.0, 50.0, 1.0), pole("far", 10.0, 10.0, 1.0)];
     let model = CostModel::new(&m, &[]);
     // One segment whose midpoint is 2 m from the pole's axis, below its top.
-    let path = bare(vec![Point3::new(48.0, 48.0, 10.0), Point3::new(52.0, 48.0, 10.0)]);
+    let path = bare(vec![
+        Point3::new(48.0, 48.0, 10.0),
+        Point3::new(52.0, 48.0, 10.0),
+    ]);
     let safe = 1.0 + 5f64.sqrt() + 0.5; // r_k + r_F + r_Q
     let expected = (1.0 - 2.0 / safe) / (1.0 * 2.0); // L = 1, K = 2
     let t = model.terms(&path);
@@ -105,7 +111,10 @@ fn j2_above_a_cylinder_measures_to_its_top_disc() {
     m.obstacles = vec![low];
     let model = CostModel::new(&m, &[]);
     // Midpoint right above the axis, 1 m over the top: d = r + 1 = 2 m.
-    let path = bare(vec![Point3::new(49.0, 50.0, 10.0), Point3::new(51.0, 50.0, 10.0)]);
+    let path = bare(vec![
+        Point3::new(49.0, 50.0, 10.0),
+        Point3::new(51.0, 50.0, 10.0),
+    ]);
     let safe = 1.0 + 5f64.sqrt() + 0.5;
     assert!(close(model.terms(&path).obstacle, 1.0 - 2.0 / safe));
 }
@@ -115,18 +124,21 @@ fn j3_sums_the_altitude_band_violations_eq5() {
     let mut m = open_field();
     m.theta_pso.segments = 3;
     let model = CostModel::new(&m, &[]);
-    // Three equal legs with midpoints at z = 20 (5 over), 10 (inside), 3 (2 under).
+    // Legs of 10, 17 and 10 m get one segment each; midpoints at z = 20 (5 m
+    // over), 11.5 (inside) and 3 (2 m under).
     let path = bare(vec![
         Point3::new(0.0, 0.0, 20.0),
         Point3::new(10.0, 0.0, 20.0),
-        Point3::new(20.0, 0.0, 10.0),
-        Point3::new(20.0, 10.0 - 1e-12, 3.0),
+        Point3::new(10.0, 0.0, 3.0),
+        Point3::new(20.0, 0.0, 3.0),
     ]);
-    // The middle leg is longer (√200 vs 10) but still gets one segment.
     let t = model.terms(&path);
     assert!(close(t.altitude, 5.0 + 0.0 + 2.0), "{}", t.altitude);
     // At or below the ground: the finite stand-in for ∞.
-    let under = bare(vec![Point3::new(0.0, 0.0, -1.0), Point3::new(1.0, 0.0, -1.0)]);
+    let under = bare(vec![
+        Point3::new(0.0, 0.0, -1.0),
+        Point3::new(1.0, 0.0, -1.0),
+    ]);
     m.theta_pso.segments = 1;
     let t = CostModel::new(&m, &[]).terms(&under);
     assert_eq!(t.altitude, m.theta_pso.ground_penalty);
@@ -150,7 +162,10 @@ fn jr_is_the_mean_horizontal_distance_to_enabled_iwps_eq11() {
     let iwps = [iwp(0.0, 4.0, true), iwp(100.0, 100.0, false)];
     let model = CostModel::new(&m, &iwps);
     // Two segments, midpoints (3, 0) and (9, 0): distances 5 and √97 to (0, 4).
-    let path = bare(vec![Point3::new(0.0, 0.0, 10.0), Point3::new(12.0, 0.0, 10.0)]);
+    let path = bare(vec![
+        Point3::new(0.0, 0.0, 10.0),
+        Point3::new(12.0, 0.0, 10.0),
+    ]);
     let expected = (5.0 + 97f64.sqrt()) / 2.0;
     assert!(close(model.terms(&path).waypoints, expected));
 }
@@ -199,7 +214,10 @@ fn the_operator_can_disable_an_iwp_and_choose_its_shape() {
     let m = mission::default_mission().mission;
     let iwps = find_iwps(&m);
     assert_eq!(iwps.len(), 1, "{iwps:?}");
-    assert_eq!(iwps[0].between, ["light pole 4".to_string(), "pier 5".to_string()]);
+    assert_eq!(
+        iwps[0].between,
+        ["light pole 4".to_string(), "pier 5".to_string()]
+    );
     assert!(matches!(iwps[0].shape, Shape::Alignment { .. }));
     let mut m2 = m.clone();
     m2.reconfiguration.waypoints[0].enabled = false;
@@ -232,11 +250,17 @@ fn rotation_keeps_uav1_level_and_moves_the_others_vertically() {
     assert_eq!(turned[0], Vector3::new(0.0, 2.0, 0.0));
     assert!(close(turned[1].z.abs(), 2.0) && close(turned[2].z.abs(), 2.0));
     assert!(close(turned[1].z, -turned[2].z));
-    assert!(turned.iter().all(|o| close(o.x, 0.0)), "in the vertical plane across the path");
+    assert!(
+        turned.iter().all(|o| close(o.x, 0.0)),
+        "in the vertical plane across the path"
+    );
     // Rigid: the distances between UAVs never change.
     for b in [0.25, 0.5, 0.75] {
         let mid = Shape::Rotation.offsets(&f.slots, b);
-        assert!(close((mid[1] - mid[2]).norm(), (f.slots[1] - f.slots[2]).norm()));
+        assert!(close(
+            (mid[1] - mid[2]).norm(),
+            (f.slots[1] - f.slots[2]).norm()
+        ));
     }
 }
 
@@ -257,7 +281,10 @@ fn auto_picks_the_least_change_that_fits() {
     // 3 m gap: shrinking to (1.5 - 0.5) / 2 = 0.5 fits and moves UAVs ≤ 1.1 m,
     // less than the column (≥ 2 m) or the rotation (which does not fit).
     let shape = resolve_shape(ShapeChoice::Auto, 3.0, &f, 0.5);
-    assert!(matches!(shape, Shape::Shrink { scale } if close(scale, 0.5)), "{shape:?}");
+    assert!(
+        matches!(shape, Shape::Shrink { scale } if close(scale, 0.5)),
+        "{shape:?}"
+    );
     // 1.2 m gap: shrink would need scale 0.05 < 2 r_Q / √13: only the column fits.
     let shape = resolve_shape(ShapeChoice::Auto, 1.2, &f, 0.5);
     assert!(matches!(shape, Shape::Alignment { .. }), "{shape:?}");
@@ -298,13 +325,20 @@ fn rotation_keeps_uav1_on_the_centroid_height_profile() {
     let mut others_moved = 0.0f64;
     for (k, s) in o.trajectories[0].samples.iter().enumerate() {
         let centroid_z = walker.at(s.t * m.formation.ground_speed).z;
-        assert!((s.position.z - centroid_z).abs() < 1e-9, "UAV 1 off at t = {}", s.t);
+        assert!(
+            (s.position.z - centroid_z).abs() < 1e-9,
+            "UAV 1 off at t = {}",
+            s.t
+        );
         if (r.t2..=r.t3).contains(&s.t) {
             let dz = o.trajectories[1].samples[k].position.z - centroid_z;
             others_moved = others_moved.max(dz.abs());
         }
     }
-    assert!(close(others_moved, 2.0), "UAV 2 is 2 m off level in the hold: {others_moved}");
+    assert!(
+        close(others_moved, 2.0),
+        "UAV 2 is 2 m off level in the hold: {others_moved}"
+    );
 }
 
 #[test]
@@ -340,10 +374,7 @@ fn the_bridge_is_planned_feasibly_through_the_narrow_passage_for_20_seeds() {
         assert_eq!(o.reconfigurations[0].shape.name(), "alignment");
         // The centroid path goes through the IWP between light pole 4 and pier 5.
         let iwp = o.iwps[0].position;
-        let through = o
-            .centroid_path
-            .iter()
-            .any(|p| (p.xy() - iwp).norm() < 1e-9);
+        let through = o.centroid_path.iter().any(|p| (p.xy() - iwp).norm() < 1e-9);
         assert!(through, "seed {seed}");
         costs.push(o.cost.total);
     }
@@ -384,7 +415,12 @@ fn a_walled_in_start_is_reported_infeasible() {
     m.obstacles = (0..24)
         .map(|i| {
             let a = i as f64 * std::f64::consts::TAU / 24.0;
-            pole(&format!("ring {i}"), 10.0 + 6.0 * a.cos() + 10.0, 50.0 + 6.0 * a.sin(), 0.7)
+            pole(
+                &format!("ring {i}"),
+                10.0 + 6.0 * a.cos() + 10.0,
+                50.0 + 6.0 * a.sin(),
+                0.7,
+            )
         })
         .collect();
     m.route.start = Point3::new(20.0, 50.0, 10.0);
@@ -415,14 +451,23 @@ fn cancelling_returns_promptly_with_the_best_so_far() {
     assert_eq!(o.iterations, 5);
     assert_eq!(iterations_seen, 5);
     assert_eq!(o.convergence.len(), 6);
-    assert!(!o.trajectories.is_empty(), "a cancelled run still returns its best path");
+    assert!(
+        !o.trajectories.is_empty(),
+        "a cancelled run still returns its best path"
+    );
 }
 
 #[test]
 fn an_invalid_mission_is_an_error_not_a_panic() {
     let mut m = open_field();
     m.theta_pso.swarm_size = 0;
-    let r = plan(&m, 1, PlanOptions::default(), &mut Silent, &CancelToken::new());
+    let r = plan(
+        &m,
+        1,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    );
     assert!(r.is_err_and(|e| e.to_string().contains("theta_pso.swarm_size")));
 }
 
@@ -441,12 +486,23 @@ fn the_observer_sees_every_iteration_with_a_non_increasing_best() {
         Event::Stage(s) => stages.push(s.to_owned()),
         _ => {}
     };
-    let o = plan(&m, 1, PlanOptions::default(), &mut observer, &CancelToken::new());
+    let o = plan(
+        &m,
+        1,
+        PlanOptions::default(),
+        &mut observer,
+        &CancelToken::new(),
+    );
     assert!(o.is_ok());
     assert_eq!(totals.len(), 21);
     assert!(totals.windows(2).all(|w| w[1] <= w[0]));
     assert_eq!(
         stages,
-        ["intermediate waypoints", "planning", "trajectories", "verification"]
+        [
+            "intermediate waypoints",
+            "planning",
+            "trajectories",
+            "verification"
+        ]
     );
 }

@@ -104,7 +104,7 @@ pub struct Route {
 
 /// The formation flown by the θ-PSO pipeline (θ-PSO paper, Section III).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct Formation {
     /// r_Q: safe radius of one UAV, metres (eq. 7).
     pub uav_radius: f64,
@@ -153,7 +153,7 @@ pub enum ShapeChoice {
 
 /// How the formation reconfigures at intermediate waypoints (Section III.B).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct Reconfiguration {
     /// Shape used at IWPs that have no entry in `waypoints`.
     pub default_shape: ShapeChoice,
@@ -244,7 +244,7 @@ impl Default for ThetaPsoParams {
             social: 1.49618,
             segments: 64,
             weight_length: 1.0,
-            weight_obstacle: 1000.0,
+            weight_obstacle: 100_000.0,
             weight_altitude: 100.0,
             weight_waypoints: 1.0,
             ground_penalty: 1.0e6,

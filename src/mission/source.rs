@@ -144,35 +144,41 @@ impl<'a> SourceMap<'a> {
     /// The deepest field whose key or value contains the byte `offset`
     /// (used to name the field of a parser error that only has a span).
     pub fn path_at(&self, offset: usize) -> FieldPath {
-        let mut path = FieldPath::root();
-        let Some(root) = self.root.as_ref() else {
-            return path;
-        };
-        let mut value_table: Option<&DeTable> = Some(root.get_ref());
-        let mut value_array: Option<&[Spanned<DeValue>]> = None;
-        loop {
-            let next = if let Some(t) = value_table {
-                t.iter()
-                    .find(|(k, v)| contains(&k.span(), offset) || contains(&v.span(), offset))
-                    .map(|(k, v)| (PathSegment::Key(k.get_ref().to_string()), v))
-            } else if let Some(items) = value_array {
-                items
-                    .iter()
-                    .enumerate()
-                    .find(|(_, v)| contains(&v.span(), offset))
-                    .map(|(i, v)| (PathSegment::Index(i), v))
-            } else {
-                None
-            };
-            let Some((segment, value)) = next else { break };
-            path.0.push(segment);
-            (value_table, value_array) = match value.get_ref() {
-                DeValue::Table(t) => (Some(t), None),
-                DeValue::Array(a) => (None, Some(a.as_ref())),
-                _ => (None, None),
-            };
+        let mut segments = Vec::new();
+        if let Some(root) = self.root.as_ref() {
+            find_in_table(root.get_ref(), offset, &mut segments);
         }
-        path
+        segments.reverse();
+        FieldPath(segments)
+    }
+}
+
+/// Searches the children (not the table's own span: toml gives an array of
+/// tables a span that does not cover its later tables). Pushes the path in
+/// reverse, deepest segment first.
+fn find_in_table(table: &DeTable<'_>, offset: usize, out: &mut Vec<PathSegment>) -> bool {
+    for (key, value) in table.iter() {
+        if contains(&key.span(), offset) || find_in_value(value, offset, out) {
+            out.push(PathSegment::Key(key.get_ref().to_string()));
+            return true;
+        }
+    }
+    false
+}
+
+fn find_in_value(value: &Spanned<DeValue<'_>>, offset: usize, out: &mut Vec<PathSegment>) -> bool {
+    match value.get_ref() {
+        DeValue::Table(t) => find_in_table(t, offset, out) || contains(&value.span(), offset),
+        DeValue::Array(items) => {
+            for (i, item) in items.iter().enumerate() {
+                if find_in_value(item, offset, out) {
+                    out.push(PathSegment::Index(i));
+                    return true;
+                }
+            }
+            contains(&value.span(), offset)
+        }
+        _ => contains(&value.span(), offset),
     }
 }
 
@@ -196,7 +202,13 @@ mod tests {
     fn locates_keys_inside_arrays_of_tables() {
         let map = SourceMap::new(TEXT);
         let path = FieldPath::root().key("obstacles").index(1).key("radius");
-        assert_eq!(map.locate(&path), Some(LineCol { line: 11, column: 1 }));
+        assert_eq!(
+            map.locate(&path),
+            Some(LineCol {
+                line: 11,
+                column: 1
+            })
+        );
         let x = FieldPath::root().key("bounds").key("x");
         assert_eq!(map.locate(&x), Some(LineCol { line: 4, column: 1 }));
     }

@@ -29,7 +29,11 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
     c.bounds(&root.key("bounds"), &mission.bounds);
     c.route(&root.key("route"), mission);
     c.formation(&root.key("formation"), &mission.formation);
-    c.reconfiguration(&root.key("reconfiguration"), &mission.reconfiguration, mission);
+    c.reconfiguration(
+        &root.key("reconfiguration"),
+        &mission.reconfiguration,
+        mission,
+    );
     c.theta_pso(&root.key("theta_pso"), &mission.theta_pso);
     c.flatlo(&root.key("flatlo"), &mission.flatlo);
     c.fleet(&root.key("fleet"), &mission.fleet, &mission.bounds);
@@ -170,6 +174,21 @@ impl Checker {
                 ),
             );
         }
+        let r_f = mission.formation.radius();
+        let b = &mission.bounds;
+        let margin = (p.x - b.x[0])
+            .min(b.x[1] - p.x)
+            .min(p.y - b.y[0])
+            .min(b.y[1] - p.y);
+        if margin >= 0.0 && margin < r_f {
+            self.warning(
+                path.clone(),
+                format!(
+                    "{what} is {margin:.2} m from the edge of the bounds, less than the \
+                     formation radius r_F = {r_f:.2} m: UAVs may leave the bounds"
+                ),
+            );
+        }
         let safe = mission.formation.safe_radius();
         for o in &mission.obstacles {
             let clearance = o.cylinder().clearance(p);
@@ -283,7 +302,10 @@ impl Checker {
             if w.between[0] == w.between[1] {
                 self.error(
                     at.key("between"),
-                    format!("names '{}' twice; an IWP lies between two obstacles", w.between[0]),
+                    format!(
+                        "names '{}' twice; an IWP lies between two obstacles",
+                        w.between[0]
+                    ),
                 );
             }
             if let Some(scale) = w.scale {
@@ -326,7 +348,10 @@ impl Checker {
         if p.inertia >= 1.0 {
             self.warning(
                 path.key("inertia"),
-                format!("w = {} ≥ 1 lets the swarm's velocities grow without bound", p.inertia),
+                format!(
+                    "w = {} ≥ 1 lets the swarm's velocities grow without bound",
+                    p.inertia
+                ),
             );
         }
         if p.weight_obstacle == 0.0 {
@@ -341,7 +366,10 @@ impl Checker {
         if p.aircraft < 2 {
             self.error(
                 path.key("aircraft"),
-                format!("a squadron transition needs at least 2 aircraft, got {}", p.aircraft),
+                format!(
+                    "a squadron transition needs at least 2 aircraft, got {}",
+                    p.aircraft
+                ),
             );
         }
         for (key, value, unit) in [
@@ -423,7 +451,10 @@ impl Checker {
         if p.noise > 0.05 {
             self.warning(
                 path.key("noise"),
-                format!("{} % noise is far above the paper's 0.25 %", p.noise * 100.0),
+                format!(
+                    "{} % noise is far above the paper's 0.25 %",
+                    p.noise * 100.0
+                ),
             );
         }
     }
@@ -514,7 +545,10 @@ impl Checker {
             if t.time < previous {
                 self.error(
                     at.key("time"),
-                    format!("targets must be in time order: {} s comes after {previous} s", t.time),
+                    format!(
+                        "targets must be in time order: {} s comes after {previous} s",
+                        t.time
+                    ),
                 );
             }
             previous = t.time;
@@ -530,7 +564,10 @@ impl Checker {
             if push.agent >= p.agents {
                 self.error(
                     at.key("agent"),
-                    format!("there are only {} agents (0-based index {})", p.agents, push.agent),
+                    format!(
+                        "there are only {} agents (0-based index {})",
+                        p.agents, push.agent
+                    ),
                 );
             }
             self.non_negative(at.key("time"), push.time, " s");
@@ -594,7 +631,10 @@ impl Checker {
             } else if obstacles[..i].iter().any(|p| p.name == o.name) {
                 self.error(
                     at.key("name"),
-                    format!("'{}' is used by an earlier obstacle; names must be unique", o.name),
+                    format!(
+                        "'{}' is used by an earlier obstacle; names must be unique",
+                        o.name
+                    ),
                 );
             }
             self.positive(at.key("radius"), o.radius, " m");

@@ -90,7 +90,12 @@ impl Problem {
         let builder = PathBuilder::new(mission, &iwps);
         let cost = CostModel::new(mission, &iwps);
         // θ and Δθ both live in [-π/2, π/2] (Fig. 3, line 10).
-        let space = SearchSpace::uniform(3 * mission.theta_pso.waypoints, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2);
+        let space = SearchSpace::uniform(
+            3 * mission.theta_pso.waypoints,
+            -FRAC_PI_2,
+            FRAC_PI_2,
+            FRAC_PI_2,
+        );
         Problem {
             iwps,
             builder,
@@ -181,7 +186,10 @@ pub fn plan(
     let completion = if result.stopped {
         observer.on_event(Event::Log(
             Level::Warn,
-            &format!("cancelled after {} iterations; keeping the best so far", result.iterations),
+            &format!(
+                "cancelled after {} iterations; keeping the best so far",
+                result.iterations
+            ),
         ));
         Completion::Cancelled
     } else {

@@ -24,8 +24,9 @@ pub fn decode_angle(theta: f64, min: f64, max: f64) -> f64 {
 /// [s_j − h − T, s_j − h] transform (t1..t2), [s_j − h, s_j + h] hold (t2..t3),
 /// [s_j + h, s_j + h + T] return (t3..t4), with T the transition distance and
 /// h the hold length: the mission's hold distance plus the larger obstacle
-/// radius plus r_F, so the new shape is complete before any UAV reaches the
-/// obstacles' depth (for the paper's thin poles this is the "1 m before").
+/// radius plus the larger of the nominal and reconfigured formation radii, so
+/// the new shape is complete `hold_distance` before its leading UAV reaches
+/// the obstacles' depth (the paper's "1 m before").
 #[derive(Debug, Clone, PartialEq)]
 pub struct Zone {
     /// Index into the IWP list.
@@ -93,7 +94,7 @@ struct Via {
     pair: [usize; 2],
     shape: Shape,
     center: nalgebra::Point2<f64>,
-    /// Normal scaled by the hold length.
+    /// Normal scaled by the half length of the straight crossing.
     reach: nalgebra::Vector2<f64>,
     hold: f64,
     transition: f64,
@@ -113,12 +114,14 @@ impl PathBuilder {
             .filter(|(_, iwp)| iwp.enabled)
             .map(|(i, iwp)| {
                 let [p, q] = iwp.obstacles;
-                let deepest = mission.obstacles[p]
-                    .radius
-                    .max(mission.obstacles[q].radius);
-                let hold = mission.reconfiguration.hold_distance + deepest + r_f;
-                let half_height = vertical_half_height(&iwp.shape.offsets(nominal, 1.0))
-                    .max(vertical_half_height(nominal));
+                let deepest = mission.obstacles[p].radius.max(mission.obstacles[q].radius);
+                let shaped = iwp.shape.offsets(nominal, 1.0);
+                let reach = r_f.max(radius(&shaped));
+                let hold = mission.reconfiguration.hold_distance + deepest + reach;
+                // Straight far enough that the whole shape, and the chord the
+                // heading is taken from, lie on the crossing line while held.
+                let straight = hold + reach + r_f.max(1.0);
+                let half_height = vertical_half_height(&shaped).max(vertical_half_height(nominal));
                 let (lo, hi) = (b.z[0] + half_height, b.z[1] - half_height);
                 let z_range = if lo <= hi {
                     [lo, hi]
@@ -131,22 +134,35 @@ impl PathBuilder {
                     pair: iwp.obstacles,
                     shape: iwp.shape,
                     center: iwp.position,
-                    reach: iwp.normal * hold,
+                    reach: iwp.normal * straight,
                     hold,
                     transition: mission.reconfiguration.transition_distance,
                     z_range,
                 }
             })
             .collect();
+        // The centroid searches a box shrunk by r_F so every UAV stays inside
+        // the bounds; a box too small for that collapses to its middle line.
+        let shrink = |[lo, hi]: [f64; 2], by: f64| {
+            if hi - lo > 2.0 * by {
+                [lo + by, hi - by]
+            } else {
+                let mid = (lo + hi) / 2.0;
+                [mid, mid]
+            }
+        };
+        let half_height = vertical_half_height(nominal);
         PathBuilder {
             start: mission.route.start,
             goal: mission.route.goal,
-            bounds: [b.x, b.y, b.z],
+            bounds: [shrink(b.x, r_f), shrink(b.y, r_f), shrink(b.z, half_height)],
             vias,
         }
     }
 
-    /// Waypoints decoded from a particle: 3 angles per waypoint (x, y, z), eq. 1.
+    /// Waypoints decoded from a particle: 3 angles per waypoint (x, y, z), eq. 1,
+    /// into the bounds less the formation's radius (horizontally) and its
+    /// vertical half-height (in the altitude band).
     pub fn decode(&self, angles: &[f64]) -> Vec<Point3<f64>> {
         angles
             .chunks_exact(3)
@@ -256,7 +272,10 @@ impl<'a> ArcWalker<'a> {
             return Point3::origin();
         }
         let s = s.clamp(0.0, self.length());
-        let i = self.arcs.partition_point(|&a| a <= s).clamp(1, n.max(2) - 1);
+        let i = self
+            .arcs
+            .partition_point(|&a| a <= s)
+            .clamp(1, n.max(2) - 1);
         if n == 1 {
             return self.points[0];
         }

@@ -1,0 +1,126 @@
+//! The `skyform` binary as a script or CI sees it: output and exit status.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn skyform(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_skyform"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap_or_else(|e| panic!("cannot start skyform: {e}"))
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+#[test]
+fn check_passes_on_the_shipped_missions() {
+    let out = skyform(&[
+        "check",
+        "missions/bridge-inspection.toml",
+        "missions/flatlo-squadron.toml",
+        "missions/fleet-triangle.toml",
+        "missions/narrow-passage.toml",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    assert_eq!(text(&out.stdout).matches(": ok (0 error(s)").count(), 4);
+}
+
+#[test]
+fn check_fails_with_file_line_and_field_on_a_bad_file() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let path = dir.path().join("bad.toml");
+    let bad = "name = \"bad\"\n[bounds]\nx = [0.0, 10.0]\ny = [0.0, 10.0]\nz = [5.0, 1.0]\n\
+               [route]\nstart = [1.0, 1.0, 2.0]\ngoal = [9.0, 9.0, 2.0]\n";
+    std::fs::write(&path, bad).unwrap_or_else(|e| panic!("{e}"));
+    let name = path.display().to_string();
+    let out = skyform(&["check", &name]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains(&format!("{name}:5:1: error: bounds.z: is inverted")),
+        "{stdout}"
+    );
+    assert!(stdout.contains("FAILED"));
+
+    let json = skyform(&["check", "--json", &name]);
+    let parsed: serde_json::Value =
+        serde_json::from_slice(&json.stdout).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(parsed[0]["valid"], serde_json::Value::Bool(false));
+    assert_eq!(parsed[0]["diagnostics"][0]["path"], "bounds.z");
+    assert_eq!(parsed[0]["diagnostics"][0]["location"]["line"], 5);
+}
+
+#[test]
+fn a_missing_file_is_an_error_naming_it() {
+    let out = skyform(&["check", "no/such/mission.toml"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stdout).contains("cannot read no/such/mission.toml"));
+}
+
+#[test]
+fn run_theta_pso_prints_a_summary_and_the_outcome_as_json() {
+    let out = skyform(&[
+        "run",
+        "theta-pso",
+        "missions/bridge-inspection.toml",
+        "--seed",
+        "3",
+        "--json",
+        "-",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("FEASIBLE")
+            && stderr.contains("alignment between 'light pole 4' and 'pier 5'")
+    );
+    assert!(
+        stderr.contains("progress: 100%"),
+        "plain progress lines when not a terminal"
+    );
+    let outcome: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(outcome["seed"], 3);
+    assert_eq!(outcome["verification"]["feasible"], true);
+    assert_eq!(outcome["trajectories"].as_array().map(Vec::len), Some(3));
+    assert_eq!(outcome["convergence"].as_array().map(Vec::len), Some(151));
+}
+
+#[test]
+fn run_theta_pso_exits_2_on_an_infeasible_plan() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let path = dir.path().join("walled.toml");
+    let mut text_toml = String::from(
+        "name = \"walled in\"\n[bounds]\nx = [0.0, 100.0]\ny = [0.0, 100.0]\nz = [5.0, 15.0]\n\
+         [route]\nstart = [20.0, 50.0, 10.0]\ngoal = [90.0, 50.0, 10.0]\n\
+         [theta_pso]\nswarm_size = 20\niterations = 20\n",
+    );
+    for i in 0..24 {
+        let a = i as f64 * std::f64::consts::TAU / 24.0;
+        text_toml.push_str(&format!(
+            "[[obstacles]]\nname = \"ring {i}\"\ncenter = [{}, {}]\nradius = 0.7\nheight = 30.0\n",
+            20.0 + 6.0 * a.cos(),
+            50.0 + 6.0 * a.sin()
+        ));
+    }
+    std::fs::write(&path, text_toml).unwrap_or_else(|e| panic!("{e}"));
+    let out = skyform(&["run", "theta-pso", &path.display().to_string()]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("INFEASIBLE"));
+    assert!(text(&out.stdout).contains("FAIL obstacle clearance"));
+}
+
+#[test]
+fn run_theta_pso_on_an_invalid_mission_exits_1() {
+    let out = skyform(&["run", "theta-pso", "Cargo.toml"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("Cargo.toml is not a valid mission"));
+    assert!(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("Cargo.toml")
+            .exists()
+    );
+}
