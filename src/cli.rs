@@ -7,8 +7,9 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::mission::{self, Checked, Report};
-use crate::pipeline::{CancelToken, Completion, Event, Level, Observer};
+use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, Tee};
 use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
+use crate::record::{self, Recorder, Sinks};
 
 /// Terminal mission designer for multi-UAV formations.
 #[derive(Debug, Parser)]
@@ -37,6 +38,14 @@ pub enum Command {
     /// Run a planning pipeline on a mission.
     #[command(subcommand)]
     Run(RunCommand),
+    /// Log a mission's scene (bounds, obstacles, route, IWPs) to Rerun without
+    /// planning anything.
+    Record {
+        /// Mission TOML file.
+        mission: PathBuf,
+        #[command(flatten)]
+        record: RecordArgs,
+    },
 }
 
 #[derive(Debug, Subcommand)]
@@ -58,7 +67,33 @@ pub enum RunCommand {
         /// Evaluate the swarm on one thread (same result, slower).
         #[arg(long)]
         sequential: bool,
+        #[command(flatten)]
+        record: RecordArgs,
     },
+}
+
+/// Where to send a Rerun recording of the run.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RecordArgs {
+    /// Save a Rerun recording to FILE (open it with `rerun FILE`).
+    #[arg(long, value_name = "FILE")]
+    pub rrd: Option<PathBuf>,
+    /// Stream to a running Rerun viewer [default URL: rerun+http://127.0.0.1:9876/proxy].
+    #[arg(long, value_name = "URL", num_args = 0..=1, default_missing_value = record::DEFAULT_VIEWER_URL)]
+    pub connect: Option<String>,
+    /// Start a local Rerun viewer (the `rerun` binary on PATH) and stream to it.
+    #[arg(long)]
+    pub spawn: bool,
+}
+
+impl RecordArgs {
+    fn sinks(&self) -> Sinks {
+        Sinks {
+            rrd: self.rrd.clone(),
+            connect: self.connect.clone(),
+            spawn: self.spawn,
+        }
+    }
 }
 
 /// Exit status of a run, as the shell sees it.
@@ -87,7 +122,60 @@ pub fn main() -> ExitCode {
             seed,
             json,
             sequential,
-        }) => ExitCode::from(run_theta_pso(&mission, seed, json.as_deref(), sequential)),
+            record,
+        }) => ExitCode::from(run_theta_pso(
+            &mission,
+            seed,
+            json.as_deref(),
+            sequential,
+            &record.sinks(),
+        )),
+        Command::Record { mission, record } => {
+            ExitCode::from(record_mission(&mission, &record.sinks()))
+        }
+    }
+}
+
+/// `skyform record`.
+fn record_mission(path: &std::path::Path, sinks: &Sinks) -> u8 {
+    if sinks.is_empty() {
+        eprintln!("error: say where the recording goes: --rrd FILE, --connect [URL] or --spawn");
+        return exit::ERROR;
+    }
+    let loaded = match mission::load(path) {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return exit::ERROR;
+        }
+    };
+    eprint!("{}", loaded.warnings);
+    match record::record_scene(&loaded.mission, sinks) {
+        Ok((finished, warnings)) => {
+            for w in warnings {
+                eprintln!("warning: {w}");
+            }
+            report_recording(finished.as_ref());
+            exit::OK
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            exit::ERROR
+        }
+    }
+}
+
+/// One line about the file a recording left.
+fn report_recording(finished: Option<&record::Finished>) {
+    let Some(f) = finished else { return };
+    if let Some((path, size)) = &f.file {
+        eprintln!("recording: wrote {} ({size} bytes)", path.display());
+    }
+    if f.dropped > 0 {
+        eprintln!(
+            "warning: the viewer fell behind; {} recording messages were dropped",
+            f.dropped
+        );
     }
 }
 
@@ -178,6 +266,7 @@ fn run_theta_pso(
     seed: Option<u64>,
     json: Option<&std::path::Path>,
     sequential: bool,
+    sinks: &Sinks,
 ) -> u8 {
     let loaded = match mission::load(path) {
         Ok(l) => l,
@@ -189,21 +278,46 @@ fn run_theta_pso(
     eprint!("{}", loaded.warnings);
     let mission = loaded.mission;
     let seed = seed.unwrap_or(mission.seed);
+    let mut warnings = Vec::new();
+    let mut recorder = match Recorder::start(&mission.name, sinks, &mut warnings) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return exit::ERROR;
+        }
+    };
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
     let cancel = cancel_on_ctrl_c();
     let mut progress = StderrProgress::new();
     let options = PlanOptions {
         parallel: !sequential,
     };
-    let outcome = match planner::plan(&mission, seed, options, &mut progress, &cancel) {
+    let result = match recorder.as_mut() {
+        Some(r) => {
+            r.log_mission(&mission);
+            planner::plan(&mission, seed, options, &mut Tee(&mut progress, r), &cancel)
+        }
+        None => planner::plan(&mission, seed, options, &mut progress, &cancel),
+    };
+    let outcome = match result {
         Ok(o) => o,
         Err(e) => {
             eprintln!("\nerror: {e}");
             return exit::ERROR;
         }
     };
+    if let Some(r) = recorder.as_mut() {
+        r.log_theta_pso(&outcome);
+    }
+    // Every clone of the stream is dropped here, so the file is complete
+    // (with its footer) before anything else is printed or the process ends.
+    let finished = recorder.map(Recorder::finish);
     if progress.terminal {
         eprintln!();
     }
+    report_recording(finished.as_ref());
     let json_to_stdout = json.is_some_and(|p| p.as_os_str() == "-");
     let summary = theta_pso_summary(&outcome);
     if json_to_stdout {

@@ -4,9 +4,12 @@
 //! pipelines turn it into outcomes, and views (CLI, TUI, Rerun) show them.
 //! See `docs/architecture.md`.
 
+#[cfg(feature = "rerun")]
 pub mod cli;
 pub mod geometry;
 pub mod mission;
 pub mod pipeline;
 pub mod planner;
+#[cfg(feature = "rerun")]
+pub mod record;
 pub mod swarm;

@@ -71,6 +71,16 @@ impl<F: FnMut(Event<'_>)> Observer for F {
     }
 }
 
+/// Forwards every event to two observers (progress bar and recorder, say).
+pub struct Tee<'a, 'b>(pub &'a mut dyn Observer, pub &'b mut dyn Observer);
+
+impl Observer for Tee<'_, '_> {
+    fn on_event(&mut self, event: Event<'_>) {
+        self.0.on_event(event);
+        self.1.on_event(event);
+    }
+}
+
 /// A shared flag to ask a running pipeline to stop. Cloning shares the flag.
 #[derive(Debug, Clone, Default)]
 pub struct CancelToken(Arc<AtomicBool>);

@@ -1,0 +1,617 @@
+//! Rerun recordings: the mission scene, live θ-PSO progress and the results,
+//! saved to `.rrd` and/or streamed to a viewer.
+//!
+//! Layout (see `docs/rerun.md`): `world` is right-handed, Z up, metres, with
+//! `world/bounds`, `world/obstacles`, `world/route`, `world/iwps` static.
+//! θ-PSO logs under `theta_pso/…`: the best path of each iteration and the
+//! cost terms on the `iteration` timeline, the UAVs on `sim_time`.
+//!
+//! Nothing here runs on the pipeline's thread but the cheap conversion of an
+//! event into a message: a worker thread owns the `RecordingStream` and is fed
+//! through a bounded queue that drops the oldest message when full, so a slow
+//! or vanished viewer never blocks planning (or, later, the UI).
+
+use std::net::{SocketAddr, TcpStream, ToSocketAddrs};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use crossbeam_channel::{Receiver, Sender, TrySendError};
+use nalgebra::Point3;
+use rerun::sink::{FileSink, GrpcSink, LogSink};
+use rerun::{RecordingStream, RecordingStreamBuilder};
+
+use crate::mission::{Mission, to_toml_string};
+use crate::pipeline::{CostTerms, Event, Level, Observer};
+use crate::planner::{ThetaPsoOutcome, find_iwps};
+
+/// The viewer's standard local address.
+pub const DEFAULT_VIEWER_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
+
+/// Messages in flight before the oldest are dropped.
+const QUEUE_CAPACITY: usize = 4096;
+
+/// Where a recording goes. Any combination; none at all records nothing.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Sinks {
+    /// Save to this `.rrd` file.
+    pub rrd: Option<PathBuf>,
+    /// Stream to a running viewer at this URL.
+    pub connect: Option<String>,
+    /// Start a local viewer (`rerun` on PATH) and stream to it.
+    pub spawn: bool,
+}
+
+impl Sinks {
+    pub fn is_empty(&self) -> bool {
+        self.rrd.is_none() && self.connect.is_none() && !self.spawn
+    }
+}
+
+/// Errors that stop a recording from starting (a viewer that cannot be
+/// reached is only a warning).
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    #[error("cannot create the recording file {path}: {message}")]
+    File { path: String, message: String },
+    #[error("'{url}' is not a Rerun viewer URL (expected e.g. {DEFAULT_VIEWER_URL}): {message}")]
+    Url { url: String, message: String },
+    #[error("cannot start the recording: {0}")]
+    Stream(String),
+}
+
+/// What the worker is asked to log.
+enum Message {
+    Scene(Box<Mission>),
+    Iteration {
+        iteration: usize,
+        cost: CostTerms,
+        path: Vec<[f32; 3]>,
+    },
+    Log(Level, String),
+    ThetaPso(Box<ThetaPsoOutcome>),
+}
+
+/// A recording in progress. `finish` (or drop) flushes it and closes the file.
+pub struct Recorder {
+    queue: Sender<Message>,
+    /// Kept to drop the oldest message when the queue is full.
+    oldest: Receiver<Message>,
+    worker: Option<JoinHandle<()>>,
+    dropped: usize,
+    file: Option<PathBuf>,
+}
+
+/// What a finished recording left behind.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Finished {
+    /// The `.rrd` written, with its size in bytes.
+    pub file: Option<(PathBuf, u64)>,
+    /// Messages dropped because the queue was full.
+    pub dropped: usize,
+}
+
+impl Recorder {
+    /// Opens the sinks and starts the worker. `None` when `sinks` is empty or
+    /// every viewer sink failed; `warnings` gets one line per viewer that
+    /// could not be reached or started.
+    pub fn start(
+        name: &str,
+        sinks: &Sinks,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<Recorder>, RecordError> {
+        let mut boxes: Vec<Box<dyn LogSink>> = Vec::new();
+        if let Some(path) = &sinks.rrd {
+            check_rrd_path(path).map_err(|message| RecordError::File {
+                path: path.display().to_string(),
+                message,
+            })?;
+            let sink = FileSink::new(path).map_err(|e| RecordError::File {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            })?;
+            boxes.push(Box::new(sink));
+        }
+        let mut urls = Vec::new();
+        if sinks.spawn {
+            match spawn_viewer() {
+                Ok(url) => urls.push(url),
+                Err(w) => warnings.push(w),
+            }
+        }
+        if let Some(url) = &sinks.connect {
+            urls.push(url.clone());
+        }
+        for url in urls {
+            let uri: rerun::external::re_uri::ProxyUri =
+                url.parse().map_err(|e| RecordError::Url {
+                    url: url.clone(),
+                    message: format!("{e}"),
+                })?;
+            // Probe first: the SDK accepts an unreachable address silently and
+            // would buffer everything for a viewer that never comes.
+            if viewer_listening(&uri.origin.host.to_string(), uri.origin.port) {
+                boxes.push(Box::new(GrpcSink::new(uri)));
+            } else {
+                warnings.push(format!(
+                    "no Rerun viewer answers at {url}; continuing without it \
+                     (start one with `rerun`, or save with --rrd)"
+                ));
+            }
+        }
+        if boxes.is_empty() {
+            return Ok(None);
+        }
+        let stream = RecordingStreamBuilder::new("skyform")
+            .set_sinks(boxes)
+            .map_err(|e| RecordError::Stream(e.to_string()))?;
+        let _ = stream.send_recording_name(name);
+        let (queue, inbox) = crossbeam_channel::bounded(QUEUE_CAPACITY);
+        let oldest = inbox.clone();
+        let worker = std::thread::Builder::new()
+            .name("rerun-recorder".into())
+            .spawn(move || run_worker(stream, inbox))
+            .map_err(|e| RecordError::Stream(e.to_string()))?;
+        Ok(Some(Recorder {
+            queue,
+            oldest,
+            worker: Some(worker),
+            dropped: 0,
+            file: sinks.rrd.clone(),
+        }))
+    }
+
+    fn send(&mut self, mut message: Message) {
+        loop {
+            match self.queue.try_send(message) {
+                Ok(()) => return,
+                Err(TrySendError::Full(m)) => {
+                    if self.oldest.try_recv().is_ok() {
+                        self.dropped += 1;
+                    }
+                    message = m;
+                }
+                Err(TrySendError::Disconnected(_)) => return,
+            }
+        }
+    }
+
+    /// Logs the mission as static data.
+    pub fn log_mission(&mut self, mission: &Mission) {
+        self.send(Message::Scene(Box::new(mission.clone())));
+    }
+
+    /// Logs a θ-PSO result.
+    pub fn log_theta_pso(&mut self, outcome: &ThetaPsoOutcome) {
+        self.send(Message::ThetaPso(Box::new(outcome.clone())));
+    }
+
+    /// Flushes everything and closes the sinks; the `.rrd` is complete after this.
+    pub fn finish(mut self) -> Finished {
+        self.close()
+    }
+
+    fn close(&mut self) -> Finished {
+        // Disconnecting the queue ends the worker's loop once it has drained it.
+        let (dead, _) = crossbeam_channel::bounded(0);
+        drop(std::mem::replace(&mut self.queue, dead));
+        if let Some(worker) = self.worker.take() {
+            let _ = worker.join();
+        }
+        let file = self.file.take().map(|p| {
+            let size = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(0);
+            (p, size)
+        });
+        Finished {
+            file,
+            dropped: self.dropped,
+        }
+    }
+}
+
+impl Drop for Recorder {
+    fn drop(&mut self) {
+        if self.worker.is_some() {
+            self.close();
+        }
+    }
+}
+
+/// The recorder as a pipeline observer: events become queued messages.
+impl Observer for Recorder {
+    fn on_event(&mut self, event: Event<'_>) {
+        match event {
+            Event::PathIteration {
+                iteration,
+                cost,
+                path,
+            } => self.send(Message::Iteration {
+                iteration,
+                cost: *cost,
+                path: path.iter().map(f32x3).collect(),
+            }),
+            Event::Log(level, text) => self.send(Message::Log(level, text.to_owned())),
+            Event::Stage(_) | Event::Progress(_) => {}
+        }
+    }
+}
+
+fn f32x3(p: &Point3<f64>) -> [f32; 3] {
+    [p.x as f32, p.y as f32, p.z as f32]
+}
+
+/// Is something listening at host:port? A short TCP connect, nothing more.
+fn viewer_listening(host: &str, port: u16) -> bool {
+    let addrs: Vec<SocketAddr> = (host, port)
+        .to_socket_addrs()
+        .map(|a| a.collect())
+        .unwrap_or_default();
+    addrs
+        .iter()
+        .any(|a| TcpStream::connect_timeout(a, Duration::from_millis(300)).is_ok())
+}
+
+/// Starts `rerun` with its output silenced (it would scribble over a TUI) and
+/// waits for it to listen. Returns the URL to connect to, or a warning.
+fn spawn_viewer() -> Result<String, String> {
+    let port = rerun::DEFAULT_SERVER_PORT;
+    if viewer_listening("127.0.0.1", port) {
+        return Ok(DEFAULT_VIEWER_URL.to_owned());
+    }
+    let child = Command::new("rerun")
+        .arg("--port")
+        .arg(port.to_string())
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn();
+    if let Err(e) = child {
+        return Err(format!(
+            "cannot start the Rerun viewer ({e}); install it with \
+             `pip install rerun-sdk==0.36.3`. Continuing without it."
+        ));
+    }
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while Instant::now() < deadline {
+        if viewer_listening("127.0.0.1", port) {
+            return Ok(DEFAULT_VIEWER_URL.to_owned());
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    Err("the Rerun viewer started but did not listen within 10 s; continuing without it".into())
+}
+
+/// The worker: takes messages until the queue is closed, batching the
+/// θ-PSO iterations that arrive together into one `send_columns` per series.
+fn run_worker(stream: RecordingStream, inbox: Receiver<Message>) {
+    let mut pending: Vec<(usize, CostTerms, Vec<[f32; 3]>)> = Vec::new();
+    while let Ok(first) = inbox.recv() {
+        let mut batch = vec![first];
+        batch.extend(inbox.try_iter());
+        for message in batch {
+            match message {
+                Message::Iteration {
+                    iteration,
+                    cost,
+                    path,
+                } => pending.push((iteration, cost, path)),
+                other => {
+                    flush_iterations(&stream, &mut pending);
+                    log_message(&stream, other);
+                }
+            }
+        }
+        flush_iterations(&stream, &mut pending);
+    }
+    let _ = stream.flush_with_timeout(Duration::from_secs(10));
+    drop(stream);
+}
+
+fn log_message(stream: &RecordingStream, message: Message) {
+    let result = match message {
+        Message::Scene(mission) => log_scene(stream, &mission),
+        Message::ThetaPso(outcome) => log_theta_pso(stream, &outcome),
+        Message::Log(level, text) => {
+            let level = match level {
+                Level::Info => rerun::TextLogLevel::INFO,
+                Level::Warn => rerun::TextLogLevel::WARN,
+            };
+            stream.log(
+                "theta_pso/log",
+                &rerun::TextLog::new(text).with_level(level),
+            )
+        }
+        Message::Iteration { .. } => Ok(()),
+    };
+    // A logging error (a sink gone) must not stop the run; the recording is
+    // best effort from here on.
+    let _ = result;
+}
+
+/// Picks one term out of the cost breakdown.
+type CostTerm = fn(&CostTerms) -> f64;
+
+/// One `send_columns` per series for all iterations gathered so far.
+fn flush_iterations(
+    stream: &RecordingStream,
+    pending: &mut Vec<(usize, CostTerms, Vec<[f32; 3]>)>,
+) {
+    if pending.is_empty() {
+        return;
+    }
+    let iterations =
+        rerun::TimeColumn::new_sequence("iteration", pending.iter().map(|(i, _, _)| *i as i64));
+    let series: [(&str, CostTerm); 5] = [
+        ("theta_pso/cost/J_total", |c| c.total),
+        ("theta_pso/cost/J1_length", |c| c.length),
+        ("theta_pso/cost/J2_obstacle", |c| c.obstacle),
+        ("theta_pso/cost/J3_altitude", |c| c.altitude),
+        ("theta_pso/cost/JR_waypoints", |c| c.waypoints),
+    ];
+    for (path, term) in series {
+        let values: Vec<f64> = pending.iter().map(|(_, c, _)| term(c)).collect();
+        if let Ok(columns) = rerun::Scalars::update_fields()
+            .with_scalars(values)
+            .columns_of_unit_batches()
+        {
+            let _ = stream.send_columns(path, [iterations.clone()], columns);
+        }
+    }
+    let strips: Vec<Vec<[f32; 3]>> = pending.drain(..).map(|(_, _, p)| p).collect();
+    if let Ok(columns) = rerun::LineStrips3D::update_fields()
+        .with_strips(strips)
+        .columns_of_unit_batches()
+    {
+        let _ = stream.send_columns("theta_pso/best_path", [iterations], columns);
+    }
+}
+
+/// The mission as static data.
+fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamResult<()> {
+    stream.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+    let b = &m.bounds;
+    stream.log_static(
+        "world/bounds",
+        &rerun::Boxes3D::from_mins_and_sizes(
+            [[b.x[0] as f32, b.y[0] as f32, b.z[0] as f32]],
+            [[
+                (b.x[1] - b.x[0]) as f32,
+                (b.y[1] - b.y[0]) as f32,
+                (b.z[1] - b.z[0]) as f32,
+            ]],
+        )
+        .with_labels(["altitude band"]),
+    )?;
+    if !m.obstacles.is_empty() {
+        let o = &m.obstacles;
+        stream.log_static(
+            "world/obstacles",
+            &rerun::Cylinders3D::from_lengths_and_radii(
+                o.iter().map(|o| o.height as f32),
+                o.iter().map(|o| o.radius as f32),
+            )
+            .with_centers(o.iter().map(|o| {
+                [
+                    o.center.x as f32,
+                    o.center.y as f32,
+                    (o.height / 2.0) as f32,
+                ]
+            }))
+            .with_labels(o.iter().map(|o| o.name.clone()))
+            .with_colors(o.iter().map(|_| rerun::Color::from_rgb(150, 150, 160))),
+        )?;
+    }
+    stream.log_static(
+        "world/route",
+        &rerun::Points3D::new([f32x3(&m.route.start), f32x3(&m.route.goal)])
+            .with_labels(["start", "goal"])
+            .with_radii([0.6f32, 0.6])
+            .with_colors([
+                rerun::Color::from_rgb(60, 200, 60),
+                rerun::Color::from_rgb(220, 60, 60),
+            ]),
+    )?;
+    let iwps = find_iwps(m);
+    if !iwps.is_empty() {
+        let z = ((m.bounds.z[0] + m.bounds.z[1]) / 2.0) as f32;
+        stream.log_static(
+            "world/iwps",
+            &rerun::Points3D::new(
+                iwps.iter()
+                    .map(|i| [i.position.x as f32, i.position.y as f32, z]),
+            )
+            .with_labels(iwps.iter().map(|i| {
+                let state = if i.enabled { "" } else { " (disabled)" };
+                format!("IWP {} | {}{state}", i.between[0], i.between[1])
+            }))
+            .with_radii(iwps.iter().map(|_| 0.4f32))
+            .with_colors(iwps.iter().map(|i| {
+                if i.enabled {
+                    rerun::Color::from_rgb(250, 200, 0)
+                } else {
+                    rerun::Color::from_rgb(120, 120, 120)
+                }
+            })),
+        )?;
+    }
+    let toml = to_toml_string(m).unwrap_or_default();
+    stream.log_static(
+        "mission",
+        &rerun::TextDocument::from_markdown(format!(
+            "# {}\n\n{}\n\nskyform {}\n\n```toml\n{toml}\n```\n",
+            m.name,
+            m.description,
+            env!("CARGO_PKG_VERSION")
+        )),
+    )?;
+    Ok(())
+}
+
+/// UAV colours, one per slot, cycling.
+fn uav_color(n: usize) -> rerun::Color {
+    const PALETTE: [(u8, u8, u8); 6] = [
+        (31, 119, 180),
+        (255, 127, 14),
+        (44, 160, 44),
+        (214, 39, 40),
+        (148, 103, 189),
+        (23, 190, 207),
+    ];
+    let (r, g, b) = PALETTE[n % PALETTE.len()];
+    rerun::Color::from_rgb(r, g, b)
+}
+
+/// A θ-PSO outcome: planned paths, UAVs moving on `sim_time`, events, violations.
+fn log_theta_pso(
+    stream: &RecordingStream,
+    o: &ThetaPsoOutcome,
+) -> rerun::RecordingStreamResult<()> {
+    stream.send_property(
+        "theta_pso",
+        &rerun::TextDocument::from_markdown(format!(
+            "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\niterations: {}\n\
+             feasible: {}\ncost J: {:.4}\nlength: {:.2} m\nduration: {:.2} s\nskyform: {}",
+            o.mission,
+            o.pipeline,
+            o.seed,
+            o.completion,
+            o.iterations,
+            o.feasible(),
+            o.cost.total,
+            o.path_length,
+            o.duration,
+            env!("CARGO_PKG_VERSION")
+        )),
+    )?;
+    stream.log_static(
+        "theta_pso/plan/centroid",
+        &rerun::LineStrips3D::new([o.centroid_path.iter().map(f32x3).collect::<Vec<_>>()])
+            .with_colors([rerun::Color::from_rgb(255, 255, 255)])
+            .with_labels(["centroid"]),
+    )?;
+    for t in &o.trajectories {
+        let color = uav_color(t.uav);
+        let entity = format!("theta_pso/plan/uav_{}", t.uav + 1);
+        stream.log_static(
+            entity.as_str(),
+            &rerun::LineStrips3D::new([t
+                .samples
+                .iter()
+                .map(|s| f32x3(&s.position))
+                .collect::<Vec<_>>()])
+            .with_colors([color])
+            .with_labels([format!("UAV {}", t.uav + 1)]),
+        )?;
+        let times = rerun::TimeColumn::new_duration_secs("sim_time", t.samples.iter().map(|s| s.t));
+        let positions: Vec<[f32; 3]> = t.samples.iter().map(|s| f32x3(&s.position)).collect();
+        let velocities: Vec<[f32; 3]> = t
+            .samples
+            .iter()
+            .map(|s| {
+                [
+                    s.velocity.x as f32,
+                    s.velocity.y as f32,
+                    s.velocity.z as f32,
+                ]
+            })
+            .collect();
+        let uav = format!("theta_pso/uavs/uav_{}", t.uav + 1);
+        stream.log_static(
+            uav.as_str(),
+            &rerun::Points3D::update_fields()
+                .with_colors([color])
+                .with_radii([0.5f32])
+                .with_labels([format!("UAV {}", t.uav + 1)]),
+        )?;
+        stream.send_columns(
+            uav.as_str(),
+            [times.clone()],
+            rerun::Points3D::update_fields()
+                .with_positions(positions.clone())
+                .columns_of_unit_batches()?,
+        )?;
+        let arrows = format!("{uav}/velocity");
+        stream.log_static(
+            arrows.as_str(),
+            &rerun::Arrows3D::update_fields().with_colors([color]),
+        )?;
+        stream.send_columns(
+            arrows.as_str(),
+            [times],
+            rerun::Arrows3D::update_fields()
+                .with_origins(positions)
+                .with_vectors(velocities)
+                .columns_of_unit_batches()?,
+        )?;
+    }
+    for r in &o.reconfigurations {
+        for (label, t) in [
+            ("t1: transformation starts", r.t1),
+            ("t2: shape complete", r.t2),
+            ("t3: return starts", r.t3),
+            ("t4: back to nominal", r.t4),
+        ] {
+            stream.set_duration_secs("sim_time", t);
+            stream.log(
+                "theta_pso/events",
+                &rerun::TextLog::new(format!(
+                    "{} between '{}' and '{}': {label}",
+                    r.shape.name(),
+                    r.between[0],
+                    r.between[1]
+                ))
+                .with_level(rerun::TextLogLevel::INFO),
+            )?;
+        }
+    }
+    for v in &o.verification.violations {
+        stream.set_duration_secs("sim_time", v.location.time);
+        let other = v.location.other.as_deref().unwrap_or("");
+        stream.log(
+            "theta_pso/violations",
+            &rerun::Points3D::new([f32x3(&v.location.position)])
+                .with_colors([rerun::Color::from_rgb(255, 0, 0)])
+                .with_radii([0.8f32])
+                .with_labels([format!("{} {:.2} {other}", v.check, v.value)]),
+        )?;
+        stream.log(
+            "theta_pso/events",
+            &rerun::TextLog::new(format!(
+                "violation: UAV {} {} = {:.3} {other}",
+                v.location.uav + 1,
+                v.check,
+                v.value
+            ))
+            .with_level(rerun::TextLogLevel::WARN),
+        )?;
+    }
+    stream.reset_time();
+    Ok(())
+}
+
+/// `skyform record`: the mission scene alone.
+pub fn record_scene(
+    mission: &Mission,
+    sinks: &Sinks,
+) -> Result<(Option<Finished>, Vec<String>), RecordError> {
+    let mut warnings = Vec::new();
+    let recorder = Recorder::start(&mission.name, sinks, &mut warnings)?;
+    Ok((
+        recorder.map(|mut r| {
+            r.log_mission(mission);
+            r.finish()
+        }),
+        warnings,
+    ))
+}
+
+/// An `.rrd` can only be written into an existing directory.
+fn check_rrd_path(path: &Path) -> Result<(), String> {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => {
+            Err(format!("{} is not a directory", dir.display()))
+        }
+        _ => Ok(()),
+    }
+}

@@ -1,0 +1,276 @@
+//! Rerun recordings, read back with the SDK's own decoder.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::net::TcpListener;
+use std::path::Path;
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+use re_chunk::Chunk;
+use re_log_encoding::DecoderApp;
+use re_log_types::LogMsg;
+use skyform::mission;
+
+fn skyform(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_skyform"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap_or_else(|e| panic!("cannot start skyform: {e}"))
+}
+
+/// Every chunk of an .rrd, decoded by the SDK.
+fn chunks(path: &Path) -> Vec<Chunk> {
+    let file = File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let messages = DecoderApp::decode_eager(BufReader::new(file))
+        .unwrap_or_else(|e| panic!("{}: not an rrd: {e}", path.display()));
+    messages
+        .map(|m| m.unwrap_or_else(|e| panic!("decoding {}: {e}", path.display())))
+        .filter_map(|m| match m {
+            LogMsg::ArrowMsg(_, arrow) => Some(Chunk::from_arrow_msg(&arrow)),
+            _ => None,
+        })
+        .map(|c| c.unwrap_or_else(|e| panic!("bad chunk: {e}")))
+        .collect()
+}
+
+fn entity_paths(chunks: &[Chunk]) -> Vec<String> {
+    let mut paths: Vec<String> = chunks.iter().map(|c| c.entity_path().to_string()).collect();
+    paths.sort();
+    paths.dedup();
+    paths
+}
+
+/// All f32 values of `component` ("Cylinders3D:radii") logged at `entity`.
+fn f32_values(chunks: &[Chunk], entity: &str, component: &str) -> Vec<f32> {
+    let mut out = Vec::new();
+    for c in chunks
+        .iter()
+        .filter(|c| c.entity_path().to_string() == entity)
+    {
+        for d in c.component_descriptors() {
+            if d.component.as_str() == component {
+                for slice in c.iter_slices::<f32>(d.component) {
+                    out.extend_from_slice(slice);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// As `f32_values`, for f64 components (scalars).
+fn f64_values(chunks: &[Chunk], entity: &str, component: &str) -> Vec<f64> {
+    let mut out = Vec::new();
+    for c in chunks
+        .iter()
+        .filter(|c| c.entity_path().to_string() == entity)
+    {
+        for d in c.component_descriptors() {
+            if d.component.as_str() == component {
+                for slice in c.iter_slices::<f64>(d.component) {
+                    out.extend_from_slice(slice);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The largest time on `timeline` in chunks of `entity`, raw (nanoseconds for durations).
+fn last_time(chunks: &[Chunk], entity: &str, timeline: &str) -> Option<i64> {
+    chunks
+        .iter()
+        .filter(|c| c.entity_path().to_string() == entity)
+        .filter_map(|c| {
+            c.timelines()
+                .iter()
+                .find(|(name, _)| name.as_str() == timeline)
+                .and_then(|(_, col)| col.times_raw().iter().copied().max())
+        })
+        .max()
+}
+
+#[test]
+fn a_theta_pso_recording_holds_the_scene_the_plan_and_the_timelines() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let rrd = dir.path().join("bridge.rrd");
+    let json = dir.path().join("bridge.json");
+    let out = skyform(&[
+        "run",
+        "theta-pso",
+        "missions/bridge-inspection.toml",
+        "--seed",
+        "5",
+        "--rrd",
+        &rrd.display().to_string(),
+        "--json",
+        &json.display().to_string(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let outcome: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&json).unwrap_or_else(|e| panic!("{e}")))
+            .unwrap_or_else(|e| panic!("{e}"));
+
+    let chunks = chunks(&rrd);
+    let paths = entity_paths(&chunks);
+    for expected in [
+        "/world",
+        "/world/bounds",
+        "/world/obstacles",
+        "/world/route",
+        "/world/iwps",
+        "/theta_pso/best_path",
+        "/theta_pso/cost/J_total",
+        "/theta_pso/cost/J2_obstacle",
+        "/theta_pso/plan/centroid",
+        "/theta_pso/events",
+    ] {
+        assert!(
+            paths.iter().any(|p| p == expected),
+            "missing {expected} in {paths:?}"
+        );
+    }
+
+    // Obstacles: one cylinder per mission obstacle, true radius and height.
+    let m = mission::default_mission().mission;
+    let radii = f32_values(&chunks, "/world/obstacles", "Cylinders3D:radii");
+    let lengths = f32_values(&chunks, "/world/obstacles", "Cylinders3D:lengths");
+    assert_eq!(radii.len(), m.obstacles.len());
+    for (o, (r, h)) in m.obstacles.iter().zip(radii.iter().zip(&lengths)) {
+        assert_eq!(*r, o.radius as f32, "{}", o.name);
+        assert_eq!(*h, o.height as f32, "{}", o.name);
+    }
+
+    // One moving point per UAV, and the last sim_time is the mission duration.
+    let uavs: Vec<_> = paths
+        .iter()
+        .filter(|p| p.starts_with("/theta_pso/uavs/uav_") && !p.ends_with("velocity"))
+        .collect();
+    assert_eq!(uavs.len(), 3, "{uavs:?}");
+    let duration = outcome["duration"].as_f64().unwrap_or(f64::NAN);
+    for uav in &uavs {
+        let last = last_time(&chunks, uav, "sim_time").map(|ns| ns as f64 * 1e-9);
+        let last = last.unwrap_or(f64::NAN);
+        assert!(
+            (last - duration).abs() < 1e-6,
+            "{uav}: last sim_time {last} vs {duration}"
+        );
+    }
+    // The convergence series covers every iteration, 0..=150.
+    assert_eq!(
+        last_time(&chunks, "/theta_pso/cost/J_total", "iteration"),
+        Some(150)
+    );
+    // …and its values are the outcome's convergence history.
+    let totals = f64_values(&chunks, "/theta_pso/cost/J_total", "Scalars:scalars");
+    let history: Vec<f64> = outcome["convergence"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|v| v.as_f64()).collect())
+        .unwrap_or_default();
+    // (serde_json's default float parsing can be one ulp off, hence the tolerance.)
+    assert_eq!(totals.len(), history.len());
+    for (a, b) in totals.iter().zip(&history) {
+        assert!((a - b).abs() <= 1e-12 * a.abs(), "{a} vs {b}");
+    }
+}
+
+#[test]
+fn record_writes_the_mission_scene_alone() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let rrd = dir.path().join("scene.rrd");
+    let out = skyform(&[
+        "record",
+        "missions/narrow-passage.toml",
+        "--rrd",
+        &rrd.display().to_string(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let chunks = chunks(&rrd);
+    let paths = entity_paths(&chunks);
+    assert!(paths.iter().any(|p| p == "/world/obstacles"));
+    assert!(
+        !paths.iter().any(|p| p.starts_with("/theta_pso")),
+        "{paths:?}"
+    );
+    assert_eq!(
+        f32_values(&chunks, "/world/obstacles", "Cylinders3D:radii"),
+        vec![7.0, 8.0]
+    );
+}
+
+#[test]
+fn an_unreachable_viewer_costs_one_warning_and_no_time() {
+    // A port that was just free: nothing listens there.
+    let port = TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .map(|a| a.port())
+        .unwrap_or(9);
+    let url = format!("rerun+http://127.0.0.1:{port}/proxy");
+    let started = Instant::now();
+    let plain = skyform(&["run", "theta-pso", "missions/bridge-inspection.toml"]);
+    let without = started.elapsed();
+    let started = Instant::now();
+    let out = skyform(&[
+        "run",
+        "theta-pso",
+        "missions/bridge-inspection.toml",
+        "--connect",
+        &url,
+    ]);
+    let with = started.elapsed();
+    assert_eq!(plain.status.code(), Some(0));
+    assert_eq!(out.status.code(), Some(0));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let warnings: Vec<_> = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning:"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(warnings[0].contains(&url));
+    // The probe gives up within 300 ms; nothing else waits for the viewer.
+    assert!(
+        with < without + Duration::from_secs(2),
+        "{with:?} vs {without:?}"
+    );
+    assert_eq!(
+        plain.stdout, out.stdout,
+        "same plan with or without a viewer"
+    );
+}
+
+#[test]
+fn a_bad_viewer_url_or_rrd_directory_is_a_clear_error() {
+    let out = skyform(&[
+        "record",
+        "missions/narrow-passage.toml",
+        "--connect",
+        "not a url",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("'not a url' is not a Rerun viewer URL"));
+    let out = skyform(&[
+        "record",
+        "missions/narrow-passage.toml",
+        "--rrd",
+        "/no/such/dir/x.rrd",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&out.stderr)
+            .contains("cannot create the recording file /no/such/dir/x.rrd")
+    );
+    let out = skyform(&["record", "missions/narrow-passage.toml"]);
+    assert_eq!(out.status.code(), Some(1));
+}
