@@ -266,16 +266,25 @@ fn spawn_viewer() -> Result<String, String> {
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn();
-    if let Err(e) = child {
-        return Err(format!(
-            "cannot start the Rerun viewer ({e}); install it with \
-             `pip install rerun-sdk==0.36.3`. Continuing without it."
-        ));
-    }
+    let mut child = match child {
+        Ok(c) => c,
+        Err(e) => {
+            return Err(format!(
+                "cannot start the Rerun viewer ({e}); install it with \
+                 `pip install rerun-sdk==0.36.3`. Continuing without it."
+            ));
+        }
+    };
     let deadline = Instant::now() + Duration::from_secs(10);
     while Instant::now() < deadline {
         if viewer_listening("127.0.0.1", port) {
             return Ok(DEFAULT_VIEWER_URL.to_owned());
+        }
+        if let Ok(Some(status)) = child.try_wait() {
+            return Err(format!(
+                "the Rerun viewer exited at once ({status}; is there a display?); \
+                 continuing without it"
+            ));
         }
         std::thread::sleep(Duration::from_millis(100));
     }
