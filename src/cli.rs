@@ -142,15 +142,10 @@ fn record_mission(path: &std::path::Path, sinks: &Sinks) -> u8 {
         eprintln!("error: say where the recording goes: --rrd FILE, --connect [URL] or --spawn");
         return exit::ERROR;
     }
-    let loaded = match mission::load(path) {
-        Ok(l) => l,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return exit::ERROR;
-        }
+    let Some(mission) = load_reporting(path) else {
+        return exit::ERROR;
     };
-    eprint!("{}", loaded.warnings);
-    match record::record_scene(&loaded.mission, sinks) {
+    match record::record_scene(&mission, sinks) {
         Ok((finished, warnings)) => {
             for w in warnings {
                 eprintln!("warning: {w}");
@@ -161,6 +156,20 @@ fn record_mission(path: &std::path::Path, sinks: &Sinks) -> u8 {
         Err(e) => {
             eprintln!("error: {e}");
             exit::ERROR
+        }
+    }
+}
+
+/// Loads a mission for a command: its warnings and errors go to stderr.
+fn load_reporting(path: &std::path::Path) -> Option<mission::Mission> {
+    match mission::load(path) {
+        Ok(loaded) => {
+            eprint!("{}", loaded.warnings);
+            Some(loaded.mission)
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            None
         }
     }
 }
@@ -268,15 +277,9 @@ fn run_theta_pso(
     sequential: bool,
     sinks: &Sinks,
 ) -> u8 {
-    let loaded = match mission::load(path) {
-        Ok(l) => l,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return exit::ERROR;
-        }
+    let Some(mission) = load_reporting(path) else {
+        return exit::ERROR;
     };
-    eprint!("{}", loaded.warnings);
-    let mission = loaded.mission;
     let seed = seed.unwrap_or(mission.seed);
     let mut warnings = Vec::new();
     let mut recorder = match Recorder::start(&mission.name, sinks, &mut warnings) {

@@ -1,15 +1,9 @@
 //! The `skyform` binary as a script or CI sees it: output and exit status.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn skyform(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_skyform"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap_or_else(|e| panic!("cannot start skyform: {e}"))
-}
+mod common;
+use common::skyform;
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()

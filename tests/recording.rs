@@ -4,21 +4,15 @@ use std::fs::File;
 use std::io::BufReader;
 use std::net::TcpListener;
 use std::path::Path;
-use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-use re_chunk::Chunk;
+use re_chunk::{Chunk, ChunkComponentSlicer};
 use re_log_encoding::DecoderApp;
 use re_log_types::LogMsg;
 use skyform::mission;
 
-fn skyform(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_skyform"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap_or_else(|e| panic!("cannot start skyform: {e}"))
-}
+mod common;
+use common::skyform;
 
 /// Every chunk of an .rrd, decoded by the SDK.
 fn chunks(path: &Path) -> Vec<Chunk> {
@@ -42,8 +36,12 @@ fn entity_paths(chunks: &[Chunk]) -> Vec<String> {
     paths
 }
 
-/// All f32 values of `component` ("Cylinders3D:radii") logged at `entity`.
-fn f32_values(chunks: &[Chunk], entity: &str, component: &str) -> Vec<f32> {
+/// All values of a primitive component ("Cylinders3D:radii" as f32,
+/// "Scalars:scalars" as f64) logged at `entity`.
+fn values<T>(chunks: &[Chunk], entity: &str, component: &str) -> Vec<T>
+where
+    T: Copy + for<'a> ChunkComponentSlicer<Item<'a> = &'a [T]>,
+{
     let mut out = Vec::new();
     for c in chunks
         .iter()
@@ -51,25 +49,7 @@ fn f32_values(chunks: &[Chunk], entity: &str, component: &str) -> Vec<f32> {
     {
         for d in c.component_descriptors() {
             if d.component.as_str() == component {
-                for slice in c.iter_slices::<f32>(d.component) {
-                    out.extend_from_slice(slice);
-                }
-            }
-        }
-    }
-    out
-}
-
-/// As `f32_values`, for f64 components (scalars).
-fn f64_values(chunks: &[Chunk], entity: &str, component: &str) -> Vec<f64> {
-    let mut out = Vec::new();
-    for c in chunks
-        .iter()
-        .filter(|c| c.entity_path().to_string() == entity)
-    {
-        for d in c.component_descriptors() {
-            if d.component.as_str() == component {
-                for slice in c.iter_slices::<f64>(d.component) {
+                for slice in c.iter_slices::<T>(d.component) {
                     out.extend_from_slice(slice);
                 }
             }
@@ -140,8 +120,8 @@ fn a_theta_pso_recording_holds_the_scene_the_plan_and_the_timelines() {
 
     // Obstacles: one cylinder per mission obstacle, true radius and height.
     let m = mission::default_mission().mission;
-    let radii = f32_values(&chunks, "/world/obstacles", "Cylinders3D:radii");
-    let lengths = f32_values(&chunks, "/world/obstacles", "Cylinders3D:lengths");
+    let radii = values::<f32>(&chunks, "/world/obstacles", "Cylinders3D:radii");
+    let lengths = values::<f32>(&chunks, "/world/obstacles", "Cylinders3D:lengths");
     assert_eq!(radii.len(), m.obstacles.len());
     for (o, (r, h)) in m.obstacles.iter().zip(radii.iter().zip(&lengths)) {
         assert_eq!(*r, o.radius as f32, "{}", o.name);
@@ -169,7 +149,7 @@ fn a_theta_pso_recording_holds_the_scene_the_plan_and_the_timelines() {
         Some(150)
     );
     // …and its values are the outcome's convergence history.
-    let totals = f64_values(&chunks, "/theta_pso/cost/J_total", "Scalars:scalars");
+    let totals = values::<f64>(&chunks, "/theta_pso/cost/J_total", "Scalars:scalars");
     let history: Vec<f64> = outcome["convergence"]
         .as_array()
         .map(|a| a.iter().filter_map(|v| v.as_f64()).collect())
@@ -205,7 +185,7 @@ fn record_writes_the_mission_scene_alone() {
         "{paths:?}"
     );
     assert_eq!(
-        f32_values(&chunks, "/world/obstacles", "Cylinders3D:radii"),
+        values::<f32>(&chunks, "/world/obstacles", "Cylinders3D:radii"),
         vec![7.0, 8.0]
     );
 }
