@@ -43,6 +43,18 @@ impl Cylinder {
     }
 }
 
+/// Distance from `p` to the segment a-b, in the plane.
+pub fn segment_point_distance(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>) -> f64 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + ab * t - p).norm()
+}
+
 /// Length of the polyline through `points`.
 pub fn polyline_length(points: &[Point3<f64>]) -> f64 {
     points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
@@ -77,6 +89,14 @@ mod tests {
         let above = POLE.axis_distance(&Point3::new(2.5, 0.0, 10.0 + 1e-9));
         assert!((below - above).abs() < 1e-6);
         assert_eq!(below, 2.5);
+    }
+
+    #[test]
+    fn segment_point_distance_clamps_to_the_ends() {
+        let (a, b) = (Point2::new(0.0, 0.0), Point2::new(4.0, 0.0));
+        assert_eq!(segment_point_distance(&a, &b, &Point2::new(2.0, 3.0)), 3.0);
+        assert_eq!(segment_point_distance(&a, &b, &Point2::new(7.0, 4.0)), 5.0);
+        assert_eq!(segment_point_distance(&a, &a, &Point2::new(3.0, 4.0)), 5.0);
     }
 
     #[test]

@@ -14,6 +14,7 @@
 use nalgebra::{Point2, Vector2, Vector3};
 use serde::Serialize;
 
+use crate::geometry::segment_point_distance;
 use crate::mission::{Formation, Mission, ShapeChoice};
 
 /// An intermediate waypoint between two obstacles.
@@ -262,15 +263,4 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
         }
     }
     found
-}
-
-fn segment_point_distance(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + ab * t - p).norm()
 }
