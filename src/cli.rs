@@ -404,7 +404,7 @@ pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
                 .other
                 .as_deref()
                 .map_or_else(String::new, |o| format!(" vs {o}"));
-            format!("  (UAV {} at t = {:.1} s{other})", a.uav, a.time)
+            format!("  (UAV {} at t = {:.1} s{other})", a.uav + 1, a.time)
         });
         let verdict = if check.ok { "ok  " } else { "FAIL" };
         let _ = writeln!(

@@ -15,6 +15,7 @@ use crate::mission::Mission;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Location {
     pub time: f64,
+    /// 0-based slot index (UAV n + 1 in messages, as in the paper).
     pub uav: usize,
     /// The other UAV or the obstacle, when the check involves one.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -168,7 +169,7 @@ pub fn verify(mission: &Mission, trajectories: &[Trajectory]) -> Verification {
             }
             for (m, other) in trajectories.iter().enumerate().skip(n + 1) {
                 let d = (other.samples[k].position - p).norm();
-                let name = || Some(format!("UAV {m}"));
+                let name = || Some(format!("UAV {}", m + 1));
                 if closest.observe(d, || here(name())) {
                     note(closest.check.name, d, here(name()));
                 }
