@@ -147,6 +147,8 @@ impl Recorder {
             .set_sinks(boxes)
             .map_err(|e| RecordError::Stream(e.to_string()))?;
         let _ = stream.send_recording_name(name);
+        // A layout that shows the plan large: not essential, so a failure is ignored.
+        let _ = layout().send(&stream, rerun::blueprint::BlueprintActivation::default());
         let (queue, inbox) = crossbeam_channel::bounded(QUEUE_CAPACITY);
         let oldest = inbox.clone();
         let worker = std::thread::Builder::new()
@@ -374,6 +376,32 @@ fn flush_iterations(
     {
         let _ = stream.send_columns("theta_pso/best_path", [iterations], columns);
     }
+}
+
+/// The viewer layout: the 3D scene large on the left; on the right the cost
+/// terms on one plot, the events and log lines, and the mission file.
+fn layout() -> rerun::blueprint::Blueprint {
+    use rerun::blueprint::{
+        Blueprint, Horizontal, Spatial3DView, TextDocumentView, TextLogView, TimePanel,
+        TimeSeriesView, Vertical,
+    };
+    Blueprint::new(
+        Horizontal::new([
+            Spatial3DView::new("scene").with_origin("/").into(),
+            Vertical::new([
+                TimeSeriesView::new("θ-PSO cost (iteration)")
+                    .with_origin("/theta_pso/cost")
+                    .into(),
+                TextLogView::new("events").with_origin("/theta_pso").into(),
+                TextDocumentView::new("mission")
+                    .with_origin("/mission")
+                    .into(),
+            ])
+            .into(),
+        ])
+        .with_column_shares([2.0, 1.0]),
+    )
+    .with_time_panel(TimePanel::new().with_timeline("sim_time"))
 }
 
 /// The mission as static data.
