@@ -159,6 +159,7 @@ pub fn plan(
         parallel: options.parallel,
     };
     let mut convergence = Vec::with_capacity(p.iterations + 1);
+    let mut shown: Option<(CentroidPath, CostTerms)> = None;
     let result = swarm::minimize(
         &problem.space,
         &config,
@@ -166,13 +167,19 @@ pub fn plan(
         |angles| problem.evaluate(angles).total,
         |report| {
             convergence.push(report.best.cost);
-            let path = problem.path(&report.best.position);
-            let cost = problem.cost.terms(&path);
-            observer.on_event(Event::PathIteration {
-                iteration: report.iteration,
-                cost: &cost,
-                path: &path.points,
-            });
+            // The best only changes on improvement; rebuild its path only then.
+            if report.improved || shown.is_none() {
+                let path = problem.path(&report.best.position);
+                let cost = problem.cost.terms(&path);
+                shown = Some((path, cost));
+            }
+            if let Some((path, cost)) = &shown {
+                observer.on_event(Event::PathIteration {
+                    iteration: report.iteration,
+                    cost,
+                    path: &path.points,
+                });
+            }
             observer.on_event(Event::Progress(
                 0.95 * report.iteration as f64 / p.iterations.max(1) as f64,
             ));
