@@ -3,7 +3,7 @@
 //! Metres, ENU (z up), ground at z = 0. This module is a leaf: it knows nothing
 //! of missions or pipelines.
 
-use nalgebra::{Point2, Point3};
+use nalgebra::{Point2, Point3, Vector3};
 
 /// A vertical cylinder standing on the ground: axis through `center`, from
 /// z = 0 up to z = `height`.
@@ -53,6 +53,12 @@ pub fn segment_point_distance(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>)
         0.0
     };
     (a + ab * t - p).norm()
+}
+
+/// Distance of the farthest offset from the origin: a formation's radius r_F
+/// when the offsets are its slots (θ-PSO eq. 6).
+pub fn farthest_offset(offsets: &[Vector3<f64>]) -> f64 {
+    offsets.iter().map(|o| o.norm()).fold(0.0, f64::max)
 }
 
 /// Length of the polyline through `points`.

@@ -73,6 +73,15 @@ impl Bounds {
         self.contains_xy(&p.xy()) && (self.z[0]..=self.z[1]).contains(&p.z)
     }
 
+    /// Horizontal distance from `p` to the nearest side of the x-y box:
+    /// positive inside, negative outside.
+    pub fn horizontal_margin(&self, p: &Point3<f64>) -> f64 {
+        (p.x - self.x[0])
+            .min(self.x[1] - p.x)
+            .min(p.y - self.y[0])
+            .min(self.y[1] - p.y)
+    }
+
     pub fn contains_xy(&self, p: &Point2<f64>) -> bool {
         (self.x[0]..=self.x[1]).contains(&p.x) && (self.y[0]..=self.y[1]).contains(&p.y)
     }
@@ -469,7 +478,7 @@ impl Obstacle {
 impl Formation {
     /// r_F = max_n ‖ΔT_n‖: distance of the farthest UAV from the centroid (eq. 6).
     pub fn radius(&self) -> f64 {
-        self.slots.iter().map(|s| s.norm()).fold(0.0, f64::max)
+        crate::geometry::farthest_offset(&self.slots)
     }
 
     /// Safe radius of the whole formation around its centroid, r_F + r_Q.

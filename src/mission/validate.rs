@@ -175,11 +175,7 @@ impl Checker {
             );
         }
         let r_f = mission.formation.radius();
-        let b = &mission.bounds;
-        let margin = (p.x - b.x[0])
-            .min(b.x[1] - p.x)
-            .min(p.y - b.y[0])
-            .min(b.y[1] - p.y);
+        let margin = mission.bounds.horizontal_margin(p);
         if margin >= 0.0 && margin < r_f {
             self.warning(
                 path.clone(),

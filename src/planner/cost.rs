@@ -14,9 +14,9 @@
 
 use nalgebra::{Point2, Point3};
 
-use super::iwp::{Iwp, lateral_half_width, radius};
+use super::iwp::{Iwp, lateral_half_width};
 use super::path::CentroidPath;
-use crate::geometry::Cylinder;
+use crate::geometry::{Cylinder, polyline_length};
 use crate::mission::{Mission, ThetaPsoParams};
 use crate::pipeline::CostTerms;
 
@@ -40,7 +40,7 @@ impl CostModel {
         CostModel {
             params: mission.theta_pso.clone(),
             obstacles: mission.obstacles.iter().map(|o| o.cylinder()).collect(),
-            nominal_safe: radius(&f.slots) + f.uav_radius,
+            nominal_safe: f.safe_radius(),
             shape_half_width: iwps
                 .iter()
                 .map(|i| lateral_half_width(&i.shape.offsets(&f.slots, 1.0), f.uav_radius))
@@ -57,7 +57,7 @@ impl CostModel {
     /// J and its terms for a centroid path.
     pub fn terms(&self, path: &CentroidPath) -> CostTerms {
         let points = &path.points;
-        let total: f64 = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        let total = polyline_length(points);
         let target = self.params.segments.max(1) as f64;
         let mut segments = 0usize;
         let (mut j2, mut j3, mut jr) = (0.0, 0.0, 0.0);

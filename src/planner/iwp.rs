@@ -122,11 +122,6 @@ pub fn vertical_half_height(offsets: &[Vector3<f64>]) -> f64 {
     offsets.iter().map(|o| o.z.abs()).fold(0.0, f64::max)
 }
 
-/// Largest distance of a slot from the centroid.
-pub fn radius(offsets: &[Vector3<f64>]) -> f64 {
-    offsets.iter().map(|o| o.norm()).fold(0.0, f64::max)
-}
-
 /// Smallest distance between two slots (∞ for fewer than two).
 pub fn min_pair_distance(offsets: &[Vector3<f64>]) -> f64 {
     let mut best = f64::INFINITY;

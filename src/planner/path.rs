@@ -10,7 +10,8 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::iwp::{Iwp, Shape, radius, vertical_half_height};
+use super::iwp::{Iwp, Shape, vertical_half_height};
+use crate::geometry::farthest_offset;
 use crate::mission::Mission;
 
 /// Eq. 1, third line: x = ½ [(x_max − x_min) sin θ + x_max + x_min].
@@ -107,7 +108,7 @@ impl PathBuilder {
     pub fn new(mission: &Mission, iwps: &[Iwp]) -> Self {
         let b = &mission.bounds;
         let nominal = &mission.formation.slots;
-        let r_f = radius(nominal);
+        let r_f = mission.formation.radius();
         let vias = iwps
             .iter()
             .enumerate()
@@ -116,7 +117,7 @@ impl PathBuilder {
                 let [p, q] = iwp.obstacles;
                 let deepest = mission.obstacles[p].radius.max(mission.obstacles[q].radius);
                 let shaped = iwp.shape.offsets(nominal, 1.0);
-                let reach = r_f.max(radius(&shaped));
+                let reach = r_f.max(farthest_offset(&shaped));
                 let hold = mission.reconfiguration.hold_distance + deepest + reach;
                 // Straight far enough that the whole shape, and the chord the
                 // heading is taken from, lie on the crossing line while held.

@@ -9,7 +9,7 @@
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
-use super::iwp::{Iwp, radius};
+use super::iwp::Iwp;
 use super::path::{ArcWalker, CentroidPath};
 use crate::mission::Formation;
 
@@ -58,7 +58,7 @@ pub fn generate(
     let speed = formation.ground_speed;
     let duration = walker.length() / speed;
     let steps = (duration / SAMPLE_PERIOD).ceil().max(1.0) as usize;
-    let span = radius(&formation.slots).max(1.0);
+    let span = formation.radius().max(1.0);
     let times: Vec<f64> = (0..=steps)
         .map(|k| (k as f64 * SAMPLE_PERIOD).min(duration))
         .collect();

@@ -160,10 +160,7 @@ pub fn verify(mission: &Mission, trajectories: &[Trajectory]) -> Verification {
             if high.observe(p.z, || here(None)) {
                 note(high.check.name, p.z, here(None));
             }
-            let margin = (p.x - b.x[0])
-                .min(b.x[1] - p.x)
-                .min(p.y - b.y[0])
-                .min(b.y[1] - p.y);
+            let margin = b.horizontal_margin(&p);
             if inside.observe(margin, || here(None)) {
                 note(inside.check.name, margin, here(None));
             }
