@@ -12,15 +12,25 @@ use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
 use crate::record::{self, Recorder, Sinks};
 
 /// Terminal mission designer for multi-UAV formations.
+///
+/// Without a command, opens the mission designer (TUI) on FILE, or on the
+/// built-in bridge-inspection mission.
 #[derive(Debug, Parser)]
-#[command(name = "skyform", version, about, long_about = None)]
+#[command(name = "skyform", version, about, long_about = None, args_conflicts_with_subcommands = true)]
 pub struct Cli {
     #[command(subcommand)]
-    pub command: Command,
+    pub command: Option<Command>,
+    /// Mission file to open in the designer (created on first save if missing).
+    pub file: Option<PathBuf>,
 }
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Open a mission file in the designer (TUI); same as `skyform FILE`.
+    Edit {
+        /// Mission TOML file (created on first save if missing).
+        file: PathBuf,
+    },
     /// Validate mission files: print every error and warning with its line.
     ///
     /// Exits 0 when every file is valid, 1 when any has an error.
@@ -111,7 +121,11 @@ pub mod exit {
 /// Entry point of the binary.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command {
+    let Some(command) = cli.command else {
+        return ExitCode::from(edit(cli.file));
+    };
+    match command {
+        Command::Edit { file } => ExitCode::from(edit(Some(file))),
         Command::Check {
             files,
             strict,
@@ -132,6 +146,17 @@ pub fn main() -> ExitCode {
         )),
         Command::Record { mission, record } => {
             ExitCode::from(record_mission(&mission, &record.sinks()))
+        }
+    }
+}
+
+/// The TUI; errors (not a terminal, a file that is not a mission) go to stderr.
+fn edit(file: Option<PathBuf>) -> u8 {
+    match crate::tui::run(file) {
+        Ok(()) => exit::OK,
+        Err(e) => {
+            eprintln!("error: {e}");
+            exit::ERROR
         }
     }
 }

@@ -13,3 +13,4 @@ pub mod planner;
 #[cfg(feature = "rerun")]
 pub mod record;
 pub mod swarm;
+pub mod tui;

@@ -118,3 +118,25 @@ fn run_theta_pso_on_an_invalid_mission_exits_1() {
             .exists()
     );
 }
+
+#[test]
+fn the_designer_refuses_a_file_that_is_not_a_mission_and_needs_a_terminal() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let path = dir.path().join("broken.toml");
+    std::fs::write(&path, "name = \"x\"\n[bounds\n").unwrap_or_else(|e| panic!("{e}"));
+    let name = path.display().to_string();
+    for args in [vec![name.as_str()], vec!["edit", name.as_str()]] {
+        let out = skyform(&args);
+        assert_eq!(out.status.code(), Some(1));
+        let stderr = text(&out.stderr);
+        assert!(stderr.contains(&format!("{name}:2:")), "{stderr}");
+    }
+    // A good file, but the test's stdout is a pipe: no TUI, a clear message.
+    let out = skyform(&["missions/bridge-inspection.toml"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("needs a terminal"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -5,6 +5,7 @@ mod builtin;
 mod diagnostic;
 mod file;
 mod model;
+mod presets;
 mod source;
 mod validate;
 
@@ -15,5 +16,6 @@ pub use file::{
     write_atomically,
 };
 pub use model::*;
+pub use presets::Preset;
 pub use source::{FieldPath, LineCol, PathSegment, SourceMap};
 pub use validate::validate;

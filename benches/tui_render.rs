@@ -1,0 +1,30 @@
+//! TUI drawing speed: one full frame of a 200-obstacle mission with a
+//! planned result, at 200×60 cells. Target (issue 5): ≤ 2 ms per frame.
+
+use std::time::Instant;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+use skyform::tui::fixtures::{app_with_result, crowded_mission};
+use skyform::tui::view;
+
+fn full_frame(c: &mut Criterion) {
+    let app = app_with_result(crowded_mission(200), 3, 20);
+    assert!(
+        app.shown().and_then(|j| j.outcome.as_ref()).is_some(),
+        "the frame must show a result"
+    );
+    let mut terminal = Terminal::new(TestBackend::new(200, 60)).expect("test backend");
+    let now = Instant::now();
+    c.bench_function("tui/frame_200_obstacles_200x60", |b| {
+        b.iter(|| {
+            terminal
+                .draw(|frame| view::draw(frame, &app, now))
+                .map(|_| ())
+        })
+    });
+}
+
+criterion_group!(benches, full_frame);
+criterion_main!(benches);

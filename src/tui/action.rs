@@ -1,0 +1,95 @@
+//! Everything that can happen in the TUI, as data.
+//!
+//! Keys and mouse events become actions (`input.rs`); `App::update` is the
+//! only place state changes. Tests drive the app with actions directly.
+
+use nalgebra::Point2;
+
+use super::app::Focus;
+use super::fields::Item;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// Quit, asking first when there are unsaved changes.
+    Quit,
+    ToggleHelp,
+    /// Close the overlay (or cancel the prompt) on top.
+    Dismiss,
+    FocusNext,
+    FocusPrevious,
+    FocusOn(Focus),
+    /// Left pane: the map.
+    ShowMap,
+    /// Left pane: the formation editor.
+    ShowFormation,
+    ToggleSideView,
+
+    SelectNext,
+    SelectPrevious,
+    Select(Item),
+    /// Move the selection by whole steps (east, north on the map; forward,
+    /// left in the formation editor).
+    Nudge(f64, f64),
+    /// Grow (+1) or shrink (-1) the nudge step.
+    ChangeStep(i32),
+
+    /// Multiply the zoom; about the point, when given.
+    Zoom(f64, Option<Point2<f64>>),
+    /// Pan by a fraction of the view (x, y).
+    Pan(f64, f64),
+    /// Fit the bounds (or the slots) to the view.
+    Fit,
+
+    /// A new obstacle at the point, or at the view's centre.
+    AddObstacle(Option<Point2<f64>>),
+    ToggleAddTool,
+    Duplicate,
+    Delete,
+    AddSlot,
+    CyclePreset,
+    /// Cycle the selected IWP's shape: auto → alignment → rotation → shrink.
+    CycleShape,
+    /// Enable/disable the selected IWP.
+    ToggleWaypoint,
+
+    FieldUp,
+    FieldDown,
+    /// Start typing into the field under the cursor (optionally with a first character).
+    EditStart(Option<char>),
+    EditInput(char),
+    EditBackspace,
+    EditCommit,
+    EditCancel,
+
+    Undo,
+    Redo,
+
+    /// Run θ-PSO with the mission's seed.
+    Run,
+    /// Run θ-PSO with a seed not used yet.
+    RunNewSeed,
+    /// Cancel the selected (or latest) running job.
+    Cancel,
+    JobUp,
+    JobDown,
+    /// Show the selected job's result on the map.
+    ShowJob,
+    ToggleRecording,
+    CycleViewer,
+
+    Save,
+    SaveAs,
+    Open,
+    /// Yes to the prompt on screen.
+    Confirm,
+    /// Text typed into a prompt (save-as file name).
+    PromptInput(char),
+    PromptBackspace,
+    /// Move in the open-file list.
+    PickerMove(i32),
+
+    /// A mouse drag of an item begins at a point of its pane.
+    DragStart(Item, Point2<f64>),
+    DragTo(Point2<f64>),
+    DragEnd,
+}

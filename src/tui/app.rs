@@ -1,0 +1,1101 @@
+//! The TUI's state and its one mutator, [`App::update`].
+//!
+//! Nothing here draws or reads the terminal: the view (`view/`) is a pure
+//! function of this state, and input (`input.rs`) only produces actions, so
+//! the whole app can be driven and checked in tests without a terminal.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use crossbeam_channel::{Receiver, Sender, unbounded};
+use nalgebra::{Point2, Vector3};
+
+use super::action::Action;
+use super::document::Document;
+use super::fields::{self, Field, Item};
+use super::jobs::{self, Job, JobId, JobMsg, RecordSettings, Viewer};
+use crate::geometry::farthest_offset;
+use crate::mission::{self, Mission, Preset, Severity, check_str};
+use crate::pipeline::Level;
+use crate::planner::{Iwp, find_iwps};
+
+/// Which panel takes the keys that are not global.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Focus {
+    Map,
+    Inspector,
+    Jobs,
+}
+
+/// What the large left pane shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pane {
+    Map,
+    Formation,
+}
+
+/// A line of text being typed into an inspector field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Editing {
+    pub buffer: String,
+    /// Why the text cannot be used, or the validation message it would cause
+    /// (updated on every key).
+    pub problem: Option<(Severity, String)>,
+}
+
+/// A file the open dialog offers.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Entry {
+    File(PathBuf),
+    Builtin(&'static str),
+}
+
+impl Entry {
+    pub fn label(&self) -> String {
+        match self {
+            Entry::File(p) => p.display().to_string(),
+            Entry::Builtin(name) => format!("(built-in) {name}"),
+        }
+    }
+}
+
+/// What to do once a save went through.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AfterSave {
+    Stay,
+    Quit,
+}
+
+/// A window on top of the screen that takes the keys.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Overlay {
+    Help,
+    /// Unsaved changes: save, discard or stay.
+    Quit,
+    SaveAs {
+        input: String,
+        then: AfterSave,
+    },
+    /// The mission has errors: save anyway?
+    SaveInvalid {
+        path: Option<PathBuf>,
+        errors: Vec<String>,
+        then: AfterSave,
+    },
+    Open {
+        entries: Vec<Entry>,
+        cursor: usize,
+    },
+    /// Unsaved changes would be lost by opening `entry`.
+    Discard(Entry),
+}
+
+/// The status line's message.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Status {
+    pub text: String,
+    pub error: bool,
+}
+
+/// A drag in progress: the item and where it was grabbed relative to its position.
+#[derive(Debug, Clone, PartialEq)]
+struct Drag {
+    item: Item,
+    grab: nalgebra::Vector2<f64>,
+}
+
+/// Nudge steps offered, metres.
+pub const STEPS: [f64; 10] = [0.01, 0.1, 0.5, 1.0, 5.0, 10.0, 50.0, 100.0, 500.0, 1000.0];
+
+/// The whole TUI state.
+pub struct App {
+    pub doc: Document,
+    /// The IWPs of the current mission (eq. 9), refreshed on every change;
+    /// empty while the mission has errors.
+    pub iwps: Vec<Iwp>,
+    pub selected: Item,
+    /// Inspector cursor.
+    pub field: usize,
+    pub editing: Option<Editing>,
+    pub focus: Focus,
+    pub pane: Pane,
+    pub side_view: bool,
+    /// Map zoom (1 = bounds fit the view) and centre (None = the bounds' centre).
+    pub zoom: f64,
+    pub center: Option<Point2<f64>>,
+    pub formation_zoom: f64,
+    /// Index into [`STEPS`].
+    pub step: usize,
+    /// Clicking an empty spot of the map places an obstacle.
+    pub add_tool: bool,
+    pub preset: Preset,
+    pub jobs: Vec<Job>,
+    pub job_cursor: usize,
+    /// The job whose result the map shows.
+    pub shown_job: Option<JobId>,
+    pub overlay: Option<Overlay>,
+    pub status: Option<Status>,
+    /// Record runs to an `.rrd` beside the mission.
+    pub record_rrd: bool,
+    pub viewer: Viewer,
+    pub should_quit: bool,
+    /// Where relative paths (save as, open) start.
+    pub cwd: PathBuf,
+    drag: Option<Drag>,
+    job_tx: Sender<JobMsg>,
+    job_rx: Receiver<JobMsg>,
+}
+
+impl App {
+    pub fn new(doc: Document, cwd: PathBuf) -> Self {
+        let (job_tx, job_rx) = unbounded();
+        let mut app = App {
+            doc,
+            iwps: Vec::new(),
+            selected: Item::Mission,
+            field: 0,
+            editing: None,
+            focus: Focus::Map,
+            pane: Pane::Map,
+            side_view: false,
+            zoom: 1.0,
+            center: None,
+            formation_zoom: 1.0,
+            step: 3,
+            add_tool: false,
+            preset: Preset::Triangle,
+            jobs: Vec::new(),
+            job_cursor: 0,
+            shown_job: None,
+            overlay: None,
+            status: None,
+            record_rrd: false,
+            viewer: Viewer::Off,
+            should_quit: false,
+            cwd,
+            drag: None,
+            job_tx,
+            job_rx,
+        };
+        app.refresh();
+        app
+    }
+
+    pub fn mission(&self) -> &Mission {
+        self.doc.mission()
+    }
+
+    /// The channel the main loop waits on, next to input.
+    pub fn job_messages(&self) -> &Receiver<JobMsg> {
+        &self.job_rx
+    }
+
+    pub fn step_size(&self) -> f64 {
+        STEPS[self.step.min(STEPS.len() - 1)]
+    }
+
+    pub fn any_running(&self) -> bool {
+        self.jobs.iter().any(Job::is_running)
+    }
+
+    /// The job whose result is on the map.
+    pub fn shown(&self) -> Option<&Job> {
+        let id = self.shown_job?;
+        self.jobs.iter().find(|j| j.id == id)
+    }
+
+    /// A result is stale when the mission changed after its run started.
+    pub fn is_stale(&self, job: &Job) -> bool {
+        &job.mission != self.mission()
+    }
+
+    /// The inspector's fields for the selection.
+    pub fn fields(&self) -> Vec<Field> {
+        fields::fields(&self.selected, self.mission())
+    }
+
+    fn set_status(&mut self, text: impl Into<String>) {
+        self.status = Some(Status {
+            text: text.into(),
+            error: false,
+        });
+    }
+
+    fn set_error(&mut self, text: impl Into<String>) {
+        self.status = Some(Status {
+            text: text.into(),
+            error: true,
+        });
+    }
+
+    /// After any change to the mission: keep the selection valid, recompute IWPs.
+    fn refresh(&mut self) {
+        let m = self.doc.mission();
+        self.iwps = if self.doc.error_count() == 0 {
+            find_iwps(m)
+        } else {
+            Vec::new()
+        };
+        if !self.selected.exists(m) {
+            self.selected = match self.selected {
+                Item::Obstacle(_) if !m.obstacles.is_empty() => {
+                    Item::Obstacle(m.obstacles.len() - 1)
+                }
+                Item::Slot(_) | Item::Waypoint(_) => Item::Formation,
+                _ => Item::Bounds,
+            };
+        }
+        let n = fields::fields(&self.selected, m).len();
+        self.field = self.field.min(n.saturating_sub(1));
+    }
+
+    fn edit(&mut self, change: impl FnOnce(&mut Mission)) {
+        self.doc.edit(change);
+        self.refresh();
+    }
+
+    /// Changes state for one action. Never panics on user input.
+    pub fn update(&mut self, action: Action) {
+        use Action::*;
+        match action {
+            Quit => self.quit(),
+            ToggleHelp => {
+                self.overlay = match self.overlay {
+                    Some(Overlay::Help) => None,
+                    _ => Some(Overlay::Help),
+                }
+            }
+            Dismiss => {
+                if self.editing.is_some() {
+                    self.editing = None;
+                } else if self.overlay.is_some() {
+                    self.overlay = None;
+                } else if self.add_tool {
+                    self.add_tool = false;
+                }
+            }
+            FocusNext | FocusPrevious => {
+                self.editing = None;
+                let order = [Focus::Map, Focus::Inspector, Focus::Jobs];
+                let i = order.iter().position(|f| *f == self.focus).unwrap_or(0);
+                let d = if action == FocusNext {
+                    1
+                } else {
+                    order.len() - 1
+                };
+                self.focus = order[(i + d) % order.len()];
+            }
+            FocusOn(focus) => {
+                if focus != self.focus {
+                    self.editing = None;
+                }
+                self.focus = focus;
+            }
+            ShowMap => {
+                self.pane = Pane::Map;
+                if !fields::map_items(self.mission()).contains(&self.selected) {
+                    self.select(Item::Bounds);
+                }
+            }
+            ShowFormation => {
+                self.pane = Pane::Formation;
+                self.side_view = false;
+                if !fields::formation_items(self.mission(), &self.iwps).contains(&self.selected) {
+                    self.select(Item::Formation);
+                }
+            }
+            ToggleSideView => {
+                if self.pane == Pane::Map {
+                    self.side_view = !self.side_view;
+                }
+            }
+            SelectNext | SelectPrevious => {
+                let items = match self.pane {
+                    Pane::Map => fields::map_items(self.mission()),
+                    Pane::Formation => fields::formation_items(self.mission(), &self.iwps),
+                };
+                if !items.is_empty() {
+                    let i = items.iter().position(|it| *it == self.selected);
+                    let n = items.len();
+                    let next = match (i, action == SelectNext) {
+                        (Some(i), true) => (i + 1) % n,
+                        (Some(i), false) => (i + n - 1) % n,
+                        (None, _) => 0,
+                    };
+                    self.select(items[next].clone());
+                }
+            }
+            Select(item) => self.select(item),
+            Nudge(dx, dy) => self.nudge(dx, dy),
+            ChangeStep(d) => {
+                self.step = (self.step as i32 + d).clamp(0, STEPS.len() as i32 - 1) as usize;
+                self.set_status(format!(
+                    "nudge step {} m",
+                    fields::fmt_num(self.step_size())
+                ));
+            }
+            Zoom(factor, at) => self.zoom_by(factor, at),
+            Pan(fx, fy) => {
+                let b = &self.mission().bounds;
+                let (w, h) = (b.x[1] - b.x[0], b.y[1] - b.y[0]);
+                let c = self.center.unwrap_or(Point2::new(
+                    (b.x[0] + b.x[1]) / 2.0,
+                    (b.y[0] + b.y[1]) / 2.0,
+                ));
+                self.center = Some(Point2::new(
+                    c.x + fx * w / self.zoom,
+                    c.y + fy * h / self.zoom,
+                ));
+            }
+            Fit => match self.pane {
+                Pane::Map => {
+                    self.zoom = 1.0;
+                    self.center = None;
+                }
+                Pane::Formation => self.formation_zoom = 1.0,
+            },
+            AddObstacle(at) => {
+                let b = &self.mission().bounds;
+                let p = at.or(self.center).unwrap_or(Point2::new(
+                    (b.x[0] + b.x[1]) / 2.0,
+                    (b.y[0] + b.y[1]) / 2.0,
+                ));
+                let obstacle = fields::new_obstacle(self.mission(), p);
+                let name = obstacle.name.clone();
+                self.edit(|m| m.obstacles.push(obstacle));
+                let i = self.mission().obstacles.len() - 1;
+                self.pane = Pane::Map;
+                self.select(Item::Obstacle(i));
+                self.set_status(format!("added '{name}' at ({:.1}, {:.1})", p.x, p.y));
+            }
+            ToggleAddTool => {
+                self.add_tool = !self.add_tool;
+                self.set_status(if self.add_tool {
+                    "add tool: click an empty spot of the map to place an obstacle (Esc to stop)"
+                } else {
+                    "add tool off"
+                });
+            }
+            Duplicate => {
+                if let Item::Obstacle(i) = self.selected
+                    && let Some(o) = self.mission().obstacles.get(i)
+                {
+                    let copy = fields::duplicate_obstacle(self.mission(), o);
+                    self.edit(|m| m.obstacles.push(copy));
+                    self.select(Item::Obstacle(self.mission().obstacles.len() - 1));
+                }
+            }
+            Delete => self.delete(),
+            AddSlot => {
+                let slots = &self.mission().formation.slots;
+                let back = slots.iter().map(|s| s.x).fold(0.0, f64::min);
+                let spacing = self.preset_spacing();
+                self.edit(|m| {
+                    m.formation
+                        .slots
+                        .push(Vector3::new(back - spacing, 0.0, 0.0))
+                });
+                self.select(Item::Slot(self.mission().formation.slots.len() - 1));
+            }
+            CyclePreset => {
+                self.preset = self.preset.next();
+                let n = self.mission().formation.slots.len().max(1);
+                let spacing = self.preset_spacing();
+                let slots = self.preset.slots(n, spacing);
+                self.edit(|m| m.formation.slots = slots);
+                self.set_status(format!(
+                    "formation: {} of {n}, {} m apart",
+                    self.preset.name(),
+                    fields::fmt_num(spacing)
+                ));
+            }
+            CycleShape => {
+                if let Item::Waypoint(_) = &self.selected {
+                    let item = self.selected.clone();
+                    self.edit(|m| {
+                        if let Ok(choice) = fields::waypoint_choice(m, &item) {
+                            choice.shape = fields::next_shape(choice.shape);
+                        }
+                    });
+                }
+            }
+            ToggleWaypoint => {
+                if let Item::Waypoint(_) = &self.selected {
+                    let item = self.selected.clone();
+                    self.edit(|m| {
+                        if let Ok(choice) = fields::waypoint_choice(m, &item) {
+                            choice.enabled = !choice.enabled;
+                        }
+                    });
+                }
+            }
+            FieldUp => {
+                self.editing = None;
+                self.field = self.field.saturating_sub(1);
+            }
+            FieldDown => {
+                self.editing = None;
+                let n = self.fields().len();
+                self.field = (self.field + 1).min(n.saturating_sub(1));
+            }
+            EditStart(first) => {
+                let fields = self.fields();
+                if let Some(f) = fields.get(self.field) {
+                    let buffer = match first {
+                        Some(c) => c.to_string(),
+                        None => f.value.clone(),
+                    };
+                    self.focus = Focus::Inspector;
+                    self.editing = Some(Editing {
+                        buffer,
+                        problem: None,
+                    });
+                    self.check_editing();
+                }
+            }
+            EditInput(c) => {
+                if let Some(e) = &mut self.editing {
+                    e.buffer.push(c);
+                    self.check_editing();
+                }
+            }
+            EditBackspace => {
+                if let Some(e) = &mut self.editing {
+                    e.buffer.pop();
+                    self.check_editing();
+                }
+            }
+            EditCommit => self.commit_edit(),
+            EditCancel => self.editing = None,
+            Undo => {
+                self.editing = None;
+                if self.doc.undo() {
+                    self.refresh();
+                    self.set_status("undone");
+                } else {
+                    self.set_status("nothing to undo");
+                }
+            }
+            Redo => {
+                self.editing = None;
+                if self.doc.redo() {
+                    self.refresh();
+                    self.set_status("redone");
+                } else {
+                    self.set_status("nothing to redo");
+                }
+            }
+            Run => self.run(self.mission().seed),
+            RunNewSeed => {
+                let seed = self
+                    .jobs
+                    .iter()
+                    .map(|j| j.seed)
+                    .max()
+                    .map_or(self.mission().seed.wrapping_add(1), |s| s.wrapping_add(1));
+                self.run(seed);
+            }
+            Cancel => {
+                let target = self
+                    .jobs
+                    .get(self.job_cursor)
+                    .filter(|j| j.is_running())
+                    .or_else(|| self.jobs.iter().rev().find(|j| j.is_running()));
+                match target {
+                    Some(job) => {
+                        job.cancel.cancel();
+                        let id = job.id;
+                        self.set_status(format!("cancelling job {id}…"));
+                    }
+                    None => self.set_status("no job is running"),
+                }
+            }
+            JobUp => self.job_cursor = self.job_cursor.saturating_sub(1),
+            JobDown => {
+                self.job_cursor = (self.job_cursor + 1).min(self.jobs.len().saturating_sub(1))
+            }
+            ShowJob => {
+                if let Some(job) = self.jobs.get(self.job_cursor) {
+                    self.shown_job = Some(job.id);
+                    self.pane = Pane::Map;
+                }
+            }
+            ToggleRecording => {
+                self.record_rrd = !self.record_rrd;
+                self.set_status(if self.record_rrd {
+                    "runs are recorded to an .rrd beside the mission"
+                } else {
+                    "runs are not recorded"
+                });
+            }
+            CycleViewer => {
+                self.viewer = self.viewer.next();
+                self.set_status(match self.viewer {
+                    Viewer::Off => "no Rerun viewer".to_owned(),
+                    Viewer::Connect => {
+                        "runs stream to a running Rerun viewer (rerun --port 9876)".to_owned()
+                    }
+                    Viewer::Spawn => "runs start a Rerun viewer (`rerun` on PATH)".to_owned(),
+                });
+            }
+            Save => match self.overlay {
+                Some(Overlay::Quit) => self.save(None, AfterSave::Quit, false),
+                _ => self.save(None, AfterSave::Stay, false),
+            },
+            SaveAs => {
+                let input = self
+                    .doc
+                    .path()
+                    .map(|p| p.display().to_string())
+                    .unwrap_or_else(|| format!("{}.toml", slug(&self.mission().name)));
+                self.overlay = Some(Overlay::SaveAs {
+                    input,
+                    then: AfterSave::Stay,
+                });
+            }
+            Open => {
+                let entries = open_entries(&self.cwd);
+                self.overlay = Some(Overlay::Open { entries, cursor: 0 });
+            }
+            Confirm => self.confirm(),
+            PromptInput(c) => {
+                if let Some(Overlay::SaveAs { input, .. }) = &mut self.overlay {
+                    input.push(c);
+                }
+            }
+            PromptBackspace => {
+                if let Some(Overlay::SaveAs { input, .. }) = &mut self.overlay {
+                    input.pop();
+                }
+            }
+            PickerMove(d) => {
+                if let Some(Overlay::Open { entries, cursor }) = &mut self.overlay {
+                    let n = entries.len() as i32;
+                    if n > 0 {
+                        *cursor = (*cursor as i32 + d).clamp(0, n - 1) as usize;
+                    }
+                }
+            }
+            DragStart(item, at) => {
+                self.select(item.clone());
+                if let Some(position) = self.position_of(&item) {
+                    self.doc.begin_gesture();
+                    self.drag = Some(Drag {
+                        item,
+                        grab: position - at,
+                    });
+                }
+            }
+            DragTo(at) => {
+                if let Some(drag) = self.drag.clone() {
+                    let p = at + drag.grab;
+                    self.doc.gesture_edit(|m| set_position(m, &drag.item, p));
+                }
+            }
+            DragEnd => {
+                if self.drag.take().is_some() {
+                    self.doc.end_gesture();
+                    self.refresh();
+                }
+            }
+        }
+    }
+
+    fn select(&mut self, item: Item) {
+        if item != self.selected {
+            self.editing = None;
+            self.field = 0;
+        }
+        self.selected = item;
+    }
+
+    fn quit(&mut self) {
+        if self.doc.is_modified() {
+            self.overlay = Some(Overlay::Quit);
+        } else {
+            self.shutdown();
+        }
+    }
+
+    /// Cancels running jobs (they return their best at once) and stops.
+    fn shutdown(&mut self) {
+        for job in self.jobs.iter().filter(|j| j.is_running()) {
+            job.cancel.cancel();
+        }
+        self.should_quit = true;
+    }
+
+    fn preset_spacing(&self) -> f64 {
+        let f = &self.mission().formation;
+        let mut d = f64::INFINITY;
+        for (i, a) in f.slots.iter().enumerate() {
+            for b in &f.slots[i + 1..] {
+                d = d.min((a - b).norm());
+            }
+        }
+        let floor = 2.0 * f.uav_radius + 1.0;
+        if d.is_finite() {
+            d.max(floor)
+        } else {
+            floor.max(2.0)
+        }
+    }
+
+    fn zoom_by(&mut self, factor: f64, at: Option<Point2<f64>>) {
+        match self.pane {
+            Pane::Map => {
+                let zoom = (self.zoom * factor).clamp(0.1, 10_000.0);
+                let applied = zoom / self.zoom;
+                if let Some(p) = at {
+                    let b = &self.mission().bounds;
+                    let c = self.center.unwrap_or(Point2::new(
+                        (b.x[0] + b.x[1]) / 2.0,
+                        (b.y[0] + b.y[1]) / 2.0,
+                    ));
+                    self.center = Some(p + (c - p) / applied);
+                }
+                self.zoom = zoom;
+            }
+            Pane::Formation => {
+                self.formation_zoom = (self.formation_zoom * factor).clamp(0.1, 100.0)
+            }
+        }
+    }
+
+    fn nudge(&mut self, dx: f64, dy: f64) {
+        let s = self.step_size();
+        let item = self.selected.clone();
+        match &item {
+            Item::Obstacle(_) | Item::Start | Item::Goal => {
+                if let Some(p) = self.position_of(&item) {
+                    let to = p + nalgebra::Vector2::new(dx * s, dy * s);
+                    self.edit(|m| set_position(m, &item, to));
+                }
+            }
+            Item::Slot(i) => {
+                let i = *i;
+                // Formation frame on screen: forward is up, left is left.
+                self.edit(|m| {
+                    if let Some(slot) = m.formation.slots.get_mut(i) {
+                        slot.x += dy * s;
+                        slot.y -= dx * s;
+                    }
+                });
+            }
+            _ => self.set_status("select an obstacle, the start, the goal or a slot to move it"),
+        }
+    }
+
+    /// Where a movable item is, in its pane's plane (map: x, y ENU; formation:
+    /// forward, left).
+    pub fn position_of(&self, item: &Item) -> Option<Point2<f64>> {
+        let m = self.mission();
+        match item {
+            Item::Obstacle(i) => m.obstacles.get(*i).map(|o| o.center),
+            Item::Start => Some(m.route.start.xy()),
+            Item::Goal => Some(m.route.goal.xy()),
+            Item::Slot(i) => m.formation.slots.get(*i).map(|s| Point2::new(s.x, s.y)),
+            _ => None,
+        }
+    }
+
+    fn delete(&mut self) {
+        match self.selected.clone() {
+            Item::Obstacle(i) => {
+                let name = self.mission().obstacles.get(i).map(|o| o.name.clone());
+                self.edit(|m| {
+                    if i < m.obstacles.len() {
+                        m.obstacles.remove(i);
+                    }
+                });
+                if let Some(name) = name {
+                    self.set_status(format!("deleted '{name}' (u to undo)"));
+                }
+            }
+            Item::Slot(i) => {
+                if self.mission().formation.slots.len() <= 1 {
+                    self.set_error("a formation needs at least one slot");
+                    return;
+                }
+                self.edit(|m| {
+                    if i < m.formation.slots.len() {
+                        m.formation.slots.remove(i);
+                    }
+                });
+            }
+            Item::Waypoint(between) => {
+                self.edit(|m| {
+                    m.reconfiguration.waypoints.retain(|w| {
+                        !(w.between == between
+                            || (w.between[0] == between[1] && w.between[1] == between[0]))
+                    })
+                });
+                self.set_status("IWP back to the mission's default shape");
+            }
+            _ => self.set_status("only obstacles, slots and IWP choices can be deleted"),
+        }
+    }
+
+    /// Re-checks the text being typed: parse it, apply it to a copy, validate.
+    fn check_editing(&mut self) {
+        let fields = self.fields();
+        let Some(field) = fields.get(self.field) else {
+            return;
+        };
+        let Some(editing) = &self.editing else {
+            return;
+        };
+        let mut trial = self.mission().clone();
+        let problem = match field.set(&mut trial, &self.selected, &editing.buffer) {
+            Err(e) => Some((Severity::Error, e)),
+            Ok(()) => mission::validate(&trial)
+                .into_iter()
+                .filter(|d| concerns(&d.path.to_string(), &field.path))
+                .min_by_key(|d| d.severity)
+                .map(|d| (d.severity, d.message)),
+        };
+        if let Some(e) = &mut self.editing {
+            e.problem = problem;
+        }
+    }
+
+    fn commit_edit(&mut self) {
+        let Some(editing) = self.editing.take() else {
+            return;
+        };
+        let fields = self.fields();
+        let Some(field) = fields.get(self.field) else {
+            return;
+        };
+        let mut trial = self.mission().clone();
+        match field.set(&mut trial, &self.selected, &editing.buffer) {
+            Ok(()) => {
+                self.edit(|m| *m = trial);
+                let n = self.fields().len();
+                self.field = (self.field + 1).min(n.saturating_sub(1));
+            }
+            Err(e) => {
+                // Keep the text so it can be corrected.
+                self.set_error(format!("{}: {e}", field.label));
+                self.editing = Some(Editing {
+                    problem: Some((Severity::Error, e)),
+                    ..editing
+                });
+            }
+        }
+    }
+
+    fn run(&mut self, seed: u64) {
+        let errors: Vec<String> = self
+            .doc
+            .diagnostics()
+            .iter()
+            .filter(|d| d.is_error())
+            .map(|d| format!("{}: {}", d.path, d.message))
+            .collect();
+        if let Some(first) = errors.first() {
+            self.set_error(format!(
+                "cannot run: {} error(s) in the mission; first: {first}",
+                errors.len()
+            ));
+            return;
+        }
+        let id = self.jobs.last().map_or(1, |j| j.id + 1);
+        let job = Job::new(id, seed, self.mission().clone(), Instant::now());
+        let record = RecordSettings {
+            rrd: self.record_rrd.then(|| self.rrd_path("theta-pso", seed)),
+            viewer: self.viewer,
+        };
+        jobs::spawn_theta_pso(
+            id,
+            job.mission.clone(),
+            seed,
+            job.cancel.clone(),
+            record,
+            self.job_tx.clone(),
+        );
+        self.jobs.push(job);
+        self.job_cursor = self.jobs.len() - 1;
+        self.set_status(format!(
+            "job {id}: θ-PSO started with seed {seed} (x cancels)"
+        ));
+    }
+
+    /// `<mission file stem>-<pipeline>-seed<N>.rrd` beside the mission file.
+    pub fn rrd_path(&self, pipeline: &str, seed: u64) -> PathBuf {
+        let (dir, stem) = match self.doc.path() {
+            Some(p) => (
+                p.parent().map(Path::to_path_buf).unwrap_or_default(),
+                p.file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| slug(&self.mission().name)),
+            ),
+            None => (self.cwd.clone(), slug(&self.mission().name)),
+        };
+        dir.join(format!("{stem}-{pipeline}-seed{seed}.rrd"))
+    }
+
+    /// Applies a worker's message (`now` stamps job ends).
+    pub fn on_job_msg(&mut self, msg: JobMsg, now: Instant) {
+        let id = msg.job();
+        let note = match &msg {
+            JobMsg::Log(_, Level::Warn, text) => Some((true, format!("job {id}: {text}"))),
+            JobMsg::Log(_, Level::Info, text) if text.starts_with("recorded") => {
+                Some((false, format!("job {id}: {text}")))
+            }
+            JobMsg::Done(_, Err(e)) => Some((true, format!("job {id} failed: {e}"))),
+            _ => None,
+        };
+        let done = matches!(msg, JobMsg::Done(_, Ok(_)));
+        if let Some(job) = self.jobs.iter_mut().find(|j| j.id == id) {
+            job.apply(msg, now);
+            if done {
+                let text = match &job.outcome {
+                    Some(o) => format!(
+                        "job {id} {}: J = {:.2}, {:.1} m, {}",
+                        if job.state == jobs::JobState::Cancelled {
+                            "cancelled"
+                        } else {
+                            "done"
+                        },
+                        o.cost.total,
+                        o.path_length,
+                        if o.feasible() {
+                            "feasible"
+                        } else {
+                            "INFEASIBLE"
+                        }
+                    ),
+                    None => format!("job {id} done"),
+                };
+                self.shown_job = Some(id);
+                self.set_status(text);
+            }
+        }
+        if let Some((error, text)) = note {
+            self.status = Some(Status { text, error });
+        }
+    }
+
+    /// Applies every message already waiting; returns whether there was any.
+    pub fn drain_job_messages(&mut self) -> bool {
+        let mut any = false;
+        while let Ok(msg) = self.job_rx.try_recv() {
+            self.on_job_msg(msg, Instant::now());
+            any = true;
+        }
+        any
+    }
+
+    /// Blocks until no job runs (tests, headless use). False on timeout.
+    pub fn wait_for_jobs(&mut self, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        while self.any_running() {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.job_rx.recv_timeout(left) {
+                Ok(msg) => self.on_job_msg(msg, Instant::now()),
+                Err(_) => return false,
+            }
+        }
+        self.drain_job_messages();
+        true
+    }
+
+    fn save(&mut self, path: Option<PathBuf>, then: AfterSave, confirmed: bool) {
+        let target = path.or_else(|| self.doc.path().map(Path::to_path_buf));
+        let Some(target) = target else {
+            self.overlay = Some(Overlay::SaveAs {
+                input: format!("{}.toml", slug(&self.mission().name)),
+                then,
+            });
+            return;
+        };
+        let errors: Vec<String> = self
+            .doc
+            .diagnostics()
+            .iter()
+            .filter(|d| d.is_error())
+            .map(|d| format!("{}: {}", d.path, d.message))
+            .collect();
+        if !errors.is_empty() && !confirmed {
+            self.overlay = Some(Overlay::SaveInvalid {
+                path: Some(target),
+                errors,
+                then,
+            });
+            return;
+        }
+        let target = if target.is_relative() {
+            self.cwd.join(target)
+        } else {
+            target
+        };
+        match self.doc.save(Some(target)) {
+            Ok(p) => {
+                self.overlay = None;
+                self.set_status(format!("saved {}", p.display()));
+                if then == AfterSave::Quit {
+                    self.shutdown();
+                }
+            }
+            Err(e) => {
+                self.overlay = None;
+                self.set_error(format!("not saved: {e}"));
+            }
+        }
+    }
+
+    fn confirm(&mut self) {
+        match self.overlay.clone() {
+            Some(Overlay::Quit) => {
+                self.overlay = None;
+                self.shutdown();
+            }
+            Some(Overlay::SaveAs { input, then }) => {
+                let input = input.trim();
+                if input.is_empty() {
+                    self.set_error("type a file name");
+                    return;
+                }
+                self.save(Some(PathBuf::from(input)), then, false);
+            }
+            Some(Overlay::SaveInvalid { path, then, .. }) => self.save(path, then, true),
+            Some(Overlay::Open { entries, cursor }) => {
+                if let Some(entry) = entries.get(cursor).cloned() {
+                    if self.doc.is_modified() {
+                        self.overlay = Some(Overlay::Discard(entry));
+                    } else {
+                        self.open(entry);
+                    }
+                }
+            }
+            Some(Overlay::Discard(entry)) => self.open(entry),
+            Some(Overlay::Help) | None => {}
+        }
+    }
+
+    /// Replaces the document with another mission. A file that cannot be
+    /// read as a mission at all is refused; one with validation errors opens
+    /// (the inspector shows them).
+    pub fn open(&mut self, entry: Entry) {
+        self.overlay = None;
+        let (text, name, path) = match &entry {
+            Entry::File(p) => match mission::read(p) {
+                Ok(text) => (text, p.display().to_string(), Some(p.clone())),
+                Err(e) => return self.set_error(e.to_string()),
+            },
+            Entry::Builtin(name) => match mission::BUILTIN.iter().find(|b| b.file_name == *name) {
+                Some(b) => (b.text.to_owned(), b.file_name.to_owned(), None),
+                None => return self.set_error(format!("no built-in mission {name}")),
+            },
+        };
+        let checked = check_str(&text, Some(&name));
+        match checked.mission {
+            Some(m) => {
+                self.doc = Document::new(m, path);
+                self.selected = Item::Mission;
+                self.field = 0;
+                self.editing = None;
+                self.zoom = 1.0;
+                self.center = None;
+                self.shown_job = None;
+                self.refresh();
+                let errors = checked.report.error_count();
+                if errors > 0 {
+                    self.set_error(format!("opened {name}: {errors} error(s) to fix"));
+                } else {
+                    self.set_status(format!("opened {name}"));
+                }
+            }
+            None => {
+                let first = checked
+                    .report
+                    .errors()
+                    .next()
+                    .map(|d| d.to_string())
+                    .unwrap_or_default();
+                self.set_error(format!("cannot open {name}: {first}"));
+            }
+        }
+    }
+}
+
+/// Whether a diagnostic at `path` belongs to the field at `field`.
+pub fn concerns(path: &str, field: &str) -> bool {
+    path == field
+        || path
+            .strip_prefix(field)
+            .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('['))
+}
+
+fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
+    match item {
+        Item::Obstacle(i) => {
+            if let Some(o) = m.obstacles.get_mut(*i) {
+                o.center = p;
+            }
+        }
+        Item::Start => {
+            m.route.start.x = p.x;
+            m.route.start.y = p.y;
+        }
+        Item::Goal => {
+            m.route.goal.x = p.x;
+            m.route.goal.y = p.y;
+        }
+        Item::Slot(i) => {
+            if let Some(s) = m.formation.slots.get_mut(*i) {
+                s.x = p.x;
+                s.y = p.y;
+            }
+        }
+        _ => {}
+    }
+}
+
+/// A file-name-friendly version of a mission name.
+fn slug(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
+        .collect();
+    let s = s.trim_matches('-').to_owned();
+    if s.is_empty() { "mission".into() } else { s }
+}
+
+/// The missions the open dialog offers: `*.toml` in `missions/` and the
+/// current directory, then the built-in ones.
+pub fn open_entries(cwd: &Path) -> Vec<Entry> {
+    let mut files = Vec::new();
+    for dir in [cwd.join("missions"), cwd.to_path_buf()] {
+        if let Ok(read) = std::fs::read_dir(&dir) {
+            for entry in read.flatten() {
+                let p = entry.path();
+                if p.extension().is_some_and(|e| e == "toml") && p.is_file() {
+                    let shown = p.strip_prefix(cwd).map(Path::to_path_buf).unwrap_or(p);
+                    files.push(shown);
+                }
+            }
+        }
+    }
+    files.sort();
+    files.dedup();
+    let mut entries: Vec<Entry> = files
+        .into_iter()
+        .filter(|p| p.file_name().is_some_and(|n| n != "Cargo.toml"))
+        .map(|p| Entry::File(if p.is_relative() { cwd.join(p) } else { p }))
+        .collect();
+    entries.extend(mission::BUILTIN.iter().map(|b| Entry::Builtin(b.file_name)));
+    entries
+}
+
+/// The formation's radius (for drawing and hit-testing slots).
+pub fn formation_extent(m: &Mission) -> f64 {
+    farthest_offset(&m.formation.slots).max(1.0)
+}

@@ -1,0 +1,185 @@
+//! The mission being edited: where it lives on disk, what was last saved,
+//! and the undo history.
+//!
+//! Every change goes through [`Document::edit`] (one undo step) or a drag
+//! ([`Document::begin_gesture`] … [`Document::end_gesture`], one undo step
+//! however many moves it makes). "Modified" compares with the saved mission
+//! rather than counting edits, so undoing back to the saved state clears it.
+
+use std::path::{Path, PathBuf};
+
+use crate::mission::{self, Diagnostic, Mission, MissionError, validate};
+
+/// Undo steps kept; the oldest are forgotten first.
+const HISTORY_LIMIT: usize = 500;
+
+#[derive(Debug, Clone)]
+pub struct Document {
+    mission: Mission,
+    /// The file it is saved to; `None` for the built-in default until "save as".
+    path: Option<PathBuf>,
+    saved: Mission,
+    /// The file does not exist yet: modified until the first save.
+    never_saved: bool,
+    undo: Vec<Mission>,
+    redo: Vec<Mission>,
+    /// The mission before the gesture (drag) in progress, if any.
+    gesture: Option<Mission>,
+    /// `validate(mission)`, refreshed after every change.
+    diagnostics: Vec<Diagnostic>,
+}
+
+impl Document {
+    pub fn new(mission: Mission, path: Option<PathBuf>) -> Self {
+        let diagnostics = validate(&mission);
+        Document {
+            saved: mission.clone(),
+            never_saved: false,
+            mission,
+            path,
+            undo: Vec::new(),
+            redo: Vec::new(),
+            gesture: None,
+            diagnostics,
+        }
+    }
+
+    /// A document for a file that does not exist yet: the content of
+    /// `mission`, unsaved, to be written to `path`.
+    pub fn new_file(mission: Mission, path: PathBuf) -> Self {
+        Document {
+            never_saved: true,
+            ..Document::new(mission, Some(path))
+        }
+    }
+
+    pub fn mission(&self) -> &Mission {
+        &self.mission
+    }
+
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+
+    /// The name shown in the status bar.
+    pub fn title(&self) -> String {
+        match &self.path {
+            Some(p) => p.display().to_string(),
+            None => "(built-in) bridge-inspection.toml".to_owned(),
+        }
+    }
+
+    pub fn is_modified(&self) -> bool {
+        self.never_saved || self.mission != self.saved
+    }
+
+    pub fn diagnostics(&self) -> &[Diagnostic] {
+        &self.diagnostics
+    }
+
+    pub fn error_count(&self) -> usize {
+        self.diagnostics.iter().filter(|d| d.is_error()).count()
+    }
+
+    /// Applies `change` as one undo step. A change that leaves the mission as
+    /// it was records nothing.
+    pub fn edit(&mut self, change: impl FnOnce(&mut Mission)) {
+        let before = self.mission.clone();
+        change(&mut self.mission);
+        if self.mission != before {
+            self.push_undo(before);
+            self.changed();
+        }
+    }
+
+    /// Starts a gesture (a mouse drag): its moves are one undo step.
+    pub fn begin_gesture(&mut self) {
+        if self.gesture.is_none() {
+            self.gesture = Some(self.mission.clone());
+        }
+    }
+
+    /// A move inside the gesture (or a plain edit when none is in progress).
+    pub fn gesture_edit(&mut self, change: impl FnOnce(&mut Mission)) {
+        if self.gesture.is_none() {
+            return self.edit(change);
+        }
+        change(&mut self.mission);
+        self.diagnostics = validate(&self.mission);
+    }
+
+    pub fn end_gesture(&mut self) {
+        if let Some(before) = self.gesture.take()
+            && before != self.mission
+        {
+            self.push_undo(before);
+            self.changed();
+        }
+    }
+
+    pub fn can_undo(&self) -> bool {
+        !self.undo.is_empty()
+    }
+
+    pub fn can_redo(&self) -> bool {
+        !self.redo.is_empty()
+    }
+
+    /// Returns false when there is nothing to undo.
+    pub fn undo(&mut self) -> bool {
+        self.end_gesture();
+        match self.undo.pop() {
+            Some(previous) => {
+                self.redo
+                    .push(std::mem::replace(&mut self.mission, previous));
+                self.diagnostics = validate(&self.mission);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Returns false when there is nothing to redo.
+    pub fn redo(&mut self) -> bool {
+        self.end_gesture();
+        match self.redo.pop() {
+            Some(next) => {
+                self.undo.push(std::mem::replace(&mut self.mission, next));
+                self.diagnostics = validate(&self.mission);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Saves atomically to the document's file (or `path`, which becomes the
+    /// document's file: "save as").
+    pub fn save(&mut self, path: Option<PathBuf>) -> Result<PathBuf, MissionError> {
+        let target = match path.or_else(|| self.path.clone()) {
+            Some(p) => p,
+            None => {
+                return Err(MissionError::Write {
+                    path: "(built-in mission)".into(),
+                    source: std::io::Error::other("it has no file yet: use save as"),
+                });
+            }
+        };
+        mission::save(&self.mission, &target)?;
+        self.saved = self.mission.clone();
+        self.never_saved = false;
+        self.path = Some(target.clone());
+        Ok(target)
+    }
+
+    fn push_undo(&mut self, before: Mission) {
+        self.undo.push(before);
+        if self.undo.len() > HISTORY_LIMIT {
+            self.undo.remove(0);
+        }
+        self.redo.clear();
+    }
+
+    fn changed(&mut self) {
+        self.diagnostics = validate(&self.mission);
+    }
+}

@@ -1,0 +1,66 @@
+//! Ready-made app states for the TUI's tests and render benchmark.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use nalgebra::{Point2, Point3};
+
+use super::app::App;
+use super::document::Document;
+use super::jobs::{Job, JobMsg};
+use crate::mission::{self, Mission, Obstacle};
+use crate::pipeline::{CancelToken, Silent};
+use crate::planner::{PlanOptions, plan};
+
+/// A 400 m × 400 m field with `n` small posts on a jittered grid, clear of
+/// the start and goal corners: a stress case for drawing.
+pub fn crowded_mission(n: usize) -> Mission {
+    let mut m = mission::default_mission().mission;
+    m.name = format!("{n} posts");
+    m.bounds.x = [0.0, 400.0];
+    m.bounds.y = [0.0, 400.0];
+    m.route.start = Point3::new(10.0, 10.0, 10.0);
+    m.route.goal = Point3::new(390.0, 390.0, 10.0);
+    m.reconfiguration.waypoints.clear();
+    let side = (n as f64).sqrt().ceil() as usize;
+    let pitch = 340.0 / side as f64;
+    m.obstacles = (0..n)
+        .map(|k| {
+            let (i, j) = (k % side, k / side);
+            let wobble = ((k * 7919) % 13) as f64 / 13.0 - 0.5;
+            Obstacle {
+                name: format!("post {}", k + 1),
+                center: Point2::new(
+                    30.0 + (i as f64 + 0.5) * pitch + wobble * 3.0,
+                    30.0 + (j as f64 + 0.5) * pitch,
+                ),
+                radius: 1.0 + ((k * 31) % 5) as f64 * 0.3,
+                height: 20.0,
+                kind: Some("post".into()),
+            }
+        })
+        .collect();
+    m
+}
+
+/// An app on `mission` whose map shows a finished θ-PSO run (`iterations`
+/// swarm iterations, seed `seed`), planned synchronously.
+pub fn app_with_result(mut mission: Mission, seed: u64, iterations: usize) -> App {
+    mission.theta_pso.iterations = iterations;
+    let outcome = plan(
+        &mission,
+        seed,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    );
+    let mut app = App::new(
+        Document::new(mission.clone(), Some(PathBuf::from("mission.toml"))),
+        PathBuf::from("."),
+    );
+    let started = Instant::now();
+    app.jobs.push(Job::new(1, seed, mission, started));
+    let result = outcome.map(Box::new).map_err(|e| e.to_string());
+    app.on_job_msg(JobMsg::Done(1, result), started);
+    app
+}

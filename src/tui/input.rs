@@ -1,0 +1,370 @@
+//! Keys and mouse events to actions. The keymap is also data ([`KEYS`]) so
+//! the help overlay and the README list exactly what the code does.
+
+use ratatui::crossterm::event::{
+    KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind,
+};
+use ratatui::layout::{Position, Rect};
+
+use super::action::Action;
+use super::app::{App, Focus, Overlay, Pane, formation_extent};
+use super::fields::Item;
+use super::view::map::{Viewport, formation_split};
+use super::view::{Areas, layout};
+
+/// Every key, grouped as the help overlay shows them: (group, keys, what).
+pub const KEYS: &[(&str, &str, &str)] = &[
+    ("General", "?", "this help"),
+    (
+        "General",
+        "q  Ctrl-c",
+        "quit (asks when there are unsaved changes)",
+    ),
+    ("General", "Tab  Shift-Tab", "focus map → inspector → jobs"),
+    ("General", "1  2", "map / formation editor"),
+    (
+        "General",
+        "v",
+        "side view: distance along the path vs altitude",
+    ),
+    ("General", "u  Ctrl-z", "undo"),
+    ("General", "Ctrl-r  Ctrl-y", "redo"),
+    ("General", "Ctrl-s", "save (atomic); W save as; o open"),
+    (
+        "Select & move",
+        "n  p",
+        "next / previous item (map: mission, bounds, start, goal, obstacles, θ-PSO; formation: slots, IWPs)",
+    ),
+    (
+        "Select & move",
+        "← → ↑ ↓",
+        "nudge the selection one step (map & formation focus)",
+    ),
+    ("Select & move", "[  ]", "smaller / larger nudge step"),
+    ("Select & move", "+  -  0", "zoom in / out / fit"),
+    ("Select & move", "Shift-arrows", "pan the map"),
+    (
+        "Select & move",
+        "mouse",
+        "click selects, drag moves, wheel zooms",
+    ),
+    (
+        "Edit",
+        "a",
+        "add an obstacle at the view's centre (formation: add a slot)",
+    ),
+    (
+        "Edit",
+        "A",
+        "add tool: click an empty spot to place an obstacle",
+    ),
+    ("Edit", "d", "duplicate the selected obstacle"),
+    (
+        "Edit",
+        "Del  D",
+        "delete the selected obstacle / slot / IWP choice",
+    ),
+    (
+        "Edit",
+        "Enter",
+        "edit the field (inspector); type a number to replace it",
+    ),
+    (
+        "Edit",
+        "Esc",
+        "cancel typing, close a window, leave the add tool",
+    ),
+    (
+        "Formation",
+        "P",
+        "apply the next preset: triangle, line abreast, column, V, diamond",
+    ),
+    (
+        "Formation",
+        "s  Space",
+        "cycle the IWP's shape / enable or disable it",
+    ),
+    ("Run", "r", "run θ-PSO with the mission's seed"),
+    ("Run", "N", "run θ-PSO with a new seed"),
+    ("Run", "x", "cancel the selected (or latest) running job"),
+    (
+        "Run",
+        "Enter",
+        "jobs focus: show that job's result on the map",
+    ),
+    (
+        "Run",
+        "e  E",
+        "record runs to .rrd beside the mission / Rerun viewer: off, connect, spawn",
+    ),
+];
+
+/// The action for a key press, given what is on screen.
+pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
+    if key.kind == KeyEventKind::Release {
+        return None;
+    }
+    let ctrl = key.modifiers.contains(KeyModifiers::CONTROL);
+    let shift = key.modifiers.contains(KeyModifiers::SHIFT);
+    if ctrl && key.code == KeyCode::Char('c') {
+        return Some(Action::Quit);
+    }
+    if let Some(overlay) = &app.overlay {
+        return overlay_key(overlay, key, ctrl);
+    }
+    if app.editing.is_some() {
+        return match key.code {
+            KeyCode::Enter | KeyCode::Tab => Some(Action::EditCommit),
+            KeyCode::Esc => Some(Action::EditCancel),
+            KeyCode::Backspace => Some(Action::EditBackspace),
+            KeyCode::Up => Some(Action::FieldUp),
+            KeyCode::Down => Some(Action::FieldDown),
+            KeyCode::Char(c) if !ctrl => Some(Action::EditInput(c)),
+            _ => None,
+        };
+    }
+    if ctrl {
+        return match key.code {
+            KeyCode::Char('s') => Some(Action::Save),
+            KeyCode::Char('z') => Some(Action::Undo),
+            KeyCode::Char('r') | KeyCode::Char('y') => Some(Action::Redo),
+            _ => None,
+        };
+    }
+    let focus = app.focus;
+    let moves_things = focus == Focus::Map;
+    match key.code {
+        KeyCode::Char('?') => Some(Action::ToggleHelp),
+        KeyCode::Char('q') => Some(Action::Quit),
+        KeyCode::Esc => Some(Action::Dismiss),
+        KeyCode::Tab => Some(Action::FocusNext),
+        KeyCode::BackTab => Some(Action::FocusPrevious),
+        KeyCode::Char('1') if focus != Focus::Inspector => Some(Action::ShowMap),
+        KeyCode::Char('2') if focus != Focus::Inspector => Some(Action::ShowFormation),
+        KeyCode::Char('v') => Some(Action::ToggleSideView),
+        KeyCode::Char('u') => Some(Action::Undo),
+        KeyCode::Char('W') => Some(Action::SaveAs),
+        KeyCode::Char('o') => Some(Action::Open),
+        KeyCode::Char('n') => Some(Action::SelectNext),
+        KeyCode::Char('p') => Some(Action::SelectPrevious),
+        KeyCode::Char('[') => Some(Action::ChangeStep(-1)),
+        KeyCode::Char(']') => Some(Action::ChangeStep(1)),
+        KeyCode::Char('+') | KeyCode::Char('=') => Some(Action::Zoom(1.25, None)),
+        KeyCode::Char('-') if focus != Focus::Inspector => Some(Action::Zoom(0.8, None)),
+        KeyCode::Char('0') if focus != Focus::Inspector => Some(Action::Fit),
+        KeyCode::Char('a') => Some(match app.pane {
+            Pane::Map => Action::AddObstacle(None),
+            Pane::Formation => Action::AddSlot,
+        }),
+        KeyCode::Char('A') => Some(Action::ToggleAddTool),
+        KeyCode::Char('d') => Some(Action::Duplicate),
+        KeyCode::Delete | KeyCode::Char('D') => Some(Action::Delete),
+        KeyCode::Char('P') => Some(Action::CyclePreset),
+        KeyCode::Char('s') => Some(Action::CycleShape),
+        KeyCode::Char(' ') => Some(Action::ToggleWaypoint),
+        KeyCode::Char('r') => Some(Action::Run),
+        KeyCode::Char('N') => Some(Action::RunNewSeed),
+        KeyCode::Char('x') => Some(Action::Cancel),
+        KeyCode::Char('e') => Some(Action::ToggleRecording),
+        KeyCode::Char('E') => Some(Action::CycleViewer),
+        KeyCode::Left | KeyCode::Right | KeyCode::Up | KeyCode::Down
+            if shift && app.pane == Pane::Map =>
+        {
+            let (x, y) = arrow(key.code);
+            Some(Action::Pan(x * 0.1, y * 0.1))
+        }
+        KeyCode::Left | KeyCode::Right | KeyCode::Up | KeyCode::Down if moves_things => {
+            let (x, y) = arrow(key.code);
+            Some(Action::Nudge(x, y))
+        }
+        KeyCode::Up => Some(match focus {
+            Focus::Jobs => Action::JobUp,
+            _ => Action::FieldUp,
+        }),
+        KeyCode::Down => Some(match focus {
+            Focus::Jobs => Action::JobDown,
+            _ => Action::FieldDown,
+        }),
+        KeyCode::Enter => Some(match focus {
+            Focus::Jobs => Action::ShowJob,
+            _ => Action::EditStart(None),
+        }),
+        KeyCode::Char(c)
+            if focus == Focus::Inspector && (c.is_ascii_digit() || c == '-' || c == '.') =>
+        {
+            Some(Action::EditStart(Some(c)))
+        }
+        _ => None,
+    }
+}
+
+fn arrow(code: KeyCode) -> (f64, f64) {
+    match code {
+        KeyCode::Left => (-1.0, 0.0),
+        KeyCode::Right => (1.0, 0.0),
+        KeyCode::Up => (0.0, 1.0),
+        _ => (0.0, -1.0),
+    }
+}
+
+fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
+    match overlay {
+        Overlay::Help => Some(Action::Dismiss),
+        Overlay::Quit => match key.code {
+            KeyCode::Char('y') | KeyCode::Char('d') => Some(Action::Confirm),
+            KeyCode::Char('s') => Some(Action::Save),
+            KeyCode::Char('q') => Some(Action::Confirm),
+            _ if ctrl && key.code == KeyCode::Char('s') => Some(Action::Save),
+            KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
+            _ => None,
+        },
+        Overlay::SaveAs { .. } => match key.code {
+            KeyCode::Enter => Some(Action::Confirm),
+            KeyCode::Esc => Some(Action::Dismiss),
+            KeyCode::Backspace => Some(Action::PromptBackspace),
+            KeyCode::Char(c) if !ctrl => Some(Action::PromptInput(c)),
+            _ => None,
+        },
+        Overlay::SaveInvalid { .. } | Overlay::Discard(_) => match key.code {
+            KeyCode::Char('y') => Some(Action::Confirm),
+            KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
+            _ => None,
+        },
+        Overlay::Open { .. } => match key.code {
+            KeyCode::Up => Some(Action::PickerMove(-1)),
+            KeyCode::Down => Some(Action::PickerMove(1)),
+            KeyCode::Enter => Some(Action::Confirm),
+            KeyCode::Esc | KeyCode::Char('q') => Some(Action::Dismiss),
+            _ => None,
+        },
+    }
+}
+
+/// The action for a mouse event on a screen of size `screen`.
+pub fn mouse_action(app: &App, mouse: MouseEvent, screen: Rect) -> Option<Action> {
+    if app.overlay.is_some() {
+        return None;
+    }
+    let areas = layout(screen)?;
+    let at = Position::new(mouse.column, mouse.row);
+    match mouse.kind {
+        MouseEventKind::Down(MouseButton::Left) => {
+            if areas.left.contains(at) {
+                let (item, point) = hit(app, &areas, mouse.column, mouse.row)?;
+                return match item {
+                    Some(item) => Some(Action::DragStart(item, point)),
+                    None if app.add_tool && app.pane == Pane::Map => {
+                        Some(Action::AddObstacle(Some(point)))
+                    }
+                    None => Some(Action::FocusOn(Focus::Map)),
+                };
+            }
+            if areas.inspector.contains(at) {
+                return Some(Action::FocusOn(Focus::Inspector));
+            }
+            if areas.jobs.contains(at) {
+                return Some(Action::FocusOn(Focus::Jobs));
+            }
+            None
+        }
+        MouseEventKind::Drag(MouseButton::Left) => {
+            let vp = pane_viewport(app, &areas);
+            let p = clamp_to(&vp, mouse.column, mouse.row);
+            Some(Action::DragTo(to_pane(app, p)))
+        }
+        MouseEventKind::Up(MouseButton::Left) => Some(Action::DragEnd),
+        MouseEventKind::ScrollUp | MouseEventKind::ScrollDown if areas.left.contains(at) => {
+            let factor = if mouse.kind == MouseEventKind::ScrollUp {
+                1.25
+            } else {
+                0.8
+            };
+            let vp = pane_viewport(app, &areas);
+            let about = if app.pane == Pane::Map && !app.side_view {
+                vp.to_world(mouse.column, mouse.row)
+            } else {
+                None
+            };
+            Some(Action::Zoom(factor, about))
+        }
+        _ => None,
+    }
+}
+
+fn pane_viewport(app: &App, areas: &Areas) -> Viewport {
+    match app.pane {
+        Pane::Map => Viewport::map(app, areas.left),
+        Pane::Formation => Viewport::formation(app, formation_split(app, areas.left)[0]),
+    }
+}
+
+/// Canvas point → the pane's plane (formation canvas is (−y, x)).
+fn to_pane(app: &App, p: nalgebra::Point2<f64>) -> nalgebra::Point2<f64> {
+    match app.pane {
+        Pane::Map => p,
+        Pane::Formation => nalgebra::Point2::new(p.y, -p.x),
+    }
+}
+
+/// The canvas point under a cell, clamped into the view (a drag can leave it).
+fn clamp_to(vp: &Viewport, column: u16, row: u16) -> nalgebra::Point2<f64> {
+    let r = vp.inner;
+    let c = column.clamp(r.x, r.x + r.width.saturating_sub(1));
+    let w = row.clamp(r.y, r.y + r.height.saturating_sub(1));
+    vp.to_world(c, w)
+        .unwrap_or_else(|| nalgebra::Point2::new(vp.x[0], vp.y[0]))
+}
+
+/// What is under a click in the left pane, and the point in the pane's plane.
+fn hit(
+    app: &App,
+    areas: &Areas,
+    column: u16,
+    row: u16,
+) -> Option<(Option<Item>, nalgebra::Point2<f64>)> {
+    if app.side_view && app.pane == Pane::Map {
+        return None;
+    }
+    let vp = pane_viewport(app, areas);
+    let canvas_point = vp.to_world(column, row)?;
+    let p = to_pane(app, canvas_point);
+    // About one cell around the click.
+    let tolerance = vp.metres_per_column() * 1.5;
+    let m = app.mission();
+    let mut best: Option<(f64, Item)> = None;
+    let mut consider = |d: f64, item: Item| {
+        if best.as_ref().is_none_or(|(bd, _)| d < *bd) {
+            best = Some((d, item));
+        }
+    };
+    match app.pane {
+        Pane::Map => {
+            for (item, q) in [
+                (Item::Start, m.route.start.xy()),
+                (Item::Goal, m.route.goal.xy()),
+            ] {
+                let d = (q - p).norm();
+                if d <= tolerance * 1.5 {
+                    // Markers win over the obstacle they may sit next to.
+                    consider(d - tolerance * 2.0, item);
+                }
+            }
+            for (i, o) in m.obstacles.iter().enumerate() {
+                let d = (o.center - p).norm();
+                if d <= o.radius + tolerance {
+                    consider(d - o.radius, Item::Obstacle(i));
+                }
+            }
+        }
+        Pane::Formation => {
+            let reach = m.formation.uav_radius.max(formation_extent(m) * 0.05) + tolerance;
+            for (i, s) in m.formation.slots.iter().enumerate() {
+                let d = (nalgebra::Point2::new(s.x, s.y) - p).norm();
+                if d <= reach {
+                    consider(d, Item::Slot(i));
+                }
+            }
+        }
+    }
+    Some((best.map(|(_, item)| item), p))
+}

@@ -1,0 +1,190 @@
+//! The terminal mission designer.
+//!
+//! The state/update/view split of ratatui's component apps: `app.rs` holds
+//! the state and its one mutator, `action.rs` the vocabulary of changes,
+//! `input.rs` turns keys and mouse into actions, `view/` draws the state, and
+//! `jobs.rs` runs pipelines on worker threads that report through a channel.
+//! The loop below waits on input *or* job messages, so it never spins while
+//! idle and never blocks while a job runs.
+
+pub mod action;
+pub mod app;
+pub mod document;
+pub mod fields;
+#[doc(hidden)]
+pub mod fixtures;
+pub mod input;
+pub mod jobs;
+pub mod view;
+
+use std::io::{self, IsTerminal};
+use std::path::{Path, PathBuf};
+use std::thread;
+use std::time::{Duration, Instant};
+
+use crossbeam_channel::{Receiver, after, never, select, unbounded};
+use ratatui::DefaultTerminal;
+use ratatui::crossterm::event::{self, DisableMouseCapture, EnableMouseCapture, Event};
+use ratatui::crossterm::execute;
+use ratatui::layout::Rect;
+
+pub use action::Action;
+pub use app::App;
+pub use document::Document;
+
+use crate::mission::{self, check_str};
+
+/// How often the screen refreshes while a job runs (elapsed times, gauges).
+const TICK: Duration = Duration::from_millis(100);
+
+/// The document for `path`: the built-in default without one; the file when
+/// it exists (validation errors are shown in the TUI, not refused); a new,
+/// unsaved document to be written there when it does not. A file that is not
+/// a mission at all is an error naming each problem with its line.
+pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), String> {
+    let Some(path) = path else {
+        return Ok((
+            Document::new(mission::default_mission().mission, None),
+            None,
+        ));
+    };
+    if !path.exists() {
+        let doc = Document::new_file(mission::default_mission().mission, path.to_path_buf());
+        let note = format!("{} does not exist yet: Ctrl-s creates it", path.display());
+        return Ok((doc, Some(note)));
+    }
+    let text = mission::read(path).map_err(|e| e.to_string())?;
+    let name = path.display().to_string();
+    let checked = check_str(&text, Some(&name));
+    match checked.mission {
+        Some(m) => {
+            let errors = checked.report.error_count();
+            let note =
+                (errors > 0).then(|| format!("{name}: {errors} error(s) to fix before running"));
+            Ok((Document::new(m, Some(path.to_path_buf())), note))
+        }
+        None => Err(format!(
+            "{name} is not a valid mission:\n{}",
+            checked.report
+        )),
+    }
+}
+
+/// Runs the TUI on `path` (or the built-in mission) until the operator quits.
+pub fn run(path: Option<PathBuf>) -> Result<(), String> {
+    let (doc, note) = open_document(path.as_deref())?;
+    if !io::stdout().is_terminal() || !io::stdin().is_terminal() {
+        return Err("the mission designer needs a terminal; for scripts use `skyform run` or `skyform check` (see --help)".into());
+    }
+    let cwd = std::env::current_dir().unwrap_or_else(|_| PathBuf::from("."));
+    let mut app = App::new(doc, cwd);
+    if let Some(note) = note {
+        app.status = Some(app::Status {
+            text: note,
+            error: true,
+        });
+    }
+
+    let mut terminal =
+        ratatui::try_init().map_err(|e| format!("cannot set up the terminal: {e}"))?;
+    install_panic_hook();
+    // Mouse is a convenience: a terminal without it still works by keyboard.
+    let _ = execute!(io::stdout(), EnableMouseCapture);
+    let result = event_loop(&mut terminal, &mut app);
+    // Cancelled jobs stop at their next iteration; let them finish their
+    // recordings before the process ends.
+    app.wait_for_jobs(Duration::from_secs(5));
+    let _ = execute!(io::stdout(), DisableMouseCapture);
+    ratatui::restore();
+    result.map_err(|e| format!("terminal error: {e}"))
+}
+
+/// ratatui's hook restores the terminal on a panic; only a panic of the UI
+/// thread should do that. A job's panic is caught by the job and shown as a
+/// failed job, so it must neither restore the terminal nor print over the UI.
+fn install_panic_hook() {
+    let ui = thread::current().id();
+    let restore_and_report = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if thread::current().id() == ui {
+            let _ = execute!(io::stdout(), DisableMouseCapture);
+            restore_and_report(info);
+        }
+    }));
+}
+
+/// Reads terminal events on a thread so the loop can wait on them and on
+/// jobs at once.
+fn spawn_input() -> Receiver<io::Result<Event>> {
+    let (tx, rx) = unbounded();
+    let _ = thread::Builder::new()
+        .name("skyform-input".into())
+        .spawn(move || {
+            loop {
+                let event = event::read();
+                let failed = event.is_err();
+                if tx.send(event).is_err() || failed {
+                    break;
+                }
+            }
+        });
+    rx
+}
+
+fn event_loop(terminal: &mut DefaultTerminal, app: &mut App) -> io::Result<()> {
+    let input = spawn_input();
+    let job_messages = app.job_messages().clone();
+    let mut redraw = true;
+    loop {
+        if redraw {
+            terminal.draw(|frame| view::draw(frame, app, Instant::now()))?;
+        }
+        if app.should_quit {
+            return Ok(());
+        }
+        let tick = if app.any_running() {
+            after(TICK)
+        } else {
+            never()
+        };
+        redraw = false;
+        select! {
+            recv(input) -> event => match event {
+                Ok(event) => redraw |= handle(terminal, app, event?)?,
+                Err(_) => return Err(io::Error::other("the terminal input closed")),
+            },
+            recv(job_messages) -> msg => {
+                if let Ok(msg) = msg {
+                    app.on_job_msg(msg, Instant::now());
+                    redraw = true;
+                }
+            },
+            recv(tick) -> _ => redraw = true,
+        }
+        // Take what else is waiting before drawing once.
+        redraw |= app.drain_job_messages();
+        while let Ok(event) = input.try_recv() {
+            redraw |= handle(terminal, app, event?)?;
+        }
+    }
+}
+
+/// Applies one terminal event; returns whether the screen must be redrawn.
+fn handle(terminal: &DefaultTerminal, app: &mut App, event: Event) -> io::Result<bool> {
+    let action = match event {
+        Event::Key(key) => input::key_action(app, key),
+        Event::Mouse(mouse) => {
+            let size = terminal.size()?;
+            input::mouse_action(app, mouse, Rect::new(0, 0, size.width, size.height))
+        }
+        Event::Resize(..) => return Ok(true),
+        _ => None,
+    };
+    Ok(match action {
+        Some(action) => {
+            app.update(action);
+            true
+        }
+        None => false,
+    })
+}

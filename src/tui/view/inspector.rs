@@ -1,0 +1,161 @@
+//! The inspector: the selected item's fields, with the validation messages
+//! that concern each field right under it.
+
+use ratatui::Frame;
+use ratatui::layout::Rect;
+use ratatui::style::{Color, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, BorderType, Borders, Paragraph, Wrap};
+
+use crate::mission::Severity;
+use crate::tui::app::{App, Focus, concerns};
+use crate::tui::fields::Item;
+
+fn severity_span(severity: Severity, text: String) -> Span<'static> {
+    match severity {
+        Severity::Error => {
+            Span::styled(format!("  ✗ {text}"), Style::default().fg(Color::LightRed))
+        }
+        Severity::Warning => {
+            Span::styled(format!("  ⚠ {text}"), Style::default().fg(Color::Yellow))
+        }
+    }
+}
+
+/// The mission path prefix of an item: diagnostics under it that no field
+/// claims are listed at the bottom.
+fn item_path(item: &Item) -> Option<String> {
+    match item {
+        Item::Obstacle(i) => Some(format!("obstacles[{i}]")),
+        Item::Bounds => Some("bounds".into()),
+        Item::Start => Some("route.start".into()),
+        Item::Goal => Some("route.goal".into()),
+        Item::Formation => Some("formation".into()),
+        Item::Slot(i) => Some(format!("formation.slots[{i}]")),
+        Item::ThetaPso => Some("theta_pso".into()),
+        Item::Mission | Item::Waypoint(_) => None,
+    }
+}
+
+pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
+    let focused = app.focus == Focus::Inspector;
+    let m = app.mission();
+    let fields = app.fields();
+    let diagnostics = app.doc.diagnostics();
+    let label_width = fields
+        .iter()
+        .map(|f| f.label.chars().count())
+        .max()
+        .unwrap_or(0);
+    let mut lines: Vec<Line> = Vec::new();
+    let mut cursor_line = 0;
+    for (k, f) in fields.iter().enumerate() {
+        let cursor = k == app.field;
+        let editing = cursor && app.editing.is_some();
+        let label = format!("{:<label_width$}  ", f.label);
+        let label_style = if cursor && focused {
+            Style::default().black().on_yellow()
+        } else if cursor {
+            Style::default().yellow()
+        } else {
+            Style::default().fg(Color::Gray)
+        };
+        let value = match (&app.editing, editing) {
+            (Some(e), true) => {
+                Span::styled(format!("{}▏", e.buffer), Style::default().white().on_blue())
+            }
+            _ => Span::raw(f.value.clone()),
+        };
+        if cursor {
+            cursor_line = lines.len();
+        }
+        lines.push(Line::from(vec![Span::styled(label, label_style), value]));
+        if editing {
+            if let Some(Some((severity, text))) = app.editing.as_ref().map(|e| e.problem.clone()) {
+                lines.push(Line::from(severity_span(severity, text)));
+            }
+        } else {
+            // Show each message once, under the first field it concerns.
+            let first_with_path = fields.iter().position(|g| g.path == f.path) == Some(k);
+            if first_with_path {
+                for d in diagnostics
+                    .iter()
+                    .filter(|d| concerns(&d.path.to_string(), &f.path))
+                {
+                    lines.push(Line::from(severity_span(d.severity, d.message.clone())));
+                }
+            }
+        }
+    }
+    // Messages about the item that no field shows (e.g. an obstacle outside the bounds).
+    if let Some(prefix) = item_path(&app.selected) {
+        for d in diagnostics.iter().filter(|d| {
+            let p = d.path.to_string();
+            concerns(&p, &prefix) && !fields.iter().any(|f| concerns(&p, &f.path))
+        }) {
+            lines.push(Line::from(severity_span(
+                d.severity,
+                format!("{}: {}", d.path, d.message),
+            )));
+        }
+    }
+    if app.selected == Item::Mission {
+        let errors = app.doc.error_count();
+        let warnings = diagnostics.len() - errors;
+        lines.push(Line::raw(""));
+        lines.push(Line::from(vec![
+            Span::raw(format!(
+                "{} obstacles · {} UAVs · ",
+                m.obstacles.len(),
+                m.formation.slots.len()
+            )),
+            if errors == 0 {
+                Span::styled("valid", Style::default().green())
+            } else {
+                Span::styled(format!("{errors} error(s)"), Style::default().red().bold())
+            },
+            Span::raw(if warnings > 0 {
+                format!(" · {warnings} warning(s)")
+            } else {
+                String::new()
+            }),
+        ]));
+        for d in diagnostics.iter().take(6) {
+            lines.push(Line::from(severity_span(
+                d.severity,
+                format!("{}: {}", d.path, d.message),
+            )));
+        }
+    }
+    lines.push(Line::raw(""));
+    let hint = if app.editing.is_some() {
+        "Enter apply · Esc cancel"
+    } else {
+        "↑↓ field · Enter/type to edit · n/p next/prev item"
+    };
+    lines.push(Line::styled(hint, Style::default().fg(Color::DarkGray)));
+
+    let border = if focused {
+        Color::Yellow
+    } else {
+        Color::DarkGray
+    };
+    let block = Block::default()
+        .borders(Borders::ALL)
+        .border_type(BorderType::Rounded)
+        .border_style(Style::default().fg(border))
+        .title(Line::from(vec![
+            Span::styled(" Inspector ", Style::default().bold()),
+            Span::raw(format!("· {} ", app.selected.title(m))),
+        ]));
+    // Keep the cursor visible in a long list.
+    let inner_height = area.height.saturating_sub(2) as usize;
+    let scroll = cursor_line.saturating_sub(inner_height.saturating_sub(3)) as u16;
+    frame.render_widget(
+        Paragraph::new(lines)
+            .block(block)
+            .wrap(Wrap { trim: false })
+            .scroll((scroll, 0)),
+        area,
+    );
+}

@@ -1,0 +1,250 @@
+//! The jobs panel: every launched run with its progress, and the selected
+//! one's convergence chart and verification.
+
+use std::time::Instant;
+
+use ratatui::Frame;
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::{Color, Style};
+use ratatui::symbols::Marker;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Axis, Block, BorderType, Borders, Chart, Dataset, GraphType, Paragraph};
+
+use crate::tui::app::{App, Focus};
+use crate::tui::jobs::{Job, JobState};
+
+/// `██████░░░░ 60%` in `width` cells.
+fn bar(progress: f64, width: usize) -> String {
+    let progress = progress.clamp(0.0, 1.0);
+    let filled = ((progress * width as f64).round() as usize).min(width);
+    format!(
+        "{}{} {:>3.0}%",
+        "█".repeat(filled),
+        "░".repeat(width - filled),
+        progress * 100.0
+    )
+}
+
+fn state_span(job: &Job) -> Span<'static> {
+    match &job.state {
+        JobState::Running => Span::styled(job.stage.clone(), Style::default().cyan()),
+        JobState::Cancelled => Span::styled("cancelled", Style::default().yellow()),
+        JobState::Failed(_) => Span::styled("FAILED", Style::default().red().bold()),
+        JobState::Done { feasible: true } => Span::styled("feasible", Style::default().green()),
+        JobState::Done { feasible: false } => {
+            Span::styled("INFEASIBLE", Style::default().red().bold())
+        }
+    }
+}
+
+pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
+    let focused = app.focus == Focus::Jobs;
+    let border = if focused {
+        Color::Yellow
+    } else {
+        Color::DarkGray
+    };
+    let rec = match (app.record_rrd, app.viewer) {
+        (false, crate::tui::jobs::Viewer::Off) => String::new(),
+        (rrd, viewer) => format!(
+            "· rec{}{} ",
+            if rrd { " .rrd" } else { "" },
+            if viewer != crate::tui::jobs::Viewer::Off {
+                format!(" viewer:{}", viewer.label())
+            } else {
+                String::new()
+            }
+        ),
+    };
+    let block = Block::default()
+        .borders(Borders::ALL)
+        .border_type(BorderType::Rounded)
+        .border_style(Style::default().fg(border))
+        .title(Line::from(vec![
+            Span::styled(" Jobs ", Style::default().bold()),
+            Span::styled(rec, Style::default().red()),
+        ]));
+    let inner = block.inner(area);
+    frame.render_widget(block, area);
+    if app.jobs.is_empty() {
+        let text = vec![
+            Line::raw("No runs yet."),
+            Line::from(vec![
+                Span::styled("r", Style::default().yellow().bold()),
+                Span::raw(" run θ-PSO with the mission's seed"),
+            ]),
+            Line::from(vec![
+                Span::styled("N", Style::default().yellow().bold()),
+                Span::raw(" run with a new seed"),
+            ]),
+            Line::from(vec![
+                Span::styled("e", Style::default().yellow().bold()),
+                Span::raw(" record runs to .rrd · "),
+                Span::styled("E", Style::default().yellow().bold()),
+                Span::raw(" Rerun viewer"),
+            ]),
+        ];
+        frame.render_widget(Paragraph::new(text), inner);
+        return;
+    }
+    let list_height = (app.jobs.len() as u16).min(inner.height / 3).max(1);
+    let [list, detail] =
+        Layout::vertical([Constraint::Length(list_height), Constraint::Min(0)]).areas(inner);
+
+    // The list, scrolled to keep the cursor in view.
+    let first = app.job_cursor.saturating_sub(list_height as usize - 1);
+    let bar_width = (inner.width as usize).saturating_sub(50).clamp(4, 12);
+    let lines: Vec<Line> = app
+        .jobs
+        .iter()
+        .enumerate()
+        .skip(first)
+        .take(list_height as usize)
+        .map(|(k, job)| {
+            let cursor = k == app.job_cursor;
+            let shown = app.shown_job == Some(job.id);
+            let head = format!(
+                "{}{}{:>2} {} s{:<3} ",
+                if cursor { "▶" } else { " " },
+                if shown { "◉" } else { " " },
+                job.id,
+                job.pipeline,
+                job.seed
+            );
+            let style = if cursor && focused {
+                Style::default().black().on_yellow()
+            } else {
+                Style::default()
+            };
+            let cost = job
+                .best_cost()
+                .map_or("-".to_owned(), |c| format!("{c:.1}"));
+            Line::from(vec![
+                Span::styled(head, style),
+                Span::styled(
+                    bar(job.progress, bar_width),
+                    Style::default().fg(Color::LightBlue),
+                ),
+                Span::raw(format!(
+                    " {:>5.1}s J {cost} ",
+                    job.elapsed(now).as_secs_f64()
+                )),
+                state_span(job),
+            ])
+        })
+        .collect();
+    frame.render_widget(Paragraph::new(lines), list);
+
+    let Some(job) = app.jobs.get(app.job_cursor) else {
+        return;
+    };
+    let mut facts: Vec<Line> = Vec::new();
+    if let JobState::Failed(e) = &job.state {
+        facts.push(Line::styled(format!("error: {e}"), Style::default().red()));
+    }
+    if let Some(o) = &job.outcome {
+        let v = &o.verification;
+        facts.push(Line::raw(format!(
+            "J {:.2} · {:.1} m · {:.1} s · {} reconfiguration(s)",
+            o.cost.total,
+            o.path_length,
+            o.duration,
+            o.reconfigurations.len()
+        )));
+        facts.push(if v.feasible {
+            Line::styled("✓ all checks pass", Style::default().green())
+        } else {
+            Line::styled(
+                format!("✗ {} violation(s)", v.violation_count),
+                Style::default().red().bold(),
+            )
+        });
+        for c in v.checks.iter().filter(|c| !c.ok).take(2) {
+            facts.push(Line::styled(
+                format!(
+                    "✗ {} {} {} (worst {:.3})",
+                    c.name,
+                    c.relation,
+                    c.limit,
+                    c.worst.unwrap_or(f64::NAN)
+                ),
+                Style::default().red(),
+            ));
+        }
+        if app.is_stale(job) {
+            facts.push(Line::styled(
+                "stale: the mission changed since this run",
+                Style::default().yellow(),
+            ));
+        }
+    } else if let Some(w) = &job.last_warning {
+        facts.push(Line::styled(w.clone(), Style::default().yellow()));
+    }
+    let facts_height = (facts.len() as u16).min(detail.height / 2);
+    let [chart_area, facts_area] =
+        Layout::vertical([Constraint::Min(0), Constraint::Length(facts_height)]).areas(detail);
+    frame.render_widget(Paragraph::new(facts), facts_area);
+    draw_chart(frame, job, chart_area);
+}
+
+/// Best total cost per iteration (the convergence curve).
+fn draw_chart(frame: &mut Frame, job: &Job, area: Rect) {
+    if area.height < 4 || job.convergence.is_empty() {
+        return;
+    }
+    let points: Vec<(f64, f64)> = job
+        .convergence
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.is_finite())
+        .map(|(i, c)| (i as f64, *c))
+        .collect();
+    if points.is_empty() {
+        return;
+    }
+    let n = points.len() as f64;
+    let last = points[points.len() - 1].1;
+    // The first iterations can cost orders of magnitude more (penalties):
+    // scale to the last half so the end of the curve is readable.
+    let tail = &points[points.len() / 2..];
+    let hi = tail
+        .iter()
+        .map(|p| p.1)
+        .fold(f64::MIN, f64::max)
+        .max(last * 1.001);
+    let lo = tail.iter().map(|p| p.1).fold(f64::MAX, f64::min).min(last);
+    let pad = ((hi - lo) * 0.1).max(1e-6);
+    let (lo, hi) = (lo - pad, hi + pad);
+    let clipped: Vec<(f64, f64)> = points.iter().map(|&(x, y)| (x, y.min(hi))).collect();
+    let dataset = Dataset::default()
+        .marker(Marker::Braille)
+        .graph_type(GraphType::Line)
+        .style(Style::default().fg(Color::LightBlue))
+        .data(&clipped);
+    let chart = Chart::new(vec![dataset])
+        .x_axis(
+            Axis::default()
+                .bounds([0.0, (n - 1.0).max(1.0)])
+                .labels(["0".to_owned(), format!("{}", points.len() - 1)])
+                .style(Style::default().fg(Color::DarkGray)),
+        )
+        .y_axis(
+            Axis::default()
+                .bounds([lo, hi])
+                .labels([format!("{lo:.1}"), format!("{hi:.1}")])
+                .style(Style::default().fg(Color::DarkGray)),
+        );
+    frame.render_widget(chart, area);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bar;
+
+    #[test]
+    fn the_bar_fills_in_proportion() {
+        assert_eq!(bar(0.5, 10), "█████░░░░░  50%");
+        assert_eq!(bar(1.2, 4), "████ 100%");
+        assert_eq!(bar(0.0, 4), "░░░░   0%");
+    }
+}

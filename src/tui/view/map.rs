@@ -1,0 +1,720 @@
+//! The map (top-down and side views) and the formation editor's drawing.
+//!
+//! Terminal cells are about twice as tall as wide, so a [`Viewport`] gives a
+//! row twice the metres of a column: circles stay round at any zoom. The same
+//! viewport turns a mouse position back into metres for hit-testing.
+
+use nalgebra::{Point2, Point3};
+use ratatui::Frame;
+use ratatui::layout::{Margin, Rect};
+use ratatui::style::{Color, Style};
+use ratatui::symbols::Marker;
+use ratatui::text::{Line as TextLine, Span};
+use ratatui::widgets::canvas::{Canvas, Context, Line, Painter, Rectangle, Shape};
+use ratatui::widgets::{Block, BorderType, Borders, Cell, Row, Table};
+
+use crate::mission::{Mission, ShapeChoice};
+use crate::planner::ThetaPsoOutcome;
+use crate::tui::app::{App, Focus, formation_extent};
+use crate::tui::fields::{Item, shape_name};
+
+/// Colours of the UAVs, in slot order.
+pub const UAV_COLORS: [Color; 6] = [
+    Color::Cyan,
+    Color::Magenta,
+    Color::LightGreen,
+    Color::LightBlue,
+    Color::LightYellow,
+    Color::LightRed,
+];
+
+pub fn uav_color(i: usize) -> Color {
+    UAV_COLORS[i % UAV_COLORS.len()]
+}
+
+/// A rectangle of the screen and the piece of the plane it shows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Viewport {
+    /// The cells drawn into (inside the pane's border).
+    pub inner: Rect,
+    pub x: [f64; 2],
+    pub y: [f64; 2],
+}
+
+impl Viewport {
+    /// A view of `inner` centred on `center`, `metres_per_column` wide per cell.
+    fn centred(inner: Rect, center: Point2<f64>, metres_per_column: f64) -> Self {
+        let half_w = inner.width.max(1) as f64 * metres_per_column / 2.0;
+        let half_h = inner.height.max(1) as f64 * 2.0 * metres_per_column / 2.0;
+        Viewport {
+            inner,
+            x: [center.x - half_w, center.x + half_w],
+            y: [center.y - half_h, center.y + half_h],
+        }
+    }
+
+    /// The top-down map of `app` drawn in the pane `area` (border included).
+    pub fn map(app: &App, area: Rect) -> Self {
+        let inner = area.inner(Margin::new(1, 1));
+        let b = &app.mission().bounds;
+        let (w, h) = (
+            (b.x[1] - b.x[0]).abs().max(1.0),
+            (b.y[1] - b.y[0]).abs().max(1.0),
+        );
+        let fit =
+            (w / inner.width.max(1) as f64).max(h / (2.0 * inner.height.max(1) as f64)) * 1.08;
+        let center = app.center.unwrap_or(Point2::new(
+            (b.x[0] + b.x[1]) / 2.0,
+            (b.y[0] + b.y[1]) / 2.0,
+        ));
+        Viewport::centred(inner, center, fit / app.zoom)
+    }
+
+    /// The formation editor: canvas x is to the right of travel (−y of the
+    /// formation frame), canvas y is forward (x).
+    pub fn formation(app: &App, area: Rect) -> Self {
+        let inner = area.inner(Margin::new(1, 1));
+        let r = formation_extent(app.mission()) + app.mission().formation.uav_radius + 1.0;
+        let fit = (2.0 * r / inner.width.max(1) as f64)
+            .max(2.0 * r / (2.0 * inner.height.max(1) as f64))
+            * 1.15;
+        Viewport::centred(inner, Point2::origin(), fit / app.formation_zoom)
+    }
+
+    pub fn metres_per_column(&self) -> f64 {
+        (self.x[1] - self.x[0]) / self.inner.width.max(1) as f64
+    }
+
+    /// The cell a point falls in, or None outside the view.
+    pub fn to_cell(&self, p: Point2<f64>) -> Option<(u16, u16)> {
+        let r = self.inner;
+        let fx = (p.x - self.x[0]) / (self.x[1] - self.x[0]) * r.width as f64;
+        let fy = (self.y[1] - p.y) / (self.y[1] - self.y[0]) * r.height as f64;
+        let inside = (0.0..r.width as f64).contains(&fx) && (0.0..r.height as f64).contains(&fy);
+        inside.then(|| (r.x + fx as u16, r.y + fy as u16))
+    }
+
+    /// The point under a cell, or None outside the view.
+    pub fn to_world(&self, column: u16, row: u16) -> Option<Point2<f64>> {
+        let r = self.inner;
+        if column < r.x || row < r.y || column >= r.x + r.width || row >= r.y + r.height {
+            return None;
+        }
+        let fx = (column - r.x) as f64 + 0.5;
+        let fy = (row - r.y) as f64 + 0.5;
+        Some(Point2::new(
+            self.x[0] + fx * (self.x[1] - self.x[0]) / r.width as f64,
+            self.y[1] - fy * (self.y[1] - self.y[0]) / r.height as f64,
+        ))
+    }
+}
+
+/// A circle drawn with as many points as it has braille dots around it, so
+/// small circles are cheap and large ones stay closed.
+struct Ring {
+    x: f64,
+    y: f64,
+    radius: f64,
+    color: Color,
+    /// Metres per braille dot horizontally.
+    dot: f64,
+}
+
+impl Shape for Ring {
+    fn draw(&self, painter: &mut Painter) {
+        let around = std::f64::consts::TAU * self.radius / self.dot.max(1e-9);
+        let n = (around * 1.5).clamp(8.0, 1440.0) as usize;
+        // Step around by rotating one vector: no sin/cos per point.
+        let (sin, cos) = (std::f64::consts::TAU / n as f64).sin_cos();
+        let (mut dx, mut dy) = (self.radius, 0.0);
+        for _ in 0..n {
+            if let Some((px, py)) = painter.get_point(self.x + dx, self.y + dy) {
+                painter.paint(px, py, self.color);
+            }
+            (dx, dy) = (dx * cos - dy * sin, dx * sin + dy * cos);
+        }
+    }
+}
+
+/// Consecutive points joined by lines, decimated to what the screen can show.
+struct Polyline<'a> {
+    points: &'a [(f64, f64)],
+    color: Color,
+}
+
+impl Shape for Polyline<'_> {
+    fn draw(&self, painter: &mut Painter) {
+        for pair in self.points.windows(2) {
+            Line::new(pair[0].0, pair[0].1, pair[1].0, pair[1].1, self.color).draw(painter);
+        }
+    }
+}
+
+/// Keeps points at least `min_step` apart (plus the last one).
+fn decimate(points: impl Iterator<Item = (f64, f64)>, min_step: f64) -> Vec<(f64, f64)> {
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    let mut last = None;
+    let min_step2 = min_step * min_step;
+    for p in points {
+        match out.last() {
+            Some(q) if (p.0 - q.0).powi(2) + (p.1 - q.1).powi(2) < min_step2 => last = Some(p),
+            _ => {
+                out.push(p);
+                last = None;
+            }
+        }
+    }
+    if let Some(p) = last {
+        out.push(p);
+    }
+    out
+}
+
+fn pane_block(title: TextLine<'static>, focused: bool) -> Block<'static> {
+    let border = if focused {
+        Color::Yellow
+    } else {
+        Color::DarkGray
+    };
+    Block::default()
+        .borders(Borders::ALL)
+        .border_type(BorderType::Rounded)
+        .border_style(Style::default().fg(border))
+        .title(title)
+}
+
+/// What the map shows of the result, and in which colour.
+fn result_of(app: &App) -> Option<(&ThetaPsoOutcome, bool)> {
+    let job = app.shown()?;
+    let outcome = job.outcome.as_deref()?;
+    Some((outcome, app.is_stale(job)))
+}
+
+/// The top-down map (or the side view when toggled).
+pub fn draw_map(frame: &mut Frame, app: &App, area: Rect) {
+    if app.side_view {
+        return draw_side(frame, app, area);
+    }
+    let m = app.mission();
+    let vp = Viewport::map(app, area);
+    let scale = vp.metres_per_column();
+    let mut title = vec![
+        Span::styled(" Map ", Style::default().bold()),
+        Span::raw(format!(
+            "· {:.1} m/cell · step {} m ",
+            scale,
+            crate::tui::fields::fmt_num(app.step_size())
+        )),
+    ];
+    if app.add_tool {
+        title.push(Span::styled(
+            " ADD: click to place ",
+            Style::default().black().on_green(),
+        ));
+    }
+    let result = result_of(app);
+    match (&result, app.shown()) {
+        (Some((o, stale)), Some(job)) => {
+            let verdict = if o.feasible() {
+                "feasible"
+            } else {
+                "INFEASIBLE"
+            };
+            let text = format!(" job {} seed {}: {verdict} ", job.id, job.seed);
+            title.push(if *stale {
+                Span::styled(
+                    format!(" STALE{text}(mission edited) "),
+                    Style::default().black().on_yellow(),
+                )
+            } else if o.feasible() {
+                Span::styled(text, Style::default().green())
+            } else {
+                Span::styled(text, Style::default().red().bold())
+            });
+        }
+        (None, Some(job)) if job.is_running() => {
+            title.push(Span::styled(
+                format!(" job {} running… ", job.id),
+                Style::default().cyan(),
+            ));
+        }
+        _ => {}
+    }
+    let block = pane_block(TextLine::from(title), app.focus == Focus::Map);
+    let dot = scale / 2.0;
+    let canvas = Canvas::default()
+        .block(block)
+        .marker(Marker::Braille)
+        .x_bounds(vp.x)
+        .y_bounds(vp.y)
+        .paint(|ctx| paint_map(ctx, app, m, dot, scale));
+    frame.render_widget(canvas, area);
+}
+
+fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
+    let b = &m.bounds;
+    ctx.draw(&Rectangle {
+        x: b.x[0],
+        y: b.y[0],
+        width: b.x[1] - b.x[0],
+        height: b.y[1] - b.y[0],
+        color: Color::Gray,
+    });
+    let safe = m.formation.safe_radius();
+    // Safe radii first, lightly, so obstacles and paths draw over them.
+    for o in &m.obstacles {
+        ctx.draw(&Ring {
+            x: o.center.x,
+            y: o.center.y,
+            radius: o.radius + safe,
+            color: Color::DarkGray,
+            dot,
+        });
+    }
+    for (i, o) in m.obstacles.iter().enumerate() {
+        let selected = app.selected == Item::Obstacle(i);
+        let color = if selected {
+            Color::Yellow
+        } else if o.height <= b.z[0] {
+            Color::Gray
+        } else {
+            Color::LightRed
+        };
+        ctx.draw(&Ring {
+            x: o.center.x,
+            y: o.center.y,
+            radius: o.radius,
+            color,
+            dot,
+        });
+        if selected {
+            // A filled centre so a small selected obstacle is easy to see.
+            ctx.draw(&Ring {
+                x: o.center.x,
+                y: o.center.y,
+                radius: o.radius * 0.5,
+                color,
+                dot,
+            });
+        }
+    }
+    ctx.layer();
+
+    // The result: live best path while running, else the shown outcome.
+    if let Some(job) = app
+        .shown()
+        .filter(|j| j.is_running() && !j.live_path.is_empty())
+    {
+        let pts = decimate(job.live_path.iter().map(|p| (p.x, p.y)), dot);
+        ctx.draw(&Polyline {
+            points: &pts,
+            color: Color::Blue,
+        });
+    } else if let Some(job) = app
+        .jobs
+        .iter()
+        .rev()
+        .find(|j| j.is_running() && !j.live_path.is_empty())
+    {
+        let pts = decimate(job.live_path.iter().map(|p| (p.x, p.y)), dot);
+        ctx.draw(&Polyline {
+            points: &pts,
+            color: Color::Blue,
+        });
+    }
+    if let Some((o, stale)) = result_of(app) {
+        for (k, t) in o.trajectories.iter().enumerate() {
+            let color = if stale { Color::DarkGray } else { uav_color(k) };
+            let pts = decimate(t.samples.iter().map(|s| (s.position.x, s.position.y)), dot);
+            ctx.draw(&Polyline {
+                points: &pts,
+                color,
+            });
+        }
+        let color = if stale { Color::Gray } else { Color::White };
+        let pts: Vec<(f64, f64)> = o.centroid_path.iter().map(|p| (p.x, p.y)).collect();
+        ctx.draw(&Polyline {
+            points: &pts,
+            color,
+        });
+        ctx.layer();
+        // Reconfiguration zones [t1, t4]: the centroid's stretch, highlighted.
+        if !stale {
+            for r in &o.reconfigurations {
+                let zone = centroid_between(o, r.t1, r.t4);
+                let pts = decimate(zone.into_iter(), dot);
+                ctx.draw(&Polyline {
+                    points: &pts,
+                    color: Color::LightCyan,
+                });
+            }
+        }
+        for v in o.verification.violations.iter().take(50) {
+            ctx.print(
+                v.location.position.x,
+                v.location.position.y,
+                Span::styled("✗", Style::default().red().bold()),
+            );
+        }
+    }
+
+    // IWPs (eq. 9): enabled ones bright, disabled ones dim.
+    for w in &app.iwps {
+        let (glyph, style) = if w.enabled {
+            ("◆", Style::default().fg(Color::LightCyan))
+        } else {
+            ("◇", Style::default().fg(Color::DarkGray))
+        };
+        ctx.print(w.position.x, w.position.y, Span::styled(glyph, style));
+    }
+    // Obstacle names, where they fit.
+    if m.obstacles.len() <= 40 {
+        for (i, o) in m.obstacles.iter().enumerate() {
+            let style = if app.selected == Item::Obstacle(i) {
+                Style::default().yellow().bold()
+            } else {
+                Style::default().fg(Color::Gray)
+            };
+            ctx.print(
+                o.center.x + o.radius + scale,
+                o.center.y,
+                Span::styled(o.name.clone(), style),
+            );
+        }
+    }
+    draw_formation_at_start(ctx, app, m, dot);
+    let marker = |item: Item, glyph: &'static str, color: Color| {
+        let style = if app.selected == item {
+            Style::default().black().bg(color).bold()
+        } else {
+            Style::default().fg(color).bold()
+        };
+        Span::styled(glyph, style)
+    };
+    let (s, g) = (&m.route.start, &m.route.goal);
+    ctx.print(s.x, s.y, marker(Item::Start, "S", Color::Green));
+    ctx.print(g.x, g.y, marker(Item::Goal, "G", Color::Red));
+}
+
+/// The formation centroid (mean of the UAVs) from time `t0` to `t1`, x-y.
+fn centroid_between(o: &ThetaPsoOutcome, t0: f64, t1: f64) -> Vec<(f64, f64)> {
+    let Some(first) = o.trajectories.first() else {
+        return Vec::new();
+    };
+    let n = o.trajectories.len() as f64;
+    (0..first.samples.len())
+        .filter(|&k| (t0..=t1).contains(&first.samples[k].t))
+        .map(|k| {
+            let (mut x, mut y) = (0.0, 0.0);
+            for t in &o.trajectories {
+                if let Some(s) = t.samples.get(k) {
+                    x += s.position.x;
+                    y += s.position.y;
+                }
+            }
+            (x / n, y / n)
+        })
+        .collect()
+}
+
+/// The slots around the start, facing the goal (or the planned path's first leg).
+fn draw_formation_at_start(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
+    let start = m.route.start;
+    let toward = result_of(app)
+        .and_then(|(o, _)| o.centroid_path.get(1).copied())
+        .unwrap_or(m.route.goal);
+    let d = (toward - start).xy();
+    let heading = if d.norm() > 1e-9 { d.y.atan2(d.x) } else { 0.0 };
+    let (s, c) = heading.sin_cos();
+    for (i, slot) in m.formation.slots.iter().enumerate() {
+        let x = start.x + c * slot.x - s * slot.y;
+        let y = start.y + s * slot.x + c * slot.y;
+        ctx.draw(&Ring {
+            x,
+            y,
+            radius: m.formation.uav_radius,
+            color: uav_color(i),
+            dot,
+        });
+    }
+}
+
+/// Distance along the path vs altitude, with the altitude band and the
+/// obstacles the path passes.
+fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
+    let m = app.mission();
+    let result = result_of(app);
+    let centroid: Vec<Point3<f64>> = match &result {
+        Some((o, _)) => o.centroid_path.clone(),
+        None => vec![m.route.start, m.route.goal],
+    };
+    let along = cumulative(&centroid);
+    let length = along.last().copied().unwrap_or(0.0).max(1.0);
+    let top = m
+        .obstacles
+        .iter()
+        .map(|o| o.height)
+        .fold(m.bounds.z[1], f64::max)
+        .max(1.0)
+        * 1.15;
+    let title = TextLine::from(vec![
+        Span::styled(" Side view ", Style::default().bold()),
+        Span::raw(format!(
+            "· distance along the path (0-{length:.0} m) vs altitude (0-{top:.0} m) · v: top view "
+        )),
+    ]);
+    let stale = result.as_ref().is_some_and(|(_, s)| *s);
+    let canvas = Canvas::default()
+        .block(pane_block(title, app.focus == Focus::Map))
+        .marker(Marker::Braille)
+        .x_bounds([-0.02 * length, 1.02 * length])
+        .y_bounds([0.0, top])
+        .paint(|ctx| {
+            for z in m.bounds.z {
+                ctx.draw(&Line::new(0.0, z, length, z, Color::DarkGray));
+            }
+            ctx.print(
+                0.0,
+                m.bounds.z[1],
+                Span::styled("z max", Style::default().fg(Color::DarkGray)),
+            );
+            ctx.print(
+                0.0,
+                m.bounds.z[0],
+                Span::styled("z min", Style::default().fg(Color::DarkGray)),
+            );
+            // Obstacles the formation passes within its safe radius.
+            let reach = m.formation.safe_radius();
+            for o in &m.obstacles {
+                if let Some((s, d)) = closest_along(&centroid, &along, &o.center)
+                    && d < o.radius + reach
+                {
+                    ctx.draw(&Rectangle {
+                        x: s - o.radius,
+                        y: 0.0,
+                        width: 2.0 * o.radius,
+                        height: o.height,
+                        color: Color::LightRed,
+                    });
+                }
+            }
+            ctx.layer();
+            if let Some((o, _)) = &result {
+                for (k, t) in o.trajectories.iter().enumerate() {
+                    let color = if stale { Color::DarkGray } else { uav_color(k) };
+                    let speed = m.formation.ground_speed;
+                    let pts = decimate(
+                        t.samples.iter().map(|s| (s.t * speed, s.position.z)),
+                        length / 400.0,
+                    );
+                    ctx.draw(&Polyline {
+                        points: &pts,
+                        color,
+                    });
+                }
+            }
+            let pts: Vec<(f64, f64)> = along
+                .iter()
+                .zip(&centroid)
+                .map(|(s, p)| (*s, p.z))
+                .collect();
+            ctx.draw(&Polyline {
+                points: &pts,
+                color: if stale { Color::Gray } else { Color::White },
+            });
+            if result.is_none() {
+                ctx.print(
+                    0.05 * length,
+                    top * 0.9,
+                    Span::raw("straight line start → goal; run θ-PSO (r) for the plan"),
+                );
+            }
+        });
+    frame.render_widget(canvas, area);
+}
+
+fn cumulative(points: &[Point3<f64>]) -> Vec<f64> {
+    let mut s = 0.0;
+    let mut out = Vec::with_capacity(points.len());
+    for (i, p) in points.iter().enumerate() {
+        if i > 0 {
+            s += (p - points[i - 1]).xy().norm();
+        }
+        out.push(s);
+    }
+    out
+}
+
+/// Along-path distance of the closest approach to `c`, and that distance.
+fn closest_along(points: &[Point3<f64>], along: &[f64], c: &Point2<f64>) -> Option<(f64, f64)> {
+    let mut best: Option<(f64, f64)> = None;
+    for i in 1..points.len() {
+        let a = points[i - 1].xy();
+        let b = points[i].xy();
+        let ab = b - a;
+        let len2 = ab.norm_squared();
+        let t = if len2 > 0.0 {
+            ((c - a).dot(&ab) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let p = a + ab * t;
+        let d = (c - p).norm();
+        if best.is_none_or(|(_, bd)| d < bd) {
+            best = Some((along[i - 1] + t * len2.sqrt(), d));
+        }
+    }
+    best
+}
+
+/// The formation editor's drawing (top) and IWP table (bottom).
+pub fn formation_split(app: &App, area: Rect) -> [Rect; 2] {
+    let list_height = (app.iwps.len() as u16 + 3).clamp(4, area.height / 2);
+    ratatui::layout::Layout::vertical([
+        ratatui::layout::Constraint::Min(6),
+        ratatui::layout::Constraint::Length(list_height),
+    ])
+    .areas(area)
+}
+
+/// The formation editor: slots in the formation frame, and the IWPs' shapes.
+pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect) {
+    let m = app.mission();
+    let [top, bottom] = formation_split(app, area);
+    let vp = Viewport::formation(app, top);
+    let title = TextLine::from(vec![
+        Span::styled(" Formation ", Style::default().bold()),
+        Span::raw(format!(
+            "· {} UAVs · r_F {:.2} m · forward ↑ · P preset ({}) · a add · Del remove ",
+            m.formation.slots.len(),
+            m.formation.radius(),
+            app.preset.name()
+        )),
+    ]);
+    let dot = vp.metres_per_column() / 2.0;
+    let canvas = Canvas::default()
+        .block(pane_block(title, app.focus == Focus::Map))
+        .marker(Marker::Braille)
+        .x_bounds(vp.x)
+        .y_bounds(vp.y)
+        .paint(|ctx| {
+            // Axes through the centroid.
+            ctx.draw(&Line::new(vp.x[0], 0.0, vp.x[1], 0.0, Color::DarkGray));
+            ctx.draw(&Line::new(0.0, vp.y[0], 0.0, vp.y[1], Color::DarkGray));
+            ctx.draw(&Ring {
+                x: 0.0,
+                y: 0.0,
+                radius: m.formation.radius(),
+                color: Color::DarkGray,
+                dot,
+            });
+            ctx.layer();
+            for (i, s) in m.formation.slots.iter().enumerate() {
+                let selected = app.selected == Item::Slot(i);
+                let color = if selected {
+                    Color::Yellow
+                } else {
+                    uav_color(i)
+                };
+                ctx.draw(&Ring {
+                    x: -s.y,
+                    y: s.x,
+                    radius: m.formation.uav_radius,
+                    color,
+                    dot,
+                });
+                let style = if selected {
+                    Style::default().yellow().bold()
+                } else {
+                    Style::default().fg(color)
+                };
+                ctx.print(-s.y, s.x, Span::styled(format!("{}", i + 1), style));
+            }
+            ctx.print(
+                vp.x[0],
+                vp.y[1],
+                Span::styled("forward", Style::default().fg(Color::DarkGray)),
+            );
+        });
+    frame.render_widget(canvas, top);
+
+    let header = Row::new(["IWP between", "gap m", "on", "choice", "shape used"])
+        .style(Style::default().bold());
+    let rows: Vec<Row> = app
+        .iwps
+        .iter()
+        .map(|w| {
+            let selected = app.selected == Item::Waypoint(w.between.clone());
+            let style = if selected {
+                Style::default().black().on_yellow()
+            } else if w.enabled {
+                Style::default()
+            } else {
+                Style::default().fg(Color::DarkGray)
+            };
+            let choice = if w.choice == ShapeChoice::Auto {
+                "auto".to_owned()
+            } else {
+                shape_name(w.choice).to_owned()
+            };
+            Row::new([
+                Cell::from(format!("{} ↔ {}", w.between[0], w.between[1])),
+                Cell::from(format!("{:.2}", w.gap)),
+                Cell::from(if w.enabled { "yes" } else { "no" }),
+                Cell::from(choice),
+                Cell::from(w.shape.name()),
+            ])
+            .style(style)
+        })
+        .collect();
+    let empty = app.iwps.is_empty();
+    let title = if empty {
+        " IWPs (eq. 9): none: no gap narrower than the formation ".to_owned()
+    } else {
+        " IWPs (eq. 9) · s cycle shape · space on/off ".to_owned()
+    };
+    let table = Table::new(
+        rows,
+        [
+            ratatui::layout::Constraint::Min(20),
+            ratatui::layout::Constraint::Length(6),
+            ratatui::layout::Constraint::Length(3),
+            ratatui::layout::Constraint::Length(10),
+            ratatui::layout::Constraint::Length(10),
+        ],
+    )
+    .header(header)
+    .block(pane_block(TextLine::from(title), false));
+    frame.render_widget(table, bottom);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_row_spans_twice_the_metres_of_a_column() {
+        let vp = Viewport::centred(Rect::new(1, 1, 100, 40), Point2::new(0.0, 0.0), 0.5);
+        assert!((vp.x[1] - vp.x[0] - 50.0).abs() < 1e-12);
+        assert!((vp.y[1] - vp.y[0] - 40.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_cell_maps_back_to_the_metres_under_it() {
+        let vp = Viewport::centred(Rect::new(1, 1, 100, 40), Point2::new(10.0, 20.0), 0.5);
+        // The cell right of the centre line, below it.
+        let p = vp.to_world(51, 21).unwrap();
+        assert!((p.x - 10.25).abs() < 1e-9, "{p}");
+        assert!((p.y - 19.5).abs() < 1e-9, "{p}");
+        assert_eq!(vp.to_world(0, 5), None, "the border is not the map");
+    }
+
+    #[test]
+    fn decimation_keeps_the_ends() {
+        let pts: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 * 0.01, 0.0)).collect();
+        let d = decimate(pts.into_iter(), 0.25);
+        assert_eq!(d.first(), Some(&(0.0, 0.0)));
+        assert_eq!(d.last(), Some(&(1.0, 0.0)));
+        assert!(d.len() <= 6, "{d:?}");
+    }
+}

@@ -1,0 +1,319 @@
+//! Drawing: a pure function of the app state (and the clock, for elapsed
+//! times), so every screen can be snapshot-tested on a `TestBackend`.
+
+pub mod inspector;
+pub mod jobs;
+pub mod map;
+
+use std::time::Instant;
+
+use ratatui::Frame;
+use ratatui::layout::{Constraint, Flex, Layout, Rect};
+use ratatui::style::{Color, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, BorderType, Borders, Clear, Paragraph, Wrap};
+
+use super::app::{App, Focus, Overlay, Pane};
+use super::input::KEYS;
+
+/// Below this the layout cannot show a usable map and inspector.
+pub const MIN_WIDTH: u16 = 80;
+pub const MIN_HEIGHT: u16 = 24;
+
+/// Where each panel goes on a screen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Areas {
+    /// Map, side view or formation editor.
+    pub left: Rect,
+    pub inspector: Rect,
+    pub jobs: Rect,
+    pub status: Rect,
+}
+
+/// The panels for a screen of `area`; None when it is too small.
+pub fn layout(area: Rect) -> Option<Areas> {
+    if area.width < MIN_WIDTH || area.height < MIN_HEIGHT {
+        return None;
+    }
+    let [body, status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
+    let side = (area.width * 2 / 5).clamp(44, 64);
+    let [left, right] =
+        Layout::horizontal([Constraint::Min(0), Constraint::Length(side)]).areas(body);
+    let [inspector, jobs] =
+        Layout::vertical([Constraint::Percentage(50), Constraint::Percentage(50)]).areas(right);
+    Some(Areas {
+        left,
+        inspector,
+        jobs,
+        status,
+    })
+}
+
+/// Draws the whole screen.
+pub fn draw(frame: &mut Frame, app: &App, now: Instant) {
+    let area = frame.area();
+    let Some(areas) = layout(area) else {
+        let text = vec![
+            Line::styled("Terminal too small", Style::default().bold()),
+            Line::raw(format!(
+                "{}×{}: skyform needs at least {MIN_WIDTH}×{MIN_HEIGHT}.",
+                area.width, area.height
+            )),
+            Line::raw("Enlarge the window, or press q to quit."),
+        ];
+        frame.render_widget(
+            Paragraph::new(text).wrap(Wrap { trim: true }).centered(),
+            area,
+        );
+        return;
+    };
+    match app.pane {
+        Pane::Map => map::draw_map(frame, app, areas.left),
+        Pane::Formation => map::draw_formation(frame, app, areas.left),
+    }
+    inspector::draw(frame, app, areas.inspector);
+    jobs::draw(frame, app, areas.jobs, now);
+    draw_status(frame, app, areas.status);
+    if let Some(overlay) = &app.overlay {
+        draw_overlay(frame, app, overlay, area);
+    }
+}
+
+fn draw_status(frame: &mut Frame, app: &App, area: Rect) {
+    let modified = app.doc.is_modified();
+    let mut spans = vec![
+        Span::styled(
+            format!(" {} ", app.doc.title()),
+            Style::default().black().on_gray(),
+        ),
+        if modified {
+            Span::styled(" ● modified ", Style::default().black().on_yellow())
+        } else {
+            Span::raw(" ")
+        },
+    ];
+    let errors = app.doc.error_count();
+    if errors > 0 {
+        spans.push(Span::styled(
+            format!(" {errors} error(s) "),
+            Style::default().white().on_red(),
+        ));
+    }
+    spans.push(Span::raw(" "));
+    if let Some(status) = &app.status {
+        let style = if status.error {
+            Style::default().light_red().bold()
+        } else {
+            Style::default()
+        };
+        spans.push(Span::styled(status.text.clone(), style));
+    }
+    let hints = match (app.focus, app.pane) {
+        _ if app.editing.is_some() => "Enter apply · Esc cancel",
+        (Focus::Map, Pane::Map) => "n/p select · arrows move · a add · r run · ? help",
+        (Focus::Map, Pane::Formation) => "n/p select · arrows move · P preset · s shape · ? help",
+        (Focus::Inspector, _) => "↑↓ field · Enter edit · Tab focus · ? help",
+        (Focus::Jobs, _) => "↑↓ job · Enter show · x cancel · ? help",
+    };
+    let used: usize = spans.iter().map(|s| s.content.chars().count()).sum();
+    let room = (area.width as usize).saturating_sub(used + 1);
+    if room > hints.chars().count() {
+        spans.push(Span::raw(" ".repeat(room - hints.chars().count())));
+        spans.push(Span::styled(hints, Style::default().fg(Color::DarkGray)));
+    }
+    frame.render_widget(Paragraph::new(Line::from(spans)), area);
+}
+
+/// A centred box of at most `width` × `height` cells.
+fn centred(area: Rect, width: u16, height: u16) -> Rect {
+    let [v] = Layout::vertical([Constraint::Length(height.min(area.height))])
+        .flex(Flex::Center)
+        .areas(area);
+    let [h] = Layout::horizontal([Constraint::Length(width.min(area.width))])
+        .flex(Flex::Center)
+        .areas(v);
+    h
+}
+
+fn boxed(title: &str, color: Color) -> Block<'static> {
+    Block::default()
+        .borders(Borders::ALL)
+        .border_type(BorderType::Double)
+        .border_style(Style::default().fg(color))
+        .title(Span::styled(format!(" {title} "), Style::default().bold()))
+}
+
+fn key(k: &str) -> Span<'static> {
+    Span::styled(k.to_owned(), Style::default().yellow().bold())
+}
+
+fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
+    match overlay {
+        Overlay::Help => {
+            let mut lines = Vec::new();
+            let mut group = "";
+            for (g, keys, what) in KEYS {
+                if *g != group {
+                    if !group.is_empty() {
+                        lines.push(Line::raw(""));
+                    }
+                    lines.push(Line::styled(
+                        g.to_string(),
+                        Style::default().bold().underlined(),
+                    ));
+                    group = g;
+                }
+                lines.push(Line::from(vec![
+                    key(&format!("  {keys:<16}")),
+                    Span::raw(what.to_string()),
+                ]));
+            }
+            let height = lines.len() as u16 + 2;
+            let r = centred(area, 96, height);
+            frame.render_widget(Clear, r);
+            frame.render_widget(
+                Paragraph::new(lines)
+                    .wrap(Wrap { trim: false })
+                    .block(boxed("Keys · any key closes", Color::Cyan)),
+                r,
+            );
+        }
+        Overlay::Quit => {
+            let lines = vec![
+                Line::raw(format!("{} has unsaved changes.", app.doc.title())),
+                Line::raw(""),
+                Line::from(vec![
+                    key("s"),
+                    Span::raw(" save and quit   "),
+                    key("y"),
+                    Span::raw(" quit without saving   "),
+                    key("Esc"),
+                    Span::raw(" stay"),
+                ]),
+            ];
+            let r = centred(area, 70, 5);
+            frame.render_widget(Clear, r);
+            frame.render_widget(
+                Paragraph::new(lines)
+                    .wrap(Wrap { trim: false })
+                    .block(boxed("Quit?", Color::Yellow)),
+                r,
+            );
+        }
+        Overlay::SaveAs { input, .. } => {
+            let lines = vec![
+                Line::raw(format!("File (relative to {}):", app.cwd.display())),
+                Line::from(Span::styled(
+                    format!("{input}▏"),
+                    Style::default().white().on_blue(),
+                )),
+                Line::from(vec![
+                    key("Enter"),
+                    Span::raw(" save   "),
+                    key("Esc"),
+                    Span::raw(" cancel"),
+                ]),
+            ];
+            let r = centred(area, 72, 5);
+            frame.render_widget(Clear, r);
+            frame.render_widget(
+                Paragraph::new(lines).block(boxed("Save as", Color::Cyan)),
+                r,
+            );
+        }
+        Overlay::SaveInvalid { errors, .. } => {
+            let mut lines = vec![Line::raw(format!(
+                "The mission has {} error(s):",
+                errors.len()
+            ))];
+            for e in errors.iter().take(8) {
+                lines.push(Line::styled(
+                    format!("  ✗ {e}"),
+                    Style::default().light_red(),
+                ));
+            }
+            if errors.len() > 8 {
+                lines.push(Line::raw(format!("  … and {} more", errors.len() - 8)));
+            }
+            lines.push(Line::raw(
+                "It can be saved, but not run until they are fixed.",
+            ));
+            lines.push(Line::from(vec![
+                key("y"),
+                Span::raw(" save anyway   "),
+                key("Esc"),
+                Span::raw(" cancel"),
+            ]));
+            let r = centred(area, 90, lines.len() as u16 + 2);
+            frame.render_widget(Clear, r);
+            frame.render_widget(
+                Paragraph::new(lines)
+                    .wrap(Wrap { trim: false })
+                    .block(boxed("Save an invalid mission?", Color::Red)),
+                r,
+            );
+        }
+        Overlay::Open { entries, cursor } => {
+            let height = (entries.len() as u16 + 3).min(area.height.saturating_sub(4));
+            let first = cursor.saturating_sub(height.saturating_sub(4) as usize);
+            let mut lines: Vec<Line> = entries
+                .iter()
+                .enumerate()
+                .skip(first)
+                .take(height.saturating_sub(3) as usize)
+                .map(|(k, e)| {
+                    let label = match e {
+                        super::app::Entry::File(p) => {
+                            p.strip_prefix(&app.cwd).unwrap_or(p).display().to_string()
+                        }
+                        other => other.label(),
+                    };
+                    if k == *cursor {
+                        Line::styled(format!("▶ {label}"), Style::default().black().on_yellow())
+                    } else {
+                        Line::raw(format!("  {label}"))
+                    }
+                })
+                .collect();
+            lines.push(Line::from(vec![
+                key("↑↓"),
+                Span::raw(" choose   "),
+                key("Enter"),
+                Span::raw(" open   "),
+                key("Esc"),
+                Span::raw(" cancel"),
+            ]));
+            let r = centred(area, 72, height + 2);
+            frame.render_widget(Clear, r);
+            frame.render_widget(
+                Paragraph::new(lines).block(boxed(
+                    "Open a mission (missions/, ./, built-in)",
+                    Color::Cyan,
+                )),
+                r,
+            );
+        }
+        Overlay::Discard(entry) => {
+            let lines = vec![
+                Line::raw(format!(
+                    "Discard the unsaved changes and open {}?",
+                    entry.label()
+                )),
+                Line::from(vec![
+                    key("y"),
+                    Span::raw(" discard and open   "),
+                    key("Esc"),
+                    Span::raw(" cancel"),
+                ]),
+            ];
+            let r = centred(area, 80, 4);
+            frame.render_widget(Clear, r);
+            frame.render_widget(
+                Paragraph::new(lines)
+                    .wrap(Wrap { trim: false })
+                    .block(boxed("Unsaved changes", Color::Yellow)),
+                r,
+            );
+        }
+    }
+}

@@ -1,0 +1,133 @@
+//! Screens of the TUI drawn on ratatui's `TestBackend` and compared with the
+//! reviewed snapshots in `tests/snapshots/` (insta). A change to a screen
+//! shows up as a diff; accept it with `cargo insta review` (or
+//! `INSTA_UPDATE=always cargo test --test tui_snapshots`) after looking at it.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use nalgebra::Point3;
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+use skyform::mission::default_mission;
+use skyform::tui::app::Focus;
+use skyform::tui::fields::Item;
+use skyform::tui::fixtures::app_with_result;
+use skyform::tui::jobs::{Job, JobMsg};
+use skyform::tui::{Action, App, Document, view};
+
+const WIDTH: u16 = 140;
+const HEIGHT: u16 = 42;
+
+fn render(app: &App, now: Instant) -> String {
+    let mut terminal = Terminal::new(TestBackend::new(WIDTH, HEIGHT)).unwrap();
+    terminal.draw(|frame| view::draw(frame, app, now)).unwrap();
+    terminal.backend().to_string()
+}
+
+fn default_app() -> App {
+    App::new(
+        Document::new(default_mission().mission, None),
+        PathBuf::from("/missions"),
+    )
+}
+
+#[test]
+fn main_screen_on_the_default_mission() {
+    let screen = render(&default_app(), Instant::now());
+    assert!(screen.contains("(built-in) bridge-inspection.toml"));
+    assert!(screen.contains("light pole 4"));
+    insta::assert_snapshot!(screen);
+}
+
+#[test]
+fn inspector_with_a_validation_error() {
+    let mut app = default_app();
+    app.update(Action::Select(Item::Obstacle(2)));
+    app.update(Action::FocusOn(Focus::Inspector));
+    for _ in 0..4 {
+        app.update(Action::FieldDown);
+    }
+    app.update(Action::EditStart(Some('0')));
+    app.update(Action::EditCommit);
+    let screen = render(&app, Instant::now());
+    assert!(screen.contains("must be positive, got 0 m"), "{screen}");
+    assert!(screen.contains("1 error(s)"));
+    insta::assert_snapshot!(screen);
+}
+
+#[test]
+fn help_overlay() {
+    let mut app = default_app();
+    app.update(Action::ToggleHelp);
+    let screen = render(&app, Instant::now());
+    assert!(screen.contains("Keys · any key closes"));
+    insta::assert_snapshot!(screen);
+}
+
+#[test]
+fn jobs_panel_mid_run() {
+    let mut app = default_app();
+    let started = Instant::now();
+    let m = app.mission().clone();
+    app.jobs.push(Job::new(1, 7, m.clone(), started));
+    app.shown_job = Some(1);
+    app.update(Action::FocusOn(Focus::Jobs));
+    let path = vec![m.route.start, Point3::new(60.0, 45.0, 8.0), m.route.goal];
+    app.on_job_msg(JobMsg::Stage(1, "planning".into()), started);
+    for (k, cost) in [420.0, 300.0, 240.0, 200.0, 190.0, 185.0]
+        .into_iter()
+        .enumerate()
+    {
+        let path = (k == 0).then(|| path.clone());
+        app.on_job_msg(JobMsg::Iteration { id: 1, cost, path }, started);
+    }
+    app.on_job_msg(JobMsg::Progress(1, 0.4), started);
+    let screen = render(&app, started + Duration::from_millis(1500));
+    assert!(screen.contains("40%"), "{screen}");
+    assert!(screen.contains("1.5s"));
+    assert!(screen.contains("planning"), "{screen}");
+    insta::assert_snapshot!(screen);
+}
+
+#[test]
+fn jobs_panel_with_a_finished_result() {
+    let mut app = app_with_result(default_mission().mission, 7, 150);
+    app.update(Action::FocusOn(Focus::Jobs));
+    let started = app.jobs[0].started;
+    let screen = render(&app, started);
+    assert!(screen.contains("feasible"), "{screen}");
+    assert!(screen.contains("all checks pass"), "{screen}");
+    insta::assert_snapshot!(screen);
+}
+
+#[test]
+fn a_stale_result_is_marked_on_the_map() {
+    let mut app = app_with_result(default_mission().mission, 7, 20);
+    app.update(Action::Select(Item::Goal));
+    app.update(Action::FocusOn(Focus::Map));
+    app.update(Action::Nudge(-1.0, 0.0));
+    let screen = render(&app, app.jobs[0].started);
+    assert!(screen.contains("STALE"), "{screen}");
+}
+
+#[test]
+fn a_terminal_too_small_gets_a_message() {
+    let mut terminal = Terminal::new(TestBackend::new(60, 20)).unwrap();
+    terminal
+        .draw(|frame| view::draw(frame, &default_app(), Instant::now()))
+        .unwrap();
+    let screen = terminal.backend().to_string();
+    assert!(screen.contains("Terminal too small"));
+    assert!(screen.contains("60×20: skyform needs at least 80×24."));
+}
+
+#[test]
+fn the_formation_editor_shows_slots_and_iwps() {
+    let mut app = default_app();
+    app.update(Action::ShowFormation);
+    let screen = render(&app, Instant::now());
+    assert!(screen.contains("3 UAVs"));
+    assert!(screen.contains("light pole 4 ↔ pier 5"), "{screen}");
+    insta::assert_snapshot!(screen);
+}

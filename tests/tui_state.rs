@@ -1,0 +1,541 @@
+//! The TUI's state machine, driven by actions as the keys would drive it:
+//! edits, undo/redo, the modified flag, stale results, saving and quitting.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use nalgebra::Point2;
+use skyform::mission::{self, Mission, Severity, default_mission};
+use skyform::tui::app::{Focus, Overlay};
+use skyform::tui::fields::Item;
+use skyform::tui::fixtures::app_with_result;
+use skyform::tui::jobs::JobState;
+use skyform::tui::{Action, App, Document};
+
+fn app_in(dir: &std::path::Path) -> App {
+    let path = dir.join("bridge.toml");
+    let m = default_mission().mission;
+    mission::save(&m, &path).unwrap();
+    App::new(Document::new(m, Some(path)), dir.to_path_buf())
+}
+
+/// Types `text` into the selected item's field labelled `label` and applies it.
+fn type_into(app: &mut App, label: &str, text: &str) {
+    let k = app
+        .fields()
+        .iter()
+        .position(|f| f.label == label)
+        .unwrap_or_else(|| panic!("no field {label}"));
+    app.update(Action::FocusOn(Focus::Inspector));
+    while app.field > k {
+        app.update(Action::FieldUp);
+    }
+    while app.field < k {
+        app.update(Action::FieldDown);
+    }
+    let mut chars = text.chars();
+    app.update(Action::EditStart(chars.next()));
+    for c in chars {
+        app.update(Action::EditInput(c));
+    }
+    app.update(Action::EditCommit);
+}
+
+#[test]
+fn add_move_edit_then_undo_three_times_and_redo() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let original = app.mission().clone();
+    let n = original.obstacles.len();
+
+    app.update(Action::AddObstacle(Some(Point2::new(30.0, 40.0))));
+    assert_eq!(app.selected, Item::Obstacle(n));
+    app.update(Action::FocusOn(Focus::Map));
+    app.update(Action::Nudge(1.0, 0.0)); // one 1 m step east
+    type_into(&mut app, "radius (m)", "3.5");
+
+    let added = &app.mission().obstacles[n];
+    assert_eq!(added.center, Point2::new(31.0, 40.0));
+    assert_eq!(added.radius, 3.5);
+    assert!(app.doc.is_modified());
+
+    for _ in 0..3 {
+        app.update(Action::Undo);
+    }
+    assert_eq!(
+        app.mission(),
+        &original,
+        "three undos take back add, move and edit"
+    );
+    assert!(
+        !app.doc.is_modified(),
+        "back at the saved mission: not modified"
+    );
+
+    app.update(Action::Redo);
+    let mut expected = original.clone();
+    expected.obstacles.push(skyform::mission::Obstacle {
+        center: Point2::new(30.0, 40.0),
+        ..app.mission().obstacles[n].clone()
+    });
+    assert_eq!(
+        app.mission(),
+        &expected,
+        "redo brings the obstacle back where it was added"
+    );
+    assert_eq!(app.mission().obstacles[n].radius, 1.0);
+    assert!(app.doc.is_modified());
+}
+
+#[test]
+fn a_drag_is_one_undo_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let before = app.mission().clone();
+    let start = before.obstacles[0].center;
+    app.update(Action::DragStart(Item::Obstacle(0), start));
+    for k in 1..=10 {
+        app.update(Action::DragTo(
+            start + nalgebra::Vector2::new(k as f64, 0.5 * k as f64),
+        ));
+    }
+    app.update(Action::DragEnd);
+    assert_eq!(
+        app.mission().obstacles[0].center,
+        start + nalgebra::Vector2::new(10.0, 5.0)
+    );
+    app.update(Action::Undo);
+    assert_eq!(app.mission(), &before);
+    app.update(Action::Undo);
+    assert_eq!(
+        app.status.as_ref().map(|s| s.text.as_str()),
+        Some("nothing to undo")
+    );
+}
+
+#[test]
+fn a_click_without_moving_records_no_undo_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let at = app.mission().route.goal.xy();
+    app.update(Action::DragStart(Item::Goal, at));
+    app.update(Action::DragEnd);
+    assert_eq!(app.selected, Item::Goal);
+    assert!(!app.doc.can_undo());
+    assert!(!app.doc.is_modified());
+}
+
+#[test]
+fn validation_follows_the_typing() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Select(Item::Obstacle(0)));
+    app.update(Action::FocusOn(Focus::Inspector));
+    for _ in 0..4 {
+        app.update(Action::FieldDown);
+    }
+    assert_eq!(app.fields()[app.field].label, "radius (m)");
+    app.update(Action::EditStart(Some('-')));
+    let problem = app.editing.as_ref().unwrap().problem.clone();
+    assert_eq!(
+        problem,
+        Some((Severity::Error, "'-' is not a number".into()))
+    );
+    app.update(Action::EditInput('2'));
+    let (severity, message) = app.editing.as_ref().unwrap().problem.clone().unwrap();
+    assert_eq!(severity, Severity::Error);
+    assert!(message.contains("must be positive"), "{message}");
+    app.update(Action::EditBackspace);
+    app.update(Action::EditBackspace);
+    app.update(Action::EditInput('2'));
+    assert_eq!(app.editing.as_ref().unwrap().problem, None, "2 m is fine");
+    // Nothing was applied while typing.
+    assert_eq!(app.mission(), &default_mission().mission);
+    app.update(Action::EditCancel);
+    assert!(app.editing.is_none());
+    assert!(!app.doc.is_modified());
+}
+
+#[test]
+fn an_edit_after_a_run_marks_the_result_stale_and_undo_makes_it_fresh() {
+    let app = &mut app_with_result(default_mission().mission, 7, 20);
+    let job = app.shown().expect("a shown result");
+    assert!(!app.is_stale(job));
+    app.update(Action::Select(Item::Goal));
+    app.update(Action::FocusOn(Focus::Map));
+    app.update(Action::Nudge(0.0, 1.0));
+    assert!(app.is_stale(app.shown().unwrap()));
+    app.update(Action::Undo);
+    assert!(!app.is_stale(app.shown().unwrap()));
+}
+
+#[test]
+fn a_run_in_the_background_gives_the_same_result_as_the_pipeline() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Run);
+    assert_eq!(app.jobs.len(), 1);
+    assert!(app.wait_for_jobs(Duration::from_secs(60)));
+    let job = &app.jobs[0];
+    assert_eq!(job.state, JobState::Done { feasible: true });
+    let direct = skyform::planner::plan(
+        app.mission(),
+        app.mission().seed,
+        Default::default(),
+        &mut skyform::pipeline::Silent,
+        &Default::default(),
+    )
+    .unwrap();
+    let outcome = job.outcome.as_ref().unwrap();
+    assert_eq!(outcome.cost, direct.cost);
+    assert_eq!(job.convergence, direct.convergence);
+    assert_eq!(app.shown_job, Some(job.id));
+
+    app.update(Action::RunNewSeed);
+    assert!(app.wait_for_jobs(Duration::from_secs(60)));
+    assert_eq!(app.jobs[1].seed, app.mission().seed + 1);
+}
+
+#[test]
+fn cancel_keeps_the_best_so_far() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    type_into(&mut app, "seed", "3"); // any edit; then a long run
+    app.update(Action::Select(Item::ThetaPso));
+    type_into(&mut app, "iterations", "1000000");
+    app.update(Action::Run);
+    // Let it get going, then cancel.
+    while app.jobs[0].convergence.len() < 3 {
+        let msg = app
+            .job_messages()
+            .recv_timeout(Duration::from_secs(30))
+            .unwrap();
+        app.on_job_msg(msg, std::time::Instant::now());
+    }
+    app.update(Action::Cancel);
+    assert!(app.wait_for_jobs(Duration::from_secs(30)));
+    let job = &app.jobs[0];
+    assert_eq!(job.state, JobState::Cancelled);
+    let outcome = job.outcome.as_ref().unwrap();
+    assert!(outcome.iterations < 1_000_000);
+    assert!(!outcome.trajectories.is_empty());
+}
+
+#[test]
+fn an_invalid_mission_is_not_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Select(Item::Obstacle(0)));
+    type_into(&mut app, "radius (m)", "0");
+    app.update(Action::Run);
+    assert!(app.jobs.is_empty());
+    let status = app.status.clone().unwrap();
+    assert!(status.error);
+    assert!(
+        status.text.contains("obstacles[0].radius"),
+        "{}",
+        status.text
+    );
+}
+
+#[test]
+fn save_writes_the_file_and_clears_the_modified_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::AddObstacle(Some(Point2::new(12.0, 34.0))));
+    assert!(app.doc.is_modified());
+    app.update(Action::Save);
+    assert!(!app.doc.is_modified());
+    let saved = mission::load(&dir.path().join("bridge.toml"))
+        .unwrap()
+        .mission;
+    assert_eq!(&saved, app.mission());
+    assert_eq!(
+        saved.obstacles.last().unwrap().center,
+        Point2::new(12.0, 34.0)
+    );
+    // No temporary file left behind.
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 1, "{names:?}");
+}
+
+#[test]
+fn an_invalid_mission_is_saved_only_after_a_confirmation_naming_the_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Select(Item::Obstacle(2)));
+    type_into(&mut app, "radius (m)", "-1");
+    app.update(Action::Save);
+    match &app.overlay {
+        Some(Overlay::SaveInvalid { errors, .. }) => {
+            assert!(
+                errors
+                    .iter()
+                    .any(|e| e.starts_with("obstacles[2].radius: must be positive")),
+                "{errors:?}"
+            )
+        }
+        other => panic!("expected the confirmation, got {other:?}"),
+    }
+    let path = dir.path().join("bridge.toml");
+    assert_eq!(
+        mission::load(&path).unwrap().mission,
+        default_mission().mission,
+        "not saved yet"
+    );
+    app.update(Action::Confirm);
+    assert!(app.overlay.is_none());
+    assert!(!app.doc.is_modified());
+    let text = std::fs::read_to_string(&path).unwrap();
+    let checked = mission::check_str(&text, None);
+    assert_eq!(checked.mission.unwrap().obstacles[2].radius, -1.0);
+}
+
+#[test]
+fn the_built_in_mission_is_saved_through_save_as() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = App::new(
+        Document::new(default_mission().mission, None),
+        dir.path().to_path_buf(),
+    );
+    app.update(Action::Save);
+    assert!(matches!(app.overlay, Some(Overlay::SaveAs { .. })));
+    for _ in 0..60 {
+        app.update(Action::PromptBackspace);
+    }
+    for c in "mine.toml".chars() {
+        app.update(Action::PromptInput(c));
+    }
+    app.update(Action::Confirm);
+    assert_eq!(app.doc.path(), Some(dir.path().join("mine.toml").as_path()));
+    assert_eq!(
+        mission::load(&dir.path().join("mine.toml"))
+            .unwrap()
+            .mission,
+        default_mission().mission
+    );
+}
+
+#[test]
+fn quitting_with_unsaved_changes_asks_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Quit);
+    assert!(app.should_quit, "nothing to lose: quits at once");
+
+    let mut app = app_in(dir.path());
+    app.update(Action::AddObstacle(None));
+    app.update(Action::Quit);
+    assert!(!app.should_quit);
+    assert_eq!(app.overlay, Some(Overlay::Quit));
+    app.update(Action::Dismiss);
+    assert!(app.overlay.is_none() && !app.should_quit);
+    // Save and quit.
+    app.update(Action::Quit);
+    app.update(Action::Save);
+    assert!(app.should_quit);
+    assert_eq!(
+        mission::load(&dir.path().join("bridge.toml"))
+            .unwrap()
+            .mission,
+        *app.mission()
+    );
+}
+
+#[test]
+fn open_lists_the_missions_and_refuses_to_drop_changes_silently() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut app = App::new(Document::new(default_mission().mission, None), root.clone());
+    app.update(Action::AddObstacle(None));
+    app.update(Action::Open);
+    let Some(Overlay::Open { entries, .. }) = app.overlay.clone() else {
+        panic!("no picker");
+    };
+    let narrow = entries
+        .iter()
+        .position(|e| e.label().ends_with("missions/narrow-passage.toml"))
+        .expect("missions/ is listed");
+    app.update(Action::PickerMove(narrow as i32));
+    app.update(Action::Confirm);
+    assert!(
+        matches!(app.overlay, Some(Overlay::Discard(_))),
+        "asks before dropping the edit"
+    );
+    app.update(Action::Confirm);
+    let expected: Mission = mission::load(&root.join("missions/narrow-passage.toml"))
+        .unwrap()
+        .mission;
+    assert_eq!(app.mission(), &expected);
+    assert!(!app.doc.is_modified());
+}
+
+#[test]
+fn presets_and_slot_edits_change_the_formation() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::ShowFormation);
+    assert_eq!(app.selected, Item::Formation);
+    app.update(Action::CyclePreset); // triangle → line abreast
+    let slots = &app.mission().formation.slots;
+    assert_eq!(slots.len(), 3);
+    assert!(slots.iter().all(|s| s.x == 0.0), "line abreast: {slots:?}");
+    app.update(Action::AddSlot);
+    assert_eq!(app.mission().formation.slots.len(), 4);
+    assert_eq!(app.selected, Item::Slot(3));
+    app.update(Action::Delete);
+    assert_eq!(app.mission().formation.slots.len(), 3);
+
+    // The bridge's IWP: cycle its shape and switch it off.
+    app.update(Action::Select(Item::Waypoint([
+        "light pole 4".into(),
+        "pier 5".into(),
+    ])));
+    let before = app.iwps[0].choice;
+    app.update(Action::CycleShape);
+    assert_ne!(app.iwps[0].choice, before);
+    app.update(Action::ToggleWaypoint);
+    assert!(!app.iwps[0].enabled);
+}
+
+mod mouse {
+    use super::*;
+    use ratatui::crossterm::event::{KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
+    use ratatui::layout::Rect;
+    use skyform::tui::input::mouse_action;
+    use skyform::tui::view::layout;
+    use skyform::tui::view::map::Viewport;
+
+    const SCREEN: Rect = Rect::new(0, 0, 140, 42);
+
+    fn event(kind: MouseEventKind, (column, row): (u16, u16)) -> MouseEvent {
+        MouseEvent {
+            kind,
+            column,
+            row,
+            modifiers: KeyModifiers::NONE,
+        }
+    }
+
+    fn cell_of(app: &App, p: Point2<f64>) -> (u16, u16) {
+        let areas = layout(SCREEN).unwrap();
+        Viewport::map(app, areas.left)
+            .to_cell(p)
+            .expect("on the map")
+    }
+
+    #[test]
+    fn click_selects_and_drag_moves_an_obstacle_as_one_step() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut app = app_in(dir.path());
+        let tree = app
+            .mission()
+            .obstacles
+            .iter()
+            .position(|o| o.name == "tree 9")
+            .unwrap();
+        let center = app.mission().obstacles[tree].center;
+        let cell = cell_of(&app, center);
+        let down = mouse_action(
+            &app,
+            event(MouseEventKind::Down(MouseButton::Left), cell),
+            SCREEN,
+        );
+        assert!(
+            matches!(down, Some(Action::DragStart(Item::Obstacle(i), _)) if i == tree),
+            "{down:?}"
+        );
+        app.update(down.unwrap());
+        let to = (cell.0 + 10, cell.1 + 3);
+        let drag = mouse_action(
+            &app,
+            event(MouseEventKind::Drag(MouseButton::Left), to),
+            SCREEN,
+        )
+        .unwrap();
+        app.update(drag);
+        app.update(
+            mouse_action(
+                &app,
+                event(MouseEventKind::Up(MouseButton::Left), to),
+                SCREEN,
+            )
+            .unwrap(),
+        );
+        let moved = app.mission().obstacles[tree].center;
+        // Ten columns right and three rows down, at the map's scale.
+        let areas = layout(SCREEN).unwrap();
+        let metres = Viewport::map(&app, areas.left).metres_per_column();
+        assert!(
+            (moved.x - center.x - 10.0 * metres).abs() < metres,
+            "{moved} from {center}"
+        );
+        assert!(
+            (center.y - moved.y - 6.0 * metres).abs() < 2.0 * metres,
+            "{moved} from {center}"
+        );
+        app.update(Action::Undo);
+        assert_eq!(app.mission().obstacles[tree].center, center);
+    }
+
+    #[test]
+    fn the_add_tool_places_an_obstacle_where_clicked() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut app = app_in(dir.path());
+        let spot = Point2::new(20.0, 80.0);
+        let cell = cell_of(&app, spot);
+        let plain = mouse_action(
+            &app,
+            event(MouseEventKind::Down(MouseButton::Left), cell),
+            SCREEN,
+        );
+        assert_eq!(
+            plain,
+            Some(Action::FocusOn(Focus::Map)),
+            "an empty spot selects nothing"
+        );
+        app.update(Action::ToggleAddTool);
+        let add = mouse_action(
+            &app,
+            event(MouseEventKind::Down(MouseButton::Left), cell),
+            SCREEN,
+        )
+        .unwrap();
+        app.update(add);
+        let placed = app.mission().obstacles.last().unwrap().center;
+        assert!((placed - spot).norm() < 2.0, "{placed}");
+    }
+
+    #[test]
+    fn the_wheel_zooms_about_the_pointer() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut app = app_in(dir.path());
+        let spot = Point2::new(100.0, 30.0);
+        let cell = cell_of(&app, spot);
+        let areas = layout(SCREEN).unwrap();
+        let under = Viewport::map(&app, areas.left)
+            .to_world(cell.0, cell.1)
+            .unwrap();
+        app.update(mouse_action(&app, event(MouseEventKind::ScrollUp, cell), SCREEN).unwrap());
+        assert!((app.zoom - 1.25).abs() < 1e-12);
+        let after = Viewport::map(&app, areas.left)
+            .to_world(cell.0, cell.1)
+            .unwrap();
+        assert!(
+            (after - under).norm() < 1e-9,
+            "the point under the pointer stays: {under} → {after}"
+        );
+    }
+}
+
+#[test]
+fn the_readme_lists_every_key_the_help_overlay_shows() {
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    for (_, keys, what) in skyform::tui::input::KEYS {
+        let row = format!("| `{keys}` | {what} |");
+        assert!(readme.contains(&row), "README.md lacks the key row {row}");
+    }
+}
