@@ -6,8 +6,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use crate::flatlo::{self, FlatloOutcome};
 use crate::mission::{self, Checked, Report};
-use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, Tee};
+use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError, Tee};
 use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
 use crate::record::{self, Recorder, Sinks};
 
@@ -80,6 +81,24 @@ pub enum RunCommand {
         #[command(flatten)]
         record: RecordArgs,
     },
+    /// FLATLO: the latitudinal-to-longitudinal squadron transition, simulated
+    /// with the point-mass aircraft model and verified.
+    ///
+    /// Progress goes to stderr, a summary to stdout. Exit status: 0 the
+    /// squadron kept its minimum separation, 1 error, 2 it did not, 130
+    /// cancelled (Ctrl-C).
+    Flatlo {
+        /// Mission TOML file (its [flatlo] section).
+        mission: PathBuf,
+        /// Seed of the noise (default: the mission's `seed`).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Write the whole outcome as JSON to FILE, or to stdout with `-`.
+        #[arg(long, value_name = "FILE|-")]
+        json: Option<PathBuf>,
+        #[command(flatten)]
+        record: RecordArgs,
+    },
 }
 
 /// Where to send a Rerun recording of the run.
@@ -137,12 +156,29 @@ pub fn main() -> ExitCode {
             json,
             sequential,
             record,
-        }) => ExitCode::from(run_theta_pso(
+        }) => {
+            let options = PlanOptions {
+                parallel: !sequential,
+            };
+            ExitCode::from(run_pipeline(
+                &mission,
+                seed,
+                json.as_deref(),
+                &record.sinks(),
+                |m, seed, observer, cancel| planner::plan(m, seed, options, observer, cancel),
+            ))
+        }
+        Command::Run(RunCommand::Flatlo {
+            mission,
+            seed,
+            json,
+            record,
+        }) => ExitCode::from(run_pipeline(
             &mission,
             seed,
             json.as_deref(),
-            sequential,
             &record.sinks(),
+            flatlo::plan,
         )),
         Command::Record { mission, record } => {
             ExitCode::from(record_mission(&mission, &record.sinks()))
@@ -252,6 +288,17 @@ impl StderrProgress {
     }
 }
 
+impl StderrProgress {
+    /// "  best J = …" once an optimiser reported a cost.
+    fn best_text(&self) -> String {
+        if self.best.is_finite() {
+            format!("  best J = {:.3}", self.best)
+        } else {
+            String::new()
+        }
+    }
+}
+
 impl Observer for StderrProgress {
     fn on_event(&mut self, event: Event<'_>) {
         match event {
@@ -270,14 +317,14 @@ impl Observer for StderrProgress {
                 if self.terminal {
                     let filled = (fraction * 30.0).round() as usize;
                     eprint!(
-                        "\r{:<14} [{:<30}] {percent:>3}%  best J = {:.3}",
+                        "\r{:<14} [{:<30}] {percent:>3}%{}",
                         self.stage,
                         "#".repeat(filled.min(30)),
-                        self.best
+                        self.best_text()
                     );
                 } else if percent / 10 > self.last_decile {
                     self.last_decile = percent / 10;
-                    eprintln!("progress: {percent}% (best J = {:.3})", self.best);
+                    eprintln!("progress: {percent}%{}", self.best_text());
                 }
             }
             Event::Log(level, message) => {
@@ -294,13 +341,58 @@ impl Observer for StderrProgress {
     }
 }
 
-/// `skyform run theta-pso`.
-fn run_theta_pso(
+/// What `skyform run` needs of any pipeline's outcome.
+trait RunOutcome: serde::Serialize {
+    fn summary(&self) -> String;
+    fn completion(&self) -> Completion;
+    /// The result meets its hard constraints (exit 0 rather than 2).
+    fn ok(&self) -> bool;
+    fn record(&self, recorder: &mut Recorder);
+}
+
+impl RunOutcome for ThetaPsoOutcome {
+    fn summary(&self) -> String {
+        theta_pso_summary(self)
+    }
+    fn completion(&self) -> Completion {
+        self.completion
+    }
+    fn ok(&self) -> bool {
+        self.feasible()
+    }
+    fn record(&self, recorder: &mut Recorder) {
+        recorder.log_theta_pso(self);
+    }
+}
+
+impl RunOutcome for FlatloOutcome {
+    fn summary(&self) -> String {
+        flatlo_summary(self)
+    }
+    fn completion(&self) -> Completion {
+        self.completion
+    }
+    fn ok(&self) -> bool {
+        self.passed()
+    }
+    fn record(&self, recorder: &mut Recorder) {
+        recorder.log_flatlo(self);
+    }
+}
+
+/// `skyform run PIPELINE`: load, record, run with progress and Ctrl-C,
+/// summarise, write JSON, choose the exit status.
+fn run_pipeline<O: RunOutcome>(
     path: &std::path::Path,
     seed: Option<u64>,
     json: Option<&std::path::Path>,
-    sequential: bool,
     sinks: &Sinks,
+    plan: impl FnOnce(
+        &mission::Mission,
+        u64,
+        &mut dyn Observer,
+        &CancelToken,
+    ) -> Result<O, PipelineError>,
 ) -> u8 {
     let Some(mission) = load_reporting(path) else {
         return exit::ERROR;
@@ -319,15 +411,12 @@ fn run_theta_pso(
     }
     let cancel = cancel_on_ctrl_c();
     let mut progress = StderrProgress::new();
-    let options = PlanOptions {
-        parallel: !sequential,
-    };
     let result = match recorder.as_mut() {
         Some(r) => {
             r.log_mission(&mission);
-            planner::plan(&mission, seed, options, &mut Tee(&mut progress, r), &cancel)
+            plan(&mission, seed, &mut Tee(&mut progress, r), &cancel)
         }
-        None => planner::plan(&mission, seed, options, &mut progress, &cancel),
+        None => plan(&mission, seed, &mut progress, &cancel),
     };
     let outcome = match result {
         Ok(o) => o,
@@ -337,7 +426,7 @@ fn run_theta_pso(
         }
     };
     if let Some(r) = recorder.as_mut() {
-        r.log_theta_pso(&outcome);
+        outcome.record(r);
     }
     // Every clone of the stream is dropped here, so the file is complete
     // (with its footer) before anything else is printed or the process ends.
@@ -347,7 +436,7 @@ fn run_theta_pso(
     }
     report_recording(finished.as_ref());
     let json_to_stdout = json.is_some_and(|p| p.as_os_str() == "-");
-    let summary = theta_pso_summary(&outcome);
+    let summary = outcome.summary();
     if json_to_stdout {
         eprint!("{summary}");
     } else {
@@ -368,9 +457,9 @@ fn run_theta_pso(
             return exit::ERROR;
         }
     }
-    if outcome.completion == Completion::Cancelled {
+    if outcome.completion() == Completion::Cancelled {
         exit::CANCELLED
-    } else if outcome.feasible() {
+    } else if outcome.ok() {
         exit::OK
     } else {
         exit::INFEASIBLE
@@ -444,6 +533,66 @@ pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
         "INFEASIBLE"
     };
     let _ = writeln!(s, "  result       {verdict}");
+    s
+}
+
+/// The human summary of a FLATLO outcome.
+pub fn flatlo_summary(o: &FlatloOutcome) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "FLATLO transition for \"{}\" (seed {})",
+        o.mission, o.seed
+    );
+    let _ = writeln!(
+        s,
+        "  run          {:?}, {:.1} s simulated; every aircraft on the line at t = {:.1} s",
+        o.completion, o.duration, o.arrival_time
+    );
+    for a in &o.aircraft {
+        let _ = writeln!(
+            s,
+            "  aircraft {:<3} {:<6} Δm {:>8.0} m  Δ {:>7.0} m  transition {:>8.0} m at {:>6.2} m/s  tracking max {:>7.1} m, RMS {:>6.1} m",
+            a.index,
+            format!("{:?}", a.side).to_lowercase(),
+            a.advance,
+            a.lateral_distance,
+            a.transition_length,
+            a.airspeed,
+            a.tracking_max,
+            a.tracking_rms
+        );
+    }
+    for p in &o.pairs {
+        let _ = writeln!(
+            s,
+            "  pair {:>2}-{:<2}    closest {:>9.1} m at t = {:.0} s",
+            p.a, p.b, p.min_distance, p.time
+        );
+    }
+    let v = &o.verification;
+    let spacing: Vec<String> = v
+        .final_spacing
+        .iter()
+        .map(|x| format!("{}→{} {:.1} m", x.front, x.back, x.spacing))
+        .collect();
+    let _ = writeln!(s, "  final line   {}", spacing.join(", "));
+    let _ = writeln!(
+        s,
+        "               spacing error {:.3} % of Δd, lateral spread {:.1} m",
+        v.max_spacing_error * 100.0,
+        v.lateral_spread
+    );
+    let verdict = if v.passed { "PASS" } else { "FAIL" };
+    let closest = v.closest.map_or("-".to_owned(), |c| {
+        format!("aircraft {} and {} at {:.1} m", c.a, c.b, c.min_distance)
+    });
+    let _ = writeln!(
+        s,
+        "  result       {verdict}: closest {closest}, minimum separation {:.0} m",
+        v.min_separation
+    );
     s
 }
 

@@ -6,8 +6,10 @@
 
 #[cfg(feature = "rerun")]
 pub mod cli;
+pub mod flatlo;
 pub mod geometry;
 pub mod mission;
+pub mod ode;
 pub mod pipeline;
 pub mod planner;
 #[cfg(feature = "rerun")]

@@ -22,6 +22,7 @@ use nalgebra::Point3;
 use rerun::sink::{FileSink, GrpcSink, LogSink};
 use rerun::{RecordingStream, RecordingStreamBuilder};
 
+use crate::flatlo::FlatloOutcome;
 use crate::mission::{Mission, to_toml_string};
 use crate::pipeline::{CostTerms, Event, Level, Observer};
 use crate::planner::{ThetaPsoOutcome, find_iwps};
@@ -71,6 +72,7 @@ enum Message {
     },
     Log(Level, String),
     ThetaPso(Box<ThetaPsoOutcome>),
+    Flatlo(Box<FlatloOutcome>),
 }
 
 /// A recording in progress. `finish` (or drop) flushes it and closes the file.
@@ -187,6 +189,11 @@ impl Recorder {
     /// Logs a θ-PSO result.
     pub fn log_theta_pso(&mut self, outcome: &ThetaPsoOutcome) {
         self.send(Message::ThetaPso(Box::new(outcome.clone())));
+    }
+
+    /// Logs a FLATLO result.
+    pub fn log_flatlo(&mut self, outcome: &FlatloOutcome) {
+        self.send(Message::Flatlo(Box::new(outcome.clone())));
     }
 
     /// Flushes everything and closes the sinks; the `.rrd` is complete after this.
@@ -323,6 +330,7 @@ fn log_message(stream: &RecordingStream, message: Message) {
     let result = match message {
         Message::Scene(mission) => log_scene(stream, &mission),
         Message::ThetaPso(outcome) => log_theta_pso(stream, &outcome),
+        Message::Flatlo(outcome) => log_flatlo(stream, &outcome),
         Message::Log(level, text) => {
             let level = match level {
                 Level::Info => rerun::TextLogLevel::INFO,
@@ -621,6 +629,125 @@ fn log_theta_pso(
                 v.value
             ))
             .with_level(rerun::TextLogLevel::WARN),
+        )?;
+    }
+    stream.reset_time();
+    Ok(())
+}
+
+/// A FLATLO outcome: references and flown paths per aircraft, the aircraft
+/// on `sim_time`, their airspeed, γ, χ and controls as series, the closest
+/// approaches as events.
+fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingStreamResult<()> {
+    let v = &o.verification;
+    stream.send_property(
+        "flatlo",
+        &rerun::TextDocument::from_markdown(format!(
+            "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\naircraft: {}\n\
+             arrival: {:.1} s\nduration: {:.1} s\nclosest: {}\nspacing error: {:.3e}\n\
+             passed: {}\nskyform: {}",
+            o.mission,
+            o.pipeline,
+            o.seed,
+            o.completion,
+            o.aircraft.len(),
+            o.arrival_time,
+            o.duration,
+            v.closest.map_or("-".to_owned(), |c| format!(
+                "{} and {} at {:.0} m",
+                c.a, c.b, c.min_distance
+            )),
+            v.max_spacing_error,
+            v.passed,
+            env!("CARGO_PKG_VERSION")
+        )),
+    )?;
+    for a in &o.aircraft {
+        let color = uav_color(a.index);
+        let name = format!("aircraft_{}", a.index);
+        stream.log_static(
+            format!("flatlo/reference/{name}"),
+            &rerun::LineStrips3D::new([a
+                .reference
+                .iter()
+                .map(|s| f32x3(&s.position))
+                .collect::<Vec<_>>()])
+            .with_colors([rerun::Color::from_rgb(170, 170, 170)])
+            .with_labels([format!("reference {}", a.index)]),
+        )?;
+        stream.log_static(
+            format!("flatlo/flown/{name}"),
+            &rerun::LineStrips3D::new([a
+                .flown
+                .iter()
+                .map(|s| f32x3(&s.position))
+                .collect::<Vec<_>>()])
+            .with_colors([color])
+            .with_labels([format!("aircraft {}", a.index)]),
+        )?;
+        let times = rerun::TimeColumn::new_duration_secs("sim_time", a.flown.iter().map(|s| s.t));
+        let entity = format!("flatlo/aircraft/{name}");
+        stream.log_static(
+            entity.as_str(),
+            &rerun::Points3D::update_fields()
+                .with_colors([color])
+                .with_radii([150.0f32])
+                .with_labels([format!("aircraft {}", a.index)]),
+        )?;
+        stream.send_columns(
+            entity.as_str(),
+            [times.clone()],
+            rerun::Points3D::update_fields()
+                .with_positions(
+                    a.flown
+                        .iter()
+                        .map(|s| f32x3(&s.position))
+                        .collect::<Vec<_>>(),
+                )
+                .columns_of_unit_batches()?,
+        )?;
+        type Series = fn(&crate::flatlo::FlownSample) -> f64;
+        let series: [(&str, Series); 6] = [
+            ("airspeed", |s| s.airspeed),
+            ("gamma_deg", |s| s.gamma.to_degrees()),
+            ("chi_deg", |s| s.chi.to_degrees()),
+            ("thrust", |s| s.controls.thrust),
+            ("load_factor", |s| s.controls.load_factor),
+            ("bank_deg", |s| s.controls.bank.to_degrees()),
+        ];
+        for (quantity, value) in series {
+            stream.send_columns(
+                format!("flatlo/{quantity}/{name}"),
+                [times.clone()],
+                rerun::Scalars::update_fields()
+                    .with_scalars(a.flown.iter().map(value).collect::<Vec<f64>>())
+                    .columns_of_unit_batches()?,
+            )?;
+        }
+    }
+    stream.set_duration_secs("sim_time", o.arrival_time);
+    stream.log(
+        "flatlo/events",
+        &rerun::TextLog::new(format!(
+            "every aircraft on the longitudinal line at t = {:.1} s",
+            o.arrival_time
+        ))
+        .with_level(rerun::TextLogLevel::INFO),
+    )?;
+    for p in &o.pairs {
+        stream.set_duration_secs("sim_time", p.time);
+        let level = if p.min_distance < v.min_separation {
+            rerun::TextLogLevel::WARN
+        } else {
+            rerun::TextLogLevel::INFO
+        };
+        stream.log(
+            "flatlo/events",
+            &rerun::TextLog::new(format!(
+                "closest approach of aircraft {} and {}: {:.0} m",
+                p.a, p.b, p.min_distance
+            ))
+            .with_level(level),
         )?;
     }
     stream.reset_time();

@@ -140,3 +140,31 @@ fn the_designer_refuses_a_file_that_is_not_a_mission_and_needs_a_terminal() {
         text(&out.stderr)
     );
 }
+
+#[test]
+fn run_flatlo_summarises_the_squadron_and_exits_by_its_verdict() {
+    let out = skyform(&["run", "flatlo", "missions/flatlo-squadron.toml"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("FLATLO transition for \"FLATLO squadron transition\" (seed 3)"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("aircraft 3   right"), "{stdout}");
+    assert!(stdout.contains("result       PASS"), "{stdout}");
+
+    // A separation the squadron cannot keep: exit 2, and the summary says why.
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let strict = dir.path().join("strict.toml");
+    let source = std::fs::read_to_string("missions/flatlo-squadron.toml").unwrap_or_default();
+    let edited = source.replace("min_separation = 1000.0", "min_separation = 16000.0");
+    assert_ne!(edited, source);
+    std::fs::write(&strict, edited).unwrap_or_else(|e| panic!("{e}"));
+    let out = skyform(&["run", "flatlo", strict.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stdout).contains("result       FAIL: closest aircraft 1 and 3"),
+        "{}",
+        text(&out.stdout)
+    );
+}

@@ -254,3 +254,73 @@ fn a_bad_viewer_url_or_rrd_directory_is_a_clear_error() {
     let out = skyform(&["record", "missions/narrow-passage.toml"]);
     assert_eq!(out.status.code(), Some(1));
 }
+
+#[test]
+fn a_flatlo_recording_holds_references_flights_series_and_events() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let rrd = dir.path().join("flatlo.rrd");
+    let json = dir.path().join("flatlo.json");
+    let out = skyform(&[
+        "run",
+        "flatlo",
+        "missions/flatlo-squadron.toml",
+        "--rrd",
+        rrd.to_str().unwrap_or_default(),
+        "--json",
+        json.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let outcome: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap_or_default())
+            .unwrap_or_default();
+    let chunks = chunks(&rrd);
+    let paths = entity_paths(&chunks);
+    for i in 0..4 {
+        for prefix in [
+            "reference",
+            "flown",
+            "aircraft",
+            "airspeed",
+            "gamma_deg",
+            "chi_deg",
+            "thrust",
+            "load_factor",
+            "bank_deg",
+        ] {
+            let entity = format!("/flatlo/{prefix}/aircraft_{i}");
+            assert!(paths.contains(&entity), "{entity} missing from {paths:?}");
+        }
+        // One airspeed value per flown sample, equal to the outcome's.
+        let airspeed: Vec<f64> = values(
+            &chunks,
+            &format!("/flatlo/airspeed/aircraft_{i}"),
+            "Scalars:scalars",
+        );
+        let flown = outcome["aircraft"][i]["flown"]
+            .as_array()
+            .map(Vec::len)
+            .unwrap_or(0);
+        assert_eq!(airspeed.len(), flown);
+        let first = outcome["aircraft"][i]["flown"][0]["airspeed"]
+            .as_f64()
+            .unwrap_or(f64::NAN);
+        assert!((airspeed[0] - first).abs() < 1e-9);
+        let last = last_time(
+            &chunks,
+            &format!("/flatlo/aircraft/aircraft_{i}"),
+            "sim_time",
+        )
+        .unwrap_or(0);
+        let duration = outcome["duration"].as_f64().unwrap_or(0.0);
+        assert!(
+            (last as f64 / 1e9 - duration).abs() < 0.2,
+            "{last} ns vs {duration} s"
+        );
+    }
+    assert!(paths.contains(&"/flatlo/events".to_owned()));
+}

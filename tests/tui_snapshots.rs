@@ -13,7 +13,7 @@ use skyform::mission::default_mission;
 use skyform::tui::app::Focus;
 use skyform::tui::fields::Item;
 use skyform::tui::fixtures::app_with_result;
-use skyform::tui::jobs::{Job, JobMsg};
+use skyform::tui::jobs::{Job, JobMsg, Pipeline};
 use skyform::tui::{Action, App, Document, view};
 
 const WIDTH: u16 = 140;
@@ -70,7 +70,8 @@ fn jobs_panel_mid_run() {
     let mut app = default_app();
     let started = Instant::now();
     let m = app.mission().clone();
-    app.jobs.push(Job::new(1, 7, m.clone(), started));
+    app.jobs
+        .push(Job::new(1, Pipeline::ThetaPso, 7, m.clone(), started));
     app.shown_job = Some(1);
     app.update(Action::FocusOn(Focus::Jobs));
     let path = vec![m.route.start, Point3::new(60.0, 45.0, 8.0), m.route.goal];

@@ -186,7 +186,7 @@ fn a_run_in_the_background_gives_the_same_result_as_the_pipeline() {
         &Default::default(),
     )
     .unwrap();
-    let outcome = job.outcome.as_ref().unwrap();
+    let outcome = job.outcome.as_ref().and_then(|o| o.theta_pso()).unwrap();
     assert_eq!(outcome.cost, direct.cost);
     assert_eq!(job.convergence, direct.convergence);
     assert_eq!(app.shown_job, Some(job.id));
@@ -216,7 +216,7 @@ fn cancel_keeps_the_best_so_far() {
     assert!(app.wait_for_jobs(Duration::from_secs(30)));
     let job = &app.jobs[0];
     assert_eq!(job.state, JobState::Cancelled);
-    let outcome = job.outcome.as_ref().unwrap();
+    let outcome = job.outcome.as_ref().and_then(|o| o.theta_pso()).unwrap();
     assert!(outcome.iterations < 1_000_000);
     assert!(!outcome.trajectories.is_empty());
 }

@@ -66,7 +66,9 @@ pub enum Action {
 
     /// Run θ-PSO with the mission's seed.
     Run,
-    /// Run θ-PSO with a seed not used yet.
+    /// Run FLATLO (the squadron transition) with the mission's seed.
+    RunFlatlo,
+    /// Re-run the last pipeline with a seed not used yet.
     RunNewSeed,
     /// Cancel the selected (or latest) running job.
     Cancel,

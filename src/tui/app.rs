@@ -13,7 +13,7 @@ use nalgebra::{Point2, Vector3};
 use super::action::Action;
 use super::document::Document;
 use super::fields::{self, Field, Item};
-use super::jobs::{self, Job, JobId, JobMsg, RecordSettings, Viewer};
+use super::jobs::{self, Job, JobId, JobMsg, Pipeline, RecordSettings, Viewer};
 use crate::geometry::farthest_offset;
 use crate::mission::{self, Mission, Preset, Severity, check_str};
 use crate::pipeline::Level;
@@ -485,7 +485,8 @@ impl App {
                     self.set_status("nothing to redo");
                 }
             }
-            Run => self.run(self.mission().seed),
+            Run => self.run(Pipeline::ThetaPso, self.mission().seed),
+            RunFlatlo => self.run(Pipeline::Flatlo, self.mission().seed),
             RunNewSeed => {
                 let seed = self
                     .jobs
@@ -493,7 +494,8 @@ impl App {
                     .map(|j| j.seed)
                     .max()
                     .map_or(self.mission().seed.wrapping_add(1), |s| s.wrapping_add(1));
-                self.run(seed);
+                let pipeline = self.jobs.last().map_or(Pipeline::ThetaPso, |j| j.pipeline);
+                self.run(pipeline, seed);
             }
             Cancel => {
                 let target = self
@@ -785,7 +787,7 @@ impl App {
         }
     }
 
-    fn run(&mut self, seed: u64) {
+    fn run(&mut self, pipeline: Pipeline, seed: u64) {
         let errors: Vec<String> = self
             .doc
             .diagnostics()
@@ -801,13 +803,16 @@ impl App {
             return;
         }
         let id = self.jobs.last().map_or(1, |j| j.id + 1);
-        let job = Job::new(id, seed, self.mission().clone(), Instant::now());
+        let job = Job::new(id, pipeline, seed, self.mission().clone(), Instant::now());
         let record = RecordSettings {
-            rrd: self.record_rrd.then(|| self.rrd_path("theta-pso", seed)),
+            rrd: self
+                .record_rrd
+                .then(|| self.rrd_path(pipeline.slug(), seed)),
             viewer: self.viewer,
         };
-        jobs::spawn_theta_pso(
+        jobs::spawn_pipeline(
             id,
+            pipeline,
             job.mission.clone(),
             seed,
             job.cancel.clone(),
@@ -850,14 +855,14 @@ impl App {
         if let Some(job) = self.jobs.iter_mut().find(|j| j.id == id) {
             job.apply(msg, now);
             if done {
+                let verb = if job.state == jobs::JobState::Cancelled {
+                    "cancelled"
+                } else {
+                    "done"
+                };
                 let text = match &job.outcome {
-                    Some(o) => format!(
-                        "job {id} {}: J = {:.2}, {:.1} m, {}",
-                        if job.state == jobs::JobState::Cancelled {
-                            "cancelled"
-                        } else {
-                            "done"
-                        },
+                    Some(jobs::Outcome::ThetaPso(o)) => format!(
+                        "job {id} {verb}: J = {:.2}, {:.1} m, {}",
                         o.cost.total,
                         o.path_length,
                         if o.feasible() {
@@ -866,7 +871,19 @@ impl App {
                             "INFEASIBLE"
                         }
                     ),
-                    None => format!("job {id} done"),
+                    Some(jobs::Outcome::Flatlo(o)) => format!(
+                        "job {id} {verb}: closest {} m, spacing error {:.2} %, {}",
+                        o.verification
+                            .closest
+                            .map_or("-".into(), |c| format!("{:.0}", c.min_distance)),
+                        o.verification.max_spacing_error * 100.0,
+                        if o.passed() {
+                            "separation kept"
+                        } else {
+                            "SEPARATION LOST"
+                        }
+                    ),
+                    None => format!("job {id} {verb}"),
                 };
                 self.shown_job = Some(id);
                 self.set_status(text);

@@ -24,6 +24,8 @@ pub enum Item {
     /// The IWP between these two obstacles (eq. 9): its reconfiguration choice.
     Waypoint([String; 2]),
     ThetaPso,
+    /// The FLATLO squadron and its aircraft model.
+    Squadron,
 }
 
 impl Item {
@@ -41,6 +43,7 @@ impl Item {
             Item::Slot(i) => format!("Slot {} (UAV {})", i + 1, i + 1),
             Item::Waypoint([a, b]) => format!("IWP {a} ↔ {b}"),
             Item::ThetaPso => "θ-PSO parameters".into(),
+            Item::Squadron => "Squadron (FLATLO)".into(),
         }
     }
 
@@ -63,6 +66,7 @@ pub fn map_items(mission: &Mission) -> Vec<Item> {
     let mut items = vec![Item::Mission, Item::Bounds, Item::Start, Item::Goal];
     items.extend((0..mission.obstacles.len()).map(Item::Obstacle));
     items.push(Item::ThetaPso);
+    items.push(Item::Squadron);
     items
 }
 
@@ -503,6 +507,7 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
                 }),
             ]
         }
+        Item::Squadron => squadron_fields(m),
         Item::ThetaPso => {
             let p = &m.theta_pso;
             vec![
@@ -603,6 +608,112 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
             ]
         }
     }
+}
+
+/// FLATLO's squadron: what the operator sets per mission; the airframe
+/// constants stay in the file.
+fn squadron_fields(m: &Mission) -> Vec<Field> {
+    let p = &m.flatlo;
+    vec![
+        field("aircraft N", "flatlo.aircraft", p.aircraft, |m, _, t| {
+            m.flatlo.aircraft = count(t)?;
+            Ok(())
+        }),
+        field(
+            "spacing Δd (m)",
+            "flatlo.spacing",
+            fmt_num(p.spacing),
+            |m, _, t| {
+                m.flatlo.spacing = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "airspeed (m/s)",
+            "flatlo.airspeed",
+            fmt_num(p.airspeed),
+            |m, _, t| {
+                m.flatlo.airspeed = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "turn radius r (m)",
+            "flatlo.turn_radius",
+            fmt_num(p.turn_radius),
+            |m, _, t| {
+                m.flatlo.turn_radius = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "heading φ (°)",
+            "flatlo.heading_deg",
+            fmt_num(p.heading_deg),
+            |m, _, t| {
+                m.flatlo.heading_deg = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "climb β (°)",
+            "flatlo.climb_deg",
+            fmt_num(p.climb_deg),
+            |m, _, t| {
+                m.flatlo.climb_deg = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "altitude (m)",
+            "flatlo.altitude",
+            fmt_num(p.altitude),
+            |m, _, t| {
+                m.flatlo.altitude = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "start x (m)",
+            "flatlo.start",
+            fmt_num(p.start.x),
+            |m, _, t| {
+                m.flatlo.start.x = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "start y (m)",
+            "flatlo.start",
+            fmt_num(p.start.y),
+            |m, _, t| {
+                m.flatlo.start.y = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "final leg K2 (m)",
+            "flatlo.final_leg",
+            fmt_num(p.final_leg),
+            |m, _, t| {
+                m.flatlo.final_leg = number(t)?;
+                Ok(())
+            },
+        ),
+        field("noise σ", "flatlo.noise", fmt_num(p.noise), |m, _, t| {
+            m.flatlo.noise = number(t)?;
+            Ok(())
+        }),
+        field(
+            "min separation (m)",
+            "flatlo.min_separation",
+            fmt_num(p.min_separation),
+            |m, _, t| {
+                m.flatlo.min_separation = number(t)?;
+                Ok(())
+            },
+        ),
+    ]
 }
 
 /// A new obstacle at `center` with a name not yet used.

@@ -7,7 +7,7 @@ use nalgebra::{Point2, Point3};
 
 use super::app::App;
 use super::document::Document;
-use super::jobs::{Job, JobMsg};
+use super::jobs::{Job, JobMsg, Outcome, Pipeline};
 use crate::mission::{self, Mission, Obstacle};
 use crate::pipeline::{CancelToken, Silent};
 use crate::planner::{PlanOptions, plan};
@@ -59,8 +59,11 @@ pub fn app_with_result(mut mission: Mission, seed: u64, iterations: usize) -> Ap
         PathBuf::from("."),
     );
     let started = Instant::now();
-    app.jobs.push(Job::new(1, seed, mission, started));
-    let result = outcome.map(Box::new).map_err(|e| e.to_string());
+    app.jobs
+        .push(Job::new(1, Pipeline::ThetaPso, seed, mission, started));
+    let result = outcome
+        .map(|o| Outcome::ThetaPso(Box::new(o)))
+        .map_err(|e| e.to_string());
     app.on_job_msg(JobMsg::Done(1, result), started);
     app
 }

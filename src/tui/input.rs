@@ -85,7 +85,12 @@ pub const KEYS: &[(&str, &str, &str)] = &[
         "cycle the IWP's shape / enable or disable it",
     ),
     ("Run", "r", "run θ-PSO with the mission's seed"),
-    ("Run", "N", "run θ-PSO with a new seed"),
+    (
+        "Run",
+        "F",
+        "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
+    ),
+    ("Run", "N", "re-run the last pipeline with a new seed"),
     ("Run", "x", "cancel the selected (or latest) running job"),
     (
         "Run",
@@ -164,6 +169,7 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
         KeyCode::Char(' ') => Some(Action::ToggleWaypoint),
         KeyCode::Char('r') => Some(Action::Run),
         KeyCode::Char('N') => Some(Action::RunNewSeed),
+        KeyCode::Char('F') => Some(Action::RunFlatlo),
         KeyCode::Char('x') => Some(Action::Cancel),
         KeyCode::Char('e') => Some(Action::ToggleRecording),
         KeyCode::Char('E') => Some(Action::CycleViewer),

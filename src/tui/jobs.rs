@@ -14,11 +14,74 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::Sender;
 use nalgebra::Point3;
 
+use crate::flatlo::{self, FlatloOutcome};
 use crate::mission::Mission;
 use crate::pipeline::{CancelToken, Completion, Event, Level, Observer};
 use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
 
 pub type JobId = usize;
+
+/// The pipelines the TUI can launch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pipeline {
+    ThetaPso,
+    Flatlo,
+}
+
+impl Pipeline {
+    pub fn name(self) -> &'static str {
+        match self {
+            Pipeline::ThetaPso => "θ-PSO",
+            Pipeline::Flatlo => "FLATLO",
+        }
+    }
+
+    /// For file names (`<mission>-<slug>-seed<N>.rrd`).
+    pub fn slug(self) -> &'static str {
+        match self {
+            Pipeline::ThetaPso => "theta-pso",
+            Pipeline::Flatlo => "flatlo",
+        }
+    }
+}
+
+/// A finished run's result.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Outcome {
+    ThetaPso(Box<ThetaPsoOutcome>),
+    Flatlo(Box<FlatloOutcome>),
+}
+
+impl Outcome {
+    pub fn completion(&self) -> Completion {
+        match self {
+            Outcome::ThetaPso(o) => o.completion,
+            Outcome::Flatlo(o) => o.completion,
+        }
+    }
+
+    /// Meets its hard constraints: a feasible plan, a squadron that kept apart.
+    pub fn ok(&self) -> bool {
+        match self {
+            Outcome::ThetaPso(o) => o.feasible(),
+            Outcome::Flatlo(o) => o.passed(),
+        }
+    }
+
+    pub fn theta_pso(&self) -> Option<&ThetaPsoOutcome> {
+        match self {
+            Outcome::ThetaPso(o) => Some(o),
+            _ => None,
+        }
+    }
+
+    pub fn flatlo(&self) -> Option<&FlatloOutcome> {
+        match self {
+            Outcome::Flatlo(o) => Some(o),
+            _ => None,
+        }
+    }
+}
 
 /// Where a job's Rerun recording goes.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -70,7 +133,7 @@ pub enum JobMsg {
     },
     Log(JobId, Level, String),
     /// The run ended with an outcome, or an error (or a caught panic).
-    Done(JobId, Result<Box<ThetaPsoOutcome>, String>),
+    Done(JobId, Result<Outcome, String>),
 }
 
 /// How a job stands.
@@ -89,7 +152,7 @@ pub enum JobState {
 #[derive(Debug)]
 pub struct Job {
     pub id: JobId,
-    pub pipeline: &'static str,
+    pub pipeline: Pipeline,
     pub seed: u64,
     /// The mission as it was at launch: the result is stale when the
     /// document no longer equals it.
@@ -101,7 +164,7 @@ pub struct Job {
     pub convergence: Vec<f64>,
     /// The best centroid path so far (while running).
     pub live_path: Vec<Point3<f64>>,
-    pub outcome: Option<Box<ThetaPsoOutcome>>,
+    pub outcome: Option<Outcome>,
     /// The last warning the pipeline logged.
     pub last_warning: Option<String>,
     pub started: Instant,
@@ -110,10 +173,16 @@ pub struct Job {
 }
 
 impl Job {
-    pub fn new(id: JobId, seed: u64, mission: Mission, started: Instant) -> Self {
+    pub fn new(
+        id: JobId,
+        pipeline: Pipeline,
+        seed: u64,
+        mission: Mission,
+        started: Instant,
+    ) -> Self {
         Job {
             id,
-            pipeline: "θ-PSO",
+            pipeline,
             seed,
             mission,
             state: JobState::Running,
@@ -139,9 +208,11 @@ impl Job {
             .saturating_duration_since(self.started)
     }
 
+    /// θ-PSO's best J (FLATLO has no cost).
     pub fn best_cost(&self) -> Option<f64> {
         self.outcome
             .as_ref()
+            .and_then(Outcome::theta_pso)
             .map(|o| o.cost.total)
             .or(self.convergence.last().copied())
     }
@@ -164,13 +235,15 @@ impl Job {
                 match result {
                     Ok(outcome) => {
                         self.progress = 1.0;
-                        self.state = match outcome.completion {
+                        self.state = match outcome.completion() {
                             Completion::Cancelled => JobState::Cancelled,
                             Completion::Finished => JobState::Done {
-                                feasible: outcome.feasible(),
+                                feasible: outcome.ok(),
                             },
                         };
-                        self.convergence = outcome.convergence.clone();
+                        if let Some(o) = outcome.theta_pso() {
+                            self.convergence = o.convergence.clone();
+                        }
                         self.live_path.clear();
                         self.outcome = Some(outcome);
                     }
@@ -221,9 +294,10 @@ impl Observer for Forward {
     }
 }
 
-/// Starts a θ-PSO run of `mission` on a worker thread.
-pub fn spawn_theta_pso(
+/// Starts a run of `pipeline` on `mission` on a worker thread.
+pub fn spawn_pipeline(
     id: JobId,
+    pipeline: Pipeline,
     mission: Mission,
     seed: u64,
     cancel: CancelToken,
@@ -231,7 +305,7 @@ pub fn spawn_theta_pso(
     tx: Sender<JobMsg>,
 ) {
     spawn(id, tx, move |tx| {
-        run_theta_pso(id, &mission, seed, &cancel, &record, tx)
+        run(id, pipeline, &mission, seed, &cancel, &record, tx)
     });
 }
 
@@ -239,7 +313,7 @@ pub fn spawn_theta_pso(
 /// its result, or its panic as an error.
 pub fn spawn<F>(id: JobId, tx: Sender<JobMsg>, work: F)
 where
-    F: FnOnce(&Sender<JobMsg>) -> Result<Box<ThetaPsoOutcome>, String> + Send + 'static,
+    F: FnOnce(&Sender<JobMsg>) -> Result<Outcome, String> + Send + 'static,
 {
     let worker_tx = tx.clone();
     let spawned = thread::Builder::new()
@@ -254,40 +328,62 @@ where
     }
 }
 
-fn run_theta_pso(
+/// The pipeline itself, on the worker thread.
+fn plan(
+    pipeline: Pipeline,
+    mission: &Mission,
+    seed: u64,
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> Result<Outcome, String> {
+    match pipeline {
+        Pipeline::ThetaPso => {
+            planner::plan(mission, seed, PlanOptions::default(), observer, cancel)
+                .map(|o| Outcome::ThetaPso(Box::new(o)))
+        }
+        Pipeline::Flatlo => {
+            flatlo::plan(mission, seed, observer, cancel).map(|o| Outcome::Flatlo(Box::new(o)))
+        }
+    }
+    .map_err(|e| e.to_string())
+}
+
+fn run(
     id: JobId,
+    pipeline: Pipeline,
     mission: &Mission,
     seed: u64,
     cancel: &CancelToken,
     record: &RecordSettings,
     tx: &Sender<JobMsg>,
-) -> Result<Box<ThetaPsoOutcome>, String> {
+) -> Result<Outcome, String> {
     let mut forward = Forward {
         id,
         tx: tx.clone(),
         last_cost: None,
     };
-    let options = PlanOptions::default();
     #[cfg(feature = "rerun")]
     {
         let mut recorder = start_recording(id, mission, record, tx);
         let outcome = match recorder.as_mut() {
             Some(r) => {
                 let mut both = crate::pipeline::Tee(&mut forward, r);
-                planner::plan(mission, seed, options, &mut both, cancel)
+                plan(pipeline, mission, seed, &mut both, cancel)
             }
-            None => planner::plan(mission, seed, options, &mut forward, cancel),
-        }
-        .map_err(|e| e.to_string())?;
+            None => plan(pipeline, mission, seed, &mut forward, cancel),
+        }?;
         if let Some(mut r) = recorder {
-            r.log_theta_pso(&outcome);
+            match &outcome {
+                Outcome::ThetaPso(o) => r.log_theta_pso(o),
+                Outcome::Flatlo(o) => r.log_flatlo(o),
+            }
             let finished = r.finish();
             if let Some((file, bytes)) = finished.file {
                 let text = format!("recorded {} ({:.1} MB)", file.display(), bytes as f64 / 1e6);
                 let _ = tx.send(JobMsg::Log(id, Level::Info, text));
             }
         }
-        Ok(Box::new(outcome))
+        Ok(outcome)
     }
     #[cfg(not(feature = "rerun"))]
     {
@@ -295,9 +391,7 @@ fn run_theta_pso(
             let text = "this build has no Rerun support (feature `rerun`)".to_owned();
             let _ = tx.send(JobMsg::Log(id, Level::Warn, text));
         }
-        planner::plan(mission, seed, options, &mut forward, cancel)
-            .map(Box::new)
-            .map_err(|e| e.to_string())
+        plan(pipeline, mission, seed, &mut forward, cancel)
     }
 }
 
@@ -356,6 +450,7 @@ mod tests {
         let msg = rx.recv_timeout(Duration::from_secs(10)).unwrap();
         let mut job = Job::new(
             4,
+            Pipeline::ThetaPso,
             0,
             crate::mission::default_mission().mission,
             Instant::now(),

@@ -33,6 +33,7 @@ fn item_path(item: &Item) -> Option<String> {
         Item::Formation => Some("formation".into()),
         Item::Slot(i) => Some(format!("formation.slots[{i}]")),
         Item::ThetaPso => Some("theta_pso".into()),
+        Item::Squadron => Some("flatlo".into()),
         Item::Mission | Item::Waypoint(_) => None,
     }
 }

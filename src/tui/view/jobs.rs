@@ -74,8 +74,12 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
                 Span::raw(" run θ-PSO with the mission's seed"),
             ]),
             Line::from(vec![
+                Span::styled("F", Style::default().yellow().bold()),
+                Span::raw(" run FLATLO (the squadron transition)"),
+            ]),
+            Line::from(vec![
                 Span::styled("N", Style::default().yellow().bold()),
-                Span::raw(" run with a new seed"),
+                Span::raw(" re-run with a new seed"),
             ]),
             Line::from(vec![
                 Span::styled("e", Style::default().yellow().bold()),
@@ -108,7 +112,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
                 if cursor { "▶" } else { " " },
                 if shown { "◉" } else { " " },
                 job.id,
-                job.pipeline,
+                job.pipeline.name(),
                 job.seed
             );
             let style = if cursor && focused {
@@ -118,17 +122,14 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
             };
             let cost = job
                 .best_cost()
-                .map_or("-".to_owned(), |c| format!("{c:.1}"));
+                .map_or(String::new(), |c| format!("J {c:.1} "));
             Line::from(vec![
                 Span::styled(head, style),
                 Span::styled(
                     bar(job.progress, bar_width),
                     Style::default().fg(Color::LightBlue),
                 ),
-                Span::raw(format!(
-                    " {:>5.1}s J {cost} ",
-                    job.elapsed(now).as_secs_f64()
-                )),
+                Span::raw(format!(" {:>5.1}s {cost}", job.elapsed(now).as_secs_f64())),
                 state_span(job),
             ])
         })
@@ -142,7 +143,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
     if let JobState::Failed(e) = &job.state {
         facts.push(Line::styled(format!("error: {e}"), Style::default().red()));
     }
-    if let Some(o) = &job.outcome {
+    if let Some(o) = job.outcome.as_ref().and_then(|o| o.theta_pso()) {
         let v = &o.verification;
         facts.push(Line::raw(format!(
             "J {:.2} · {:.1} m · {:.1} s · {} reconfiguration(s)",
@@ -177,6 +178,11 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
                 Style::default().yellow(),
             ));
         }
+    } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.flatlo()) {
+        // FLATLO's verification table fills the panel (no convergence chart).
+        let lines = flatlo_table(o, app.is_stale(job));
+        frame.render_widget(Paragraph::new(lines), detail);
+        return;
     } else if let Some(w) = &job.last_warning {
         facts.push(Line::styled(w.clone(), Style::default().yellow()));
     }
@@ -185,6 +191,70 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         Layout::vertical([Constraint::Min(0), Constraint::Length(facts_height)]).areas(detail);
     frame.render_widget(Paragraph::new(facts), facts_area);
     draw_chart(frame, job, chart_area);
+}
+
+/// FLATLO's verification: every pair's closest approach, the final line, the verdict.
+fn flatlo_table(o: &crate::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'static>> {
+    let v = &o.verification;
+    let mut lines = vec![Line::from(vec![
+        Span::raw(format!(
+            "{} aircraft · on the line at {:.0} s · ",
+            o.aircraft.len(),
+            o.arrival_time
+        )),
+        if v.passed {
+            Span::styled("✓ separation kept", Style::default().green())
+        } else {
+            Span::styled("✗ SEPARATION LOST", Style::default().red().bold())
+        },
+    ])];
+    lines.push(Line::styled(
+        format!("{:<6} {:>11} {:>8}", "pair", "closest m", "at s"),
+        Style::default().bold(),
+    ));
+    let mut pairs = o.pairs.clone();
+    pairs.sort_by(|a, b| a.min_distance.total_cmp(&b.min_distance));
+    for p in pairs.iter().take(8) {
+        let style = if p.min_distance < v.min_separation {
+            Style::default().red()
+        } else {
+            Style::default()
+        };
+        lines.push(Line::styled(
+            format!(
+                "{:<6} {:>11.0} {:>8.0}",
+                format!("{}-{}", p.a, p.b),
+                p.min_distance,
+                p.time
+            ),
+            style,
+        ));
+    }
+    if pairs.len() > 8 {
+        lines.push(Line::raw(format!("… {} more pairs", pairs.len() - 8)));
+    }
+    lines.push(Line::raw(format!(
+        "final spacing error {:.3} % · lateral spread {:.1} m",
+        v.max_spacing_error * 100.0,
+        v.lateral_spread
+    )));
+    let worst = o
+        .aircraft
+        .iter()
+        .max_by(|a, b| a.tracking_max.total_cmp(&b.tracking_max));
+    if let Some(a) = worst {
+        lines.push(Line::raw(format!(
+            "worst tracking: aircraft {} max {:.1} m, RMS {:.1} m",
+            a.index, a.tracking_max, a.tracking_rms
+        )));
+    }
+    if stale {
+        lines.push(Line::styled(
+            "stale: the mission changed since this run",
+            Style::default().yellow(),
+        ));
+    }
+    lines
 }
 
 /// Best total cost per iteration (the convergence curve).

@@ -13,6 +13,7 @@ use ratatui::text::{Line as TextLine, Span};
 use ratatui::widgets::canvas::{Canvas, Context, Line, Painter, Rectangle, Shape};
 use ratatui::widgets::{Block, BorderType, Borders, Cell, Row, Table};
 
+use crate::flatlo::FlatloOutcome;
 use crate::mission::{Mission, ShapeChoice};
 use crate::planner::ThetaPsoOutcome;
 use crate::tui::app::{App, Focus, formation_extent};
@@ -56,17 +57,16 @@ impl Viewport {
     /// The top-down map of `app` drawn in the pane `area` (border included).
     pub fn map(app: &App, area: Rect) -> Self {
         let inner = area.inner(Margin::new(1, 1));
-        let b = &app.mission().bounds;
+        let (bx, by) = extent(app);
         let (w, h) = (
-            (b.x[1] - b.x[0]).abs().max(1.0),
-            (b.y[1] - b.y[0]).abs().max(1.0),
+            (bx[1] - bx[0]).abs().max(1.0),
+            (by[1] - by[0]).abs().max(1.0),
         );
         let fit =
             (w / inner.width.max(1) as f64).max(h / (2.0 * inner.height.max(1) as f64)) * 1.08;
-        let center = app.center.unwrap_or(Point2::new(
-            (b.x[0] + b.x[1]) / 2.0,
-            (b.y[0] + b.y[1]) / 2.0,
-        ));
+        let center = app
+            .center
+            .unwrap_or(Point2::new((bx[0] + bx[1]) / 2.0, (by[0] + by[1]) / 2.0));
         Viewport::centred(inner, center, fit / app.zoom)
     }
 
@@ -186,8 +186,36 @@ fn pane_block(title: TextLine<'static>, focused: bool) -> Block<'static> {
 /// What the map shows of the result, and in which colour.
 fn result_of(app: &App) -> Option<(&ThetaPsoOutcome, bool)> {
     let job = app.shown()?;
-    let outcome = job.outcome.as_deref()?;
+    let outcome = job.outcome.as_ref()?.theta_pso()?;
     Some((outcome, app.is_stale(job)))
+}
+
+/// The shown FLATLO result, if the shown job is one.
+fn flatlo_of(app: &App) -> Option<(&FlatloOutcome, bool)> {
+    let job = app.shown()?;
+    let outcome = job.outcome.as_ref()?.flatlo()?;
+    Some((outcome, app.is_stale(job)))
+}
+
+/// The x-y box the map fits: the bounds, and a shown FLATLO squadron's
+/// flight (kilometres, wherever the mission's bounds are).
+fn extent(app: &App) -> ([f64; 2], [f64; 2]) {
+    let b = &app.mission().bounds;
+    let (mut x, mut y) = (b.x, b.y);
+    if let Some((o, _)) = flatlo_of(app) {
+        for a in &o.aircraft {
+            for p in a
+                .reference
+                .iter()
+                .map(|s| s.position)
+                .chain(a.flown.iter().map(|s| s.position))
+            {
+                x = [x[0].min(p.x), x[1].max(p.x)];
+                y = [y[0].min(p.y), y[1].max(p.y)];
+            }
+        }
+    }
+    (x, y)
 }
 
 /// The top-down map (or the side view when toggled).
@@ -357,6 +385,9 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
             );
         }
     }
+    if let Some((o, stale)) = flatlo_of(app) {
+        paint_squadron(ctx, o, stale, dot);
+    }
 
     // IWPs (eq. 9): enabled ones bright, disabled ones dim.
     for w in &app.iwps {
@@ -415,6 +446,48 @@ fn centroid_between(o: &ThetaPsoOutcome, t0: f64, t1: f64) -> Vec<(f64, f64)> {
             (x / n, y / n)
         })
         .collect()
+}
+
+/// FLATLO: each aircraft's reference (grey) and flight (its colour), where it
+/// started and where it ended.
+fn paint_squadron(ctx: &mut Context, o: &FlatloOutcome, stale: bool, dot: f64) {
+    for a in &o.aircraft {
+        let reference = decimate(
+            a.reference.iter().map(|s| (s.position.x, s.position.y)),
+            dot,
+        );
+        ctx.draw(&Polyline {
+            points: &reference,
+            color: Color::DarkGray,
+        });
+    }
+    for a in &o.aircraft {
+        let color = if stale {
+            Color::Gray
+        } else {
+            uav_color(a.index)
+        };
+        let flown = decimate(a.flown.iter().map(|s| (s.position.x, s.position.y)), dot);
+        ctx.draw(&Polyline {
+            points: &flown,
+            color,
+        });
+    }
+    for a in &o.aircraft {
+        let style = Style::default().fg(uav_color(a.index)).bold();
+        ctx.print(
+            a.start.x,
+            a.start.y,
+            Span::styled(format!("{}", a.index), style),
+        );
+        if let Some(end) = a.flown.last() {
+            ctx.print(
+                end.position.x,
+                end.position.y,
+                Span::styled(format!("✈{}", a.index), style),
+            );
+        }
+    }
 }
 
 /// The slots around the start, facing the goal (or the planned path's first leg).
