@@ -12,7 +12,7 @@ use ratatui::backend::TestBackend;
 use skyform::mission::default_mission;
 use skyform::tui::app::Focus;
 use skyform::tui::fields::Item;
-use skyform::tui::fixtures::app_with_result;
+use skyform::tui::fixtures::{app_with_flatlo_result, app_with_result};
 use skyform::tui::jobs::{Job, JobMsg, Pipeline};
 use skyform::tui::{Action, App, Document, view};
 
@@ -130,5 +130,26 @@ fn the_formation_editor_shows_slots_and_iwps() {
     let screen = render(&app, Instant::now());
     assert!(screen.contains("3 UAVs"));
     assert!(screen.contains("light pole 4 ↔ pier 5"), "{screen}");
+    insta::assert_snapshot!(screen);
+}
+
+#[test]
+fn a_flatlo_result_on_the_kilometre_map_with_its_verification_table() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/flatlo-squadron.toml");
+    let m = skyform::mission::load(std::path::Path::new(path))
+        .unwrap()
+        .mission;
+    let mut app = app_with_flatlo_result(m, 3);
+    app.update(Action::FocusOn(Focus::Jobs));
+    let screen = render(&app, app.jobs[0].started);
+    assert!(screen.contains("✓ separation kept"), "{screen}");
+    assert!(
+        screen.contains("1-3"),
+        "the closest pair is listed: {screen}"
+    );
+    assert!(
+        screen.contains("✈3"),
+        "the aircraft are on the map: {screen}"
+    );
     insta::assert_snapshot!(screen);
 }

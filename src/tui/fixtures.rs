@@ -8,6 +8,7 @@ use nalgebra::{Point2, Point3};
 use super::app::App;
 use super::document::Document;
 use super::jobs::{Job, JobMsg, Outcome, Pipeline};
+use crate::flatlo;
 use crate::mission::{self, Mission, Obstacle};
 use crate::pipeline::{CancelToken, Silent};
 use crate::planner::{PlanOptions, plan};
@@ -63,6 +64,23 @@ pub fn app_with_result(mut mission: Mission, seed: u64, iterations: usize) -> Ap
         .push(Job::new(1, Pipeline::ThetaPso, seed, mission, started));
     let result = outcome
         .map(|o| Outcome::ThetaPso(Box::new(o)))
+        .map_err(|e| e.to_string());
+    app.on_job_msg(JobMsg::Done(1, result), started);
+    app
+}
+
+/// An app on `mission` whose map shows a finished FLATLO run with `seed`.
+pub fn app_with_flatlo_result(mission: Mission, seed: u64) -> App {
+    let outcome = flatlo::plan(&mission, seed, &mut Silent, &CancelToken::new());
+    let mut app = App::new(
+        Document::new(mission.clone(), Some(PathBuf::from("squadron.toml"))),
+        PathBuf::from("."),
+    );
+    let started = Instant::now();
+    app.jobs
+        .push(Job::new(1, Pipeline::Flatlo, seed, mission, started));
+    let result = outcome
+        .map(|o| Outcome::Flatlo(Box::new(o)))
         .map_err(|e| e.to_string());
     app.on_job_msg(JobMsg::Done(1, result), started);
     app

@@ -26,14 +26,19 @@ fn bar(progress: f64, width: usize) -> String {
 }
 
 fn state_span(job: &Job) -> Span<'static> {
+    let flatlo = job.pipeline == crate::tui::jobs::Pipeline::Flatlo;
     match &job.state {
         JobState::Running => Span::styled(job.stage.clone(), Style::default().cyan()),
         JobState::Cancelled => Span::styled("cancelled", Style::default().yellow()),
         JobState::Failed(_) => Span::styled("FAILED", Style::default().red().bold()),
-        JobState::Done { feasible: true } => Span::styled("feasible", Style::default().green()),
-        JobState::Done { feasible: false } => {
-            Span::styled("INFEASIBLE", Style::default().red().bold())
-        }
+        JobState::Done { feasible: true } => Span::styled(
+            if flatlo { "pass" } else { "feasible" },
+            Style::default().green(),
+        ),
+        JobState::Done { feasible: false } => Span::styled(
+            if flatlo { "FAIL" } else { "INFEASIBLE" },
+            Style::default().red().bold(),
+        ),
     }
 }
 
