@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::flatlo::{self, FlatloOutcome};
+use crate::fleet::{self, FleetOutcome};
 use crate::mission::{self, Checked, Report};
 use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError, Tee};
 use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
@@ -81,6 +82,10 @@ pub enum RunCommand {
         #[command(flatten)]
         record: RecordArgs,
     },
+    /// The distributed fleet: one PSO per quadrotor, quadrotor dynamics,
+    /// quaternion control. Exit status: 0 formed at every target and kept
+    /// the safety distance, 1 error, 2 did not, 130 cancelled (Ctrl-C).
+    Fleet(FleetArgs),
     /// FLATLO: the latitudinal-to-longitudinal squadron transition, simulated
     /// with the point-mass aircraft model and verified.
     ///
@@ -99,6 +104,26 @@ pub enum RunCommand {
         #[command(flatten)]
         record: RecordArgs,
     },
+}
+
+/// The distributed fleet: one PSO per quadrotor every τ, flown by
+/// quadrotor dynamics under quaternion control.
+///
+/// Progress goes to stderr, a summary to stdout. Exit status: 0 the fleet
+/// formed at every target and kept the safety distance, 1 error, 2 it did
+/// not, 130 cancelled (Ctrl-C).
+#[derive(Debug, clap::Args)]
+pub struct FleetArgs {
+    /// Mission TOML file (its [fleet] section).
+    pub mission: PathBuf,
+    /// Seed of the random starts and of every agent's PSO (default: the mission's `seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Write the whole outcome as JSON to FILE, or to stdout with `-`.
+    #[arg(long, value_name = "FILE|-")]
+    pub json: Option<PathBuf>,
+    #[command(flatten)]
+    pub record: RecordArgs,
 }
 
 /// Where to send a Rerun recording of the run.
@@ -168,6 +193,13 @@ pub fn main() -> ExitCode {
                 |m, seed, observer, cancel| planner::plan(m, seed, options, observer, cancel),
             ))
         }
+        Command::Run(RunCommand::Fleet(a)) => ExitCode::from(run_pipeline(
+            &a.mission,
+            a.seed,
+            a.json.as_deref(),
+            &a.record.sinks(),
+            fleet::plan,
+        )),
         Command::Run(RunCommand::Flatlo {
             mission,
             seed,
@@ -377,6 +409,21 @@ impl RunOutcome for FlatloOutcome {
     }
     fn record(&self, recorder: &mut Recorder) {
         recorder.log_flatlo(self);
+    }
+}
+
+impl RunOutcome for FleetOutcome {
+    fn summary(&self) -> String {
+        fleet_summary(self)
+    }
+    fn completion(&self) -> Completion {
+        self.completion
+    }
+    fn ok(&self) -> bool {
+        self.kept_apart() && self.obstacles_clear() && self.converged()
+    }
+    fn record(&self, recorder: &mut Recorder) {
+        recorder.log_fleet(self);
     }
 }
 
@@ -593,6 +640,74 @@ pub fn flatlo_summary(o: &FlatloOutcome) -> String {
         "  result       {verdict}: closest {closest}, minimum separation {:.0} m",
         v.min_separation
     );
+    s
+}
+
+/// The human summary of a fleet outcome.
+pub fn fleet_summary(o: &FleetOutcome) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(s, "Fleet for \"{}\" (seed {})", o.mission, o.seed);
+    let _ = writeln!(
+        s,
+        "  run          {:?}, {:.1} s simulated, {} agents",
+        o.completion,
+        o.duration,
+        o.agents.len()
+    );
+    for (k, t) in o.targets.iter().enumerate() {
+        let reached = t.converged_after.map_or("NOT REACHED".to_owned(), |a| {
+            format!("formed {a:.2} s after it appeared")
+        });
+        let _ = writeln!(
+            s,
+            "  target {:<5} ({:.2}, {:.2}) at t = {:.1} s: {reached}",
+            k + 1,
+            t.position.x,
+            t.position.y,
+            t.time
+        );
+    }
+    for d in &o.distances {
+        let last = d.values.last().copied().unwrap_or(f64::NAN);
+        let min = d.values.iter().copied().fold(f64::INFINITY, f64::min);
+        let _ = writeln!(
+            s,
+            "  pair {:>2}-{:<3}   final {last:.3} m (desired {:.3}), min {min:.3} m",
+            d.a, d.b, d.desired
+        );
+    }
+    let agents = o.closest_agents.as_ref().map_or("-".to_owned(), |c| {
+        format!(
+            "agents {} and {} at {:.3} m (t = {:.2} s)",
+            c.a, c.b, c.distance, c.time
+        )
+    });
+    let obstacle = o.closest_obstacle.as_ref().map_or("-".to_owned(), |c| {
+        format!(
+            "agent {} to '{}' at {:.3} m (t = {:.2} s)",
+            c.a, c.b, c.distance, c.time
+        )
+    });
+    let _ = writeln!(
+        s,
+        "  closest      {agents}; safety distance c = {} m",
+        o.safety_distance
+    );
+    let _ = writeln!(s, "  obstacles    {obstacle}");
+    let decisions: usize = o.agents.iter().map(|a| a.decisions).sum();
+    let evaluations: usize = o.agents.iter().map(|a| a.evaluations).sum();
+    let _ = writeln!(
+        s,
+        "  PSO effort   {decisions} decisions, {evaluations} cost evaluations ({:.0} per agent per second)",
+        evaluations as f64 / (o.agents.len().max(1) as f64 * o.duration.max(1e-9))
+    );
+    let verdict = if o.kept_apart() && o.obstacles_clear() && o.converged() {
+        "PASS"
+    } else {
+        "FAIL"
+    };
+    let _ = writeln!(s, "  result       {verdict}");
     s
 }
 

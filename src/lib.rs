@@ -7,6 +7,7 @@
 #[cfg(feature = "rerun")]
 pub mod cli;
 pub mod flatlo;
+pub mod fleet;
 pub mod geometry;
 pub mod mission;
 pub mod ode;

@@ -23,6 +23,7 @@ use rerun::sink::{FileSink, GrpcSink, LogSink};
 use rerun::{RecordingStream, RecordingStreamBuilder};
 
 use crate::flatlo::FlatloOutcome;
+use crate::fleet::FleetOutcome;
 use crate::mission::{Mission, to_toml_string};
 use crate::pipeline::{CostTerms, Event, Level, Observer};
 use crate::planner::{ThetaPsoOutcome, find_iwps};
@@ -73,6 +74,7 @@ enum Message {
     Log(Level, String),
     ThetaPso(Box<ThetaPsoOutcome>),
     Flatlo(Box<FlatloOutcome>),
+    Fleet(Box<FleetOutcome>),
 }
 
 /// A recording in progress. `finish` (or drop) flushes it and closes the file.
@@ -194,6 +196,11 @@ impl Recorder {
     /// Logs a FLATLO result.
     pub fn log_flatlo(&mut self, outcome: &FlatloOutcome) {
         self.send(Message::Flatlo(Box::new(outcome.clone())));
+    }
+
+    /// Logs a distributed-fleet result.
+    pub fn log_fleet(&mut self, outcome: &FleetOutcome) {
+        self.send(Message::Fleet(Box::new(outcome.clone())));
     }
 
     /// Flushes everything and closes the sinks; the `.rrd` is complete after this.
@@ -331,6 +338,7 @@ fn log_message(stream: &RecordingStream, message: Message) {
         Message::Scene(mission) => log_scene(stream, &mission),
         Message::ThetaPso(outcome) => log_theta_pso(stream, &outcome),
         Message::Flatlo(outcome) => log_flatlo(stream, &outcome),
+        Message::Fleet(outcome) => log_fleet(stream, &outcome),
         Message::Log(level, text) => {
             let level = match level {
                 Level::Info => rerun::TextLogLevel::INFO,
@@ -749,6 +757,130 @@ fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingSt
             ))
             .with_level(level),
         )?;
+    }
+    stream.reset_time();
+    Ok(())
+}
+
+/// A fleet outcome: agents with trails and their references on `sim_time`,
+/// detection ranges, targets, the inter-agent distances (Fig. 13) as series.
+fn log_fleet(stream: &RecordingStream, o: &FleetOutcome) -> rerun::RecordingStreamResult<()> {
+    stream.send_property(
+        "fleet",
+        &rerun::TextDocument::from_markdown(format!(
+            "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\nagents: {}\n\
+             kept apart: {}\nconverged: {}\nskyform: {}",
+            o.mission,
+            o.pipeline,
+            o.seed,
+            o.completion,
+            o.agents.len(),
+            o.kept_apart(),
+            o.converged(),
+            env!("CARGO_PKG_VERSION")
+        )),
+    )?;
+    let times = rerun::TimeColumn::new_duration_secs("sim_time", o.times.iter().copied());
+    for a in &o.agents {
+        let color = uav_color(a.index);
+        let name = format!("agent_{}", a.index);
+        let positions: Vec<[f32; 3]> = a.samples.iter().map(|s| f32x3(&s.position)).collect();
+        let references: Vec<[f32; 3]> = a.samples.iter().map(|s| f32x3(&s.reference)).collect();
+        stream.log_static(
+            format!("fleet/trails/{name}"),
+            &rerun::LineStrips3D::new([positions.clone()]).with_colors([color]),
+        )?;
+        let agent = format!("fleet/agents/{name}");
+        stream.log_static(
+            agent.as_str(),
+            &rerun::Points3D::update_fields()
+                .with_colors([color])
+                .with_radii([0.15f32])
+                .with_labels([format!("agent {}", a.index)]),
+        )?;
+        stream.send_columns(
+            agent.as_str(),
+            [times.clone()],
+            rerun::Points3D::update_fields()
+                .with_positions(positions.clone())
+                .columns_of_unit_batches()?,
+        )?;
+        let reference = format!("fleet/references/{name}");
+        stream.log_static(
+            reference.as_str(),
+            &rerun::Points3D::update_fields()
+                .with_colors([rerun::Color::from_rgb(200, 200, 200)])
+                .with_radii([0.05f32]),
+        )?;
+        stream.send_columns(
+            reference.as_str(),
+            [times.clone()],
+            rerun::Points3D::update_fields()
+                .with_positions(references)
+                .columns_of_unit_batches()?,
+        )?;
+    }
+    for d in &o.distances {
+        stream.send_columns(
+            format!("fleet/distances/{}_{}", d.a, d.b),
+            [times.clone()],
+            rerun::Scalars::update_fields()
+                .with_scalars(d.values.clone())
+                .columns_of_unit_batches()?,
+        )?;
+    }
+    if !o.distances.is_empty() {
+        stream.send_columns(
+            "fleet/distances/safety_c",
+            [times.clone()],
+            rerun::Scalars::update_fields()
+                .with_scalars(vec![o.safety_distance; o.times.len()])
+                .columns_of_unit_batches()?,
+        )?;
+    }
+    let z = o
+        .agents
+        .first()
+        .and_then(|a| a.samples.first())
+        .map_or(0.0, |s| s.position.z as f32);
+    for (k, t) in o.targets.iter().enumerate() {
+        stream.set_duration_secs("sim_time", t.time);
+        stream.log(
+            "fleet/target",
+            &rerun::Points3D::new([[t.position.x as f32, t.position.y as f32, z]])
+                .with_colors([rerun::Color::from_rgb(255, 215, 0)])
+                .with_radii([0.1f32])
+                .with_labels([format!("target {}", k + 1)]),
+        )?;
+        let text = match t.converged_after {
+            Some(after) => format!(
+                "target {} appears; formation reached {after:.2} s later",
+                k + 1
+            ),
+            None => format!("target {} appears; formation NOT reached", k + 1),
+        };
+        stream.log("fleet/events", &rerun::TextLog::new(text))?;
+    }
+    for (label, closest) in [
+        ("agents", &o.closest_agents),
+        ("obstacle", &o.closest_obstacle),
+    ] {
+        if let Some(c) = closest {
+            stream.set_duration_secs("sim_time", c.time);
+            let level = if c.distance < o.safety_distance {
+                rerun::TextLogLevel::WARN
+            } else {
+                rerun::TextLogLevel::INFO
+            };
+            stream.log(
+                "fleet/events",
+                &rerun::TextLog::new(format!(
+                    "closest approach ({label}): agent {} and {} at {:.3} m",
+                    c.a, c.b, c.distance
+                ))
+                .with_level(level),
+            )?;
+        }
     }
     stream.reset_time();
     Ok(())

@@ -447,8 +447,9 @@ impl Default for FleetParams {
             target_distance: 1.0,
             distances: Vec::new(),
             altitude: 1.0,
-            swarm_size: 30,
-            iterations: 30,
+            // The paper gives no swarm size: a 2-D step converges well within 20 × 20.
+            swarm_size: 20,
+            iterations: 20,
             inertia: 0.7298,
             cognitive: 1.49618,
             social: 1.49618,

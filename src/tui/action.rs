@@ -68,6 +68,12 @@ pub enum Action {
     Run,
     /// Run FLATLO (the squadron transition) with the mission's seed.
     RunFlatlo,
+    /// Run the distributed fleet with the mission's seed.
+    RunFleet,
+    /// Move the fleet replay by this many seconds (and pause it).
+    Scrub(f64),
+    /// Play or pause the fleet replay.
+    TogglePlay,
     /// Re-run the last pipeline with a seed not used yet.
     RunNewSeed,
     /// Cancel the selected (or latest) running job.

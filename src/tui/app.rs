@@ -138,6 +138,10 @@ pub struct App {
     /// Record runs to an `.rrd` beside the mission.
     pub record_rrd: bool,
     pub viewer: Viewer,
+    /// Fleet replay: the instant shown on the map (None = the end) and
+    /// whether it advances by itself.
+    pub replay: Option<f64>,
+    pub playing: bool,
     pub should_quit: bool,
     /// Where relative paths (save as, open) start.
     pub cwd: PathBuf,
@@ -171,6 +175,8 @@ impl App {
             status: None,
             record_rrd: false,
             viewer: Viewer::Off,
+            replay: None,
+            playing: false,
             should_quit: false,
             cwd,
             drag: None,
@@ -196,6 +202,36 @@ impl App {
 
     pub fn any_running(&self) -> bool {
         self.jobs.iter().any(Job::is_running)
+    }
+
+    /// Duration of the shown fleet result, if one is shown (the replay's range).
+    pub fn replay_end(&self) -> Option<f64> {
+        let o = self.shown()?.outcome.as_ref()?.fleet()?;
+        Some(o.duration)
+    }
+
+    /// The fleet replay instant on the map: the replay cursor, or the end.
+    pub fn replay_time(&self) -> Option<f64> {
+        self.replay_end()
+            .map(|end| self.replay.unwrap_or(end).min(end))
+    }
+
+    /// The loop needs to wake up by itself (running jobs, a playing replay).
+    pub fn wants_tick(&self) -> bool {
+        self.any_running() || self.playing
+    }
+
+    /// Time passed: a playing replay advances at real speed.
+    pub fn tick(&mut self, elapsed: Duration) {
+        if self.playing
+            && let Some(end) = self.replay_end()
+        {
+            let t = self.replay.unwrap_or(0.0) + elapsed.as_secs_f64();
+            self.replay = Some(t.min(end));
+            if t >= end {
+                self.playing = false;
+            }
+        }
     }
 
     /// The job whose result is on the map.
@@ -376,6 +412,23 @@ impl App {
                     "add tool off"
                 });
             }
+            Duplicate if matches!(self.selected, Item::Fleet | Item::FleetTarget(_)) => {
+                // A new target 10 s after the last, 1 m east of it.
+                let last = self.mission().fleet.targets.last().cloned();
+                let b = &self.mission().bounds;
+                let next = match last {
+                    Some(t) => crate::mission::FleetTarget {
+                        time: t.time + 10.0,
+                        position: t.position + nalgebra::Vector2::new(1.0, 0.0),
+                    },
+                    None => crate::mission::FleetTarget {
+                        time: 0.0,
+                        position: Point2::new((b.x[0] + b.x[1]) / 2.0, (b.y[0] + b.y[1]) / 2.0),
+                    },
+                };
+                self.edit(|m| m.fleet.targets.push(next));
+                self.select(Item::FleetTarget(self.mission().fleet.targets.len() - 1));
+            }
             Duplicate => {
                 if let Item::Obstacle(i) = self.selected
                     && let Some(o) = self.mission().obstacles.get(i)
@@ -487,6 +540,22 @@ impl App {
             }
             Run => self.run(Pipeline::ThetaPso, self.mission().seed),
             RunFlatlo => self.run(Pipeline::Flatlo, self.mission().seed),
+            RunFleet => self.run(Pipeline::Fleet, self.mission().seed),
+            Scrub(seconds) => {
+                if let Some(end) = self.replay_end() {
+                    let t = self.replay.unwrap_or(end) + seconds;
+                    self.replay = Some(t.clamp(0.0, end));
+                    self.playing = false;
+                }
+            }
+            TogglePlay => {
+                if let Some(end) = self.replay_end() {
+                    if !self.playing && self.replay.is_none_or(|t| t >= end) {
+                        self.replay = Some(0.0);
+                    }
+                    self.playing = !self.playing;
+                }
+            }
             RunNewSeed => {
                 let seed = self
                     .jobs
@@ -668,7 +737,7 @@ impl App {
         let s = self.step_size();
         let item = self.selected.clone();
         match &item {
-            Item::Obstacle(_) | Item::Start | Item::Goal => {
+            Item::Obstacle(_) | Item::Start | Item::Goal | Item::FleetTarget(_) => {
                 if let Some(p) = self.position_of(&item) {
                     let to = p + nalgebra::Vector2::new(dx * s, dy * s);
                     self.edit(|m| set_position(m, &item, to));
@@ -697,6 +766,7 @@ impl App {
             Item::Start => Some(m.route.start.xy()),
             Item::Goal => Some(m.route.goal.xy()),
             Item::Slot(i) => m.formation.slots.get(*i).map(|s| Point2::new(s.x, s.y)),
+            Item::FleetTarget(i) => m.fleet.targets.get(*i).map(|t| t.position),
             _ => None,
         }
     }
@@ -724,6 +794,14 @@ impl App {
                         m.formation.slots.remove(i);
                     }
                 });
+            }
+            Item::FleetTarget(i) => {
+                self.edit(|m| {
+                    if i < m.fleet.targets.len() {
+                        m.fleet.targets.remove(i);
+                    }
+                });
+                self.set_status("fleet target deleted (u to undo)");
             }
             Item::Waypoint(between) => {
                 self.edit(|m| {
@@ -883,9 +961,27 @@ impl App {
                             "SEPARATION LOST"
                         }
                     ),
+                    Some(jobs::Outcome::Fleet(o)) => format!(
+                        "job {id} {verb}: {} of {} targets formed, closest {}, {}",
+                        o.targets
+                            .iter()
+                            .filter(|t| t.converged_after.is_some())
+                            .count(),
+                        o.targets.len(),
+                        o.closest_agents
+                            .as_ref()
+                            .map_or("-".into(), |c| format!("{:.2} m", c.distance)),
+                        if o.kept_apart() && o.obstacles_clear() {
+                            "safety distance kept"
+                        } else {
+                            "SAFETY DISTANCE LOST"
+                        }
+                    ),
                     None => format!("job {id} {verb}"),
                 };
                 self.shown_job = Some(id);
+                self.replay = None;
+                self.playing = false;
                 self.set_status(text);
             }
         }
@@ -1064,6 +1160,11 @@ fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
             if let Some(s) = m.formation.slots.get_mut(*i) {
                 s.x = p.x;
                 s.y = p.y;
+            }
+        }
+        Item::FleetTarget(i) => {
+            if let Some(t) = m.fleet.targets.get_mut(*i) {
+                t.position = p;
             }
         }
         _ => {}

@@ -26,6 +26,10 @@ pub enum Item {
     ThetaPso,
     /// The FLATLO squadron and its aircraft model.
     Squadron,
+    /// The distributed fleet's parameters.
+    Fleet,
+    /// One target of the fleet's timed sequence.
+    FleetTarget(usize),
 }
 
 impl Item {
@@ -44,6 +48,8 @@ impl Item {
             Item::Waypoint([a, b]) => format!("IWP {a} ↔ {b}"),
             Item::ThetaPso => "θ-PSO parameters".into(),
             Item::Squadron => "Squadron (FLATLO)".into(),
+            Item::Fleet => "Fleet".into(),
+            Item::FleetTarget(i) => format!("Fleet target {}", i + 1),
         }
     }
 
@@ -52,6 +58,7 @@ impl Item {
         match self {
             Item::Obstacle(i) => *i < mission.obstacles.len(),
             Item::Slot(i) => *i < mission.formation.slots.len(),
+            Item::FleetTarget(i) => *i < mission.fleet.targets.len(),
             Item::Waypoint([a, b]) => {
                 let named = |n: &String| mission.obstacles.iter().any(|o| &o.name == n);
                 named(a) && named(b)
@@ -67,6 +74,8 @@ pub fn map_items(mission: &Mission) -> Vec<Item> {
     items.extend((0..mission.obstacles.len()).map(Item::Obstacle));
     items.push(Item::ThetaPso);
     items.push(Item::Squadron);
+    items.push(Item::Fleet);
+    items.extend((0..mission.fleet.targets.len()).map(Item::FleetTarget));
     items
 }
 
@@ -508,6 +517,37 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
             ]
         }
         Item::Squadron => squadron_fields(m),
+        Item::Fleet => fleet_fields(m),
+        Item::FleetTarget(i) => {
+            let Some(t) = m.fleet.targets.get(*i) else {
+                return Vec::new();
+            };
+            let at = |key: &str| format!("fleet.targets[{i}].{key}");
+            vec![
+                field("time (s)", at("time"), fmt_num(t.time), |m, item, t| {
+                    target(m, item)?.time = number(t)?;
+                    Ok(())
+                }),
+                field(
+                    "x (m)",
+                    at("position"),
+                    fmt_num(t.position.x),
+                    |m, item, t| {
+                        target(m, item)?.position.x = number(t)?;
+                        Ok(())
+                    },
+                ),
+                field(
+                    "y (m)",
+                    at("position"),
+                    fmt_num(t.position.y),
+                    |m, item, t| {
+                        target(m, item)?.position.y = number(t)?;
+                        Ok(())
+                    },
+                ),
+            ]
+        }
         Item::ThetaPso => {
             let p = &m.theta_pso;
             vec![
@@ -608,6 +648,127 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
             ]
         }
     }
+}
+
+fn target<'m>(
+    m: &'m mut Mission,
+    item: &Item,
+) -> Result<&'m mut crate::mission::FleetTarget, String> {
+    match item {
+        Item::FleetTarget(i) => m.fleet.targets.get_mut(*i).ok_or("no such target".into()),
+        _ => Err("not a fleet target".into()),
+    }
+}
+
+/// The fleet's parameters (Table 1 and the scenario); gains and the
+/// airframe stay in the file.
+fn fleet_fields(m: &Mission) -> Vec<Field> {
+    let p = &m.fleet;
+    vec![
+        field("agents n", "fleet.agents", p.agents, |m, _, t| {
+            m.fleet.agents = count(t)?;
+            Ok(())
+        }),
+        field(
+            "ρ target weight",
+            "fleet.rho",
+            fmt_num(p.rho),
+            |m, _, t| {
+                m.fleet.rho = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "σ steepness",
+            "fleet.sigma",
+            fmt_num(p.sigma),
+            |m, _, t| {
+                m.fleet.sigma = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "c safety (m)",
+            "fleet.safety_distance",
+            fmt_num(p.safety_distance),
+            |m, _, t| {
+                m.fleet.safety_distance = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "l neighbourhood (m)",
+            "fleet.neighbourhood",
+            fmt_num(p.neighbourhood),
+            |m, _, t| {
+                m.fleet.neighbourhood = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "d_obs detection (m)",
+            "fleet.detection_range",
+            fmt_num(p.detection_range),
+            |m, _, t| {
+                m.fleet.detection_range = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "h_max step (m)",
+            "fleet.step_max",
+            fmt_num(p.step_max),
+            |m, _, t| {
+                m.fleet.step_max = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "τ replan (s)",
+            "fleet.replan_period",
+            fmt_num(p.replan_period),
+            |m, _, t| {
+                m.fleet.replan_period = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "d_ip to target (m)",
+            "fleet.target_distance",
+            fmt_num(p.target_distance),
+            |m, _, t| {
+                m.fleet.target_distance = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "altitude (m)",
+            "fleet.altitude",
+            fmt_num(p.altitude),
+            |m, _, t| {
+                m.fleet.altitude = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "duration (s)",
+            "fleet.duration",
+            fmt_num(p.duration),
+            |m, _, t| {
+                m.fleet.duration = number(t)?;
+                Ok(())
+            },
+        ),
+        field(
+            "tolerance",
+            "fleet.tolerance",
+            fmt_num(p.tolerance),
+            |m, _, t| {
+                m.fleet.tolerance = number(t)?;
+                Ok(())
+            },
+        ),
+    ]
 }
 
 /// FLATLO's squadron: what the operator sets per mission; the airframe

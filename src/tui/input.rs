@@ -90,6 +90,16 @@ pub const KEYS: &[(&str, &str, &str)] = &[
         "F",
         "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
     ),
+    (
+        "Run",
+        "T",
+        "run the distributed fleet (select Fleet and its targets with n/p to edit them; d adds a target)",
+    ),
+    (
+        "Run",
+        ",  .  >",
+        "fleet replay: back / forward one second, play or pause",
+    ),
     ("Run", "N", "re-run the last pipeline with a new seed"),
     ("Run", "x", "cancel the selected (or latest) running job"),
     (
@@ -170,6 +180,10 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
         KeyCode::Char('r') => Some(Action::Run),
         KeyCode::Char('N') => Some(Action::RunNewSeed),
         KeyCode::Char('F') => Some(Action::RunFlatlo),
+        KeyCode::Char('T') => Some(Action::RunFleet),
+        KeyCode::Char(',') => Some(Action::Scrub(-1.0)),
+        KeyCode::Char('.') if focus != Focus::Inspector => Some(Action::Scrub(1.0)),
+        KeyCode::Char('>') => Some(Action::TogglePlay),
         KeyCode::Char('x') => Some(Action::Cancel),
         KeyCode::Char('e') => Some(Action::ToggleRecording),
         KeyCode::Char('E') => Some(Action::CycleViewer),
@@ -359,6 +373,12 @@ fn hit(
                 let d = (o.center - p).norm();
                 if d <= o.radius + tolerance {
                     consider(d - o.radius, Item::Obstacle(i));
+                }
+            }
+            for (i, t) in m.fleet.targets.iter().enumerate() {
+                let d = (t.position - p).norm();
+                if d <= tolerance * 1.5 {
+                    consider(d - tolerance * 2.0, Item::FleetTarget(i));
                 }
             }
         }

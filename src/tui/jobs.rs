@@ -15,6 +15,7 @@ use crossbeam_channel::Sender;
 use nalgebra::Point3;
 
 use crate::flatlo::{self, FlatloOutcome};
+use crate::fleet::{self, FleetOutcome};
 use crate::mission::Mission;
 use crate::pipeline::{CancelToken, Completion, Event, Level, Observer};
 use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
@@ -26,6 +27,7 @@ pub type JobId = usize;
 pub enum Pipeline {
     ThetaPso,
     Flatlo,
+    Fleet,
 }
 
 impl Pipeline {
@@ -33,6 +35,7 @@ impl Pipeline {
         match self {
             Pipeline::ThetaPso => "θ-PSO",
             Pipeline::Flatlo => "FLATLO",
+            Pipeline::Fleet => "fleet",
         }
     }
 
@@ -41,6 +44,7 @@ impl Pipeline {
         match self {
             Pipeline::ThetaPso => "theta-pso",
             Pipeline::Flatlo => "flatlo",
+            Pipeline::Fleet => "fleet",
         }
     }
 }
@@ -50,6 +54,7 @@ impl Pipeline {
 pub enum Outcome {
     ThetaPso(Box<ThetaPsoOutcome>),
     Flatlo(Box<FlatloOutcome>),
+    Fleet(Box<FleetOutcome>),
 }
 
 impl Outcome {
@@ -57,6 +62,7 @@ impl Outcome {
         match self {
             Outcome::ThetaPso(o) => o.completion,
             Outcome::Flatlo(o) => o.completion,
+            Outcome::Fleet(o) => o.completion,
         }
     }
 
@@ -65,12 +71,20 @@ impl Outcome {
         match self {
             Outcome::ThetaPso(o) => o.feasible(),
             Outcome::Flatlo(o) => o.passed(),
+            Outcome::Fleet(o) => o.kept_apart() && o.obstacles_clear() && o.converged(),
         }
     }
 
     pub fn theta_pso(&self) -> Option<&ThetaPsoOutcome> {
         match self {
             Outcome::ThetaPso(o) => Some(o),
+            _ => None,
+        }
+    }
+
+    pub fn fleet(&self) -> Option<&FleetOutcome> {
+        match self {
+            Outcome::Fleet(o) => Some(o),
             _ => None,
         }
     }
@@ -344,6 +358,9 @@ fn plan(
         Pipeline::Flatlo => {
             flatlo::plan(mission, seed, observer, cancel).map(|o| Outcome::Flatlo(Box::new(o)))
         }
+        Pipeline::Fleet => {
+            fleet::plan(mission, seed, observer, cancel).map(|o| Outcome::Fleet(Box::new(o)))
+        }
     }
     .map_err(|e| e.to_string())
 }
@@ -376,6 +393,7 @@ fn run(
             match &outcome {
                 Outcome::ThetaPso(o) => r.log_theta_pso(o),
                 Outcome::Flatlo(o) => r.log_flatlo(o),
+                Outcome::Fleet(o) => r.log_fleet(o),
             }
             let finished = r.finish();
             if let Some((file, bytes)) = finished.file {

@@ -159,7 +159,10 @@ fn event_loop(terminal: &mut DefaultTerminal, app: &mut App) -> io::Result<()> {
                     redraw = true;
                 }
             },
-            recv(tick) -> _ => redraw = true,
+            recv(tick) -> _ => {
+                app.tick(TICK);
+                redraw = true;
+            },
         }
         // Take what else is waiting before drawing once.
         redraw |= app.drain_job_messages();

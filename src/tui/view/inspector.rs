@@ -34,6 +34,8 @@ fn item_path(item: &Item) -> Option<String> {
         Item::Slot(i) => Some(format!("formation.slots[{i}]")),
         Item::ThetaPso => Some("theta_pso".into()),
         Item::Squadron => Some("flatlo".into()),
+        Item::Fleet => Some("fleet".into()),
+        Item::FleetTarget(i) => Some(format!("fleet.targets[{i}]")),
         Item::Mission | Item::Waypoint(_) => None,
     }
 }

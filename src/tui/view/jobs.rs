@@ -26,7 +26,7 @@ fn bar(progress: f64, width: usize) -> String {
 }
 
 fn state_span(job: &Job) -> Span<'static> {
-    let flatlo = job.pipeline == crate::tui::jobs::Pipeline::Flatlo;
+    let flatlo = job.pipeline != crate::tui::jobs::Pipeline::ThetaPso;
     match &job.state {
         JobState::Running => Span::styled(job.stage.clone(), Style::default().cyan()),
         JobState::Cancelled => Span::styled("cancelled", Style::default().yellow()),
@@ -183,6 +183,10 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
                 Style::default().yellow(),
             ));
         }
+    } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.fleet()) {
+        let lines = fleet_table(o, app.is_stale(job));
+        frame.render_widget(Paragraph::new(lines), detail);
+        return;
     } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.flatlo()) {
         // FLATLO's verification table fills the panel (no convergence chart).
         let lines = flatlo_table(o, app.is_stale(job));
@@ -196,6 +200,73 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         Layout::vertical([Constraint::Min(0), Constraint::Length(facts_height)]).areas(detail);
     frame.render_widget(Paragraph::new(facts), facts_area);
     draw_chart(frame, job, chart_area);
+}
+
+/// The fleet's result: each target's formation time, the closest approaches,
+/// the final inter-agent distances, the PSO effort.
+fn fleet_table(o: &crate::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>> {
+    let safe = o.kept_apart() && o.obstacles_clear();
+    let mut lines = vec![Line::from(vec![
+        Span::raw(format!(
+            "{} agents · {:.0} s · ",
+            o.agents.len(),
+            o.duration
+        )),
+        if safe {
+            Span::styled("✓ safety distance kept", Style::default().green())
+        } else {
+            Span::styled("✗ SAFETY DISTANCE LOST", Style::default().red().bold())
+        },
+    ])];
+    for (k, t) in o.targets.iter().enumerate() {
+        let text = match t.converged_after {
+            Some(a) => format!(
+                "target {} (t {:.0} s): formed after {a:.1} s",
+                k + 1,
+                t.time
+            ),
+            None => format!("target {} (t {:.0} s): NOT formed", k + 1, t.time),
+        };
+        let style = if t.converged_after.is_some() {
+            Style::default()
+        } else {
+            Style::default().red()
+        };
+        lines.push(Line::styled(text, style));
+    }
+    if let Some(c) = &o.closest_agents {
+        lines.push(Line::raw(format!(
+            "closest agents {}-{}: {:.3} m at {:.1} s (c {})",
+            c.a, c.b, c.distance, c.time, o.safety_distance
+        )));
+    }
+    if let Some(c) = &o.closest_obstacle {
+        lines.push(Line::raw(format!(
+            "closest obstacle: agent {} to {} {:.3} m",
+            c.a, c.b, c.distance
+        )));
+    }
+    for d in o.distances.iter().take(6) {
+        lines.push(Line::raw(format!(
+            "d{}{} final {:.3} m (want {:.3})",
+            d.a,
+            d.b,
+            d.values.last().copied().unwrap_or(f64::NAN),
+            d.desired
+        )));
+    }
+    let evaluations: usize = o.agents.iter().map(|a| a.evaluations).sum();
+    lines.push(Line::raw(format!(
+        "PSO: {} cost evaluations · , . > replay",
+        evaluations
+    )));
+    if stale {
+        lines.push(Line::styled(
+            "stale: the mission changed since this run",
+            Style::default().yellow(),
+        ));
+    }
+    lines
 }
 
 /// FLATLO's verification: every pair's closest approach, the final line, the verdict.

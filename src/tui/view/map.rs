@@ -14,6 +14,7 @@ use ratatui::widgets::canvas::{Canvas, Context, Line, Painter, Rectangle, Shape}
 use ratatui::widgets::{Block, BorderType, Borders, Cell, Row, Table};
 
 use crate::flatlo::FlatloOutcome;
+use crate::fleet::FleetOutcome;
 use crate::mission::{Mission, ShapeChoice};
 use crate::planner::ThetaPsoOutcome;
 use crate::tui::app::{App, Focus, formation_extent};
@@ -197,6 +198,57 @@ fn flatlo_of(app: &App) -> Option<(&FlatloOutcome, bool)> {
     Some((outcome, app.is_stale(job)))
 }
 
+/// The shown fleet result, if the shown job is one.
+fn fleet_of(app: &App) -> Option<(&FleetOutcome, bool)> {
+    let job = app.shown()?;
+    let outcome = job.outcome.as_ref()?.fleet()?;
+    Some((outcome, app.is_stale(job)))
+}
+
+/// The fleet at the replay instant: trails so far, each agent with its
+/// detection range, and its reference.
+fn paint_fleet(ctx: &mut Context, app: &App, o: &FleetOutcome, stale: bool, dot: f64) {
+    let t = app.replay_time().unwrap_or(o.duration);
+    let detection = app.mission().fleet.detection_range;
+    for a in &o.agents {
+        let color = if stale {
+            Color::Gray
+        } else {
+            uav_color(a.index)
+        };
+        let upto = a.samples.partition_point(|s| s.t <= t);
+        let trail = decimate(
+            a.samples[..upto]
+                .iter()
+                .map(|s| (s.position.x, s.position.y)),
+            dot,
+        );
+        ctx.draw(&Polyline {
+            points: &trail,
+            color,
+        });
+        if let Some(s) = a.samples[..upto].last() {
+            ctx.draw(&Ring {
+                x: s.position.x,
+                y: s.position.y,
+                radius: detection,
+                color: Color::DarkGray,
+                dot,
+            });
+            ctx.print(
+                s.position.x,
+                s.position.y,
+                Span::styled(format!("●{}", a.index), Style::default().fg(color).bold()),
+            );
+            ctx.print(
+                s.reference.x,
+                s.reference.y,
+                Span::styled("·", Style::default().fg(Color::White)),
+            );
+        }
+    }
+}
+
 /// The x-y box the map fits: the bounds, and a shown FLATLO squadron's
 /// flight (kilometres, wherever the mission's bounds are).
 fn extent(app: &App) -> ([f64; 2], [f64; 2]) {
@@ -234,6 +286,15 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect) {
             crate::tui::fields::fmt_num(app.step_size())
         )),
     ];
+    if let (Some(t), Some(end)) = (app.replay_time(), app.replay_end()) {
+        title.push(Span::styled(
+            format!(
+                " t = {t:.1} / {end:.1} s {} ",
+                if app.playing { "▶" } else { "‖" }
+            ),
+            Style::default().black().on_cyan(),
+        ));
+    }
     if app.add_tool {
         title.push(Span::styled(
             " ADD: click to place ",
@@ -387,6 +448,21 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
     }
     if let Some((o, stale)) = flatlo_of(app) {
         paint_squadron(ctx, o, stale, dot);
+    }
+    for (k, t) in m.fleet.targets.iter().enumerate() {
+        let style = if app.selected == Item::FleetTarget(k) {
+            Style::default().black().on_yellow().bold()
+        } else {
+            Style::default().fg(Color::Yellow).bold()
+        };
+        ctx.print(
+            t.position.x,
+            t.position.y,
+            Span::styled(format!("◎{}", k + 1), style),
+        );
+    }
+    if let Some((o, stale)) = fleet_of(app) {
+        paint_fleet(ctx, app, o, stale, dot);
     }
 
     // IWPs (eq. 9): enabled ones bright, disabled ones dim.

@@ -143,6 +143,15 @@ fn boxed(title: &str, color: Color) -> Block<'static> {
         .title(Span::styled(format!(" {title} "), Style::default().bold()))
 }
 
+/// Rows `lines` take once wrapped at `width` cells.
+fn rows(lines: &[Line], width: u16) -> u16 {
+    let width = usize::from(width.max(1));
+    lines
+        .iter()
+        .map(|l| l.width().max(1).div_ceil(width) as u16)
+        .sum()
+}
+
 fn key(k: &str) -> Span<'static> {
     Span::styled(k.to_owned(), Style::default().yellow().bold())
 }
@@ -150,33 +159,60 @@ fn key(k: &str) -> Span<'static> {
 fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
     match overlay {
         Overlay::Help => {
-            let mut lines = Vec::new();
-            let mut group = "";
-            for (g, keys, what) in KEYS {
-                if *g != group {
-                    if !group.is_empty() {
+            // Two columns when there is room, else one (the README lists every key too).
+            let groups = ["General", "Select & move", "Edit", "Formation", "Run"];
+            let column = |names: &[&str]| {
+                let mut lines = Vec::new();
+                for name in names {
+                    if !lines.is_empty() {
                         lines.push(Line::raw(""));
                     }
                     lines.push(Line::styled(
-                        g.to_string(),
+                        name.to_string(),
                         Style::default().bold().underlined(),
                     ));
-                    group = g;
+                    for (_, keys, what) in KEYS.iter().filter(|(g, _, _)| g == name) {
+                        lines.push(Line::from(vec![
+                            key(&format!("  {keys:<16}")),
+                            Span::raw(what.to_string()),
+                        ]));
+                    }
                 }
-                lines.push(Line::from(vec![
-                    key(&format!("  {keys:<16}")),
-                    Span::raw(what.to_string()),
-                ]));
-            }
-            let height = lines.len() as u16 + 2;
-            let r = centred(area, 96, height);
+                lines
+            };
+            let wide = area.width >= 120;
+            let (left, right) = if wide {
+                (column(&groups[..2]), column(&groups[2..]))
+            } else {
+                (column(&groups), Vec::new())
+            };
+            let width = if wide {
+                area.width.min(150)
+            } else {
+                96.min(area.width)
+            };
+            let inner_width = width.saturating_sub(2);
+            let (left_width, right_width) = if wide {
+                let l = inner_width * 45 / 100;
+                (l, inner_width - l)
+            } else {
+                (inner_width, inner_width)
+            };
+            let height = rows(&left, left_width).max(rows(&right, right_width)) + 2;
+            let r = centred(area, width, height);
             frame.render_widget(Clear, r);
-            frame.render_widget(
-                Paragraph::new(lines)
-                    .wrap(Wrap { trim: false })
-                    .block(boxed("Keys · any key closes", Color::Cyan)),
-                r,
-            );
+            let block = boxed("Keys · any key closes", Color::Cyan);
+            let inner = block.inner(r);
+            frame.render_widget(block, r);
+            if wide {
+                let [a, b] =
+                    Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)])
+                        .areas(inner);
+                frame.render_widget(Paragraph::new(left).wrap(Wrap { trim: false }), a);
+                frame.render_widget(Paragraph::new(right).wrap(Wrap { trim: false }), b);
+            } else {
+                frame.render_widget(Paragraph::new(left).wrap(Wrap { trim: false }), inner);
+            }
         }
         Overlay::Quit => {
             let lines = vec![
