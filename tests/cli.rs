@@ -168,3 +168,33 @@ fn run_flatlo_summarises_the_squadron_and_exits_by_its_verdict() {
         text(&out.stdout)
     );
 }
+
+#[test]
+fn run_fleet_reports_each_target_and_exits_by_its_verdict() {
+    let out = skyform(&[
+        "run",
+        "fleet",
+        "missions/fleet-triangle.toml",
+        "--seed",
+        "2",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("Fleet for \"Fleet triangle\" (seed 2)"),
+        "{stdout}"
+    );
+    assert_eq!(stdout.matches("formed ").count(), 4, "{stdout}");
+    assert!(stdout.contains("result       PASS"), "{stdout}");
+
+    // A formation the duration is too short for: exit 2.
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let short = dir.path().join("short.toml");
+    let source = std::fs::read_to_string("missions/fleet-triangle.toml").unwrap_or_default();
+    let edited = source.replace("duration = 80.0", "duration = 3.0");
+    assert_ne!(edited, source);
+    std::fs::write(&short, edited).unwrap_or_else(|e| panic!("{e}"));
+    let out = skyform(&["run", "fleet", short.to_str().unwrap_or_default()]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stdout));
+    assert!(text(&out.stdout).contains("NOT REACHED"));
+}

@@ -324,3 +324,59 @@ fn a_flatlo_recording_holds_references_flights_series_and_events() {
     }
     assert!(paths.contains(&"/flatlo/events".to_owned()));
 }
+
+#[test]
+fn a_fleet_recording_holds_agents_references_and_the_distance_series() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let rrd = dir.path().join("fleet.rrd");
+    let json = dir.path().join("fleet.json");
+    let out = skyform(&[
+        "run",
+        "fleet",
+        "missions/fleet-triangle.toml",
+        "--rrd",
+        rrd.to_str().unwrap_or_default(),
+        "--json",
+        json.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let outcome: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap_or_default())
+            .unwrap_or_default();
+    let chunks = chunks(&rrd);
+    let paths = entity_paths(&chunks);
+    for i in 0..3 {
+        for prefix in ["agents", "references", "trails"] {
+            let entity = format!("/fleet/{prefix}/agent_{i}");
+            assert!(paths.contains(&entity), "{entity} missing from {paths:?}");
+        }
+    }
+    // Fig. 13: one series per pair, equal to the outcome's.
+    for (a, b) in [(0, 1), (0, 2), (1, 2)] {
+        let series: Vec<f64> = values(
+            &chunks,
+            &format!("/fleet/distances/{a}_{b}"),
+            "Scalars:scalars",
+        );
+        let expected: Vec<f64> = outcome["distances"]
+            .as_array()
+            .and_then(|all| all.iter().find(|d| d["a"] == a && d["b"] == b))
+            .and_then(|d| d["values"].as_array())
+            .map(|v| v.iter().filter_map(|x| x.as_f64()).collect())
+            .unwrap_or_default();
+        assert_eq!(series.len(), expected.len());
+        assert!(
+            series
+                .iter()
+                .zip(&expected)
+                .all(|(x, y)| (x - y).abs() < 1e-9)
+        );
+    }
+    assert!(paths.contains(&"/fleet/distances/safety_c".to_owned()));
+    assert!(paths.contains(&"/fleet/events".to_owned()));
+}

@@ -539,3 +539,38 @@ fn the_readme_lists_every_key_the_help_overlay_shows() {
         assert!(readme.contains(&row), "README.md lacks the key row {row}");
     }
 }
+
+#[test]
+fn a_fleet_run_replays_on_the_map() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/fleet-triangle.toml");
+    let mut m = mission::load(std::path::Path::new(path)).unwrap().mission;
+    m.fleet.duration = 6.0;
+    let mut app = App::new(Document::new(m, None), std::env::temp_dir());
+    app.update(Action::RunFleet);
+    assert!(app.wait_for_jobs(Duration::from_secs(60)));
+    assert_eq!(app.jobs[0].pipeline, skyform::tui::jobs::Pipeline::Fleet);
+    assert_eq!(app.replay_end(), Some(6.0));
+    assert_eq!(app.replay_time(), Some(6.0), "the end until scrubbed");
+    app.update(Action::Scrub(-2.5));
+    assert_eq!(app.replay_time(), Some(3.5));
+    app.update(Action::TogglePlay);
+    assert!(app.playing && app.wants_tick());
+    app.tick(Duration::from_secs(1));
+    assert!((app.replay_time().unwrap() - 4.5).abs() < 1e-9);
+    app.tick(Duration::from_secs(10));
+    assert_eq!(app.replay_time(), Some(6.0));
+    assert!(!app.playing, "stops at the end");
+    // Fleet targets are items: select, move, add, delete.
+    app.update(Action::Select(Item::FleetTarget(0)));
+    app.update(Action::FocusOn(Focus::Map));
+    app.update(Action::Nudge(1.0, 0.0));
+    assert_eq!(
+        app.mission().fleet.targets[0].position,
+        Point2::new(3.0, 2.0)
+    );
+    let n = app.mission().fleet.targets.len();
+    app.update(Action::Duplicate);
+    assert_eq!(app.mission().fleet.targets.len(), n + 1);
+    app.update(Action::Delete);
+    assert_eq!(app.mission().fleet.targets.len(), n);
+}

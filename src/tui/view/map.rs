@@ -236,14 +236,14 @@ fn paint_fleet(ctx: &mut Context, app: &App, o: &FleetOutcome, stale: bool, dot:
                 dot,
             });
             ctx.print(
-                s.position.x,
-                s.position.y,
-                Span::styled(format!("●{}", a.index), Style::default().fg(color).bold()),
-            );
-            ctx.print(
                 s.reference.x,
                 s.reference.y,
                 Span::styled("·", Style::default().fg(Color::White)),
+            );
+            ctx.print(
+                s.position.x,
+                s.position.y,
+                Span::styled(format!("●{}", a.index), Style::default().fg(color).bold()),
             );
         }
     }
