@@ -117,3 +117,17 @@ pub enum PipelineError {
     #[error("{0}")]
     Unsupported(String),
 }
+
+/// Every pipeline's first step: a mission with errors is refused, naming them.
+pub fn require_valid(mission: &crate::mission::Mission) -> Result<(), PipelineError> {
+    let errors: Vec<String> = crate::mission::validate(mission)
+        .into_iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.to_string())
+        .collect();
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(PipelineError::InvalidMission(errors.join("\n")))
+    }
+}

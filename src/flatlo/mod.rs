@@ -17,7 +17,7 @@ use rand_distr::StandardNormal;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::mission::{FlatloParams, Mission, validate};
+use crate::mission::{FlatloParams, Mission};
 use crate::ode::rk4_step;
 use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError};
 
@@ -320,14 +320,7 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<FlatloOutcome, PipelineError> {
-    let errors: Vec<String> = validate(mission)
-        .into_iter()
-        .filter(|d| d.is_error())
-        .map(|d| d.to_string())
-        .collect();
-    if !errors.is_empty() {
-        return Err(PipelineError::InvalidMission(errors.join("\n")));
-    }
+    crate::pipeline::require_valid(mission)?;
     let p = &mission.flatlo;
     let n = p.aircraft;
 

@@ -19,7 +19,7 @@ use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::mission::{FleetParams, Mission, validate};
+use crate::mission::{FleetParams, Mission};
 use crate::ode::rk4_step;
 use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError};
 
@@ -284,14 +284,7 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<FleetOutcome, PipelineError> {
-    let errors: Vec<String> = validate(mission)
-        .into_iter()
-        .filter(|d| d.is_error())
-        .map(|d| d.to_string())
-        .collect();
-    if !errors.is_empty() {
-        return Err(PipelineError::InvalidMission(errors.join("\n")));
-    }
+    crate::pipeline::require_valid(mission)?;
     let p = &mission.fleet;
     let n = p.agents;
     observer.on_event(Event::Stage("scenario"));

@@ -16,7 +16,7 @@ use std::ops::ControlFlow;
 use nalgebra::Point3;
 use serde::Serialize;
 
-use crate::mission::{Mission, validate};
+use crate::mission::Mission;
 use crate::pipeline::{CancelToken, Completion, CostTerms, Event, Level, Observer, PipelineError};
 use crate::swarm::{self, SearchSpace, SwarmConfig};
 
@@ -125,14 +125,7 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<ThetaPsoOutcome, PipelineError> {
-    let errors: Vec<String> = validate(mission)
-        .into_iter()
-        .filter(|d| d.is_error())
-        .map(|d| d.to_string())
-        .collect();
-    if !errors.is_empty() {
-        return Err(PipelineError::InvalidMission(errors.join("\n")));
-    }
+    crate::pipeline::require_valid(mission)?;
 
     observer.on_event(Event::Stage("intermediate waypoints"));
     let problem = Problem::new(mission);

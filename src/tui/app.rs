@@ -866,13 +866,7 @@ impl App {
     }
 
     fn run(&mut self, pipeline: Pipeline, seed: u64) {
-        let errors: Vec<String> = self
-            .doc
-            .diagnostics()
-            .iter()
-            .filter(|d| d.is_error())
-            .map(|d| format!("{}: {}", d.path, d.message))
-            .collect();
+        let errors = self.doc.error_lines();
         if let Some(first) = errors.first() {
             self.set_error(format!(
                 "cannot run: {} error(s) in the mission; first: {first}",
@@ -1023,13 +1017,7 @@ impl App {
             });
             return;
         };
-        let errors: Vec<String> = self
-            .doc
-            .diagnostics()
-            .iter()
-            .filter(|d| d.is_error())
-            .map(|d| format!("{}: {}", d.path, d.message))
-            .collect();
+        let errors = self.doc.error_lines();
         if !errors.is_empty() && !confirmed {
             self.overlay = Some(Overlay::SaveInvalid {
                 path: Some(target),

@@ -81,6 +81,16 @@ impl Document {
         self.diagnostics.iter().filter(|d| d.is_error()).count()
     }
 
+    /// The errors as `field.path: message` lines (for the run refusal and the
+    /// save confirmation).
+    pub fn error_lines(&self) -> Vec<String> {
+        self.diagnostics
+            .iter()
+            .filter(|d| d.is_error())
+            .map(|d| format!("{}: {}", d.path, d.message))
+            .collect()
+    }
+
     /// Applies `change` as one undo step. A change that leaves the mission as
     /// it was records nothing.
     pub fn edit(&mut self, change: impl FnOnce(&mut Mission)) {

@@ -338,6 +338,29 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect) {
         .y_bounds(vp.y)
         .paint(|ctx| paint_map(ctx, app, m, dot, scale));
     frame.render_widget(canvas, area);
+    // The fleet replay's time slider, on the map's last row.
+    if let (Some(t), Some(end)) = (app.replay_time(), app.replay_end())
+        && area.height > 3
+    {
+        let row = Rect::new(
+            area.x + 2,
+            area.y + area.height - 2,
+            area.width.saturating_sub(4),
+            1,
+        );
+        let ratio = if end > 0.0 {
+            (t / end).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let slider = ratatui::widgets::LineGauge::default()
+            .filled_style(Style::default().fg(Color::Cyan))
+            .unfilled_style(Style::default().fg(Color::DarkGray))
+            .label(format!("t {t:.1} s"))
+            .ratio(ratio);
+        frame.render_widget(ratatui::widgets::Clear, row);
+        frame.render_widget(slider, row);
+    }
 }
 
 fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
