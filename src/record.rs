@@ -152,7 +152,8 @@ impl Recorder {
             .map_err(|e| RecordError::Stream(e.to_string()))?;
         let _ = stream.send_recording_name(name);
         // A layout that shows the plan large: not essential, so a failure is ignored.
-        let _ = layout().send(&stream, rerun::blueprint::BlueprintActivation::default());
+        let _ = layout(Layout::ThetaPso)
+            .send(&stream, rerun::blueprint::BlueprintActivation::default());
         let (queue, inbox) = crossbeam_channel::bounded(QUEUE_CAPACITY);
         let oldest = inbox.clone();
         let worker = std::thread::Builder::new()
@@ -337,8 +338,16 @@ fn log_message(stream: &RecordingStream, message: Message) {
     let result = match message {
         Message::Scene(mission) => log_scene(stream, &mission),
         Message::ThetaPso(outcome) => log_theta_pso(stream, &outcome),
-        Message::Flatlo(outcome) => log_flatlo(stream, &outcome),
-        Message::Fleet(outcome) => log_fleet(stream, &outcome),
+        Message::Flatlo(outcome) => {
+            let _ = layout(Layout::Flatlo)
+                .send(stream, rerun::blueprint::BlueprintActivation::default());
+            log_flatlo(stream, &outcome)
+        }
+        Message::Fleet(outcome) => {
+            let _ = layout(Layout::Fleet)
+                .send(stream, rerun::blueprint::BlueprintActivation::default());
+            log_fleet(stream, &outcome)
+        }
         Message::Log(level, text) => {
             let level = match level {
                 Level::Info => rerun::TextLogLevel::INFO,
@@ -394,26 +403,56 @@ fn flush_iterations(
     }
 }
 
-/// The viewer layout: the 3D scene large on the left; on the right the cost
-/// terms on one plot, the events and log lines, and the mission file.
-fn layout() -> rerun::blueprint::Blueprint {
+/// Which pipeline's plots the viewer layout puts beside the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Layout {
+    ThetaPso,
+    Flatlo,
+    Fleet,
+}
+
+/// The viewer layout: the 3D scene large on the left; on the right the
+/// pipeline's series (θ-PSO cost terms; FLATLO airspeeds and load factors;
+/// the fleet's inter-agent distances, Fig. 13), its events, and the mission
+/// file. A recording starts with the θ-PSO layout; a FLATLO or fleet result
+/// sends its own, which the viewer then shows.
+fn layout(kind: Layout) -> rerun::blueprint::Blueprint {
     use rerun::blueprint::{
         Blueprint, Horizontal, Spatial3DView, TextDocumentView, TextLogView, TimePanel,
         TimeSeriesView, Vertical,
     };
+    let (series, events) = match kind {
+        Layout::ThetaPso => (
+            vec![TimeSeriesView::new("θ-PSO cost (iteration)").with_origin("/theta_pso/cost")],
+            "/theta_pso",
+        ),
+        Layout::Flatlo => (
+            vec![
+                TimeSeriesView::new("airspeed, m/s").with_origin("/flatlo/airspeed"),
+                TimeSeriesView::new("load factor").with_origin("/flatlo/load_factor"),
+            ],
+            "/flatlo",
+        ),
+        Layout::Fleet => (
+            vec![
+                TimeSeriesView::new("inter-agent distances, m (Fig. 13)")
+                    .with_origin("/fleet/distances"),
+            ],
+            "/fleet",
+        ),
+    };
+    let mut column: Vec<rerun::blueprint::ContainerLike> =
+        series.into_iter().map(Into::into).collect();
+    column.push(TextLogView::new("events").with_origin(events).into());
+    column.push(
+        TextDocumentView::new("mission")
+            .with_origin("/mission")
+            .into(),
+    );
     Blueprint::new(
         Horizontal::new([
             Spatial3DView::new("scene").with_origin("/").into(),
-            Vertical::new([
-                TimeSeriesView::new("θ-PSO cost (iteration)")
-                    .with_origin("/theta_pso/cost")
-                    .into(),
-                TextLogView::new("events").with_origin("/theta_pso").into(),
-                TextDocumentView::new("mission")
-                    .with_origin("/mission")
-                    .into(),
-            ])
-            .into(),
+            Vertical::new(column).into(),
         ])
         .with_column_shares([2.0, 1.0]),
     )
