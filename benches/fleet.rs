@@ -48,7 +48,6 @@ fn decision(c: &mut Criterion) {
             .map(|q| cost::Neighbour {
                 position: q,
                 desired: 1.732,
-                weight: cost::influence(q.coords.norm(), 0.8, 0.4),
             })
             .to_vec(),
         obstacles: vec![cost::Detected {

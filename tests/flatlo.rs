@@ -21,16 +21,23 @@ fn paper_mission() -> Mission {
 #[test]
 fn theorem_1_references_end_in_a_line_spaced_by_delta_d_for_n_2_to_12() {
     for n in 2..=12 {
-        for (heading, spacing) in [(0.0, 18_300.0), (37.0, 9_000.0), (-120.0, 25_000.0)] {
+        for (heading, spacing, climb) in [
+            (0.0, 18_300.0, 0.0),
+            (37.0, 9_000.0, 0.0),
+            (-120.0, 25_000.0, 0.0),
+            (15.0, 18_300.0, 10.0),
+        ] {
             let p = FlatloParams {
                 aircraft: n,
                 spacing,
                 heading_deg: heading,
+                climb_deg: climb,
                 start: nalgebra::Point2::new(1_000.0, -2_000.0),
                 ..FlatloParams::default()
             };
             let plan = flatlo::references(&p);
-            let line = algorithm::line_direction(p.heading_deg.to_radians(), 0.0);
+            let line =
+                algorithm::line_direction(p.heading_deg.to_radians(), p.climb_deg.to_radians());
             // At the common arrival time each aircraft is exactly at the end of
             // its transition: they arrive together.
             let mut at_arrival = Vec::new();
@@ -62,6 +69,15 @@ fn theorem_1_references_end_in_a_line_spaced_by_delta_d_for_n_2_to_12() {
                     );
                 }
                 assert!(spread / spacing < 1e-9, "N={n}: lateral spread {spread} m");
+                // One straight line along t(φ, β), climbing or not.
+                for q in &points {
+                    let d = q - points[0];
+                    let off = (d - line * d.dot(&line)).norm();
+                    assert!(
+                        off / spacing < 1e-9,
+                        "N={n} climb {climb}: {off} m off the line"
+                    );
+                }
                 // Aircraft 0 leads and the order is by index (Algorithm 2).
                 let order: Vec<usize> = std::iter::once(spacing_list[0].front)
                     .chain(spacing_list.iter().map(|s| s.back))

@@ -574,3 +574,50 @@ fn a_fleet_run_replays_on_the_map() {
     app.update(Action::Delete);
     assert_eq!(app.mission().fleet.targets.len(), n);
 }
+
+#[test]
+fn applying_a_field_unchanged_changes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Select(Item::Obstacle(0)));
+    app.update(Action::FocusOn(Focus::Inspector));
+    for _ in 0..6 {
+        app.update(Action::EditStart(None));
+        app.update(Action::EditCommit);
+    }
+    assert!(!app.doc.can_undo(), "no undo step for an unchanged value");
+    assert!(!app.doc.is_modified());
+}
+
+#[test]
+fn a_release_over_a_window_still_ends_the_drag() {
+    use ratatui::crossterm::event::{KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
+    use skyform::tui::input::mouse_action;
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let at = app.mission().obstacles[0].center;
+    app.update(Action::DragStart(Item::Obstacle(0), at));
+    app.update(Action::DragTo(at + nalgebra::Vector2::new(3.0, 0.0)));
+    app.update(Action::ToggleHelp);
+    let up = MouseEvent {
+        kind: MouseEventKind::Up(MouseButton::Left),
+        column: 10,
+        row: 10,
+        modifiers: KeyModifiers::NONE,
+    };
+    let action = mouse_action(&app, up, ratatui::layout::Rect::new(0, 0, 140, 42));
+    assert_eq!(action, Some(Action::DragEnd));
+    app.update(Action::DragEnd);
+    app.update(Action::Dismiss);
+    // The drag was one step; a later move of another item is another.
+    app.update(Action::Select(Item::Goal));
+    app.update(Action::FocusOn(Focus::Map));
+    app.update(Action::Nudge(1.0, 0.0));
+    app.update(Action::Undo);
+    assert_eq!(
+        app.mission().obstacles[0].center,
+        at + nalgebra::Vector2::new(3.0, 0.0)
+    );
+    app.update(Action::Undo);
+    assert_eq!(app.mission().obstacles[0].center, at);
+}

@@ -129,7 +129,8 @@ impl Squadron {
 /// tends to it as T → 0). Line 47 sets φ₃ = −φ₂ for the right wing's second
 /// turn: that is the mirrored frame's heading; in the common frame the turn
 /// starts from the aircraft's own heading φ₂, otherwise the reference would
-/// kink by 2φ₂. The middle aircraft of an odd squadron (Δ = 0, where line 41
+/// kink by 2φ₂; and it turns back onto t(φ, β) in the plane of the first turn
+/// (the same as the printed turn when level, exact when climbing). The middle aircraft of an odd squadron (Δ = 0, where line 41
 /// would give a negative Δ₂) flies straight for the other aircraft's forward
 /// extent of the three manoeuvres, 2r sin(π/4) − 2r(1 − cos(π/4)), which is
 /// what keeps it Δ_d ahead of its followers.
@@ -164,7 +165,6 @@ pub fn flatlo(i: usize, q: &Squadron, p: Point3<f64>) -> Manoeuvres {
         transition.push(Primitive::forward(p1, phi2, beta2, extent));
     } else {
         let toward_centre = if side == Side::Left { PI } else { 0.0 };
-        let back = if side == Side::Left { 0.0 } else { PI };
         // k = 0: turn 45° toward the centre line.
         let (p1, phi2, beta2) = here(&transition);
         transition.push(Primitive::turn(
@@ -180,9 +180,15 @@ pub fn flatlo(i: usize, q: &Squadron, p: Point3<f64>) -> Manoeuvres {
         let delta2 = SQRT_2 * (delta - turn_lateral);
         let (p1, phi2, beta2) = here(&transition);
         transition.push(Primitive::forward(p1, phi2, beta2, delta2));
-        // k = 2: turn back onto the original heading.
-        let (p1, phi2, beta2) = here(&transition);
-        transition.push(Primitive::turn(p1, phi2, beta2, back, FRAC_PI_4, r));
+        // k = 2: turn back onto the original direction t(φ, β), in the plane
+        // of the first turn. Level (β = 0) this is C(P₁, φ₂, β₂, θ, π/4) with
+        // θ = 0 (left wing) or π (right wing); climbing, C's horizontal normal
+        // would leave the aircraft off t(φ, β) (−0.22° and 4.98° for β = 10°).
+        let (p1, _, _) = here(&transition);
+        let dir = transition
+            .last()
+            .map_or(direction(phi, beta), |m| m.end().tangent);
+        transition.push(Primitive::turn_onto(p1, dir, direction(phi, beta), r));
     }
     // k = 3: along the longitudinal line.
     let (p1, phi2, beta2) = here(&transition);

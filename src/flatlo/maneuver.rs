@@ -80,6 +80,20 @@ impl Primitive {
         }
     }
 
+    /// A turn from the unit direction `dir` onto the unit direction `onto`
+    /// (at an angle in (0, π)) on a circle of radius `r`, in the plane the two
+    /// directions span.
+    pub fn turn_onto(p: Point3<f64>, dir: Vector3<f64>, onto: Vector3<f64>, r: f64) -> Self {
+        let cos = dir.dot(&onto).clamp(-1.0, 1.0);
+        Primitive::Turn {
+            start: p,
+            dir,
+            normal: (onto - dir * cos).normalize(),
+            radius: r,
+            angle: cos.acos(),
+        }
+    }
+
     /// Arc length, metres.
     pub fn length(&self) -> f64 {
         match *self {

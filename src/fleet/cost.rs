@@ -3,10 +3,11 @@
 //! fleet: that boundary is what lets agents later run as separate processes.
 //!
 //! Readings (docs/fleet.md): Λ_i uses absolute deviations |‖·‖ − d| so that
-//! Λ_i = 0 exactly at the desired configuration (DESIGN.md); a_ij weighs the
-//! current distance d_ij(t); an obstacle's distance in Obs_ik is to its
-//! nearest point (the surface of the cylinder), the "x_kobs" the agent's
-//! sensor measures.
+//! Λ_i = 0 exactly at the desired configuration (DESIGN.md); a_ij is taken
+//! at the candidate position x_i + h, so it steers the choice of h away from
+//! d_ij < c; an obstacle's distance in Obs_ik is to its nearest point (the
+//! surface of the cylinder), the "x_kobs" the agent's sensor measures; and
+//! the safety distance is also a constraint (eq. 5), see [`CONSTRAINT`].
 
 use nalgebra::{Point2, Vector2};
 use serde::Serialize;
@@ -35,8 +36,6 @@ pub struct Neighbour {
     pub position: Point2<f64>,
     /// d_ij^d.
     pub desired: f64,
-    /// a_ij(t), from the current distance.
-    pub weight: f64,
 }
 
 /// A detected obstacle (within d_obs): a vertical cylinder.
@@ -129,7 +128,6 @@ mod tests {
                 .map(|k| Neighbour {
                     position: corner(k),
                     desired: side,
-                    weight: influence(side, 0.8, 0.4),
                 })
                 .to_vec(),
             obstacles: Vec::new(),

@@ -24,7 +24,7 @@ use crate::ode::rk4_step;
 use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError};
 
 use agent::Planner;
-use cost::{Detected, Neighbour, Observation, influence};
+use cost::{Detected, Neighbour, Observation};
 use quadrotor::{Body, State};
 
 /// Samples kept per simulated second (positions, distances).
@@ -248,12 +248,14 @@ fn observe(
         position: me,
         target,
         target_distance: p.target_distance,
+        // Eq. 2: Ξ_i, the agents within l (the round's lists reach a little
+        // further, for the safety check).
         neighbours: near
             .iter()
+            .filter(|&&j| (positions[j] - me).norm() <= p.neighbourhood)
             .map(|&j| Neighbour {
                 position: positions[j],
                 desired: desired[i][j],
-                weight: influence((positions[j] - me).norm(), p.safety_distance, p.sigma),
             })
             .collect(),
         obstacles: obstacles
@@ -347,6 +349,11 @@ pub fn plan(
     let mut completion = Completion::Finished;
     let mut round: u64 = 0;
     let mut near: Vec<Vec<usize>> = vec![Vec::new(); n];
+    // Each reference is at most √2·h_max from its agent, so two agents close
+    // in on each other by well under 2·√2·h_max + 1 m in one τ.
+    let watch_radius = p
+        .neighbourhood
+        .max(p.safety_distance + 2.0 * std::f64::consts::SQRT_2 * p.step_max + 1.0);
 
     for k in 0..=steps {
         let t = k as f64 * dt;
@@ -360,12 +367,13 @@ pub fn plan(
             .iter()
             .map(|f| quadrotor::position(&f.state).xy())
             .collect();
-        // Eq. 2's neighbourhoods are found at every scheduled round; in
-        // between (τ, a few centimetres of flight) the same lists serve the
-        // "closer than c" check, l being much larger than c.
+        // Neighbour lists are built at every scheduled round, reaching beyond
+        // c by what two agents can close within τ: in between, the same lists
+        // serve the "closer than c" check and the closest-approach record.
+        // Eq. 2's Ξ_i (within l) is taken from them in `observe`.
         let scheduled = k % replan_every == 0;
         if scheduled {
-            near = neighbourhoods(&positions, p.neighbourhood.max(p.safety_distance));
+            near = neighbourhoods(&positions, watch_radius);
         }
 
         // Record (and check) on the sample grid.
@@ -388,7 +396,8 @@ pub fn plan(
                         });
                     }
                 }
-                for o in &mission.obstacles {
+                // Obstacles the fleet flies over are not in its way (as in `observe`).
+                for o in mission.obstacles.iter().filter(|o| o.height > p.altitude) {
                     let d = (o.center - positions[i]).norm() - o.radius;
                     if closest_obstacle.as_ref().is_none_or(|c| d < c.distance) {
                         closest_obstacle = Some(Closest {
@@ -442,7 +451,9 @@ pub fn plan(
                         .any(|&j| (positions[j] - positions[i]).norm() < p.safety_distance)
             })
             .collect();
-        if due.iter().any(|&d| d) {
+        // Before the first target appears the agents hold their starts.
+        let started = t >= sc.targets[0].0;
+        if started && due.iter().any(|&d| d) {
             let snapshot = &positions;
             let desired = &sc.desired;
             let obstacles = &obstacles;
@@ -492,7 +503,7 @@ pub fn plan(
         .map(|(k, &(time, position))| {
             let window_end = sc.targets.get(k + 1).map_or(end, |next| next.0);
             let converged_after = (inside_at_end[k] && time <= end).then(|| {
-                let since = outside[k].map_or(time, |last| last + 1.0 / SAMPLE_RATE);
+                let since = outside[k].map_or(time, |last| last + record_every as f64 * dt);
                 (since - time).max(0.0)
             });
             let _ = window_end;

@@ -204,6 +204,38 @@ impl App {
         self.jobs.iter().any(Job::is_running)
     }
 
+    /// The x-y box the map fits at zoom 1: the bounds, grown to hold a shown
+    /// FLATLO flight (kilometres, wherever the mission's bounds are). Pan and
+    /// zoom start from the same box the view draws.
+    pub fn map_extent(&self) -> ([f64; 2], [f64; 2]) {
+        let b = &self.mission().bounds;
+        let (mut x, mut y) = (b.x, b.y);
+        if let Some(o) = self
+            .shown()
+            .and_then(|j| j.outcome.as_ref())
+            .and_then(|o| o.flatlo())
+        {
+            for a in &o.aircraft {
+                for p in a
+                    .reference
+                    .iter()
+                    .map(|s| s.position)
+                    .chain(a.flown.iter().map(|s| s.position))
+                {
+                    x = [x[0].min(p.x), x[1].max(p.x)];
+                    y = [y[0].min(p.y), y[1].max(p.y)];
+                }
+            }
+        }
+        (x, y)
+    }
+
+    fn map_center(&self) -> Point2<f64> {
+        let (x, y) = self.map_extent();
+        self.center
+            .unwrap_or(Point2::new((x[0] + x[1]) / 2.0, (y[0] + y[1]) / 2.0))
+    }
+
     /// Duration of the shown fleet result, if one is shown (the replay's range).
     pub fn replay_end(&self) -> Option<f64> {
         let o = self.shown()?.outcome.as_ref()?.fleet()?;
@@ -372,12 +404,9 @@ impl App {
             }
             Zoom(factor, at) => self.zoom_by(factor, at),
             Pan(fx, fy) => {
-                let b = &self.mission().bounds;
-                let (w, h) = (b.x[1] - b.x[0], b.y[1] - b.y[0]);
-                let c = self.center.unwrap_or(Point2::new(
-                    (b.x[0] + b.x[1]) / 2.0,
-                    (b.y[0] + b.y[1]) / 2.0,
-                ));
+                let (x, y) = self.map_extent();
+                let (w, h) = (x[1] - x[0], y[1] - y[0]);
+                let c = self.map_center();
                 self.center = Some(Point2::new(
                     c.x + fx * w / self.zoom,
                     c.y + fy * h / self.zoom,
@@ -522,6 +551,7 @@ impl App {
             EditCancel => self.editing = None,
             Undo => {
                 self.editing = None;
+                self.drag = None;
                 if self.doc.undo() {
                     self.refresh();
                     self.set_status("undone");
@@ -531,6 +561,7 @@ impl App {
             }
             Redo => {
                 self.editing = None;
+                self.drag = None;
                 if self.doc.redo() {
                     self.refresh();
                     self.set_status("redone");
@@ -648,6 +679,10 @@ impl App {
                 }
             }
             DragStart(item, at) => {
+                // A drag whose release was never seen ends here.
+                if self.drag.take().is_some() {
+                    self.doc.end_gesture();
+                }
                 self.select(item.clone());
                 if let Some(position) = self.position_of(&item) {
                     self.doc.begin_gesture();
@@ -718,11 +753,7 @@ impl App {
                 let zoom = (self.zoom * factor).clamp(0.1, 10_000.0);
                 let applied = zoom / self.zoom;
                 if let Some(p) = at {
-                    let b = &self.mission().bounds;
-                    let c = self.center.unwrap_or(Point2::new(
-                        (b.x[0] + b.x[1]) / 2.0,
-                        (b.y[0] + b.y[1]) / 2.0,
-                    ));
+                    let c = self.map_center();
                     self.center = Some(p + (c - p) / applied);
                 }
                 self.zoom = zoom;
@@ -847,6 +878,12 @@ impl App {
         let Some(field) = fields.get(self.field) else {
             return;
         };
+        if editing.buffer.trim() == field.value {
+            // Nothing typed: no change, no undo step (and no rounding).
+            let n = self.fields().len();
+            self.field = (self.field + 1).min(n.saturating_sub(1));
+            return;
+        }
         let mut trial = self.mission().clone();
         match field.set(&mut trial, &self.selected, &editing.buffer) {
             Ok(()) => {
@@ -894,7 +931,8 @@ impl App {
         self.jobs.push(job);
         self.job_cursor = self.jobs.len() - 1;
         self.set_status(format!(
-            "job {id}: θ-PSO started with seed {seed} (x cancels)"
+            "job {id}: {} started with seed {seed} (x cancels)",
+            pipeline.name()
         ));
     }
 

@@ -174,11 +174,20 @@ fn yes_no(text: &str) -> Result<bool, String> {
     }
 }
 
-/// Formats a number the way it would be typed: no trailing zeros.
+/// Formats a number the way it would be typed: exactly when that is short
+/// (so opening a field and applying it changes nothing), else to 4 decimals.
 pub fn fmt_num(v: f64) -> String {
-    let s = format!("{v:.4}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".into() } else { s.into() }
+    let exact = format!("{v}");
+    let s = if exact.len() <= 12 {
+        exact
+    } else {
+        let rounded = format!("{v:.4}");
+        rounded
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_owned()
+    };
+    if s == "-0" { "0".into() } else { s }
 }
 
 fn obstacle<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut Obstacle, String> {
@@ -973,5 +982,8 @@ mod tests {
         assert_eq!(fmt_num(-0.0), "0");
         assert_eq!(fmt_num(0.7298), "0.7298");
         assert_eq!(fmt_num(1e5), "100000");
+        assert_eq!(fmt_num(2.71), "2.71", "short values exactly");
+        assert_eq!(fmt_num(12.345678), "12.345678");
+        assert_eq!(fmt_num(0.1 + 0.2), "0.3", "long ones rounded");
     }
 }

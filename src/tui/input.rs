@@ -262,6 +262,10 @@ fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
 
 /// The action for a mouse event on a screen of size `screen`.
 pub fn mouse_action(app: &App, mouse: MouseEvent, screen: Rect) -> Option<Action> {
+    // A release always ends a drag, even over a window opened meanwhile.
+    if mouse.kind == MouseEventKind::Up(MouseButton::Left) {
+        return Some(Action::DragEnd);
+    }
     if app.overlay.is_some() {
         return None;
     }

@@ -142,7 +142,7 @@ fn event_loop(terminal: &mut DefaultTerminal, app: &mut App) -> io::Result<()> {
         if app.should_quit {
             return Ok(());
         }
-        let tick = if app.any_running() {
+        let tick = if app.wants_tick() {
             after(TICK)
         } else {
             never()

@@ -58,7 +58,7 @@ impl Viewport {
     /// The top-down map of `app` drawn in the pane `area` (border included).
     pub fn map(app: &App, area: Rect) -> Self {
         let inner = area.inner(Margin::new(1, 1));
-        let (bx, by) = extent(app);
+        let (bx, by) = app.map_extent();
         let (w, h) = (
             (bx[1] - bx[0]).abs().max(1.0),
             (by[1] - by[0]).abs().max(1.0),
@@ -247,27 +247,6 @@ fn paint_fleet(ctx: &mut Context, app: &App, o: &FleetOutcome, stale: bool, dot:
             );
         }
     }
-}
-
-/// The x-y box the map fits: the bounds, and a shown FLATLO squadron's
-/// flight (kilometres, wherever the mission's bounds are).
-fn extent(app: &App) -> ([f64; 2], [f64; 2]) {
-    let b = &app.mission().bounds;
-    let (mut x, mut y) = (b.x, b.y);
-    if let Some((o, _)) = flatlo_of(app) {
-        for a in &o.aircraft {
-            for p in a
-                .reference
-                .iter()
-                .map(|s| s.position)
-                .chain(a.flown.iter().map(|s| s.position))
-            {
-                x = [x[0].min(p.x), x[1].max(p.x)];
-                y = [y[0].min(p.y), y[1].max(p.y)];
-            }
-        }
-    }
-    (x, y)
 }
 
 /// The top-down map (or the side view when toggled).
