@@ -45,6 +45,12 @@ impl Cylinder {
 
 /// Distance from `p` to the segment a-b, in the plane.
 pub fn segment_point_distance(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>) -> f64 {
+    segment_projection(a, b, p).1
+}
+
+/// Where `p` projects onto the segment a-b: the fraction t ∈ [0, 1] along
+/// it, and the distance from `p` to that point.
+pub fn segment_projection(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>) -> (f64, f64) {
     let ab = b - a;
     let len2 = ab.norm_squared();
     let t = if len2 > 0.0 {
@@ -52,7 +58,7 @@ pub fn segment_point_distance(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>)
     } else {
         0.0
     };
-    (a + ab * t - p).norm()
+    (t, (a + ab * t - p).norm())
 }
 
 /// Distance of the farthest offset from the origin: a formation's radius r_F

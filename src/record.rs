@@ -387,12 +387,7 @@ fn flush_iterations(
     ];
     for (path, term) in series {
         let values: Vec<f64> = pending.iter().map(|(_, c, _)| term(c)).collect();
-        if let Ok(columns) = rerun::Scalars::update_fields()
-            .with_scalars(values)
-            .columns_of_unit_batches()
-        {
-            let _ = stream.send_columns(path, [iterations.clone()], columns);
-        }
+        let _ = log_series(stream, path, &iterations, values);
     }
     let strips: Vec<Vec<[f32; 3]>> = pending.drain(..).map(|(_, _, p)| p).collect();
     if let Ok(columns) = rerun::LineStrips3D::update_fields()
@@ -554,6 +549,41 @@ fn uav_color(n: usize) -> rerun::Color {
     rerun::Color::from_rgb(r, g, b)
 }
 
+/// A point that moves on `sim_time`: its style (colour, radius, label)
+/// logged once, its positions as one `send_columns`.
+fn log_moving_point(
+    stream: &RecordingStream,
+    entity: &str,
+    times: &rerun::TimeColumn,
+    style: rerun::Points3D,
+    positions: Vec<[f32; 3]>,
+) -> rerun::RecordingStreamResult<()> {
+    stream.log_static(entity, &style)?;
+    stream.send_columns(
+        entity,
+        [times.clone()],
+        rerun::Points3D::update_fields()
+            .with_positions(positions)
+            .columns_of_unit_batches()?,
+    )
+}
+
+/// A scalar series over `times`, as one `send_columns`.
+fn log_series(
+    stream: &RecordingStream,
+    entity: &str,
+    times: &rerun::TimeColumn,
+    values: Vec<f64>,
+) -> rerun::RecordingStreamResult<()> {
+    stream.send_columns(
+        entity,
+        [times.clone()],
+        rerun::Scalars::update_fields()
+            .with_scalars(values)
+            .columns_of_unit_batches()?,
+    )
+}
+
 /// A θ-PSO outcome: planned paths, UAVs moving on `sim_time`, events, violations.
 fn log_theta_pso(
     stream: &RecordingStream,
@@ -609,20 +639,11 @@ fn log_theta_pso(
             })
             .collect();
         let uav = format!("theta_pso/uavs/uav_{}", t.uav + 1);
-        stream.log_static(
-            uav.as_str(),
-            &rerun::Points3D::update_fields()
-                .with_colors([color])
-                .with_radii([0.5f32])
-                .with_labels([format!("UAV {}", t.uav + 1)]),
-        )?;
-        stream.send_columns(
-            uav.as_str(),
-            [times.clone()],
-            rerun::Points3D::update_fields()
-                .with_positions(positions.clone())
-                .columns_of_unit_batches()?,
-        )?;
+        let style = rerun::Points3D::update_fields()
+            .with_colors([color])
+            .with_radii([0.5f32])
+            .with_labels([format!("UAV {}", t.uav + 1)]);
+        log_moving_point(stream, &uav, &times, style, positions.clone())?;
         let arrows = format!("{uav}/velocity");
         stream.log_static(
             arrows.as_str(),
@@ -734,25 +755,12 @@ fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingSt
         )?;
         let times = rerun::TimeColumn::new_duration_secs("sim_time", a.flown.iter().map(|s| s.t));
         let entity = format!("flatlo/aircraft/{name}");
-        stream.log_static(
-            entity.as_str(),
-            &rerun::Points3D::update_fields()
-                .with_colors([color])
-                .with_radii([150.0f32])
-                .with_labels([format!("aircraft {}", a.index)]),
-        )?;
-        stream.send_columns(
-            entity.as_str(),
-            [times.clone()],
-            rerun::Points3D::update_fields()
-                .with_positions(
-                    a.flown
-                        .iter()
-                        .map(|s| f32x3(&s.position))
-                        .collect::<Vec<_>>(),
-                )
-                .columns_of_unit_batches()?,
-        )?;
+        let style = rerun::Points3D::update_fields()
+            .with_colors([color])
+            .with_radii([150.0f32])
+            .with_labels([format!("aircraft {}", a.index)]);
+        let positions = a.flown.iter().map(|s| f32x3(&s.position)).collect();
+        log_moving_point(stream, &entity, &times, style, positions)?;
         type Series = fn(&crate::flatlo::FlownSample) -> f64;
         let series: [(&str, Series); 6] = [
             ("airspeed", |s| s.airspeed),
@@ -763,13 +771,8 @@ fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingSt
             ("bank_deg", |s| s.controls.bank.to_degrees()),
         ];
         for (quantity, value) in series {
-            stream.send_columns(
-                format!("flatlo/{quantity}/{name}"),
-                [times.clone()],
-                rerun::Scalars::update_fields()
-                    .with_scalars(a.flown.iter().map(value).collect::<Vec<f64>>())
-                    .columns_of_unit_batches()?,
-            )?;
+            let entity = format!("flatlo/{quantity}/{name}");
+            log_series(stream, &entity, &times, a.flown.iter().map(value).collect())?;
         }
     }
     stream.set_duration_secs("sim_time", o.arrival_time);
@@ -830,52 +833,24 @@ fn log_fleet(stream: &RecordingStream, o: &FleetOutcome) -> rerun::RecordingStre
             &rerun::LineStrips3D::new([positions.clone()]).with_colors([color]),
         )?;
         let agent = format!("fleet/agents/{name}");
-        stream.log_static(
-            agent.as_str(),
-            &rerun::Points3D::update_fields()
-                .with_colors([color])
-                .with_radii([0.15f32])
-                .with_labels([format!("agent {}", a.index)]),
-        )?;
-        stream.send_columns(
-            agent.as_str(),
-            [times.clone()],
-            rerun::Points3D::update_fields()
-                .with_positions(positions.clone())
-                .columns_of_unit_batches()?,
-        )?;
+        let style = rerun::Points3D::update_fields()
+            .with_colors([color])
+            .with_radii([0.15f32])
+            .with_labels([format!("agent {}", a.index)]);
+        log_moving_point(stream, &agent, &times, style, positions.clone())?;
+        let style = rerun::Points3D::update_fields()
+            .with_colors([rerun::Color::from_rgb(200, 200, 200)])
+            .with_radii([0.05f32]);
         let reference = format!("fleet/references/{name}");
-        stream.log_static(
-            reference.as_str(),
-            &rerun::Points3D::update_fields()
-                .with_colors([rerun::Color::from_rgb(200, 200, 200)])
-                .with_radii([0.05f32]),
-        )?;
-        stream.send_columns(
-            reference.as_str(),
-            [times.clone()],
-            rerun::Points3D::update_fields()
-                .with_positions(references)
-                .columns_of_unit_batches()?,
-        )?;
+        log_moving_point(stream, &reference, &times, style, references)?;
     }
     for d in &o.distances {
-        stream.send_columns(
-            format!("fleet/distances/{}_{}", d.a, d.b),
-            [times.clone()],
-            rerun::Scalars::update_fields()
-                .with_scalars(d.values.clone())
-                .columns_of_unit_batches()?,
-        )?;
+        let entity = format!("fleet/distances/{}_{}", d.a, d.b);
+        log_series(stream, &entity, &times, d.values.clone())?;
     }
     if !o.distances.is_empty() {
-        stream.send_columns(
-            "fleet/distances/safety_c",
-            [times.clone()],
-            rerun::Scalars::update_fields()
-                .with_scalars(vec![o.safety_distance; o.times.len()])
-                .columns_of_unit_batches()?,
-        )?;
+        let c = vec![o.safety_distance; o.times.len()];
+        log_series(stream, "fleet/distances/safety_c", &times, c)?;
     }
     let z = o
         .agents

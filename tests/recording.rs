@@ -72,22 +72,17 @@ fn last_time(chunks: &[Chunk], entity: &str, timeline: &str) -> Option<i64> {
         .max()
 }
 
-#[test]
-fn a_theta_pso_recording_holds_the_scene_the_plan_and_the_timelines() {
+/// `skyform run PIPELINE MISSION ARGS… --rrd … --json …`, which must exit 0:
+/// the outcome as JSON and the recording's chunks.
+fn run_recorded(pipeline: &str, mission: &str, args: &[&str]) -> (serde_json::Value, Vec<Chunk>) {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let rrd = dir.path().join("bridge.rrd");
-    let json = dir.path().join("bridge.json");
-    let out = skyform(&[
-        "run",
-        "theta-pso",
-        "missions/bridge-inspection.toml",
-        "--seed",
-        "5",
-        "--rrd",
-        &rrd.display().to_string(),
-        "--json",
-        &json.display().to_string(),
-    ]);
+    let rrd = dir.path().join("run.rrd");
+    let json = dir.path().join("run.json");
+    let (rrd_arg, json_arg) = (rrd.display().to_string(), json.display().to_string());
+    let mut all = vec!["run", pipeline, mission];
+    all.extend_from_slice(args);
+    all.extend(["--rrd", &rrd_arg, "--json", &json_arg]);
+    let out = skyform(&all);
     assert_eq!(
         out.status.code(),
         Some(0),
@@ -97,8 +92,16 @@ fn a_theta_pso_recording_holds_the_scene_the_plan_and_the_timelines() {
     let outcome: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&json).unwrap_or_else(|e| panic!("{e}")))
             .unwrap_or_else(|e| panic!("{e}"));
+    (outcome, chunks(&rrd))
+}
 
-    let chunks = chunks(&rrd);
+#[test]
+fn a_theta_pso_recording_holds_the_scene_the_plan_and_the_timelines() {
+    let (outcome, chunks) = run_recorded(
+        "theta-pso",
+        "missions/bridge-inspection.toml",
+        &["--seed", "5"],
+    );
     let paths = entity_paths(&chunks);
     for expected in [
         "/world",
@@ -257,28 +260,7 @@ fn a_bad_viewer_url_or_rrd_directory_is_a_clear_error() {
 
 #[test]
 fn a_flatlo_recording_holds_references_flights_series_and_events() {
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let rrd = dir.path().join("flatlo.rrd");
-    let json = dir.path().join("flatlo.json");
-    let out = skyform(&[
-        "run",
-        "flatlo",
-        "missions/flatlo-squadron.toml",
-        "--rrd",
-        rrd.to_str().unwrap_or_default(),
-        "--json",
-        json.to_str().unwrap_or_default(),
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let outcome: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap_or_default())
-            .unwrap_or_default();
-    let chunks = chunks(&rrd);
+    let (outcome, chunks) = run_recorded("flatlo", "missions/flatlo-squadron.toml", &[]);
     let paths = entity_paths(&chunks);
     for i in 0..4 {
         for prefix in [
@@ -327,28 +309,7 @@ fn a_flatlo_recording_holds_references_flights_series_and_events() {
 
 #[test]
 fn a_fleet_recording_holds_agents_references_and_the_distance_series() {
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let rrd = dir.path().join("fleet.rrd");
-    let json = dir.path().join("fleet.json");
-    let out = skyform(&[
-        "run",
-        "fleet",
-        "missions/fleet-triangle.toml",
-        "--rrd",
-        rrd.to_str().unwrap_or_default(),
-        "--json",
-        json.to_str().unwrap_or_default(),
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let outcome: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap_or_default())
-            .unwrap_or_default();
-    let chunks = chunks(&rrd);
+    let (outcome, chunks) = run_recorded("fleet", "missions/fleet-triangle.toml", &[]);
     let paths = entity_paths(&chunks);
     for i in 0..3 {
         for prefix in ["agents", "references", "trails"] {

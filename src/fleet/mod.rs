@@ -180,11 +180,7 @@ pub fn scenario(m: &Mission, seed: u64) -> Scenario {
         starts
     };
     let targets = if p.targets.is_empty() {
-        let b = &m.bounds;
-        vec![(
-            0.0,
-            Point2::new((b.x[0] + b.x[1]) / 2.0, (b.y[0] + b.y[1]) / 2.0),
-        )]
+        vec![(0.0, m.bounds.center_xy())]
     } else {
         p.targets.iter().map(|t| (t.time, t.position)).collect()
     };

@@ -73,6 +73,11 @@ impl Bounds {
         self.contains_xy(&p.xy()) && (self.z[0]..=self.z[1]).contains(&p.z)
     }
 
+    /// The middle of the x-y box.
+    pub fn center_xy(&self) -> Point2<f64> {
+        Point2::new((self.x[0] + self.x[1]) / 2.0, (self.y[0] + self.y[1]) / 2.0)
+    }
+
     /// Horizontal distance from `p` to the nearest side of the x-y box:
     /// positive inside, negative outside.
     pub fn horizontal_margin(&self, p: &Point3<f64>) -> f64 {

@@ -17,6 +17,7 @@ use super::jobs::{self, Job, JobId, JobMsg, Pipeline, RecordSettings, Viewer};
 use crate::geometry::farthest_offset;
 use crate::mission::{self, Mission, Preset, Severity, check_str};
 use crate::pipeline::Level;
+use crate::planner::iwp::min_pair_distance;
 use crate::planner::{Iwp, find_iwps};
 
 /// Which panel takes the keys that are not global.
@@ -230,7 +231,8 @@ impl App {
         (x, y)
     }
 
-    fn map_center(&self) -> Point2<f64> {
+    /// Where the map looks: the panned centre, or the middle of the extent.
+    pub fn map_center(&self) -> Point2<f64> {
         let (x, y) = self.map_extent();
         self.center
             .unwrap_or(Point2::new((x[0] + x[1]) / 2.0, (y[0] + y[1]) / 2.0))
@@ -420,11 +422,9 @@ impl App {
                 Pane::Formation => self.formation_zoom = 1.0,
             },
             AddObstacle(at) => {
-                let b = &self.mission().bounds;
-                let p = at.or(self.center).unwrap_or(Point2::new(
-                    (b.x[0] + b.x[1]) / 2.0,
-                    (b.y[0] + b.y[1]) / 2.0,
-                ));
+                let p = at
+                    .or(self.center)
+                    .unwrap_or(self.mission().bounds.center_xy());
                 let obstacle = fields::new_obstacle(self.mission(), p);
                 let name = obstacle.name.clone();
                 self.edit(|m| m.obstacles.push(obstacle));
@@ -444,7 +444,6 @@ impl App {
             Duplicate if matches!(self.selected, Item::Fleet | Item::FleetTarget(_)) => {
                 // A new target 10 s after the last, 1 m east of it.
                 let last = self.mission().fleet.targets.last().cloned();
-                let b = &self.mission().bounds;
                 let next = match last {
                     Some(t) => crate::mission::FleetTarget {
                         time: t.time + 10.0,
@@ -452,7 +451,7 @@ impl App {
                     },
                     None => crate::mission::FleetTarget {
                         time: 0.0,
-                        position: Point2::new((b.x[0] + b.x[1]) / 2.0, (b.y[0] + b.y[1]) / 2.0),
+                        position: self.mission().bounds.center_xy(),
                     },
                 };
                 self.edit(|m| m.fleet.targets.push(next));
@@ -733,12 +732,7 @@ impl App {
 
     fn preset_spacing(&self) -> f64 {
         let f = &self.mission().formation;
-        let mut d = f64::INFINITY;
-        for (i, a) in f.slots.iter().enumerate() {
-            for b in &f.slots[i + 1..] {
-                d = d.min((a - b).norm());
-            }
-        }
+        let d = min_pair_distance(&f.slots);
         let floor = 2.0 * f.uav_radius + 1.0;
         if d.is_finite() {
             d.max(floor)

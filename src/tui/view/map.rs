@@ -15,10 +15,12 @@ use ratatui::widgets::{Block, BorderType, Borders, Cell, Row, Table};
 
 use crate::flatlo::FlatloOutcome;
 use crate::fleet::FleetOutcome;
+use crate::geometry::segment_projection;
 use crate::mission::{Mission, ShapeChoice};
 use crate::planner::ThetaPsoOutcome;
 use crate::tui::app::{App, Focus, formation_extent};
 use crate::tui::fields::{Item, shape_name};
+use crate::tui::jobs::Outcome;
 
 /// Colours of the UAVs, in slot order.
 pub const UAV_COLORS: [Color; 6] = [
@@ -65,10 +67,7 @@ impl Viewport {
         );
         let fit =
             (w / inner.width.max(1) as f64).max(h / (2.0 * inner.height.max(1) as f64)) * 1.08;
-        let center = app
-            .center
-            .unwrap_or(Point2::new((bx[0] + bx[1]) / 2.0, (by[0] + by[1]) / 2.0));
-        Viewport::centred(inner, center, fit / app.zoom)
+        Viewport::centred(inner, app.map_center(), fit / app.zoom)
     }
 
     /// The formation editor: canvas x is to the right of travel (−y of the
@@ -184,25 +183,19 @@ fn pane_block(title: TextLine<'static>, focused: bool) -> Block<'static> {
         .title(title)
 }
 
-/// What the map shows of the result, and in which colour.
+/// The shown job's outcome of one pipeline (`pick`), and whether it is stale.
+fn shown_outcome<'a, T>(
+    app: &'a App,
+    pick: impl FnOnce(&'a Outcome) -> Option<&'a T>,
+) -> Option<(&'a T, bool)> {
+    let job = app.shown()?;
+    let outcome = pick(job.outcome.as_ref()?)?;
+    Some((outcome, app.is_stale(job)))
+}
+
+/// The shown θ-PSO result, if the shown job is one.
 fn result_of(app: &App) -> Option<(&ThetaPsoOutcome, bool)> {
-    let job = app.shown()?;
-    let outcome = job.outcome.as_ref()?.theta_pso()?;
-    Some((outcome, app.is_stale(job)))
-}
-
-/// The shown FLATLO result, if the shown job is one.
-fn flatlo_of(app: &App) -> Option<(&FlatloOutcome, bool)> {
-    let job = app.shown()?;
-    let outcome = job.outcome.as_ref()?.flatlo()?;
-    Some((outcome, app.is_stale(job)))
-}
-
-/// The shown fleet result, if the shown job is one.
-fn fleet_of(app: &App) -> Option<(&FleetOutcome, bool)> {
-    let job = app.shown()?;
-    let outcome = job.outcome.as_ref()?.fleet()?;
-    Some((outcome, app.is_stale(job)))
+    shown_outcome(app, Outcome::theta_pso)
 }
 
 /// The fleet at the replay instant: trails so far, each agent with its
@@ -448,7 +441,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
             );
         }
     }
-    if let Some((o, stale)) = flatlo_of(app) {
+    if let Some((o, stale)) = shown_outcome(app, Outcome::flatlo) {
         paint_squadron(ctx, o, stale, dot);
     }
     for (k, t) in m.fleet.targets.iter().enumerate() {
@@ -463,7 +456,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
             Span::styled(format!("◎{}", k + 1), style),
         );
     }
-    if let Some((o, stale)) = fleet_of(app) {
+    if let Some((o, stale)) = shown_outcome(app, Outcome::fleet) {
         paint_fleet(ctx, app, o, stale, dot);
     }
 
@@ -700,19 +693,10 @@ fn cumulative(points: &[Point3<f64>]) -> Vec<f64> {
 fn closest_along(points: &[Point3<f64>], along: &[f64], c: &Point2<f64>) -> Option<(f64, f64)> {
     let mut best: Option<(f64, f64)> = None;
     for i in 1..points.len() {
-        let a = points[i - 1].xy();
-        let b = points[i].xy();
-        let ab = b - a;
-        let len2 = ab.norm_squared();
-        let t = if len2 > 0.0 {
-            ((c - a).dot(&ab) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let p = a + ab * t;
-        let d = (c - p).norm();
+        let (a, b) = (points[i - 1].xy(), points[i].xy());
+        let (t, d) = segment_projection(&a, &b, c);
         if best.is_none_or(|(_, bd)| d < bd) {
-            best = Some((along[i - 1] + t * len2.sqrt(), d));
+            best = Some((along[i - 1] + t * (b - a).norm(), d));
         }
     }
     best

@@ -152,6 +152,30 @@ fn rows(lines: &[Line], width: u16) -> u16 {
         .sum()
 }
 
+/// A `width` × `height` window in the middle of `area`, cleared, with
+/// `body` inside a titled border.
+fn popup(
+    frame: &mut Frame,
+    area: Rect,
+    (width, height): (u16, u16),
+    (title, color): (&str, Color),
+    body: Paragraph<'_>,
+) {
+    let r = centred(area, width, height);
+    frame.render_widget(Clear, r);
+    frame.render_widget(body.block(boxed(title, color)), r);
+}
+
+/// A line of key hints: each key highlighted, followed by what it does.
+fn hints(pairs: &[(&str, &str)]) -> Line<'static> {
+    let mut spans = Vec::with_capacity(pairs.len() * 2);
+    for (k, what) in pairs {
+        spans.push(key(k));
+        spans.push(Span::raw(what.to_string()));
+    }
+    Line::from(spans)
+}
+
 fn key(k: &str) -> Span<'static> {
     Span::styled(k.to_owned(), Style::default().yellow().bold())
 }
@@ -218,23 +242,14 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
             let lines = vec![
                 Line::raw(format!("{} has unsaved changes.", app.doc.title())),
                 Line::raw(""),
-                Line::from(vec![
-                    key("s"),
-                    Span::raw(" save and quit   "),
-                    key("y"),
-                    Span::raw(" quit without saving   "),
-                    key("Esc"),
-                    Span::raw(" stay"),
+                hints(&[
+                    ("s", " save and quit   "),
+                    ("y", " quit without saving   "),
+                    ("Esc", " stay"),
                 ]),
             ];
-            let r = centred(area, 70, 5);
-            frame.render_widget(Clear, r);
-            frame.render_widget(
-                Paragraph::new(lines)
-                    .wrap(Wrap { trim: false })
-                    .block(boxed("Quit?", Color::Yellow)),
-                r,
-            );
+            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+            popup(frame, area, (70, 5), ("Quit?", Color::Yellow), body);
         }
         Overlay::SaveAs { input, .. } => {
             let lines = vec![
@@ -243,18 +258,14 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                     format!("{input}▏"),
                     Style::default().white().on_blue(),
                 )),
-                Line::from(vec![
-                    key("Enter"),
-                    Span::raw(" save   "),
-                    key("Esc"),
-                    Span::raw(" cancel"),
-                ]),
+                hints(&[("Enter", " save   "), ("Esc", " cancel")]),
             ];
-            let r = centred(area, 72, 5);
-            frame.render_widget(Clear, r);
-            frame.render_widget(
-                Paragraph::new(lines).block(boxed("Save as", Color::Cyan)),
-                r,
+            popup(
+                frame,
+                area,
+                (72, 5),
+                ("Save as", Color::Cyan),
+                Paragraph::new(lines),
             );
         }
         Overlay::SaveInvalid { errors, .. } => {
@@ -274,19 +285,15 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
             lines.push(Line::raw(
                 "It can be saved, but not run until they are fixed.",
             ));
-            lines.push(Line::from(vec![
-                key("y"),
-                Span::raw(" save anyway   "),
-                key("Esc"),
-                Span::raw(" cancel"),
-            ]));
-            let r = centred(area, 90, lines.len() as u16 + 2);
-            frame.render_widget(Clear, r);
-            frame.render_widget(
-                Paragraph::new(lines)
-                    .wrap(Wrap { trim: false })
-                    .block(boxed("Save an invalid mission?", Color::Red)),
-                r,
+            lines.push(hints(&[("y", " save anyway   "), ("Esc", " cancel")]));
+            let size = (90, lines.len() as u16 + 2);
+            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+            popup(
+                frame,
+                area,
+                size,
+                ("Save an invalid mission?", Color::Red),
+                body,
             );
         }
         Overlay::Open { entries, cursor } => {
@@ -311,23 +318,13 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                     }
                 })
                 .collect();
-            lines.push(Line::from(vec![
-                key("↑↓"),
-                Span::raw(" choose   "),
-                key("Enter"),
-                Span::raw(" open   "),
-                key("Esc"),
-                Span::raw(" cancel"),
+            lines.push(hints(&[
+                ("↑↓", " choose   "),
+                ("Enter", " open   "),
+                ("Esc", " cancel"),
             ]));
-            let r = centred(area, 72, height + 2);
-            frame.render_widget(Clear, r);
-            frame.render_widget(
-                Paragraph::new(lines).block(boxed(
-                    "Open a mission (missions/, ./, built-in)",
-                    Color::Cyan,
-                )),
-                r,
-            );
+            let title = ("Open a mission (missions/, ./, built-in)", Color::Cyan);
+            popup(frame, area, (72, height + 2), title, Paragraph::new(lines));
         }
         Overlay::Discard(entry) => {
             let lines = vec![
@@ -335,20 +332,15 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                     "Discard the unsaved changes and open {}?",
                     entry.label()
                 )),
-                Line::from(vec![
-                    key("y"),
-                    Span::raw(" discard and open   "),
-                    key("Esc"),
-                    Span::raw(" cancel"),
-                ]),
+                hints(&[("y", " discard and open   "), ("Esc", " cancel")]),
             ];
-            let r = centred(area, 80, 4);
-            frame.render_widget(Clear, r);
-            frame.render_widget(
-                Paragraph::new(lines)
-                    .wrap(Wrap { trim: false })
-                    .block(boxed("Unsaved changes", Color::Yellow)),
-                r,
+            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+            popup(
+                frame,
+                area,
+                (80, 4),
+                ("Unsaved changes", Color::Yellow),
+                body,
             );
         }
     }
