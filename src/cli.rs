@@ -82,9 +82,12 @@ pub enum RunCommand {
         #[command(flatten)]
         record: RecordArgs,
     },
-    /// The distributed fleet: one PSO per quadrotor, quadrotor dynamics,
-    /// quaternion control. Exit status: 0 formed at every target and kept
-    /// the safety distance, 1 error, 2 did not, 130 cancelled (Ctrl-C).
+    /// The distributed fleet: one PSO per quadrotor, flown by quadrotor
+    /// dynamics under quaternion control.
+    ///
+    /// Progress goes to stderr, a summary to stdout. Exit status: 0 formed at
+    /// every target and kept the safety distance, 1 error, 2 did not, 130
+    /// cancelled (Ctrl-C).
     Fleet(FleetArgs),
     /// FLATLO: the latitudinal-to-longitudinal squadron transition, simulated
     /// with the point-mass aircraft model and verified.
