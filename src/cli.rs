@@ -521,20 +521,28 @@ pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(s, "θ-PSO plan for \"{}\" (seed {})", o.mission, o.seed);
+    let restarts = match o.restarts {
+        0 => String::new(),
+        n => format!(" ({n} restart(s): the best plan failed verification)"),
+    };
     let _ = writeln!(
         s,
-        "  run          {:?} after {} iterations, {} cost evaluations",
+        "  run          {:?} after {} iterations, {} cost evaluations{restarts}",
         o.completion, o.iterations, o.evaluations
     );
     let c = &o.cost;
     let _ = writeln!(
         s,
-        "  cost         J = {:.3}  (J1 length {:.2} m, J2 obstacles {:.5}, J3 altitude {:.3}, J_R waypoints {:.2} m)",
-        c.total, c.length, c.obstacle, c.altitude, c.waypoints
+        "  cost         J = {:.3}  (J1 length {:.2} m, J2 obstacles {:.5}, J3 altitude {:.3}, J_R waypoints {:.2} m, J_B bounds {:.3}, J_T turning {:.3})",
+        c.total, c.length, c.obstacle, c.altitude, c.waypoints, c.bounds, c.turning
     );
+    let reference = match (o.reference_length, o.length_ratio) {
+        (Some(r), Some(ratio)) => format!("; J1 / reference {ratio:.3} (shortest route {r:.1} m)"),
+        _ => "; no reference route reaches the goal".to_owned(),
+    };
     let _ = writeln!(
         s,
-        "  path         {:.1} m in {:.1} s, {} free waypoints",
+        "  path         {:.1} m in {:.1} s, {} free waypoints{reference}",
         o.path_length,
         o.duration,
         o.waypoints.len()
@@ -545,6 +553,15 @@ pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
         "  IWPs         {} found, {enabled} enabled",
         o.iwps.len()
     );
+    for i in o.iwps.iter().filter(|i| i.enabled && i.unusable.is_some()) {
+        let _ = writeln!(
+            s,
+            "  IWP          '{}' | '{}' unusable: {}",
+            i.between[0],
+            i.between[1],
+            i.unusable.as_deref().unwrap_or_default()
+        );
+    }
     for r in &o.reconfigurations {
         let _ = writeln!(
             s,
@@ -575,6 +592,22 @@ pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
             s,
             "    {verdict} {:<32} worst {worst:>9} {} {}{at}",
             check.name, check.relation, check.limit
+        );
+    }
+    for i in &o.verification.inspections {
+        let verdict = if i.ok { "ok  " } else { "FAIL" };
+        let band = i.distance.map_or_else(
+            || "never within the band".to_owned(),
+            |[lo, hi]| format!("facing UAV at {lo:.2}-{hi:.2} m"),
+        );
+        let _ = writeln!(
+            s,
+            "    {verdict} inspection of {:<19} {:>5.1} m ≥ {} m within [{}, {}] m, {band}",
+            format!("'{}'", i.obstacle),
+            i.achieved,
+            i.required,
+            i.band[0],
+            i.band[1]
         );
     }
     let verdict = if o.feasible() {
@@ -724,7 +757,7 @@ fn check(files: &[PathBuf], strict: bool, json: bool) -> u8 {
         let name = path.display().to_string();
         let report = match mission::read(path) {
             Ok(text) => {
-                let Checked { report, .. } = mission::check_str(&text, Some(&name));
+                let Checked { report, .. } = crate::diagnose::check_text(&text, Some(&name));
                 report
             }
             Err(e) => Report::new(vec![

@@ -6,6 +6,7 @@
 
 #[cfg(feature = "rerun")]
 pub mod cli;
+pub mod diagnose;
 pub mod flatlo;
 pub mod fleet;
 pub mod geometry;

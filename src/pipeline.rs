@@ -30,7 +30,11 @@ pub struct CostTerms {
     pub altitude: f64,
     /// J_R, mean horizontal distance of the path to the enabled IWPs, metres (eq. 11).
     pub waypoints: f64,
-    /// J = β1 J1 + β2 J2 + β3 J3 + β_R J_R (eqs. 2, 10).
+    /// J_B, how far the UAVs leave the x-y bounds, summed over L shares of the path, metres.
+    pub bounds: f64,
+    /// J_T, the path's horizontal turns beyond 90°, summed, radians.
+    pub turning: f64,
+    /// J = β1 J1 + β2 J2 + β3 J3 + β_R J_R + β_B J_B + β_T J_T (eqs. 2, 10).
     pub total: f64,
 }
 

@@ -486,8 +486,45 @@ fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamRes
                 ]
             }))
             .with_labels(o.iter().map(|o| o.name.clone()))
-            .with_colors(o.iter().map(|_| rerun::Color::from_rgb(150, 150, 160))),
+            .with_colors(o.iter().map(|o| {
+                if o.inspect {
+                    rerun::Color::from_rgb(200, 90, 200)
+                } else {
+                    rerun::Color::from_rgb(150, 150, 160)
+                }
+            })),
         )?;
+        // Inspected surfaces (eq. 8): the stand-off band's outer shell,
+        // translucent, over the altitude band.
+        let inspected: Vec<_> = o.iter().filter(|o| o.inspect).collect();
+        if !inspected.is_empty() {
+            let band_height = (m.bounds.z[1] - m.bounds.z[0]) as f32;
+            stream.log_static(
+                "world/inspection",
+                &rerun::Cylinders3D::from_lengths_and_radii(
+                    inspected.iter().map(|_| band_height),
+                    inspected
+                        .iter()
+                        .map(|o| (o.radius + o.stand_off_band(&m.formation)[1]) as f32),
+                )
+                .with_centers(inspected.iter().map(|o| {
+                    [
+                        o.center.x as f32,
+                        o.center.y as f32,
+                        ((m.bounds.z[0] + m.bounds.z[1]) / 2.0) as f32,
+                    ]
+                }))
+                .with_labels(inspected.iter().map(|o| {
+                    let [lo, hi] = o.stand_off_band(&m.formation);
+                    format!("inspect {}: {lo}-{hi} m", o.name)
+                }))
+                .with_colors(
+                    inspected
+                        .iter()
+                        .map(|_| rerun::Color::from_unmultiplied_rgba(200, 90, 200, 40)),
+                ),
+            )?;
+        }
     }
     stream.log_static(
         "world/route",
@@ -675,6 +712,48 @@ fn log_theta_pso(
                     r.between[1]
                 ))
                 .with_level(rerun::TextLogLevel::INFO),
+            )?;
+        }
+    }
+    // Inspection passes (eq. 8): the centroid's stretch, and when each begins and ends.
+    let speed = o.path_length / o.duration.max(1e-9);
+    let walker = crate::planner::path::ArcWalker::new(&o.centroid_path);
+    for (pass, result) in o.passes.iter().zip(&o.verification.inspections) {
+        let [t0, t1] = pass.time;
+        let steps = 20;
+        let stretch: Vec<[f32; 3]> = (0..=steps)
+            .map(|k| f32x3(&walker.at((t0 + (t1 - t0) * k as f64 / steps as f64) * speed)))
+            .collect();
+        stream.log_static(
+            format!(
+                "theta_pso/plan/pass_{}",
+                pass.obstacle.replace([' ', '/'], "_")
+            )
+            .as_str(),
+            &rerun::LineStrips3D::new([stretch])
+                .with_colors([rerun::Color::from_rgb(230, 110, 230)])
+                .with_radii([0.25f32])
+                .with_labels([format!("inspection of {}", pass.obstacle)]),
+        )?;
+        for (label, t) in [("inspection pass starts", t0), ("inspection pass ends", t1)] {
+            stream.set_duration_secs("sim_time", t);
+            let achieved = result.distance.map_or_else(
+                || "no stretch within the band".to_owned(),
+                |[lo, hi]| {
+                    format!(
+                        "{:.1} m within the band, at {lo:.2}-{hi:.2} m",
+                        result.achieved
+                    )
+                },
+            );
+            stream.log(
+                "theta_pso/events",
+                &rerun::TextLog::new(format!("{label}: '{}' ({achieved})", pass.obstacle))
+                    .with_level(if result.ok {
+                        rerun::TextLogLevel::INFO
+                    } else {
+                        rerun::TextLogLevel::WARN
+                    }),
             )?;
         }
     }

@@ -35,6 +35,9 @@ pub struct SwarmConfig {
     pub social: f64,
     /// Evaluate the particles' costs on the rayon pool. Same result either way.
     pub parallel: bool,
+    /// Which set of random streams the particles draw from: 0 for a first
+    /// run, 1, 2, … for restarts of the same seed (new streams, same seed).
+    pub streams: u64,
 }
 
 /// The box the particles move in and the largest step per iteration, per dimension.
@@ -93,15 +96,25 @@ pub struct SwarmResult {
 /// evaluation (iteration 0) and after each iteration; returning
 /// `ControlFlow::Break` stops the run, keeping the best found so far.
 /// A NaN cost counts as +∞, so it never becomes a best.
+///
+/// Particle i starts at `starts[i]` (clamped into the box) when given, at a
+/// uniform random position otherwise: a caller can seed the swarm with
+/// guesses it already has.
+///
+/// `cost(position, bound)` is called with the particle's personal best as
+/// `bound`: once it knows the cost reaches the bound it may return any value
+/// ≥ it (a partial sum), since such a candidate updates no best. The search
+/// is then exactly the one full evaluations would make.
 pub fn minimize<F, C>(
     space: &SearchSpace,
     config: &SwarmConfig,
     seed: u64,
+    starts: &[Vec<f64>],
     cost: F,
     mut on_iteration: C,
 ) -> SwarmResult
 where
-    F: Fn(&[f64]) -> f64 + Sync,
+    F: Fn(&[f64], f64) -> f64 + Sync,
     C: FnMut(&IterationReport<'_>) -> ControlFlow<()>,
 {
     let dims = space.dims();
@@ -109,22 +122,33 @@ where
     let mut rngs: Vec<ChaCha8Rng> = (0..n)
         .map(|i| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            rng.set_stream(i as u64);
+            // 2^32 streams per run: restarts never share a stream with a first run.
+            rng.set_stream((config.streams << 32) | i as u64);
             rng
         })
         .collect();
 
     let mut positions: Vec<Vec<f64>> = rngs
         .iter_mut()
-        .map(|rng| {
-            (0..dims)
+        .enumerate()
+        .map(|(i, rng)| {
+            // Draw the random start even for a seeded particle, so seeding
+            // one particle does not shift any other particle's stream.
+            let random: Vec<f64> = (0..dims)
                 .map(|d| sample(rng, space.lower[d], space.upper[d]))
-                .collect()
+                .collect();
+            match starts.get(i) {
+                Some(start) if start.len() == dims => (0..dims)
+                    .map(|d| start[d].clamp(space.lower[d], space.upper[d]))
+                    .collect(),
+                _ => random,
+            }
         })
         .collect();
     let mut velocities = vec![vec![0.0; dims]; n];
 
-    let mut costs = evaluate(&positions, &cost, config.parallel);
+    let unbounded = vec![f64::INFINITY; n];
+    let mut costs = evaluate(&positions, &unbounded, &cost, config.parallel);
     let mut evaluations = n;
     let mut personal: Vec<Best> = positions
         .iter()
@@ -163,7 +187,8 @@ where
                 x[d] = (x[d] + v[d]).clamp(space.lower[d], space.upper[d]);
             }
         }
-        costs = evaluate(&positions, &cost, config.parallel);
+        let bounds: Vec<f64> = personal.iter().map(|p| p.cost).collect();
+        costs = evaluate(&positions, &bounds, &cost, config.parallel);
         evaluations += n;
         for (i, &c) in costs.iter().enumerate() {
             if c < personal[i].cost {
@@ -208,18 +233,18 @@ fn sample(rng: &mut ChaCha8Rng, lower: f64, upper: f64) -> f64 {
     }
 }
 
-fn evaluate<F>(positions: &[Vec<f64>], cost: &F, parallel: bool) -> Vec<f64>
+fn evaluate<F>(positions: &[Vec<f64>], bounds: &[f64], cost: &F, parallel: bool) -> Vec<f64>
 where
-    F: Fn(&[f64]) -> f64 + Sync,
+    F: Fn(&[f64], f64) -> f64 + Sync,
 {
-    let guarded = |p: &Vec<f64>| {
-        let c = cost(p);
+    let guarded = |(p, bound): (&Vec<f64>, &f64)| {
+        let c = cost(p, *bound);
         if c.is_nan() { f64::INFINITY } else { c }
     };
     if parallel {
-        positions.par_iter().map(guarded).collect()
+        positions.par_iter().zip(bounds).map(guarded).collect()
     } else {
-        positions.iter().map(guarded).collect()
+        positions.iter().zip(bounds).map(guarded).collect()
     }
 }
 
@@ -246,6 +271,7 @@ mod tests {
             cognitive: 1.49618,
             social: 1.49618,
             parallel,
+            streams: 0,
         }
     }
 
@@ -256,9 +282,14 @@ mod tests {
     #[test]
     fn finds_the_minimum_of_a_sphere() {
         let space = SearchSpace::uniform(4, -1.0, 1.0, 0.5);
-        let result = minimize(&space, &config(false), 1, sphere, |_| {
-            ControlFlow::Continue(())
-        });
+        let result = minimize(
+            &space,
+            &config(false),
+            1,
+            &[],
+            |x, _| sphere(x),
+            |_| ControlFlow::Continue(()),
+        );
         assert!(result.best.cost < 1e-8, "cost {}", result.best.cost);
         assert!(result.best.position.iter().all(|v| (v - 0.3).abs() < 1e-3));
         assert_eq!(result.evaluations, 30 * 201);
@@ -267,16 +298,31 @@ mod tests {
     #[test]
     fn parallel_and_sequential_runs_are_identical() {
         let space = SearchSpace::uniform(6, -1.0, 1.0, 0.5);
-        let seq = minimize(&space, &config(false), 42, sphere, |_| {
-            ControlFlow::Continue(())
-        });
-        let par = minimize(&space, &config(true), 42, sphere, |_| {
-            ControlFlow::Continue(())
-        });
+        let seq = minimize(
+            &space,
+            &config(false),
+            42,
+            &[],
+            |x, _| sphere(x),
+            |_| ControlFlow::Continue(()),
+        );
+        let par = minimize(
+            &space,
+            &config(true),
+            42,
+            &[],
+            |x, _| sphere(x),
+            |_| ControlFlow::Continue(()),
+        );
         assert_eq!(seq, par);
-        let other = minimize(&space, &config(false), 43, sphere, |_| {
-            ControlFlow::Continue(())
-        });
+        let other = minimize(
+            &space,
+            &config(false),
+            43,
+            &[],
+            |x, _| sphere(x),
+            |_| ControlFlow::Continue(()),
+        );
         assert_ne!(seq.best.position, other.best.position, "the seed matters");
     }
 
@@ -288,7 +334,8 @@ mod tests {
             &space,
             &config(false),
             3,
-            |x| -x[0] - x[1],
+            &[],
+            |x, _| -x[0] - x[1],
             |_| ControlFlow::Continue(()),
         );
         assert_eq!(result.best.position, vec![1.0, 1.0]);
@@ -298,18 +345,59 @@ mod tests {
     fn the_global_best_never_gets_worse_and_breaking_stops_at_once() {
         let space = SearchSpace::uniform(3, -1.0, 1.0, 0.5);
         let mut history = Vec::new();
-        let result = minimize(&space, &config(false), 5, sphere, |r| {
-            history.push(r.best.cost);
-            if r.iteration == 10 {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        });
+        let result = minimize(
+            &space,
+            &config(false),
+            5,
+            &[],
+            |x, _| sphere(x),
+            |r| {
+                history.push(r.best.cost);
+                if r.iteration == 10 {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            },
+        );
         assert!(result.stopped);
         assert_eq!(result.iterations, 10);
         assert_eq!(history.len(), 11);
         assert!(history.windows(2).all(|w| w[1] <= w[0]));
+    }
+
+    #[test]
+    fn a_seeded_particle_starts_where_told_and_restarts_draw_new_streams() {
+        let space = SearchSpace::uniform(2, -1.0, 1.0, 0.5);
+        let mut first = Vec::new();
+        minimize(
+            &space,
+            &config(false),
+            4,
+            &[vec![0.3, 0.3]],
+            |x, _| sphere(x),
+            |r| {
+                first.push(r.best.cost);
+                ControlFlow::Break(())
+            },
+        );
+        assert_eq!(first, vec![0.0], "the seeded particle sits on the minimum");
+        let run = |streams| {
+            let cfg = SwarmConfig {
+                streams,
+                ..config(false)
+            };
+            minimize(
+                &space,
+                &cfg,
+                4,
+                &[],
+                |x, _| sphere(x),
+                |_| ControlFlow::Break(()),
+            )
+        };
+        assert_ne!(run(0).best.position, run(1).best.position);
+        assert_eq!(run(1), run(1));
     }
 
     #[test]
@@ -319,7 +407,8 @@ mod tests {
             &space,
             &config(false),
             9,
-            |x| if x[0] > 0.0 { f64::NAN } else { -x[0] },
+            &[],
+            |x, _| if x[0] > 0.0 { f64::NAN } else { -x[0] },
             |_| ControlFlow::Continue(()),
         );
         assert!(result.best.cost.is_finite());

@@ -101,6 +101,8 @@ fn one_agent_goes_around_an_obstacle_outside_the_safety_distance() {
         radius: 0.3,
         height: 2.5,
         kind: None,
+        inspect: false,
+        stand_off: None,
     }];
     let o = run(&m, 3);
     assert!(

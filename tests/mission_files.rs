@@ -194,6 +194,8 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                     radius: r.min(w / 20.0),
                     height: h,
                     kind: (!kind.is_empty()).then_some(kind),
+                    inspect: false,
+                    stand_off: None,
                 })
                 .collect();
             let mut m = Mission {

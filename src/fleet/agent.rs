@@ -42,6 +42,7 @@ impl Planner {
                 social: p.social,
                 // Agents run in parallel; each agent's own swarm stays on its thread.
                 parallel: false,
+                streams: 0,
             },
             space: SearchSpace::uniform(2, -p.step_max, p.step_max, p.step_max),
             decisions: 0,
@@ -57,7 +58,8 @@ impl Planner {
             &self.space,
             &self.config,
             stream,
-            |h| view.cost(&Vector2::new(h[0], h[1])),
+            &[],
+            |h, _| view.cost(&Vector2::new(h[0], h[1])),
             |_| ControlFlow::Continue(()),
         );
         self.decisions += 1;

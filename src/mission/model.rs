@@ -106,6 +106,15 @@ pub struct Obstacle {
     /// Free label ("pier", "pole", "tree", …), for display only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kind: Option<String>,
+    /// Inspect this obstacle's surface (θ-PSO eq. 8): the plan flies the
+    /// formation past it so that the UAV facing it stays within the stand-off
+    /// band over a pass of `formation.inspection_pass` metres.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub inspect: bool,
+    /// [d_min^s, d_max^s] for this obstacle, metres from its surface (eq. 8);
+    /// `formation.surface_distance` when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stand_off: Option<[f64; 2]>,
 }
 
 /// Where the formation centroid starts and ends. Metres ENU.
@@ -126,8 +135,13 @@ pub struct Formation {
     pub comm_range: f64,
     /// Constant ground speed of the centroid, m/s.
     pub ground_speed: f64,
-    /// [d_min^s, d_max^s]: distance band to the inspected surface, metres (eq. 8).
+    /// [d_min^s, d_max^s]: distance band to the inspected surface, metres
+    /// (eq. 8); the default stand-off of every inspected obstacle.
     pub surface_distance: [f64; 2],
+    /// Length of the straight inspection pass along an inspected obstacle,
+    /// metres of centroid path over which eq. 8 must hold. Not in the paper:
+    /// 6 m is 2 s of video at 3 m/s past a pier of the bridge.
+    pub inspection_pass: f64,
     /// Offsets of each UAV from the centroid in the formation frame
     /// (x forward along the horizontal path tangent, y left, z up), metres.
     pub slots: Vec<Vector3<f64>>,
@@ -141,6 +155,7 @@ impl Default for Formation {
             comm_range: 20.0,
             ground_speed: 3.0,
             surface_distance: [1.0, 5.0],
+            inspection_pass: 6.0,
             slots: vec![
                 Vector3::new(0.0, 2.0, 0.0),
                 Vector3::new(-2.0, -1.0, 0.0),
@@ -217,6 +232,12 @@ fn yes() -> bool {
 }
 
 /// θ-PSO parameters (θ-PSO paper, eqs. 1-5, 10-11, Section IV.A).
+///
+/// From the paper: the swarm size, waypoints and iterations (IV.A). Not from
+/// the paper, which gives neither: the PSO gains w, c1, c2 are Clerc and
+/// Kennedy's constriction values (IEEE TEC 6(1), 2002), the usual defaults of
+/// the PSO literature; the β weights are skyform's, chosen so that any
+/// violation (β2 J2, β3 J3) outweighs any length difference between paths.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ThetaPsoParams {
@@ -226,25 +247,42 @@ pub struct ThetaPsoParams {
     pub waypoints: usize,
     /// Swarm iterations (150 in the paper).
     pub iterations: usize,
-    /// w: inertia weight of eq. 1.
+    /// w: inertia weight of eq. 1 (0.7298, Clerc-Kennedy; not in the paper).
     pub inertia: f64,
-    /// c1: cognitive gain of eq. 1.
+    /// c1: cognitive gain of eq. 1 (1.49618, Clerc-Kennedy; not in the paper).
     pub cognitive: f64,
-    /// c2: social gain of eq. 1.
+    /// c2: social gain of eq. 1 (1.49618, Clerc-Kennedy; not in the paper).
     pub social: f64,
     /// L: straight segments the path is split into for the cost (eqs. 3-5, 11).
     pub segments: usize,
-    /// β1: weight of the path length J1 (eq. 2).
+    /// β1: weight of the path length J1 (eq. 2; skyform's choice, 1).
     pub weight_length: f64,
-    /// β2: weight of the obstacle violation J2 (eq. 2).
+    /// β2: weight of the obstacle violation J2 (eq. 2; skyform's choice, 10⁵).
     pub weight_obstacle: f64,
-    /// β3: weight of the altitude violation J3 (eq. 2).
+    /// β3: weight of the altitude violation J3 (eq. 2; skyform's choice, 100).
     pub weight_altitude: f64,
     /// Weight of J_R (eq. 10 adds it with weight 1).
     pub weight_waypoints: f64,
     /// δ_l for a segment at or below the ground. The paper's ∞ is replaced by
     /// a large finite value so that costs stay comparable.
     pub ground_penalty: f64,
+    /// Weight of the x-y bounds term: how far any UAV leaves the bounds
+    /// (not in the paper, which decodes the centroid inside them).
+    pub weight_bounds: f64,
+    /// Weight of the turning term J_T, metres of path per radian of turn
+    /// beyond 90° (not in the paper): a hairpin costs as much as 47 m of path.
+    pub weight_turning: f64,
+    /// Extra clearance the cost asks of every UAV beyond r_Q, metres: room for
+    /// the sampling of verification and for the tracking of a real autopilot.
+    /// Reduced automatically where an IWP gap leaves less room.
+    pub clearance_margin: f64,
+    /// Runs of the swarm with new random streams when the best plan still
+    /// fails verification, before the plan is reported infeasible.
+    pub restarts: usize,
+    /// Particles that start on the reference route (the shortest 2-D route
+    /// around the obstacles inflated by the formation's safe radius) instead
+    /// of at random; 0 for the paper's purely random start (Fig. 3, line 9).
+    pub seeded_particles: usize,
 }
 
 impl Default for ThetaPsoParams {
@@ -262,6 +300,11 @@ impl Default for ThetaPsoParams {
             weight_altitude: 100.0,
             weight_waypoints: 1.0,
             ground_penalty: 1.0e6,
+            weight_bounds: 100.0,
+            weight_turning: 30.0,
+            clearance_margin: 0.1,
+            restarts: 3,
+            seeded_particles: 10,
         }
     }
 }
@@ -475,6 +518,11 @@ impl Default for FleetParams {
 }
 
 impl Obstacle {
+    /// The eq. 8 band for this obstacle: its own, or the formation's.
+    pub fn stand_off_band(&self, formation: &Formation) -> [f64; 2] {
+        self.stand_off.unwrap_or(formation.surface_distance)
+    }
+
     pub fn cylinder(&self) -> crate::geometry::Cylinder {
         crate::geometry::Cylinder {
             center: self.center,

@@ -7,8 +7,8 @@ use nalgebra::Point3;
 
 use super::diagnostic::Diagnostic;
 use super::model::{
-    Bounds, FlatloParams, FleetParams, Formation, GeoOrigin, Mission, Obstacle, Reconfiguration,
-    Route, ThetaPsoParams,
+    Bounds, FlatloParams, FleetParams, Formation, GeoOrigin, Mission, Reconfiguration, Route,
+    ThetaPsoParams,
 };
 use super::source::FieldPath;
 
@@ -37,7 +37,7 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
     c.theta_pso(&root.key("theta_pso"), &mission.theta_pso);
     c.flatlo(&root.key("flatlo"), &mission.flatlo);
     c.fleet(&root.key("fleet"), &mission.fleet, &mission.bounds);
-    c.obstacles(&root.key("obstacles"), &mission.obstacles, &mission.bounds);
+    c.obstacles(&root.key("obstacles"), mission);
     c.out
 }
 
@@ -208,6 +208,7 @@ impl Checker {
         if self.range(path.key("surface_distance"), f.surface_distance, " m") {
             self.non_negative(path.key("surface_distance"), f.surface_distance[0], " m");
         }
+        self.positive(path.key("inspection_pass"), f.inspection_pass, " m");
         if f.comm_range.is_finite() && f.comm_range < 2.0 * f.uav_radius {
             self.error(
                 path.key("comm_range"),
@@ -337,6 +338,9 @@ impl Checker {
             ("weight_obstacle", p.weight_obstacle),
             ("weight_altitude", p.weight_altitude),
             ("weight_waypoints", p.weight_waypoints),
+            ("weight_bounds", p.weight_bounds),
+            ("weight_turning", p.weight_turning),
+            ("clearance_margin", p.clearance_margin),
         ] {
             self.non_negative(path.key(key), value, "");
         }
@@ -619,9 +623,38 @@ impl Checker {
         }
     }
 
-    fn obstacles(&mut self, path: &FieldPath, obstacles: &[Obstacle], bounds: &Bounds) {
+    fn obstacles(&mut self, path: &FieldPath, mission: &Mission) {
+        let (obstacles, bounds) = (&mission.obstacles, &mission.bounds);
         for (i, o) in obstacles.iter().enumerate() {
             let at = path.index(i);
+            if let Some(band) = o.stand_off
+                && self.range(at.key("stand_off"), band, " m")
+            {
+                self.non_negative(at.key("stand_off"), band[0], " m");
+            }
+            if o.inspect {
+                let [d_min, _] = o.stand_off_band(&mission.formation);
+                if o.height.is_finite() && o.height <= bounds.z[0] {
+                    self.error(
+                        at.key("inspect"),
+                        format!(
+                            "'{}' is {} m tall, below the altitude band's floor z_min = {} m: \
+                             the formation cannot fly beside its surface (eq. 8)",
+                            o.name, o.height, bounds.z[0]
+                        ),
+                    );
+                }
+                if d_min < mission.formation.uav_radius {
+                    self.warning(
+                        at.key("stand_off"),
+                        format!(
+                            "the stand-off band starts at {d_min} m, inside the UAV's safe radius \
+                             r_Q = {} m: clearance (≥ r_Q) binds first",
+                            mission.formation.uav_radius
+                        ),
+                    );
+                }
+            }
             if o.name.trim().is_empty() {
                 self.error(at.key("name"), "must not be empty");
             } else if obstacles[..i].iter().any(|p| p.name == o.name) {

@@ -1,67 +1,259 @@
-//! The θ-PSO cost J = β1 J1 + β2 J2 + β3 J3 + β_R J_R (eqs. 2-5, 10-11).
+//! The θ-PSO cost J = β1 J1 + β2 J2 + β3 J3 + β_R J_R + β_B J_B (eqs. 2-5,
+//! 10-11), judged on every UAV's path, not only the centroid's.
 //!
-//! The centroid path is split into about L straight segments: each leg of the
-//! polyline gets a share of L proportional to its length (at least one), so
-//! J1 is the exact polyline length and the segment midpoints are evenly
-//! spread. J2, J3 and J_R are evaluated at the midpoints.
+//! What verification checks is what each UAV flies: its slot offset turned
+//! with the heading, through the reconfigurations and holds (`motion`). So
+//! the cost evaluates the same function:
 //!
-//! Safe radius of eq. 4: r^S = r_k + r_F + r_Q for the nominal formation. In a
-//! reconfiguration zone the formation is narrower: there r^S = r_k + ρ with ρ
-//! blended linearly (with the zone's blend b) from r_F + r_Q to the lateral
-//! half-width of the new shape (UAV radius included). Across the IWP the path
-//! is straight along the gap's normal, so the lateral width is what must clear
-//! the obstacles.
+//! - J1 (eq. 3): the centroid path's exact polyline length.
+//! - J2 (eq. 4), per UAV and along whole pieces of path: for each UAV n and
+//!   obstacle k, max(1 − d / r^S, 0) with r^S = r_k + r_Q + margin is
+//!   *integrated* along the UAV's path (closed form on each straight piece,
+//!   `violation_along`), not sampled at midpoints, so a thin pole between
+//!   two samples is seen. Normalised by N K J1, so a path violating by v
+//!   everywhere scores v, as the paper's mean over L segments does. Zero
+//!   exactly when every UAV keeps r_Q + margin from every obstacle.
+//! - J3 (eq. 5), per UAV: the altitude-band violation of each UAV (the ±
+//!   height of a rotated shape included), summed over L equal shares of the
+//!   path as the paper sums over its L segments; below the ground the finite
+//!   `ground_penalty`.
+//! - J_B, per UAV: how far it leaves the x-y bounds, summed the same way
+//!   (the paper keeps the centroid inside by decoding; its UAVs can still
+//!   leave, at an IWP's straight crossing).
+//! - J_R (eq. 11), as printed: mean horizontal distance of the L segment
+//!   midpoints to the enabled IWPs.
+//! - J_T (not in the paper): the centroid path's horizontal turns beyond 90°,
+//!   radians, so the swarm prefers no hairpins where a gentler route exists.
+//!
+//! Speed: a leg far from every obstacle, well inside the band and the bounds
+//! cannot put a UAV in violation (every UAV stays within the formation's
+//! reach of the centroid), so only the legs that come close are followed UAV
+//! by UAV. Along them the path of each UAV is straight between knots (the
+//! path's vertices ± the heading's span, the zones' t1..t4) except where the
+//! heading turns or the shape blends; those stretches are split finely.
 
-use nalgebra::{Point2, Point3};
+use nalgebra::{Point2, Point3, Vector3};
 
-use super::iwp::{Iwp, lateral_half_width};
-use super::path::CentroidPath;
-use crate::geometry::{Cylinder, polyline_length};
-use crate::mission::{Mission, ThetaPsoParams};
+use super::iwp::{Iwp, Shape};
+use super::motion::Motion;
+use super::path::{CentroidPath, heading_span};
+use crate::geometry::Cylinder;
+use crate::mission::{Bounds, Mission, ThetaPsoParams};
 use crate::pipeline::CostTerms;
+
+/// How far a UAV's path may stray from the chord of a piece where the heading
+/// turns, metres: a fifth of the default clearance margin.
+const CHORD_TOLERANCE: f64 = 0.02;
+/// Longest piece where the shape blends, metres.
+const BLEND_STEP: f64 = 2.0;
+/// Halvings of one knot interval at most (2^8 pieces).
+const MAX_DEPTH: u32 = 8;
 
 /// Everything the cost needs, prepared once per run.
 #[derive(Debug, Clone)]
 pub struct CostModel {
     params: ThetaPsoParams,
     obstacles: Vec<Cylinder>,
-    /// r_F + r_Q of the nominal formation.
-    nominal_safe: f64,
-    /// Per IWP (same indexing as the IWP list): lateral half-width of its shape.
-    shape_half_width: Vec<f64>,
+    slots: Vec<Vector3<f64>>,
+    uav_radius: f64,
+    /// The clearance margin in use (the mission's, reduced where a gap is tight).
+    margin: f64,
+    span: f64,
+    /// Farthest any UAV can be from the centroid horizontally, any shape.
+    reach: f64,
+    /// Farthest any UAV can be above or below the centroid, any shape.
+    rise: f64,
+    /// The same in the nominal shape, outside the reconfiguration zones.
+    nominal_reach: f64,
+    nominal_rise: f64,
     /// C_j of the enabled IWPs.
     iwp_points: Vec<Point2<f64>>,
     band: [f64; 2],
+    bounds: Bounds,
+    /// Cosine of the largest heading turn over one piece: the turn at which a
+    /// UAV `reach` from the centroid strays `CHORD_TOLERANCE` from the chord.
+    max_turn_cos: f64,
+}
+
+/// Running sums of the per-UAV terms.
+#[derive(Default)]
+struct Sums {
+    /// Σ arc length × (1 − d / r^S)⁺ over UAVs, obstacles, pieces.
+    obstacle: f64,
+    /// Σ arc length × δ over UAVs, pieces.
+    altitude: f64,
+    /// Σ arc length × metres outside the bounds over UAVs, pieces.
+    bounds: f64,
 }
 
 impl CostModel {
     pub fn new(mission: &Mission, iwps: &[Iwp]) -> Self {
         let f = &mission.formation;
+        let shapes: Vec<Shape> = iwps
+            .iter()
+            .filter(|i| i.is_via())
+            .filter_map(|i| i.shape)
+            .collect();
+        let nominal_reach = f.slots.iter().map(|o| o.xy().norm()).fold(0.0, f64::max);
+        let nominal_rise = f.slots.iter().map(|o| o.z.abs()).fold(0.0, f64::max);
+        let (mut reach, mut rise) = (nominal_reach, nominal_rise);
+        for shape in &shapes {
+            for (n, o) in f.slots.iter().enumerate() {
+                let full = shape.offset(&f.slots, n, 1.0);
+                reach = reach.max(full.xy().norm()).max(o.norm());
+                rise = rise.max(match shape {
+                    // Turning about y sweeps x into z: the whole arc.
+                    Shape::Rotation => (o.x * o.x + o.z * o.z).sqrt(),
+                    _ => full.z.abs(),
+                });
+            }
+        }
+        // Room an IWP gap leaves beside the shape that crosses it.
+        let spare = iwps
+            .iter()
+            .filter(|i| i.is_via())
+            .map(|i| {
+                let offsets = i
+                    .shape
+                    .map_or_else(|| f.slots.clone(), |s| s.offsets(&f.slots, 1.0));
+                i.gap / 2.0 - super::iwp::lateral_half_width(&offsets, f.uav_radius)
+            })
+            .fold(f64::INFINITY, f64::min);
+        let margin = mission
+            .theta_pso
+            .clearance_margin
+            .min((spare / 2.0).max(0.0));
         CostModel {
             params: mission.theta_pso.clone(),
             obstacles: mission.obstacles.iter().map(|o| o.cylinder()).collect(),
-            nominal_safe: f.safe_radius(),
-            shape_half_width: iwps
-                .iter()
-                .map(|i| lateral_half_width(&i.shape.offsets(&f.slots, 1.0), f.uav_radius))
-                .collect(),
+            slots: f.slots.clone(),
+            uav_radius: f.uav_radius,
+            margin,
+            span: heading_span(mission),
+            reach,
+            rise,
+            nominal_reach,
+            nominal_rise,
             iwp_points: iwps
                 .iter()
                 .filter(|i| i.enabled)
                 .map(|i| i.position)
                 .collect(),
             band: mission.bounds.z,
+            bounds: mission.bounds.clone(),
+            max_turn_cos: {
+                let half = (1.0 - CHORD_TOLERANCE / reach.max(CHORD_TOLERANCE)).max(0.0);
+                2.0 * half * half - 1.0
+            },
         }
+    }
+
+    /// The clearance beyond r_Q the cost asks of every UAV, metres.
+    pub fn margin(&self) -> f64 {
+        self.margin
     }
 
     /// J and its terms for a centroid path.
     pub fn terms(&self, path: &CentroidPath) -> CostTerms {
+        self.terms_below(path, f64::INFINITY)
+    }
+
+    /// J and its terms, or, as soon as J is known to reach `bound`, a partial
+    /// sum that already does (every term is ≥ 0, so a partial sum is a lower
+    /// bound of J). The swarm passes a particle's personal best: a candidate
+    /// that cannot beat it changes nothing, whatever its exact cost, so the
+    /// search is the same as with full evaluations, only faster.
+    pub fn terms_below(&self, path: &CentroidPath, bound: f64) -> CostTerms {
         let points = &path.points;
-        let total = polyline_length(points);
+        let p = &self.params;
+        let motion = Motion::new(path, &self.slots, self.span);
+        let total = motion.length();
+        let turning = turning_excess(points);
+        let (segments, jr) = self.waypoint_term(points, total);
+        let mut terms = CostTerms {
+            length: total,
+            waypoints: jr,
+            turning,
+            total: p.weight_length * total + p.weight_waypoints * jr + p.weight_turning * turning,
+            ..CostTerms::default()
+        };
+        if terms.total >= bound {
+            return terms;
+        }
+        let arcs = motion.walker().arcs();
+        let mut sums = Sums::default();
+        let mut scratch = Scratch::default();
+        let n = self.slots.len().max(1) as f64;
+        let k = self.obstacles.len();
+        let l = segments.max(1) as f64;
+        let obstacle_scale = if k > 0 && total > 0.0 {
+            1.0 / (n * k as f64 * total)
+        } else {
+            0.0
+        };
+        let share = if total > 0.0 { l / (n * total) } else { 0.0 };
+        let base = terms.total;
+        for (i, leg) in points.windows(2).enumerate() {
+            let (a, b) = (leg[0], leg[1]);
+            // Outside the zones the formation keeps its nominal extent.
+            let (s0, s1) = (arcs[i], arcs[i + 1]);
+            let (reach, rise) = if path.zones.iter().any(|z| {
+                let [z0, _, _, z3] = z.arcs();
+                z0 < s1 && s0 < z3
+            }) {
+                (self.reach, self.rise)
+            } else {
+                (self.nominal_reach, self.nominal_rise)
+            };
+            scratch.near.clear();
+            for (k, c) in self.obstacles.iter().enumerate() {
+                if let Some(window) = self.touch_window(&a, &b, c, reach, rise) {
+                    scratch.near.push((k, window));
+                }
+            }
+            let low = a.z.min(b.z) - rise;
+            let high = a.z.max(b.z) + rise;
+            let band = low < self.band[0] || high > self.band[1];
+            let edge = self
+                .bounds
+                .horizontal_margin(&a)
+                .min(self.bounds.horizontal_margin(&b))
+                < reach;
+            if scratch.near.is_empty() && !band && !edge {
+                continue;
+            }
+            self.follow_leg(
+                &motion,
+                path,
+                arcs[i],
+                arcs[i + 1],
+                band || edge,
+                &mut scratch,
+                &mut sums,
+            );
+            let so_far = base
+                + p.weight_obstacle * sums.obstacle * obstacle_scale
+                + (p.weight_altitude * sums.altitude + p.weight_bounds * sums.bounds) * share;
+            if so_far >= bound {
+                break;
+            }
+        }
+        terms.obstacle = sums.obstacle * obstacle_scale;
+        terms.altitude = sums.altitude * share;
+        terms.bounds = sums.bounds * share;
+        terms.total = base
+            + p.weight_obstacle * terms.obstacle
+            + p.weight_altitude * terms.altitude
+            + p.weight_bounds * terms.bounds;
+        terms
+    }
+
+    /// J_R (eq. 11) over about L segments (each leg a share proportional to
+    /// its length, at least one); returns the segment count and J_R.
+    fn waypoint_term(&self, points: &[Point3<f64>], total: f64) -> (usize, f64) {
         let target = self.params.segments.max(1) as f64;
         let mut segments = 0usize;
-        let (mut j2, mut j3, mut jr) = (0.0, 0.0, 0.0);
-        let mut arc = 0.0;
+        let mut sum = 0.0;
         for leg in points.windows(2) {
             let (a, b) = (leg[0], leg[1]);
             let len = (b - a).norm();
@@ -70,72 +262,195 @@ impl CostModel {
             } else {
                 1
             };
-            for k in 0..pieces {
-                let u = (k as f64 + 0.5) / pieces as f64;
-                let mid = a + (b - a) * u;
-                let s = arc + len * u;
-                j2 += self.obstacle_violation(&mid, self.safe_margin(path, s));
-                j3 += self.altitude_violation(mid.z);
-                jr += self
-                    .iwp_points
-                    .iter()
-                    .map(|c| (mid.xy() - c).norm())
-                    .sum::<f64>();
+            if !self.iwp_points.is_empty() {
+                for k in 0..pieces {
+                    let u = (k as f64 + 0.5) / pieces as f64;
+                    let mid = a + (b - a) * u;
+                    sum += self
+                        .iwp_points
+                        .iter()
+                        .map(|c| (mid.xy() - c).norm())
+                        .sum::<f64>();
+                }
             }
             segments += pieces;
-            arc += len;
         }
-        let l = segments.max(1) as f64;
-        let k = self.obstacles.len();
         let m = self.iwp_points.len();
-        let obstacle = if k > 0 { j2 / (l * k as f64) } else { 0.0 };
-        let waypoints = if m > 0 { jr / (l * m as f64) } else { 0.0 };
-        let p = &self.params;
-        CostTerms {
-            length: total,
-            obstacle,
-            altitude: j3,
-            waypoints,
-            total: p.weight_length * total
-                + p.weight_obstacle * obstacle
-                + p.weight_altitude * j3
-                + p.weight_waypoints * waypoints,
+        let jr = if m > 0 {
+            sum / (segments.max(1) as f64 * m as f64)
+        } else {
+            0.0
+        };
+        (segments, jr)
+    }
+
+    /// Where along the centroid leg a-b (fractions t0 ≤ t ≤ t1) a UAV of
+    /// the formation can come within r_Q + margin of cylinder `c`, or `None`
+    /// when nowhere (broad phase: every UAV is within `reach` of the centroid
+    /// horizontally and `rise` vertically on this leg).
+    fn touch_window(
+        &self,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        c: &Cylinder,
+        reach: f64,
+        rise: f64,
+    ) -> Option<(f64, f64)> {
+        let safe = c.radius + self.uav_radius + self.margin + reach;
+        if a.z.min(b.z) - rise >= c.height + self.uav_radius + self.margin {
+            // Entirely above the top by more than the safe distance.
+            return None;
+        }
+        // |a + t (b − a) − c|² < safe² in the plane: a quadratic in t.
+        let d = b.xy() - a.xy();
+        let f = a.xy() - c.center;
+        let qa = d.norm_squared();
+        let qb = 2.0 * f.dot(&d);
+        let qc = f.norm_squared() - safe * safe;
+        if qa < 1e-18 {
+            return (qc < 0.0).then_some((0.0, 1.0));
+        }
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc <= 0.0 {
+            return None;
+        }
+        let root = disc.sqrt();
+        let t0 = ((-qb - root) / (2.0 * qa)).max(0.0);
+        let t1 = ((-qb + root) / (2.0 * qa)).min(1.0);
+        (t0 < t1).then_some((t0, t1))
+    }
+
+    /// Follows every UAV along the leg [s0, s1] of the centroid path: the
+    /// whole leg when `whole` (the band or the bounds are in reach), else only
+    /// the windows where a UAV can touch one of `scratch.near`'s obstacles.
+    #[allow(clippy::too_many_arguments)]
+    fn follow_leg(
+        &self,
+        motion: &Motion<'_>,
+        path: &CentroidPath,
+        s0: f64,
+        s1: f64,
+        whole: bool,
+        scratch: &mut Scratch,
+        sums: &mut Sums,
+    ) {
+        if s1 <= s0 {
+            return;
+        }
+        let Scratch {
+            near,
+            windows,
+            knots,
+            samples,
+            previous,
+            current,
+        } = scratch;
+        let len = s1 - s0;
+        // Obstacle windows as arc lengths, merged.
+        for (_, (t0, t1)) in near.iter_mut() {
+            (*t0, *t1) = (s0 + *t0 * len, s0 + *t1 * len);
+        }
+        windows.clear();
+        if whole {
+            windows.push((s0, s1));
+        } else {
+            windows.extend(near.iter().map(|(_, w)| *w));
+            windows.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut merged = 0;
+            for i in 1..windows.len() {
+                if windows[i].0 <= windows[merged].1 {
+                    windows[merged].1 = windows[merged].1.max(windows[i].1);
+                } else {
+                    merged += 1;
+                    windows[merged] = windows[i];
+                }
+            }
+            windows.truncate(merged + 1);
+        }
+        let span = motion.span();
+        for &(w0, w1) in windows.iter() {
+            knots.clear();
+            knots.push(w0);
+            knots.push(w1);
+            for &a in motion.walker().arcs() {
+                for s in [a - span, a + span] {
+                    if w0 < s && s < w1 {
+                        knots.push(s);
+                    }
+                }
+            }
+            for zone in &path.zones {
+                for s in zone.arcs() {
+                    if w0 < s && s < w1 {
+                        knots.push(s);
+                    }
+                }
+            }
+            knots.sort_by(f64::total_cmp);
+            knots.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+
+            // Split the intervals where the heading turns (until each piece's
+            // chord stays within CHORD_TOLERANCE of the UAVs' arcs) or the
+            // shape blends.
+            samples.clear();
+            samples.push(w0);
+            let mut heading_before = motion.walker().heading(w0, span);
+            for w in knots.windows(2) {
+                let (k0, k1) = (w[0], w[1]);
+                let heading_after = motion.walker().heading(k1, span);
+                let mid_blend = motion.shape_at((k0 + k1) / 2.0).map_or(0.0, |(_, b)| b);
+                let blend_step = if mid_blend > 0.0 && mid_blend < 1.0 {
+                    BLEND_STEP
+                } else {
+                    f64::INFINITY
+                };
+                let piece = Piece {
+                    motion,
+                    max_turn_cos: self.max_turn_cos,
+                    step: blend_step,
+                };
+                piece.split(k0, k1, heading_before, heading_after, MAX_DEPTH, samples);
+                heading_before = heading_after;
+            }
+
+            motion.positions_into(samples[0], previous);
+            for w in samples.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                motion.positions_into(b, current);
+                for &(k, (n0, n1)) in near.iter() {
+                    if b < n0 || a > n1 {
+                        continue;
+                    }
+                    let c = &self.obstacles[k];
+                    let safe = c.radius + self.uav_radius + self.margin;
+                    for (p, q) in previous.iter().zip(current.iter()) {
+                        sums.obstacle += violation_along(p, q, c, safe);
+                    }
+                }
+                if whole {
+                    self.observe_points(current, b - a, sums);
+                }
+                std::mem::swap(previous, current);
+            }
         }
     }
 
-    /// ρ at arc length s: r_F + r_Q, narrowed inside reconfiguration zones.
-    fn safe_margin(&self, path: &CentroidPath, s: f64) -> f64 {
-        let mut margin = self.nominal_safe;
-        for zone in &path.zones {
-            let b = zone.blend(s);
-            if b > 0.0 {
-                let narrow = self.shape_half_width[zone.iwp];
-                margin = margin.min((1.0 - b) * self.nominal_safe + b * narrow);
+    /// Band and bounds violations of the UAVs at one sample, weighted by the
+    /// arc length the sample stands for.
+    fn observe_points(&self, points: &[Point3<f64>], len: f64, sums: &mut Sums) {
+        if len <= 0.0 {
+            return;
+        }
+        for p in points {
+            sums.altitude += len * self.altitude_violation(p.z);
+            let out = -self.bounds.horizontal_margin(p);
+            if out > 0.0 {
+                sums.bounds += len * out;
             }
         }
-        margin
     }
 
-    /// Σ_k max(1 − d_k / r^S_k, 0) at one midpoint (the inner sum of eq. 4).
-    fn obstacle_violation(&self, p: &Point3<f64>, margin: f64) -> f64 {
-        let mut sum = 0.0;
-        for c in &self.obstacles {
-            let safe = c.radius + margin;
-            // Cheap rejection: far away horizontally means no violation at any height.
-            let dx = p.x - c.center.x;
-            let dy = p.y - c.center.y;
-            if dx * dx + dy * dy >= safe * safe {
-                continue;
-            }
-            let d = c.axis_distance(p);
-            if d < safe {
-                sum += 1.0 - d / safe;
-            }
-        }
-        sum
-    }
-
-    /// δ_l of eq. 5 for a segment at height z.
+    /// δ of eq. 5 for a UAV at height z.
     fn altitude_violation(&self, z: f64) -> f64 {
         let [z_min, z_max] = self.band;
         if z <= 0.0 {
@@ -148,4 +463,112 @@ impl CostModel {
             0.0
         }
     }
+}
+
+/// How finely to split the pieces of a UAV's path.
+struct Piece<'a, 'm> {
+    motion: &'a Motion<'m>,
+    max_turn_cos: f64,
+    /// Longest piece, metres (where the shape blends).
+    step: f64,
+}
+
+impl Piece<'_, '_> {
+    /// Pushes the ends of the pieces of (a, b] into `samples`, halving while
+    /// a piece turns the heading by more than allowed or is longer than the step.
+    fn split(
+        &self,
+        a: f64,
+        b: f64,
+        heading_a: Vector3<f64>,
+        heading_b: Vector3<f64>,
+        depth: u32,
+        samples: &mut Vec<f64>,
+    ) {
+        if depth == 0 || (heading_a.dot(&heading_b) >= self.max_turn_cos && b - a <= self.step) {
+            samples.push(b);
+            return;
+        }
+        let mid = (a + b) / 2.0;
+        let heading_mid = self.motion.walker().heading(mid, self.motion.span());
+        self.split(a, mid, heading_a, heading_mid, depth - 1, samples);
+        self.split(mid, b, heading_mid, heading_b, depth - 1, samples);
+    }
+}
+
+/// J_T: Σ over the path's corners of the horizontal turn beyond 90°,
+/// radians. A sharper corner whips the formation round (its outer UAVs speed
+/// up with the turn rate times their offset) and doubles back on the route.
+pub fn turning_excess(points: &[Point3<f64>]) -> f64 {
+    let mut excess = 0.0;
+    let mut incoming: Option<nalgebra::Vector2<f64>> = None;
+    for w in points.windows(2) {
+        let d = w[1].xy() - w[0].xy();
+        if d.norm_squared() < 1e-18 {
+            continue;
+        }
+        if let Some(a) = incoming {
+            // Only a turn past 90° (dot < 0) counts: atan2 only then.
+            let dot = a.dot(&d);
+            if dot < 0.0 {
+                excess += a.perp(&d).abs().atan2(dot) - std::f64::consts::FRAC_PI_2;
+            }
+        }
+        incoming = Some(d);
+    }
+    excess
+}
+
+/// Buffers reused across the legs of one evaluation.
+#[derive(Default)]
+struct Scratch {
+    /// Obstacles a UAV may touch on this leg, with their window along it.
+    near: Vec<(usize, (f64, f64))>,
+    windows: Vec<(f64, f64)>,
+    knots: Vec<f64>,
+    samples: Vec<f64>,
+    previous: Vec<Point3<f64>>,
+    current: Vec<Point3<f64>>,
+}
+
+/// ∫ max(1 − d / R, 0) dℓ along the straight piece p-q of a UAV's path
+/// (eq. 4's violation, integrated instead of sampled), with d the distance to
+/// the cylinder's axis (over the top disc above it) and R = r^S.
+///
+/// Along a straight line passing h from the axis, d = √(h² + u²) with u the
+/// distance along it from the closest point, so the integral has a closed
+/// form: F(u) = u − (u √(u² + h²) + h² asinh(u / h)) / 2R, taken over the
+/// part of the piece within √(R² − h²) of the closest point. Exact for a
+/// level piece below the top; above it, h is the axis distance at the closest
+/// point (which counts the height over the top disc).
+pub fn violation_along(p: &Point3<f64>, q: &Point3<f64>, c: &Cylinder, safe: f64) -> f64 {
+    let (a, b) = (p.xy(), q.xy());
+    let ab = b - a;
+    let length = ab.norm();
+    let (t, _) = crate::geometry::segment_projection(&a, &b, &c.center);
+    let h = c.axis_distance(&(p + (q - p) * t));
+    if h >= safe {
+        return 0.0;
+    }
+    let reach = (safe * safe - h * h).sqrt();
+    if length < 1e-12 {
+        return 0.0;
+    }
+    // Signed distances of the piece's ends from the line's closest point.
+    let along = ab / length;
+    let s_closest = (c.center - a).dot(&along);
+    let u0 = (-s_closest).max(-reach);
+    let u1 = (length - s_closest).min(reach);
+    if u1 <= u0 {
+        return 0.0;
+    }
+    let antiderivative = |u: f64| {
+        let tail = if h > 1e-12 {
+            u * (u * u + h * h).sqrt() + h * h * (u / h).asinh()
+        } else {
+            u * u.abs()
+        };
+        u - tail / (2.0 * safe)
+    };
+    antiderivative(u1) - antiderivative(u0)
 }

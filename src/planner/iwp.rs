@@ -10,6 +10,16 @@
 //!   r_Q of it) is not a passage and gets no IWP;
 //! - both obstacles must reach into the altitude band; over a lower one the
 //!   formation can simply fly.
+//!
+//! The formation crosses an IWP straight along the gap's normal, so what must
+//! fit is its *lateral* width (UAV radius included), not r_F. Hence:
+//! - a gap at least as wide as the nominal shape's lateral width needs no
+//!   reconfiguration: the IWP is flown straight through in the nominal shape;
+//! - `auto` picks, among the shapes that narrow the formation enough, the one
+//!   that moves the UAVs least; rotation (about the lateral axis) never
+//!   narrows it, so `auto` never offers it for a gap;
+//! - a shape that does not fit (the operator's choice) makes the IWP unusable,
+//!   with the reason, instead of a plan that fails later.
 
 use nalgebra::{Point2, Vector2, Vector3};
 use serde::Serialize;
@@ -35,8 +45,31 @@ pub struct Iwp {
     pub enabled: bool,
     /// The operator's choice (or the mission's default).
     pub choice: ShapeChoice,
-    /// The shape used, resolved from the choice.
-    pub shape: Shape,
+    /// The shape flown through the gap; `None` when the nominal formation
+    /// already fits (or when the IWP is unusable).
+    pub shape: Option<Shape>,
+    /// Why no shape can pass this gap, when none can.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unusable: Option<String>,
+    /// h: the new shape is held this far each side of the gap line, metres
+    /// of centroid path (`hold_distance` plus the depth of the wall).
+    pub hold: f64,
+}
+
+impl Iwp {
+    /// The planned path goes through this IWP.
+    pub fn is_via(&self) -> bool {
+        self.enabled && self.unusable.is_none()
+    }
+
+    /// "alignment", "shrink", …, or "nominal" when the formation passes as it is.
+    pub fn shape_name(&self) -> &'static str {
+        match (&self.shape, &self.unusable) {
+            (_, Some(_)) => "unusable",
+            (Some(shape), None) => shape.name(),
+            (None, None) => "nominal",
+        }
+    }
 }
 
 /// A formation shape at an IWP (θ-PSO paper, Fig. 2).
@@ -59,39 +92,27 @@ impl Shape {
     /// the nominal formation, 1 the full shape. Rotation turns rigidly; the
     /// others move each UAV along a straight line.
     pub fn offsets(&self, nominal: &[Vector3<f64>], blend: f64) -> Vec<Vector3<f64>> {
-        let mut out = Vec::with_capacity(nominal.len());
-        self.offsets_into(nominal, blend, &mut out);
-        out
+        (0..nominal.len())
+            .map(|n| self.offset(nominal, n, blend))
+            .collect()
     }
 
-    /// As `offsets`, into a reused buffer.
-    pub fn offsets_into(&self, nominal: &[Vector3<f64>], blend: f64, out: &mut Vec<Vector3<f64>>) {
-        out.clear();
+    /// The offset of slot `n` alone (no allocation: the cost calls this for
+    /// every UAV at every knot).
+    pub fn offset(&self, nominal: &[Vector3<f64>], n: usize, blend: f64) -> Vector3<f64> {
+        let o = nominal[n];
         match *self {
             Shape::Alignment { spacing } => {
-                let order = column_order(nominal);
-                let n = nominal.len();
-                out.extend(nominal.iter().copied());
-                for (rank, &slot) in order.iter().enumerate() {
-                    let x = (rank as f64 - (n as f64 - 1.0) / 2.0) * spacing;
-                    let target = Vector3::new(x, 0.0, 0.0);
-                    out[slot] = nominal[slot].lerp(&target, blend);
-                }
+                let count = nominal.len() as f64;
+                let x = (column_rank(nominal, n) as f64 - (count - 1.0) / 2.0) * spacing;
+                o.lerp(&Vector3::new(x, 0.0, 0.0), blend)
             }
             Shape::Rotation => {
-                let angle = blend * std::f64::consts::FRAC_PI_2;
-                let (s, c) = angle.sin_cos();
+                let (s, c) = (blend * std::f64::consts::FRAC_PI_2).sin_cos();
                 // R_y(angle): x' = c x + s z, z' = -s x + c z.
-                out.extend(
-                    nominal
-                        .iter()
-                        .map(|o| Vector3::new(c * o.x + s * o.z, o.y, -s * o.x + c * o.z)),
-                );
+                Vector3::new(c * o.x + s * o.z, o.y, -s * o.x + c * o.z)
             }
-            Shape::Shrink { scale } => {
-                let k = 1.0 - blend * (1.0 - scale);
-                out.extend(nominal.iter().map(|o| o * k));
-            }
+            Shape::Shrink { scale } => o * (1.0 - blend * (1.0 - scale)),
         }
     }
 
@@ -104,12 +125,17 @@ impl Shape {
     }
 }
 
-/// Slots sorted front to back by their forward offset, so that forming the
-/// column never makes two UAVs swap places along the path.
-fn column_order(nominal: &[Vector3<f64>]) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..nominal.len()).collect();
-    order.sort_by(|&a, &b| nominal[a].x.total_cmp(&nominal[b].x).then(a.cmp(&b)));
-    order
+/// Place of slot `n` in the column, front to back by forward offset (ties by
+/// index), so that forming the column never makes two UAVs swap places.
+fn column_rank(nominal: &[Vector3<f64>], n: usize) -> usize {
+    let key = |m: usize| (nominal[m].x, m);
+    let (x, _) = key(n);
+    (0..nominal.len())
+        .filter(|&m| {
+            let (xm, _) = key(m);
+            xm < x || (xm == x && m < n)
+        })
+        .count()
 }
 
 /// Half the width the offsets occupy across the path, UAV radius included.
@@ -144,35 +170,69 @@ pub fn column_spacing(formation: &Formation) -> f64 {
     }
 }
 
-/// Resolves a choice into a shape for a gap of width `gap`.
+/// Tolerance of the width comparisons, metres.
+const FIT_EPS: f64 = 1e-9;
+
+/// How the formation passes a gap of width `gap`: `Ok(Some(shape))` to
+/// reconfigure, `Ok(None)` when the nominal shape already fits, `Err(reason)`
+/// when the chosen shape cannot pass.
 ///
-/// `Auto` is the least change that fits: among the shapes whose lateral
-/// width fits the gap, the one that moves the UAVs least (largest slot
-/// displacement). Shrink is tried at the largest scale that fits (never below
-/// the spacing 2 r_Q allows), which often beats a full alignment. When nothing
-/// fits, alignment is the narrowest there is; verification will say whether
-/// it was enough.
-pub fn resolve_shape(choice: ShapeChoice, gap: f64, formation: &Formation, shrink: f64) -> Shape {
+/// `Auto` is the least change that fits: among the shapes that make the
+/// lateral width fit, the one that moves the UAVs least (largest slot
+/// displacement). Shrink is tried at the largest scale that leaves `margin`
+/// beside the outermost UAVs (never below the spacing 2 r_Q allows), which
+/// often beats a full alignment.
+pub fn resolve_shape(
+    choice: ShapeChoice,
+    gap: f64,
+    formation: &Formation,
+    shrink: f64,
+    margin: f64,
+) -> Result<Option<Shape>, String> {
+    let slots = &formation.slots;
+    let r_q = formation.uav_radius;
+    let fits =
+        |shape: &Shape| lateral_half_width(&shape.offsets(slots, 1.0), r_q) <= gap / 2.0 + FIT_EPS;
+    let width = |shape: &Shape| 2.0 * lateral_half_width(&shape.offsets(slots, 1.0), r_q);
+    let nominal_width = 2.0 * lateral_half_width(slots, r_q);
     let alignment = Shape::Alignment {
         spacing: column_spacing(formation),
     };
+    let explicit = |shape: Shape| {
+        if fits(&shape) {
+            Ok(Some(shape))
+        } else {
+            Err(format!(
+                "{} leaves the formation {:.2} m wide (UAV radius included) and the gap is {gap:.2} m{}",
+                shape.name(),
+                width(&shape),
+                match shape {
+                    Shape::Rotation => ": rotation keeps the width; choose alignment or shrink",
+                    _ => "",
+                }
+            ))
+        }
+    };
     match choice {
-        ShapeChoice::Alignment => alignment,
-        ShapeChoice::Rotation => Shape::Rotation,
-        ShapeChoice::Shrink => Shape::Shrink { scale: shrink },
+        ShapeChoice::Alignment => explicit(alignment),
+        ShapeChoice::Rotation => explicit(Shape::Rotation),
+        ShapeChoice::Shrink => explicit(Shape::Shrink { scale: shrink }),
         ShapeChoice::Auto => {
-            let slots = &formation.slots;
-            let r_q = formation.uav_radius;
-            let mut candidates = vec![alignment, Shape::Rotation];
+            if nominal_width <= gap + 2.0 * FIT_EPS {
+                return Ok(None);
+            }
+            let mut candidates = vec![alignment];
             let widest = slots.iter().map(|o| o.y.abs()).fold(0.0, f64::max);
             if widest > 0.0 {
-                let fit = ((gap / 2.0 - r_q) / widest).min(1.0);
+                let fit = (gap / 2.0 - r_q - margin.max(0.0)) / widest;
                 let closest = min_pair_distance(slots);
                 let floor = if closest.is_finite() {
                     2.0 * r_q / closest
                 } else {
                     0.0
                 };
+                // fit < 1 here (the nominal shape does not fit), so a shrink
+                // at `fit` always narrows the formation.
                 if fit > 0.0 && fit >= floor {
                     candidates.push(Shape::Shrink { scale: fit });
                 }
@@ -187,11 +247,102 @@ pub fn resolve_shape(choice: ShapeChoice, gap: f64, formation: &Formation, shrin
             };
             candidates
                 .into_iter()
-                .filter(|s| lateral_half_width(&s.offsets(slots, 1.0), r_q) <= gap / 2.0 + 1e-9)
+                .filter(|s| fits(s))
                 .min_by(|a, b| displacement(a).total_cmp(&displacement(b)))
-                .unwrap_or(alignment)
+                .map(Some)
+                .ok_or_else(|| {
+                    format!(
+                        "no shape fits: the narrowest, a column, is {:.2} m wide and the gap is {gap:.2} m",
+                        width(&alignment)
+                    )
+                })
         }
     }
+}
+
+/// Where a UAV at offset `o` (crossing frame: forward, lateral) would be
+/// within `reach` of an obstacle at (x_k, y_k): the open interval of the
+/// centroid's forward position x' with |x' + o.x − x_k| < √(reach² − (o.y − y_k)²).
+fn conflict(o: &Vector3<f64>, x_k: f64, y_k: f64, reach: f64) -> Option<(f64, f64)> {
+    let dy = o.y - y_k;
+    // Exactly `reach` away is clear (verification asks ≥ r_Q).
+    (dy.abs() < reach - 1e-9).then(|| {
+        let q = (reach * reach - dy * dy).sqrt();
+        (x_k - o.x - q, x_k - o.x + q)
+    })
+}
+
+/// The hold of the crossing of a gap, or why its shape cannot cross.
+///
+/// Crossing straight along the gap's normal, the formation must be in its
+/// new shape wherever the nominal shape (or one part-way into the new one)
+/// would come within r_Q + margin of an obstacle of the wall it pierces: the
+/// hold is `hold_distance` beyond the deepest such point, so the shape is
+/// complete that far before any UAV reaches the obstacles (the paper's "1 m
+/// before"). And the new shape itself must keep r_Q from every obstacle while
+/// it is held; when it cannot, the IWP is unusable.
+fn crossing_hold(
+    mission: &Mission,
+    pair: [usize; 2],
+    center: Point2<f64>,
+    normal: Vector2<f64>,
+    shape: Option<Shape>,
+) -> Result<f64, String> {
+    let f = &mission.formation;
+    let r_q = f.uav_radius;
+    let margin = mission.theta_pso.clearance_margin.max(0.0);
+    let obstacles = &mission.obstacles;
+    let deepest = obstacles[pair[0]].radius.max(obstacles[pair[1]].radius);
+    let wall_zone = deepest + f.safe_radius() + margin;
+    let mut approaching = vec![f.slots.clone()];
+    if let Some(shape) = shape {
+        for blend in [0.25, 0.5, 0.75] {
+            approaching.push(shape.offsets(&f.slots, blend));
+        }
+    }
+    let held = shape.map_or_else(|| f.slots.clone(), |s| s.offsets(&f.slots, 1.0));
+    let in_band = |k: &usize| obstacles[*k].height > mission.bounds.z[0];
+    let mut depth: f64 = 0.0;
+    for sign in [1.0, -1.0] {
+        let forward = normal * sign;
+        let left = Vector2::new(-forward.y, forward.x);
+        for k in (0..obstacles.len()).filter(in_band) {
+            let d = obstacles[k].center - center;
+            let (x_k, y_k) = (d.dot(&forward), d.dot(&left));
+            let reach = obstacles[k].radius + r_q + margin;
+            for o in approaching.iter().flatten() {
+                if let Some((lo, hi)) = conflict(o, x_k, y_k, reach) {
+                    // Only conflicts at the wall: the path may turn before
+                    // an obstacle farther along the crossing line.
+                    if lo < wall_zone && hi > -wall_zone {
+                        depth = depth.max(lo.abs()).max(hi.abs());
+                    }
+                }
+            }
+        }
+    }
+    let hold = mission.reconfiguration.hold_distance + depth;
+    for sign in [1.0, -1.0] {
+        let forward = normal * sign;
+        let left = Vector2::new(-forward.y, forward.x);
+        for k in (0..obstacles.len()).filter(in_band) {
+            let d = obstacles[k].center - center;
+            let (x_k, y_k) = (d.dot(&forward), d.dot(&left));
+            let reach = obstacles[k].radius + r_q;
+            if held
+                .iter()
+                .filter_map(|o| conflict(o, x_k, y_k, reach))
+                .any(|(lo, hi)| lo < hold && hi > -hold)
+            {
+                return Err(format!(
+                    "held through the gap, the {} would pass within r_Q of '{}'",
+                    shape.map_or("nominal formation", |s| s.name()),
+                    obstacles[k].name
+                ));
+            }
+        }
+    }
+    Ok(hold)
 }
 
 /// Every IWP of the mission by eq. 9, with the operator's choices applied.
@@ -229,10 +380,11 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
             if blocked {
                 continue;
             }
-            let choice = mission.reconfiguration.waypoints.iter().find(|w| {
-                (w.between[0] == a.name && w.between[1] == b.name)
-                    || (w.between[0] == b.name && w.between[1] == a.name)
-            });
+            let choice = mission
+                .reconfiguration
+                .waypoints
+                .iter()
+                .find(|w| same_pair(&w.between, &a.name, &b.name));
             let (enabled, shape_choice, scale) = match choice {
                 Some(w) => (
                     w.enabled,
@@ -245,17 +397,34 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
                     mission.reconfiguration.shrink_scale,
                 ),
             };
+            let position = Point2::from((p_p.coords + p_q.coords) / 2.0);
+            let normal = Vector2::new(-u.y, u.x);
+            let margin = mission.theta_pso.clearance_margin.max(0.0);
+            let resolved = resolve_shape(shape_choice, gap, f, scale, margin).and_then(|shape| {
+                crossing_hold(mission, [p, q], position, normal, shape).map(|hold| (shape, hold))
+            });
+            let (shape, hold, unusable) = match resolved {
+                Ok((shape, hold)) => (shape, hold, None),
+                Err(reason) => (None, 0.0, Some(reason)),
+            };
             found.push(Iwp {
                 between: [a.name.clone(), b.name.clone()],
                 obstacles: [p, q],
-                position: Point2::from((p_p.coords + p_q.coords) / 2.0),
+                position,
                 gap,
-                normal: Vector2::new(-u.y, u.x),
+                normal,
                 enabled,
                 choice: shape_choice,
-                shape: resolve_shape(shape_choice, gap, f, scale),
+                shape,
+                unusable,
+                hold,
             });
         }
     }
     found
+}
+
+/// The unordered pair `between` names obstacles `a` and `b`.
+pub fn same_pair(between: &[String; 2], a: &str, b: &str) -> bool {
+    (between[0] == a && between[1] == b) || (between[0] == b && between[1] == a)
 }

@@ -2,11 +2,15 @@
 //! algorithm): find the IWPs (eq. 9), search the centroid path with the
 //! angle-encoded swarm (eq. 1) against J (eqs. 2-5, 10-11), derive each UAV's
 //! timed trajectory through the reconfigurations (eqs. 12-15), and verify the
-//! result against the hard constraints.
+//! result against the hard constraints and the inspection passes (eq. 8).
 
 pub mod cost;
+pub mod inspection;
 pub mod iwp;
+pub mod motion;
 pub mod path;
+pub mod reference;
+pub mod seeding;
 pub mod trajectory;
 pub mod verify;
 
@@ -16,11 +20,12 @@ use std::ops::ControlFlow;
 use nalgebra::Point3;
 use serde::Serialize;
 
-use crate::mission::Mission;
+use crate::mission::{Diagnostic, FieldPath, Mission};
 use crate::pipeline::{CancelToken, Completion, CostTerms, Event, Level, Observer, PipelineError};
 use crate::swarm::{self, SearchSpace, SwarmConfig};
 
 pub use cost::CostModel;
+pub use inspection::{InspectionResult, PassGeometry};
 pub use iwp::{Iwp, Shape, find_iwps};
 pub use path::{CentroidPath, PathBuilder};
 pub use trajectory::{Reconfiguration, Sample, Trajectory};
@@ -46,27 +51,48 @@ pub struct ThetaPsoOutcome {
     pub mission: String,
     pub seed: u64,
     pub completion: Completion,
-    /// Swarm iterations completed.
+    /// Swarm iterations completed, over every run of the swarm.
     pub iterations: usize,
-    /// Cost evaluations made.
+    /// Cost evaluations made, over every run of the swarm.
     pub evaluations: usize,
+    /// Runs of the swarm after the first because the best still failed
+    /// verification (at most `theta_pso.restarts`).
+    pub restarts: usize,
     /// The best path's cost terms.
     pub cost: CostTerms,
-    /// Best total cost after each iteration (iteration 0 = initial swarm).
+    /// Best total cost after each iteration of the run kept (iteration 0 =
+    /// initial swarm).
     pub convergence: Vec<f64>,
     /// The intermediate waypoints of eq. 9, enabled or not.
     pub iwps: Vec<Iwp>,
     /// The free waypoints the swarm chose, decoded (eq. 1).
     pub waypoints: Vec<Point3<f64>>,
-    /// P_F*: start, waypoints and IWP via-points, goal.
+    /// P_F*: start, waypoints, IWP crossings and inspection passes, goal.
     pub centroid_path: Vec<Point3<f64>>,
     /// Metres.
     pub path_length: f64,
     /// Seconds at the formation's ground speed.
     pub duration: f64,
+    /// Length of the shortest 2-D route any feasible plan's centroid is at
+    /// least as long as (`reference`), metres; `None` when none exists.
+    pub reference_length: Option<f64>,
+    /// J1 / reference length: 1 would be a perfect plan.
+    pub length_ratio: Option<f64>,
+    /// Where each inspection pass lies along the centroid path, seconds.
+    pub passes: Vec<PlannedPass>,
     pub reconfigurations: Vec<Reconfiguration>,
     pub trajectories: Vec<Trajectory>,
     pub verification: Verification,
+}
+
+/// An inspection pass as planned.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlannedPass {
+    pub obstacle: String,
+    /// Start and end of the pass, seconds.
+    pub time: [f64; 2],
+    /// The obstacle is on the formation's left.
+    pub on_left: bool,
 }
 
 impl ThetaPsoOutcome {
@@ -85,39 +111,107 @@ pub struct Problem {
 }
 
 impl Problem {
-    pub fn new(mission: &Mission) -> Self {
+    /// The search for `mission`, or the first inspected obstacle whose pass
+    /// cannot be flown (its index and why).
+    pub fn new(mission: &Mission) -> Result<Self, (usize, String)> {
         let iwps = find_iwps(mission);
-        let builder = PathBuilder::new(mission, &iwps);
+        let passes = inspection::pass_geometries(mission)?;
+        let builder = PathBuilder::new(mission, &iwps, &passes);
         let cost = CostModel::new(mission, &iwps);
         // θ and Δθ both live in [-π/2, π/2] (Fig. 3, line 10).
-        let space = SearchSpace::uniform(
-            3 * mission.theta_pso.waypoints,
-            -FRAC_PI_2,
-            FRAC_PI_2,
-            FRAC_PI_2,
-        );
-        Problem {
+        let space =
+            SearchSpace::uniform(path::dimensions(mission), -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2);
+        Ok(Problem {
             iwps,
             builder,
             cost,
             space,
-        }
+        })
     }
 
     /// The centroid path a particle stands for.
     pub fn path(&self, angles: &[f64]) -> CentroidPath {
-        self.builder.build(&self.builder.decode(angles))
+        self.builder.build(angles)
     }
 
     /// J and its terms for a particle.
     pub fn evaluate(&self, angles: &[f64]) -> CostTerms {
         self.cost.terms(&self.path(angles))
     }
+
+    /// J for a particle, or a partial sum once it reaches `bound`
+    /// (`CostModel::terms_below`).
+    pub fn evaluate_below(&self, angles: &[f64], bound: f64) -> CostTerms {
+        self.cost.terms_below(&self.path(angles), bound)
+    }
+}
+
+/// What θ-PSO can tell about a mission before planning it: unusable IWPs
+/// (warnings: the plan goes round) and inspection passes that cannot hold
+/// eq. 8 (errors). Shown by `check` and the designer beside validation.
+pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    for iwp in find_iwps(mission) {
+        if let (true, Some(reason)) = (iwp.enabled, &iwp.unusable) {
+            let at = mission
+                .reconfiguration
+                .waypoints
+                .iter()
+                .position(|w| iwp::same_pair(&w.between, &iwp.between[0], &iwp.between[1]))
+                .map_or_else(
+                    || {
+                        FieldPath::root()
+                            .key("reconfiguration")
+                            .key("default_shape")
+                    },
+                    |i| {
+                        FieldPath::root()
+                            .key("reconfiguration")
+                            .key("waypoints")
+                            .index(i)
+                            .key("shape")
+                    },
+                );
+            out.push(Diagnostic::warning(
+                at,
+                format!(
+                    "the IWP between '{}' and '{}' ({:.2} m gap) is unusable: {reason}; \
+                     the plan will not go through it",
+                    iwp.between[0], iwp.between[1], iwp.gap
+                ),
+            ));
+        }
+    }
+    if let Err((k, reason)) = inspection::pass_geometries(mission) {
+        out.push(Diagnostic::error(
+            FieldPath::root().key("obstacles").index(k).key("stand_off"),
+            format!(
+                "'{}' cannot be inspected: {reason}",
+                mission.obstacles[k].name
+            ),
+        ));
+    }
+    out
+}
+
+/// One run of the swarm, built into a plan and verified.
+struct Attempt {
+    swarm: swarm::SwarmResult,
+    convergence: Vec<f64>,
+    path: CentroidPath,
+    cost: CostTerms,
+    trajectories: Vec<Trajectory>,
+    reconfigurations: Vec<Reconfiguration>,
+    verification: Verification,
 }
 
 /// Plans `mission` with `seed`. Reports to `observer`, stops early (keeping
 /// the best so far) when `cancel` is set. Fails only on an invalid mission;
 /// an unreachable goal is an infeasible outcome, not an error.
+///
+/// When the swarm's best fails verification, the swarm runs again with new
+/// random streams of the same seed, up to `theta_pso.restarts` times; the
+/// first feasible plan is kept, else the one of lowest cost.
 pub fn plan(
     mission: &Mission,
     seed: u64,
@@ -126,9 +220,17 @@ pub fn plan(
     cancel: &CancelToken,
 ) -> Result<ThetaPsoOutcome, PipelineError> {
     crate::pipeline::require_valid(mission)?;
+    let errors: Vec<String> = diagnostics(mission)
+        .into_iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.to_string())
+        .collect();
+    if !errors.is_empty() {
+        return Err(PipelineError::InvalidMission(errors.join("\n")));
+    }
 
     observer.on_event(Event::Stage("intermediate waypoints"));
-    let problem = Problem::new(mission);
+    let problem = Problem::new(mission).map_err(|(_, e)| PipelineError::InvalidMission(e))?;
     for iwp in &problem.iwps {
         let state = if iwp.enabled { "enabled" } else { "disabled" };
         let message = format!(
@@ -136,76 +238,123 @@ pub fn plan(
             iwp.between[0],
             iwp.between[1],
             iwp.gap,
-            iwp.shape.name()
+            iwp.shape_name()
         );
         observer.on_event(Event::Log(Level::Info, &message));
     }
+    let span = path::heading_span(mission);
+    let speed = mission.formation.ground_speed;
+    let resolution = speed * trajectory::SAMPLE_PERIOD;
+    let reference = reference::lower_bound(mission, &problem.iwps, resolution);
+    let starts = seeding::particles(mission, &problem, seed);
 
-    observer.on_event(Event::Stage("planning"));
     let p = &mission.theta_pso;
-    let config = SwarmConfig {
-        particles: p.swarm_size,
-        iterations: p.iterations,
-        inertia: p.inertia,
-        cognitive: p.cognitive,
-        social: p.social,
-        parallel: options.parallel,
-    };
-    let mut convergence = Vec::with_capacity(p.iterations + 1);
-    let mut shown: Option<(CentroidPath, CostTerms)> = None;
-    let result = swarm::minimize(
-        &problem.space,
-        &config,
-        seed,
-        |angles| problem.evaluate(angles).total,
-        |report| {
-            convergence.push(report.best.cost);
-            // The best only changes on improvement; rebuild its path only then.
-            if report.improved || shown.is_none() {
-                let path = problem.path(&report.best.position);
-                let cost = problem.cost.terms(&path);
-                shown = Some((path, cost));
-            }
-            if let Some((path, cost)) = &shown {
-                observer.on_event(Event::PathIteration {
-                    iteration: report.iteration,
-                    cost,
-                    path: &path.points,
-                });
-            }
-            observer.on_event(Event::Progress(
-                0.95 * report.iteration as f64 / p.iterations.max(1) as f64,
+    let mut kept: Option<Attempt> = None;
+    let (mut iterations, mut evaluations, mut restarts) = (0usize, 0usize, 0usize);
+    let mut completion = Completion::Finished;
+    for attempt in 0..=p.restarts {
+        if attempt > 0 {
+            restarts = attempt;
+            let message = format!(
+                "the best plan fails verification ({}); restart {attempt} of {} with new random streams",
+                kept.as_ref()
+                    .and_then(|k| k.verification.first_failure())
+                    .unwrap_or_default(),
+                p.restarts
+            );
+            observer.on_event(Event::Log(Level::Warn, &message));
+        }
+        observer.on_event(Event::Stage("planning"));
+        let config = SwarmConfig {
+            particles: p.swarm_size,
+            iterations: p.iterations,
+            inertia: p.inertia,
+            cognitive: p.cognitive,
+            social: p.social,
+            parallel: options.parallel,
+            streams: attempt as u64,
+        };
+        let mut convergence = Vec::with_capacity(p.iterations + 1);
+        let mut shown: Option<(CentroidPath, CostTerms)> = None;
+        let offset = iterations + attempt;
+        let result = swarm::minimize(
+            &problem.space,
+            &config,
+            seed,
+            &starts,
+            |angles, bound| problem.evaluate_below(angles, bound).total,
+            |report| {
+                convergence.push(report.best.cost);
+                // The best only changes on improvement; rebuild its path only then.
+                if report.improved || shown.is_none() {
+                    let path = problem.path(&report.best.position);
+                    let cost = problem.cost.terms(&path);
+                    shown = Some((path, cost));
+                }
+                if let Some((path, cost)) = &shown {
+                    observer.on_event(Event::PathIteration {
+                        iteration: offset + report.iteration,
+                        cost,
+                        path: &path.points,
+                    });
+                }
+                observer.on_event(Event::Progress(
+                    0.95 * report.iteration as f64 / p.iterations.max(1) as f64,
+                ));
+                if cancel.is_cancelled() {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            },
+        );
+        iterations += result.iterations;
+        evaluations += result.evaluations;
+        if result.stopped {
+            observer.on_event(Event::Log(
+                Level::Warn,
+                &format!(
+                    "cancelled after {} iterations; keeping the best so far",
+                    result.iterations
+                ),
             ));
-            if cancel.is_cancelled() {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        },
-    );
-    let completion = if result.stopped {
-        observer.on_event(Event::Log(
-            Level::Warn,
-            &format!(
-                "cancelled after {} iterations; keeping the best so far",
-                result.iterations
-            ),
+            completion = Completion::Cancelled;
+        }
+
+        observer.on_event(Event::Stage("trajectories"));
+        let path = problem.path(&result.best.position);
+        let cost = problem.cost.terms(&path);
+        let (trajectories, reconfigurations) =
+            trajectory::generate(&path, &problem.iwps, &mission.formation, span);
+        observer.on_event(Event::Stage("verification"));
+        let verification = verify::verify(mission, &trajectories);
+        let attempt = Attempt {
+            swarm: result,
+            convergence,
+            path,
+            cost,
+            trajectories,
+            reconfigurations,
+            verification,
+        };
+        let better = kept.as_ref().is_none_or(|k| {
+            (attempt.verification.feasible, -attempt.cost.total)
+                > (k.verification.feasible, -k.cost.total)
+        });
+        let done = attempt.verification.feasible || completion == Completion::Cancelled;
+        if better {
+            kept = Some(attempt);
+        }
+        if done {
+            break;
+        }
+    }
+    let Some(best) = kept else {
+        return Err(PipelineError::Unsupported(
+            "the swarm never ran (no attempt)".into(),
         ));
-        Completion::Cancelled
-    } else {
-        Completion::Finished
     };
-
-    observer.on_event(Event::Stage("trajectories"));
-    let waypoints = problem.builder.decode(&result.best.position);
-    let path = problem.builder.build(&waypoints);
-    let cost = problem.cost.terms(&path);
-    let (trajectories, reconfigurations) =
-        trajectory::generate(&path, &problem.iwps, &mission.formation);
-
-    observer.on_event(Event::Stage("verification"));
-    let verification = verify::verify(mission, &trajectories);
-    for check in verification.checks.iter().filter(|c| !c.ok) {
+    for check in best.verification.checks.iter().filter(|c| !c.ok) {
         let message = format!(
             "constraint broken: {} {} {} (worst {:.3})",
             check.name,
@@ -215,24 +364,49 @@ pub fn plan(
         );
         observer.on_event(Event::Log(Level::Warn, &message));
     }
+    for i in best.verification.inspections.iter().filter(|i| !i.ok) {
+        let message = format!(
+            "inspection of '{}' broken: {:.1} m of {} m within [{}, {}] m (eq. 8)",
+            i.obstacle, i.achieved, i.required, i.band[0], i.band[1]
+        );
+        observer.on_event(Event::Log(Level::Warn, &message));
+    }
     observer.on_event(Event::Progress(1.0));
 
+    let waypoints = problem.builder.decode(&best.swarm.best.position);
+    let passes = best
+        .path
+        .passes
+        .iter()
+        .map(|pass| PlannedPass {
+            obstacle: mission.obstacles[pass.obstacle].name.clone(),
+            time: [pass.arcs[0] / speed, pass.arcs[1] / speed],
+            on_left: pass.on_left,
+        })
+        .collect();
+    let reference_length = reference.map(|r| r.length);
     Ok(ThetaPsoOutcome {
         pipeline: "theta-pso",
         mission: mission.name.clone(),
         seed,
         completion,
-        iterations: result.iterations,
-        evaluations: result.evaluations,
-        cost,
-        convergence,
+        iterations,
+        evaluations,
+        restarts,
+        cost: best.cost,
+        convergence: best.convergence,
         iwps: problem.iwps,
         waypoints,
-        path_length: cost.length,
-        duration: cost.length / mission.formation.ground_speed,
-        centroid_path: path.points,
-        reconfigurations,
-        trajectories,
-        verification,
+        path_length: best.cost.length,
+        duration: best.cost.length / speed,
+        reference_length,
+        length_ratio: reference_length
+            .filter(|r| *r > 0.0)
+            .map(|r| best.cost.length / r),
+        passes,
+        centroid_path: best.path.points,
+        reconfigurations: best.reconfigurations,
+        trajectories: best.trajectories,
+        verification: best.verification,
     })
 }

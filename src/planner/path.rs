@@ -1,17 +1,26 @@
-//! From a particle to a centroid path: the eq. 1 decoding, the IWP via-points,
-//! and the reconfiguration zones along the path.
+//! From a particle to a centroid path: the eq. 1 decoding, the via-points the
+//! path must include (IWP crossings, inspection passes), and where along the
+//! path the formation changes shape.
 //!
 //! Reading: the paper plans "the optimized path P_F* … in which the
-//! intermediate waypoints for reconfiguration have been included" (III.C).
-//! So every enabled IWP is a via-point of the centroid path, crossed straight
-//! along the gap's normal: the path goes through C_j − a n, C_j, C_j + a n,
-//! where a is the hold length below. Each IWP is inserted where it lengthens
-//! the path least, so the swarm still decides the route between IWPs.
+//! intermediate waypoints for reconfiguration have been included" (III.C),
+//! and Fig. 3 line 7 places the IWPs "using eqs. (7), (8), (9)". So:
+//! - every usable IWP is a via-point of the centroid path, crossed straight
+//!   along the gap's normal through C_j − a n, C_j, C_j + a n (a: the hold
+//!   plus room for the heading to settle);
+//! - every inspected obstacle (eq. 8) is a straight pass tangent to it, at the
+//!   stand-off that keeps the facing UAV in its band; where around the
+//!   obstacle the pass lies is one more angle of the particle (decoded as eq. 1
+//!   decodes the waypoints), and which way round it is flown is the insertion's
+//!   choice.
+//!
+//! Each via is inserted into the leg where it lengthens the path least, so the
+//! swarm still decides the route between them.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Point2, Point3, Vector2, Vector3};
 
+use super::inspection::PassGeometry;
 use super::iwp::{Iwp, Shape, vertical_half_height};
-use crate::geometry::farthest_offset;
 use crate::mission::Mission;
 
 /// Eq. 1, third line: x = ½ [(x_max − x_min) sin θ + x_max + x_min].
@@ -19,15 +28,27 @@ pub fn decode_angle(theta: f64, min: f64, max: f64) -> f64 {
     0.5 * ((max - min) * theta.sin() + max + min)
 }
 
+/// The inverse of eq. 1 on [min, max]: the angle that decodes to `x` (clamped).
+pub fn encode_angle(x: f64, min: f64, max: f64) -> f64 {
+    if max > min {
+        ((2.0 * x - max - min) / (max - min))
+            .clamp(-1.0, 1.0)
+            .asin()
+    } else {
+        0.0
+    }
+}
+
 /// Where along the path the formation changes shape for one IWP.
 ///
 /// Arc lengths s along the centroid path, metres:
-/// [s_j − h − T, s_j − h] transform (t1..t2), [s_j − h, s_j + h] hold (t2..t3),
-/// [s_j + h, s_j + h + T] return (t3..t4), with T the transition distance and
-/// h the hold length: the mission's hold distance plus the larger obstacle
-/// radius plus the larger of the nominal and reconfigured formation radii, so
-/// the new shape is complete `hold_distance` before its leading UAV reaches
-/// the obstacles' depth (the paper's "1 m before").
+/// [s_j − h − T_in, s_j − h] transform (t1..t2), [s_j − h, s_j + h] hold
+/// (t2..t3), [s_j + h, s_j + h + T_out] return (t3..t4), with T the
+/// transition distance (shortened where the start or the goal is nearer) and
+/// h the hold: the mission's hold distance plus the depth at which the
+/// formation could touch the wall (see [`conflict_depth`]), so the new shape
+/// is complete `hold_distance` before any UAV reaches the obstacles (the
+/// paper's "1 m before").
 #[derive(Debug, Clone, PartialEq)]
 pub struct Zone {
     /// Index into the IWP list.
@@ -39,8 +60,10 @@ pub struct Zone {
     pub arc: f64,
     /// h, half length of the hold.
     pub hold: f64,
-    /// T, length of each transition.
-    pub transition: f64,
+    /// Length of the transformation before the hold.
+    pub transition_in: f64,
+    /// Length of the return after it.
+    pub transition_out: f64,
 }
 
 impl Zone {
@@ -48,12 +71,17 @@ impl Zone {
     /// UAV's velocity stays continuous through the transition).
     pub fn blend(&self, s: f64) -> f64 {
         let from_hold = (s - self.arc).abs() - self.hold;
+        let transition = if s < self.arc {
+            self.transition_in
+        } else {
+            self.transition_out
+        };
         if from_hold <= 0.0 {
             1.0
-        } else if from_hold >= self.transition {
+        } else if from_hold >= transition {
             0.0
         } else {
-            let u = 1.0 - from_hold / self.transition;
+            let u = 1.0 - from_hold / transition;
             u * u * (3.0 - 2.0 * u)
         }
     }
@@ -61,23 +89,47 @@ impl Zone {
     /// Arc lengths of t1, t2, t3, t4.
     pub fn arcs(&self) -> [f64; 4] {
         [
-            self.arc - self.hold - self.transition,
+            self.arc - self.hold - self.transition_in,
             self.arc - self.hold,
             self.arc + self.hold,
-            self.arc + self.hold + self.transition,
+            self.arc + self.hold + self.transition_out,
         ]
     }
 
     pub fn contains(&self, s: f64) -> bool {
-        (s - self.arc).abs() < self.hold + self.transition
+        let [a1, _, _, a4] = self.arcs();
+        a1 < s && s < a4
     }
 }
 
-/// A centroid path and its reconfiguration zones.
+/// An inspection pass as placed on one path: which obstacle, and the arc
+/// lengths along the centroid path where the pass begins and ends.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pass {
+    /// Index into `mission.obstacles`.
+    pub obstacle: usize,
+    pub arcs: [f64; 2],
+    /// The obstacle is on the formation's left (flown anticlockwise round it).
+    pub on_left: bool,
+}
+
+/// A centroid path, its reconfiguration zones and its inspection passes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CentroidPath {
     pub points: Vec<Point3<f64>>,
     pub zones: Vec<Zone>,
+    pub passes: Vec<Pass>,
+}
+
+impl CentroidPath {
+    /// A path with no zones or passes (tests, references).
+    pub fn bare(points: Vec<Point3<f64>>) -> Self {
+        CentroidPath {
+            points,
+            zones: Vec::new(),
+            passes: Vec::new(),
+        }
+    }
 }
 
 /// What is fixed for a mission while the swarm searches.
@@ -85,18 +137,26 @@ pub struct CentroidPath {
 pub struct PathBuilder {
     start: Point3<f64>,
     goal: Point3<f64>,
+    /// Decoding box of the free waypoints: the bounds less r_F horizontally
+    /// and the nominal half-height vertically.
     bounds: [[f64; 2]; 3],
-    vias: Vec<Via>,
+    free: usize,
+    crossings: Vec<Crossing>,
+    inspections: Vec<Inspection>,
 }
 
+/// A usable IWP as a via: its straight crossing.
 #[derive(Debug, Clone)]
-struct Via {
+struct Crossing {
     iwp: usize,
     pair: [usize; 2],
-    shape: Shape,
-    center: nalgebra::Point2<f64>,
+    shape: Option<Shape>,
+    center: Point2<f64>,
     /// Normal scaled by the half length of the straight crossing.
-    reach: nalgebra::Vector2<f64>,
+    reach: Vector2<f64>,
+    /// Half width of the gate a leg must pass to be taken through the gap:
+    /// half the gap plus the formation's safe radius.
+    gate: f64,
     hold: f64,
     transition: f64,
     /// Altitudes the centroid may take at the IWP so every UAV of the shape
@@ -104,42 +164,82 @@ struct Via {
     z_range: [f64; 2],
 }
 
+/// An inspected obstacle as a via: a straight pass tangent to it.
+#[derive(Debug, Clone)]
+struct Inspection {
+    obstacle: usize,
+    axis: Point2<f64>,
+    geometry: PassGeometry,
+    /// Half the straight: half the pass plus the heading's chord, so the
+    /// formation flies the whole pass on a constant heading.
+    half: f64,
+    z_range: [f64; 2],
+}
+
+/// Number of angles a particle has for a mission: three per free waypoint,
+/// one per inspected obstacle.
+pub fn dimensions(mission: &Mission) -> usize {
+    3 * mission.theta_pso.waypoints + mission.obstacles.iter().filter(|o| o.inspect).count()
+}
+
+/// Half length of the chord the formation frame's heading is taken from
+/// (see `ArcWalker::heading`).
+pub fn heading_span(mission: &Mission) -> f64 {
+    mission.formation.radius().max(1.0)
+}
+
 impl PathBuilder {
-    pub fn new(mission: &Mission, iwps: &[Iwp]) -> Self {
+    pub fn new(mission: &Mission, iwps: &[Iwp], passes: &[(usize, PassGeometry)]) -> Self {
         let b = &mission.bounds;
-        let nominal = &mission.formation.slots;
-        let r_f = mission.formation.radius();
-        let vias = iwps
+        let f = &mission.formation;
+        let nominal = &f.slots;
+        let r_f = f.radius();
+        let span = heading_span(mission);
+        let band_for = |half_height: f64| {
+            let (lo, hi) = (b.z[0] + half_height, b.z[1] - half_height);
+            if lo <= hi {
+                [lo, hi]
+            } else {
+                let mid = (b.z[0] + b.z[1]) / 2.0;
+                [mid, mid]
+            }
+        };
+        let crossings = iwps
             .iter()
             .enumerate()
-            .filter(|(_, iwp)| iwp.enabled)
+            .filter(|(_, iwp)| iwp.is_via())
             .map(|(i, iwp)| {
-                let [p, q] = iwp.obstacles;
-                let deepest = mission.obstacles[p].radius.max(mission.obstacles[q].radius);
-                let shaped = iwp.shape.offsets(nominal, 1.0);
-                let reach = r_f.max(farthest_offset(&shaped));
-                let hold = mission.reconfiguration.hold_distance + deepest + reach;
-                // Straight far enough that the whole shape, and the chord the
-                // heading is taken from, lie on the crossing line while held.
-                let straight = hold + reach + r_f.max(1.0);
+                let shaped = iwp
+                    .shape
+                    .map_or_else(|| nominal.clone(), |s| s.offsets(nominal, 1.0));
+                let hold = iwp.hold;
+                // Straight far enough that the heading, taken from a chord of
+                // ± span, points along the crossing for the whole hold. No
+                // longer: the swarm may extend it, a fixed longer one could
+                // run into a nearby obstacle.
+                let straight = hold + span;
                 let half_height = vertical_half_height(&shaped).max(vertical_half_height(nominal));
-                let (lo, hi) = (b.z[0] + half_height, b.z[1] - half_height);
-                let z_range = if lo <= hi {
-                    [lo, hi]
-                } else {
-                    let mid = (b.z[0] + b.z[1]) / 2.0;
-                    [mid, mid]
-                };
-                Via {
+                Crossing {
                     iwp: i,
                     pair: iwp.obstacles,
                     shape: iwp.shape,
                     center: iwp.position,
                     reach: iwp.normal * straight,
+                    gate: iwp.gap / 2.0 + f.safe_radius(),
                     hold,
                     transition: mission.reconfiguration.transition_distance,
-                    z_range,
+                    z_range: band_for(half_height),
                 }
+            })
+            .collect();
+        let inspections = passes
+            .iter()
+            .map(|&(k, geometry)| Inspection {
+                obstacle: k,
+                axis: mission.obstacles[k].center,
+                geometry,
+                half: mission.formation.inspection_pass / 2.0 + span,
+                z_range: band_for(vertical_half_height(nominal)),
             })
             .collect();
         // The centroid searches a box shrunk by r_F so every UAV stays inside
@@ -157,15 +257,58 @@ impl PathBuilder {
             start: mission.route.start,
             goal: mission.route.goal,
             bounds: [shrink(b.x, r_f), shrink(b.y, r_f), shrink(b.z, half_height)],
-            vias,
+            free: mission.theta_pso.waypoints,
+            crossings,
+            inspections,
         }
+    }
+
+    /// The straight crossings of the usable IWPs, end to end (portals of
+    /// the seeding route).
+    pub fn crossings(&self) -> Vec<[Point2<f64>; 2]> {
+        self.crossings
+            .iter()
+            .map(|c| [c.center - c.reach, c.center + c.reach])
+            .collect()
+    }
+
+    /// Inspected obstacles, in the order their pass angles follow the
+    /// waypoints in a particle: (index in `mission.obstacles`, axis).
+    pub fn inspections(&self) -> Vec<(usize, Point2<f64>)> {
+        self.inspections
+            .iter()
+            .map(|i| (i.obstacle, i.axis))
+            .collect()
+    }
+
+    /// The ends of inspection `i`'s straight (the pass with its lead-in and
+    /// lead-out) at angle `phi` round the axis, in the direction of travel,
+    /// with the obstacle on the formation's left or right.
+    pub fn pass_ends(&self, i: usize, phi: f64, on_left: bool) -> [Point2<f64>; 2] {
+        let ins = &self.inspections[i];
+        let (sin, cos) = phi.sin_cos();
+        let radial = Vector2::new(cos, sin);
+        // Anticlockwise round the axis: the obstacle is on the left.
+        let anticlockwise = Vector2::new(-sin, cos);
+        let (radius, direction) = if on_left {
+            (ins.geometry.radius_left, anticlockwise)
+        } else {
+            (ins.geometry.radius_right, -anticlockwise)
+        };
+        let center = ins.axis + radial * radius;
+        [center - direction * ins.half, center + direction * ins.half]
+    }
+
+    /// The decoding box of the free waypoints (x, y, z ranges).
+    pub fn decoding_box(&self) -> [[f64; 2]; 3] {
+        self.bounds
     }
 
     /// Waypoints decoded from a particle: 3 angles per waypoint (x, y, z), eq. 1,
     /// into the bounds less the formation's radius (horizontally) and its
     /// vertical half-height (in the altitude band).
     pub fn decode(&self, angles: &[f64]) -> Vec<Point3<f64>> {
-        angles
+        angles[..(3 * self.free).min(angles.len())]
             .chunks_exact(3)
             .map(|c| {
                 Point3::new(
@@ -177,64 +320,206 @@ impl PathBuilder {
             .collect()
     }
 
-    /// start → waypoints → goal with every enabled IWP inserted.
-    pub fn build(&self, waypoints: &[Point3<f64>]) -> CentroidPath {
-        let mut points = Vec::with_capacity(waypoints.len() + 2 + 3 * self.vias.len());
-        points.push(self.start);
-        points.extend_from_slice(waypoints);
-        points.push(self.goal);
-        let mut centers = Vec::with_capacity(self.vias.len());
-        for via in &self.vias {
-            let (index, triple) = self.best_insertion(&points, via);
-            // Insert after `index` (cheaper than `splice`, which allocates).
-            points.extend_from_slice(&triple);
-            points[index + 1..].rotate_right(3);
-            // Indices of earlier IWP centres after this insertion point shift by 3.
-            for c in centers.iter_mut() {
-                if *c > index {
-                    *c += 3;
-                }
-            }
-            centers.push(index + 2);
-        }
-        let mut zones = Vec::with_capacity(self.vias.len());
-        if !self.vias.is_empty() {
-            let arcs = cumulative_lengths(&points);
-            for (via, &c) in self.vias.iter().zip(&centers) {
-                zones.push(Zone {
-                    iwp: via.iwp,
-                    pair: via.pair,
-                    shape: via.shape,
-                    arc: arcs[c],
-                    hold: via.hold,
-                    transition: via.transition,
-                });
+    /// The particle that stands for these waypoints (the inverse of eq. 1),
+    /// each inspection pass placed at `pass_angles` (radians round the axis).
+    pub fn encode(&self, waypoints: &[Point3<f64>], pass_angles: &[f64]) -> Vec<f64> {
+        let mut angles = Vec::with_capacity(3 * self.free + self.inspections.len());
+        for p in waypoints.iter().take(self.free) {
+            for (d, v) in [p.x, p.y, p.z].into_iter().enumerate() {
+                angles.push(encode_angle(v, self.bounds[d][0], self.bounds[d][1]));
             }
         }
-        CentroidPath { points, zones }
+        for (i, _) in self.inspections.iter().enumerate() {
+            let phi = pass_angles.get(i).copied().unwrap_or(0.0);
+            let wrapped = (phi + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                - std::f64::consts::PI;
+            angles.push(encode_angle(
+                wrapped,
+                -std::f64::consts::PI,
+                std::f64::consts::PI,
+            ));
+        }
+        angles
     }
 
-    /// The leg (index of its first point) and the via triple, in the direction
-    /// of travel, that add the least length.
-    fn best_insertion(&self, points: &[Point3<f64>], via: &Via) -> (usize, [Point3<f64>; 3]) {
-        let mut best = (0, [Point3::origin(); 3], f64::INFINITY);
-        for (i, leg) in points.windows(2).enumerate() {
+    /// start → waypoints → goal with the vias inserted: each IWP crossing
+    /// where the path goes through its gap, each inspection pass where it
+    /// adds the least length.
+    pub fn build(&self, angles: &[f64]) -> CentroidPath {
+        let waypoints = self.decode(angles);
+        let extra = 3 * self.crossings.len() + 2 * self.inspections.len();
+        let mut points = Vec::with_capacity(waypoints.len() + 2 + extra);
+        points.push(self.start);
+        points.extend_from_slice(&waypoints);
+        points.push(self.goal);
+        // locked[i]: leg i (points[i] → points[i + 1]) is part of a via's
+        // straight and must not be split by another via.
+        let mut locked = Vec::with_capacity(points.len() - 1 + extra);
+        locked.resize(points.len() - 1, false);
+        // Vias placed: (crossing or inspection index, index of its first point).
+        let mut crossings: Vec<(usize, usize)> = Vec::with_capacity(self.crossings.len());
+        let mut passes: Vec<(usize, usize, bool)> = Vec::with_capacity(self.inspections.len());
+        for (i, c) in self.crossings.iter().enumerate() {
+            if let Some((leg, triple)) = self.crossing_leg(&points, &locked, c) {
+                insert(&mut points, &mut locked, leg, &triple);
+                shift(&mut crossings, &mut passes, leg, 3);
+                crossings.push((i, leg + 1));
+            }
+        }
+        let free_angles = &angles[(3 * self.free).min(angles.len())..];
+        for i in 0..self.inspections.len() {
+            let theta = free_angles.get(i).copied().unwrap_or(0.0);
+            let phi = decode_angle(theta, -std::f64::consts::PI, std::f64::consts::PI);
+            let (leg, pair, on_left) = self.best_pass(&points, &locked, i, phi);
+            insert(&mut points, &mut locked, leg, &pair);
+            shift(&mut crossings, &mut passes, leg, 2);
+            passes.push((i, leg + 1, on_left));
+        }
+
+        let arcs = cumulative_lengths(&points);
+        let total = arcs.last().copied().unwrap_or(0.0);
+        let zones = crossings
+            .iter()
+            .filter_map(|&(i, first)| {
+                let c = &self.crossings[i];
+                let shape = c.shape?;
+                let arc = arcs[first + 1];
+                Some(Zone {
+                    iwp: c.iwp,
+                    pair: c.pair,
+                    shape,
+                    arc,
+                    hold: c.hold,
+                    transition_in: c.transition.min((arc - c.hold).max(0.0)),
+                    transition_out: c.transition.min((total - arc - c.hold).max(0.0)),
+                })
+            })
+            .collect();
+        let passes = passes
+            .iter()
+            .map(|&(i, first, on_left)| {
+                let ins = &self.inspections[i];
+                let lead = ins.half - ins.geometry.pass_length / 2.0;
+                Pass {
+                    obstacle: ins.obstacle,
+                    arcs: [arcs[first] + lead, arcs[first + 1] - lead],
+                    on_left,
+                }
+            })
+            .collect();
+        CentroidPath {
+            points,
+            zones,
+            passes,
+        }
+    }
+
+    /// The first free leg that goes through the IWP's gap (the gap line,
+    /// widened by the formation's safe radius into the obstacles on either
+    /// side, so a path that clips the gap's edge is taken through its middle),
+    /// and the via triple in that leg's direction of travel.
+    fn crossing_leg(
+        &self,
+        points: &[Point3<f64>],
+        locked: &[bool],
+        via: &Crossing,
+    ) -> Option<(usize, [Point3<f64>; 3])> {
+        let along = Vector2::new(via.reach.y, -via.reach.x);
+        let across = along * (via.gate / along.norm().max(1e-12));
+        let (g0, g1) = (via.center - across, via.center + across);
+        points.windows(2).enumerate().find_map(|(i, leg)| {
             let (a, b) = (leg[0], leg[1]);
+            if locked[i] || !segments_cross(&a.xy(), &b.xy(), &g0, &g1) {
+                return None;
+            }
             let z = ((a.z + b.z) / 2.0).clamp(via.z_range[0], via.z_range[1]);
-            for sign in [1.0, -1.0] {
-                let reach = via.reach * sign;
-                let before = Point3::new(via.center.x - reach.x, via.center.y - reach.y, z);
-                let middle = Point3::new(via.center.x, via.center.y, z);
-                let after = Point3::new(via.center.x + reach.x, via.center.y + reach.y, z);
-                let added = (before - a).norm() + (after - before).norm() + (b - after).norm()
-                    - (b - a).norm();
-                if added < best.2 {
-                    best = (i, [before, middle, after], added);
+            let sign = if (b.xy() - a.xy()).dot(&via.reach) >= 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            let reach = via.reach * sign;
+            Some((
+                i,
+                [
+                    Point3::new(via.center.x - reach.x, via.center.y - reach.y, z),
+                    Point3::new(via.center.x, via.center.y, z),
+                    Point3::new(via.center.x + reach.x, via.center.y + reach.y, z),
+                ],
+            ))
+        })
+    }
+
+    /// The leg, the pass's two ends and its side (obstacle on the left) that
+    /// add the least length for inspection `i`'s pass at angle `phi`.
+    fn best_pass(
+        &self,
+        points: &[Point3<f64>],
+        locked: &[bool],
+        i: usize,
+        phi: f64,
+    ) -> (usize, [Point3<f64>; 2], bool) {
+        let ins = &self.inspections[i];
+        let sides = [true, false].map(|on_left| (on_left, self.pass_ends(i, phi, on_left)));
+        let mut best = (0, [Point3::origin(); 2], true, f64::INFINITY);
+        for (leg_index, leg) in points.windows(2).enumerate() {
+            if locked[leg_index] {
+                continue;
+            }
+            let (a, b) = (leg[0], leg[1]);
+            let z = ((a.z + b.z) / 2.0).clamp(ins.z_range[0], ins.z_range[1]);
+            for (on_left, [p, q]) in sides {
+                let first = Point3::new(p.x, p.y, z);
+                let last = Point3::new(q.x, q.y, z);
+                let added =
+                    (first - a).norm() + (last - first).norm() + (b - last).norm() - (b - a).norm();
+                if added < best.3 {
+                    best = (leg_index, [first, last], on_left, added);
                 }
             }
         }
-        (best.0, best.1)
+        (best.0, best.1, best.2)
     }
+}
+
+/// Puts `via` into leg `leg` (after its first point), locking the via's own legs.
+fn insert(points: &mut Vec<Point3<f64>>, locked: &mut Vec<bool>, leg: usize, via: &[Point3<f64>]) {
+    let k = via.len();
+    // Cheaper than `splice`, which allocates.
+    points.extend_from_slice(via);
+    points[leg + 1..].rotate_right(k);
+    // Leg `leg` becomes k + 1 legs: the approach, the via's own k − 1, the exit.
+    locked.extend(std::iter::repeat_n(true, k));
+    locked[leg + 1..].rotate_right(k);
+    locked[leg] = false;
+    locked[leg + k] = false;
+}
+
+/// Indices of vias placed after leg `leg` move by the `k` points inserted there.
+fn shift(
+    crossings: &mut [(usize, usize)],
+    passes: &mut [(usize, usize, bool)],
+    leg: usize,
+    k: usize,
+) {
+    for (_, first) in crossings.iter_mut() {
+        if *first > leg {
+            *first += k;
+        }
+    }
+    for (_, first, _) in passes.iter_mut() {
+        if *first > leg {
+            *first += k;
+        }
+    }
+}
+
+/// Whether the plane segments a-b and c-d intersect (touching counts).
+fn segments_cross(a: &Point2<f64>, b: &Point2<f64>, c: &Point2<f64>, d: &Point2<f64>) -> bool {
+    let orient = |p: &Point2<f64>, q: &Point2<f64>, r: &Point2<f64>| (q - p).perp(&(r - p));
+    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
+    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
+    d1 * d2 <= 0.0 && d3 * d4 <= 0.0 && !(d1 == 0.0 && d2 == 0.0 && d3 == 0.0 && d4 == 0.0)
 }
 
 /// s at each vertex: 0 at the first, the total length at the last.
@@ -249,8 +534,7 @@ pub fn cumulative_lengths(points: &[Point3<f64>]) -> Vec<f64> {
     out
 }
 
-/// A point moving along a polyline by arc length, with a cursor so that
-/// increasing queries cost O(1) each.
+/// A point moving along a polyline by arc length.
 pub struct ArcWalker<'a> {
     points: &'a [Point3<f64>],
     arcs: Vec<f64>,
@@ -268,20 +552,26 @@ impl<'a> ArcWalker<'a> {
         self.arcs.last().copied().unwrap_or(0.0)
     }
 
+    /// Arc length of every vertex.
+    pub fn arcs(&self) -> &[f64] {
+        &self.arcs
+    }
+
+    pub fn points(&self) -> &[Point3<f64>] {
+        self.points
+    }
+
     /// Position at arc length `s` (clamped to the path).
     pub fn at(&self, s: f64) -> Point3<f64> {
         let n = self.points.len();
         if n == 0 {
             return Point3::origin();
         }
-        let s = s.clamp(0.0, self.length());
-        let i = self
-            .arcs
-            .partition_point(|&a| a <= s)
-            .clamp(1, n.max(2) - 1);
         if n == 1 {
             return self.points[0];
         }
+        let s = s.clamp(0.0, self.length());
+        let i = self.arcs.partition_point(|&a| a <= s).clamp(1, n - 1);
         let (a, b) = (self.points[i - 1], self.points[i]);
         let len = self.arcs[i] - self.arcs[i - 1];
         if len <= 0.0 {

@@ -1,16 +1,17 @@
 //! Per-UAV timed trajectories from the centroid path (θ-PSO eqs. 12-15).
 //!
 //! The centroid moves along its path at the formation's ground speed. At each
-//! sample the slot offsets (formation frame: x along the horizontal direction
-//! of travel, y to its left, z up) of the current shape are turned into the
-//! inertial frame (eq. 13) and added to the centroid (eq. 14). Velocities are
-//! the time derivative of the sampled positions (eq. 15).
+//! sample every UAV is where `motion` puts it (the slot offsets of the
+//! current shape turned into the inertial frame, eq. 13, and added to the
+//! centroid, eq. 14), the same function the cost judged. Velocities are the
+//! time derivative of the sampled positions (eq. 15).
 
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
 use super::iwp::Iwp;
-use super::path::{ArcWalker, CentroidPath};
+use super::motion::Motion;
+use super::path::CentroidPath;
 use crate::mission::Formation;
 
 /// One sample of a UAV's trajectory. Seconds, metres ENU, m/s.
@@ -53,28 +54,23 @@ pub fn generate(
     path: &CentroidPath,
     iwps: &[Iwp],
     formation: &Formation,
+    span: f64,
 ) -> (Vec<Trajectory>, Vec<Reconfiguration>) {
-    let walker = ArcWalker::new(&path.points);
+    let motion = Motion::new(path, &formation.slots, span);
     let speed = formation.ground_speed;
-    let duration = walker.length() / speed;
+    let duration = motion.length() / speed;
     let steps = (duration / SAMPLE_PERIOD).ceil().max(1.0) as usize;
-    let span = formation.radius().max(1.0);
     let times: Vec<f64> = (0..=steps)
         .map(|k| (k as f64 * SAMPLE_PERIOD).min(duration))
         .collect();
 
     let n = formation.slots.len();
     let mut positions = vec![Vec::with_capacity(times.len()); n];
-    let mut offsets = Vec::with_capacity(n);
+    let mut here = Vec::with_capacity(n);
     for &t in &times {
-        let s = t * speed;
-        let centroid = walker.at(s);
-        let forward = walker.heading(s, span);
-        let left = Vector3::new(-forward.y, forward.x, 0.0);
-        current_offsets(path, &formation.slots, s, &mut offsets);
-        for (uav, o) in offsets.iter().enumerate() {
-            // Eq. 13: ΔP^I = R_IF ΔP with R_IF's columns the formation axes.
-            positions[uav].push(centroid + forward * o.x + left * o.y + Vector3::z() * o.z);
+        motion.positions_into(t * speed, &mut here);
+        for (uav, p) in here.iter().enumerate() {
+            positions[uav].push(*p);
         }
     }
 
@@ -100,7 +96,7 @@ pub fn generate(
                     .map(|i| i.between.clone())
                     .unwrap_or_default(),
                 shape: z.shape,
-                position: walker.at(z.arc),
+                position: motion.walker().at(z.arc),
                 t1: at(a1),
                 t2: at(a2),
                 t3: at(a3),
@@ -109,29 +105,6 @@ pub fn generate(
         })
         .collect();
     (trajectories, reconfigurations)
-}
-
-/// Offsets at arc length s: the nominal slots, or the shape of the zone that
-/// is furthest into its reconfiguration.
-fn current_offsets(
-    path: &CentroidPath,
-    nominal: &[Vector3<f64>],
-    s: f64,
-    out: &mut Vec<Vector3<f64>>,
-) {
-    let active = path
-        .zones
-        .iter()
-        .map(|z| (z, z.blend(s)))
-        .filter(|(_, b)| *b > 0.0)
-        .max_by(|a, b| a.1.total_cmp(&b.1));
-    match active {
-        Some((zone, b)) => zone.shape.offsets_into(nominal, b, out),
-        None => {
-            out.clear();
-            out.extend_from_slice(nominal);
-        }
-    }
 }
 
 /// Velocities by central differences (one-sided at the ends).

@@ -2,12 +2,14 @@
 //!
 //! The cost only penalises; this decides. For every UAV and every sample:
 //! clearance to every obstacle ≥ r_Q, every pair within [2 r_Q, d_com]
-//! (eq. 7), altitude inside the band (eq. 5), position inside the bounds.
+//! (eq. 7), altitude inside the band (eq. 5), position inside the bounds;
+//! and for every inspected obstacle, eq. 8 over its pass (`inspection`).
 //! A plan that fails any of them is infeasible.
 
 use nalgebra::Point3;
 use serde::Serialize;
 
+use super::inspection::{self, InspectionResult};
 use super::trajectory::Trajectory;
 use crate::mission::Mission;
 
@@ -55,6 +57,38 @@ pub struct Verification {
     pub violations: Vec<Violation>,
     /// How many samples broke a constraint in all.
     pub violation_count: usize,
+    /// Eq. 8, one row per inspected obstacle.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub inspections: Vec<InspectionResult>,
+}
+
+impl Verification {
+    /// The first broken constraint in words: the check, the UAV, the obstacle
+    /// or other UAV, and the time; or the first inspection that failed.
+    pub fn first_failure(&self) -> Option<String> {
+        if let Some(c) = self.checks.iter().find(|c| !c.ok) {
+            let worst = c
+                .worst
+                .map_or_else(|| "n/a".to_owned(), |w| format!("{w:.3}"));
+            let at = c.at.as_ref().map_or_else(String::new, |a| {
+                let other = a
+                    .other
+                    .as_deref()
+                    .map_or_else(String::new, |o| format!(" vs {o}"));
+                format!(" (UAV {} at t = {:.1} s{other})", a.uav + 1, a.time)
+            });
+            return Some(format!(
+                "{} worst {worst} {} {}{at}",
+                c.name, c.relation, c.limit
+            ));
+        }
+        self.inspections.iter().find(|i| !i.ok).map(|i| {
+            format!(
+                "inspection of '{}': {:.1} m within [{}, {}] m of its surface, {} m required (eq. 8)",
+                i.obstacle, i.achieved, i.band[0], i.band[1], i.required
+            )
+        })
+    }
 }
 
 /// Violations kept in the outcome.
@@ -180,10 +214,12 @@ pub fn verify(mission: &Mission, trajectories: &[Trajectory]) -> Verification {
         .into_iter()
         .map(|t| t.check)
         .collect();
+    let inspections = inspection::verify(mission, trajectories);
     Verification {
-        feasible: checks.iter().all(|c| c.ok),
+        feasible: checks.iter().all(|c| c.ok) && inspections.iter().all(|i| i.ok),
         checks,
         violations,
         violation_count: count,
+        inspections,
     }
 }

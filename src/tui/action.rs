@@ -51,6 +51,8 @@ pub enum Action {
     CycleShape,
     /// Enable/disable the selected IWP.
     ToggleWaypoint,
+    /// Inspect (eq. 8) the selected obstacle, or stop inspecting it.
+    ToggleInspect,
 
     FieldUp,
     FieldDown,

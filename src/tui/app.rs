@@ -15,7 +15,7 @@ use super::document::Document;
 use super::fields::{self, Field, Item};
 use super::jobs::{self, Job, JobId, JobMsg, Pipeline, RecordSettings, Viewer};
 use crate::geometry::farthest_offset;
-use crate::mission::{self, Mission, Preset, Severity, check_str};
+use crate::mission::{self, Mission, Preset, Severity};
 use crate::pipeline::Level;
 use crate::planner::iwp::min_pair_distance;
 use crate::planner::{Iwp, find_iwps};
@@ -457,6 +457,22 @@ impl App {
                 self.edit(|m| m.fleet.targets.push(next));
                 self.select(Item::FleetTarget(self.mission().fleet.targets.len() - 1));
             }
+            ToggleInspect => {
+                if let Item::Obstacle(i) = self.selected
+                    && let Some(o) = self.mission().obstacles.get(i)
+                {
+                    let inspect = !o.inspect;
+                    let name = o.name.clone();
+                    self.edit(|m| m.obstacles[i].inspect = inspect);
+                    self.set_status(if inspect {
+                        format!("inspecting '{name}': the plan flies a pass along it (eq. 8)")
+                    } else {
+                        format!("'{name}' is no longer inspected")
+                    });
+                } else {
+                    self.set_status("select an obstacle (n/p or click) to inspect it".to_owned());
+                }
+            }
             Duplicate => {
                 if let Item::Obstacle(i) = self.selected
                     && let Some(o) = self.mission().obstacles.get(i)
@@ -853,7 +869,7 @@ impl App {
         let mut trial = self.mission().clone();
         let problem = match field.set(&mut trial, &self.selected, &editing.buffer) {
             Err(e) => Some((Severity::Error, e)),
-            Ok(()) => mission::validate(&trial)
+            Ok(()) => crate::diagnose::diagnose(&trial)
                 .into_iter()
                 .filter(|d| concerns(&d.path.to_string(), &field.path))
                 .min_by_key(|d| d.severity)
@@ -1122,7 +1138,7 @@ impl App {
                 None => return self.set_error(format!("no built-in mission {name}")),
             },
         };
-        let checked = check_str(&text, Some(&name));
+        let checked = crate::diagnose::check_text(&text, Some(&name));
         match checked.mission {
             Some(m) => {
                 self.doc = Document::new(m, path);

@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::mission::{self, Diagnostic, Mission, MissionError, validate};
+use crate::mission::{self, Diagnostic, Mission, MissionError};
 
 /// Undo steps kept; the oldest are forgotten first.
 const HISTORY_LIMIT: usize = 500;
@@ -31,7 +31,7 @@ pub struct Document {
 
 impl Document {
     pub fn new(mission: Mission, path: Option<PathBuf>) -> Self {
-        let diagnostics = validate(&mission);
+        let diagnostics = crate::diagnose::diagnose(&mission);
         Document {
             saved: mission.clone(),
             never_saved: false,
@@ -115,7 +115,7 @@ impl Document {
             return self.edit(change);
         }
         change(&mut self.mission);
-        self.diagnostics = validate(&self.mission);
+        self.diagnostics = crate::diagnose::diagnose(&self.mission);
     }
 
     pub fn end_gesture(&mut self) {
@@ -142,7 +142,7 @@ impl Document {
             Some(previous) => {
                 self.redo
                     .push(std::mem::replace(&mut self.mission, previous));
-                self.diagnostics = validate(&self.mission);
+                self.diagnostics = crate::diagnose::diagnose(&self.mission);
                 true
             }
             None => false,
@@ -155,7 +155,7 @@ impl Document {
         match self.redo.pop() {
             Some(next) => {
                 self.undo.push(std::mem::replace(&mut self.mission, next));
-                self.diagnostics = validate(&self.mission);
+                self.diagnostics = crate::diagnose::diagnose(&self.mission);
                 true
             }
             None => false,
@@ -190,6 +190,6 @@ impl Document {
     }
 
     fn changed(&mut self) {
-        self.diagnostics = validate(&self.mission);
+        self.diagnostics = crate::diagnose::diagnose(&self.mission);
     }
 }

@@ -197,6 +197,21 @@ fn obstacle<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut Obstacle, Str
     }
 }
 
+/// One end of an obstacle's stand-off band; an empty entry goes back to the
+/// formation's `surface_distance` for both ends.
+fn set_stand_off(m: &mut Mission, item: &Item, end: usize, t: &str) -> Result<(), String> {
+    let default = m.formation.surface_distance;
+    let o = obstacle(m, item)?;
+    if t.trim().is_empty() {
+        o.stand_off = None;
+        return Ok(());
+    }
+    let mut band = o.stand_off.unwrap_or(default);
+    band[end] = number(t)?;
+    o.stand_off = Some(band);
+    Ok(())
+}
+
 fn slot<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut Vector3<f64>, String> {
     match item {
         Item::Slot(i) => m.formation.slots.get_mut(*i).ok_or("no such slot".into()),
@@ -378,6 +393,27 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
                         Ok(())
                     },
                 ),
+                field(
+                    "inspect (eq. 8)",
+                    at("inspect"),
+                    if o.inspect { "yes" } else { "no" },
+                    |m, item, t| {
+                        obstacle(m, item)?.inspect = yes_no(t)?;
+                        Ok(())
+                    },
+                ),
+                field(
+                    "stand-off min (m)",
+                    at("stand_off"),
+                    fmt_num(o.stand_off_band(&m.formation)[0]),
+                    |m, item, t| set_stand_off(m, item, 0, t),
+                ),
+                field(
+                    "stand-off max (m)",
+                    at("stand_off"),
+                    fmt_num(o.stand_off_band(&m.formation)[1]),
+                    |m, item, t| set_stand_off(m, item, 1, t),
+                ),
             ]
         }
         Item::Formation => {
@@ -426,6 +462,15 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
                     fmt_num(f.surface_distance[1]),
                     |m, _, t| {
                         m.formation.surface_distance[1] = number(t)?;
+                        Ok(())
+                    },
+                ),
+                field(
+                    "inspection pass (m)",
+                    "formation.inspection_pass",
+                    fmt_num(f.inspection_pass),
+                    |m, _, t| {
+                        m.formation.inspection_pass = number(t)?;
                         Ok(())
                     },
                 ),
@@ -899,6 +944,8 @@ pub fn new_obstacle(mission: &Mission, center: Point2<f64>) -> Obstacle {
         radius: 1.0,
         height: (mission.bounds.z[1] + 1.0).max(1.0),
         kind: None,
+        inspect: false,
+        stand_off: None,
     }
 }
 
@@ -939,6 +986,8 @@ mod tests {
             for (k, f) in fields(&item, &m).into_iter().enumerate() {
                 let value = if f.label.contains("shape") {
                     "shrink".to_string()
+                } else if f.value == "yes" || f.value == "no" {
+                    "yes".to_string()
                 } else {
                     "7".to_string()
                 };

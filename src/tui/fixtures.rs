@@ -38,6 +38,8 @@ pub fn crowded_mission(n: usize) -> Mission {
                 radius: 1.0 + ((k * 31) % 5) as f64 * 0.3,
                 height: 20.0,
                 kind: Some("post".into()),
+                inspect: false,
+                stand_off: None,
             }
         })
         .collect();

@@ -61,6 +61,11 @@ pub const KEYS: &[(&str, &str, &str)] = &[
     ("Edit", "d", "duplicate the selected obstacle"),
     (
         "Edit",
+        "i",
+        "inspect the selected obstacle (eq. 8) or stop inspecting it",
+    ),
+    (
+        "Edit",
         "Del  D",
         "delete the selected obstacle / slot / IWP choice",
     ),
@@ -177,6 +182,7 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
         KeyCode::Char('P') => Some(Action::CyclePreset),
         KeyCode::Char('s') => Some(Action::CycleShape),
         KeyCode::Char(' ') => Some(Action::ToggleWaypoint),
+        KeyCode::Char('i') => Some(Action::ToggleInspect),
         KeyCode::Char('r') => Some(Action::Run),
         KeyCode::Char('N') => Some(Action::RunNewSeed),
         KeyCode::Char('F') => Some(Action::RunFlatlo),

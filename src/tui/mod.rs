@@ -32,7 +32,7 @@ pub use action::Action;
 pub use app::App;
 pub use document::Document;
 
-use crate::mission::{self, check_str};
+use crate::mission;
 
 /// How often the screen refreshes while a job runs (elapsed times, gauges).
 const TICK: Duration = Duration::from_millis(100);
@@ -55,7 +55,7 @@ pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), 
     }
     let text = mission::read(path).map_err(|e| e.to_string())?;
     let name = path.display().to_string();
-    let checked = check_str(&text, Some(&name));
+    let checked = crate::diagnose::check_text(&text, Some(&name));
     match checked.mission {
         Some(m) => {
             let errors = checked.report.error_count();

@@ -355,10 +355,24 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
             dot,
         });
     }
+    // Inspected obstacles (eq. 8): their stand-off band as two rings.
+    for o in m.obstacles.iter().filter(|o| o.inspect) {
+        for d in o.stand_off_band(&m.formation) {
+            ctx.draw(&Ring {
+                x: o.center.x,
+                y: o.center.y,
+                radius: o.radius + d,
+                color: Color::Magenta,
+                dot,
+            });
+        }
+    }
     for (i, o) in m.obstacles.iter().enumerate() {
         let selected = app.selected == Item::Obstacle(i);
         let color = if selected {
             Color::Yellow
+        } else if o.inspect {
+            Color::LightMagenta
         } else if o.height <= b.z[0] {
             Color::Gray
         } else {
@@ -432,6 +446,15 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
                     color: Color::LightCyan,
                 });
             }
+            // Inspection passes (eq. 8): the centroid's stretch.
+            for pass in &o.passes {
+                let stretch = centroid_between(o, pass.time[0], pass.time[1]);
+                let pts = decimate(stretch.into_iter(), dot);
+                ctx.draw(&Polyline {
+                    points: &pts,
+                    color: Color::LightMagenta,
+                });
+            }
         }
         for v in o.verification.violations.iter().take(50) {
             ctx.print(
@@ -474,13 +497,20 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
         for (i, o) in m.obstacles.iter().enumerate() {
             let style = if app.selected == Item::Obstacle(i) {
                 Style::default().yellow().bold()
+            } else if o.inspect {
+                Style::default().fg(Color::LightMagenta)
             } else {
                 Style::default().fg(Color::Gray)
+            };
+            let label = if o.inspect {
+                format!("{} ◉", o.name)
+            } else {
+                o.name.clone()
             };
             ctx.print(
                 o.center.x + o.radius + scale,
                 o.center.y,
-                Span::styled(o.name.clone(), style),
+                Span::styled(label, style),
             );
         }
     }
@@ -797,7 +827,7 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect) {
                 Cell::from(format!("{:.2}", w.gap)),
                 Cell::from(if w.enabled { "yes" } else { "no" }),
                 Cell::from(choice),
-                Cell::from(w.shape.name()),
+                Cell::from(w.shape_name()),
             ])
             .style(style)
         })

@@ -1,0 +1,209 @@
+//! Inspection surfaces (θ-PSO eq. 8): d_n^s ∈ [d_min^s, d_max^s].
+//!
+//! Reading: the paper inspects the surfaces of the bridge's piers and poles
+//! (IV.A) and plans the IWPs "using eqs. (7), (8), (9)" (Fig. 3, line 7). A
+//! formation inspects one side of a structure at a time, so eq. 8 binds the
+//! UAV *facing* the surface, the nearest one: over a straight pass of
+//! `formation.inspection_pass` metres of centroid path, the distance from that
+//! UAV to the obstacle's surface stays within the obstacle's stand-off band.
+//! The other UAVs only keep their clearance (≥ r_Q, checked as for every
+//! obstacle). The pass is tangent to the cylinder; its distance from the axis
+//! is chosen so that the facing UAV's distance, which grows toward the pass's
+//! ends, sits in the middle of the band.
+
+use serde::Serialize;
+
+use nalgebra::Vector3;
+
+use super::trajectory::Trajectory;
+use crate::mission::Mission;
+
+/// Where a pass runs, for one obstacle and the nominal shape: the distance of
+/// the centroid's line from the obstacle's axis with the obstacle on the
+/// formation's left and on its right.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PassGeometry {
+    pub radius_left: f64,
+    pub radius_right: f64,
+    pub pass_length: f64,
+    /// The facing UAV's distance range along the pass, left and right.
+    pub range_left: [f64; 2],
+    pub range_right: [f64; 2],
+}
+
+/// Samples along a pass when its geometry is computed (setup only).
+const PASS_SAMPLES: usize = 64;
+
+/// The facing UAV's surface distance range over a straight pass whose
+/// centroid line is `radius` from the axis of a cylinder of radius `r`, the
+/// obstacle on the side `sign` (+1 left, −1 right).
+fn facing_range(slots: &[Vector3<f64>], r: f64, radius: f64, length: f64, sign: f64) -> [f64; 2] {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for i in 0..=PASS_SAMPLES {
+        let u = -length / 2.0 + length * i as f64 / PASS_SAMPLES as f64;
+        let nearest = slots
+            .iter()
+            .map(|o| ((u + o.x).powi(2) + (radius - sign * o.y).powi(2)).sqrt() - r)
+            .fold(f64::INFINITY, f64::min);
+        lo = lo.min(nearest);
+        hi = hi.max(nearest);
+    }
+    [lo, hi]
+}
+
+impl PassGeometry {
+    /// The pass for an obstacle of radius `r` with stand-off band `band`, or
+    /// why the band cannot hold over the whole pass.
+    pub fn new(
+        slots: &[Vector3<f64>],
+        r: f64,
+        band: [f64; 2],
+        length: f64,
+    ) -> Result<PassGeometry, String> {
+        let [d_min, d_max] = band;
+        let target = (d_min + d_max) / 2.0;
+        let side = |sign: f64| -> Result<(f64, [f64; 2]), String> {
+            // The facing UAV's mid-range distance grows with the line's
+            // distance from the axis: bisect for the band's middle.
+            let extent = slots.iter().map(|o| sign * o.y).fold(0.0, f64::max);
+            let (mut lo, mut hi) = (r + extent, r + extent + d_max + length + 10.0);
+            for _ in 0..80 {
+                let mid = (lo + hi) / 2.0;
+                let [a, b] = facing_range(slots, r, mid, length, sign);
+                if (a + b) / 2.0 < target {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let radius = (lo + hi) / 2.0;
+            let range = facing_range(slots, r, radius, length, sign);
+            if range[0] < d_min || range[1] > d_max {
+                return Err(format!(
+                    "a {length} m pass cannot keep the facing UAV within [{d_min}, {d_max}] m of \
+                     its surface: along a straight pass the distance varies from {:.2} to {:.2} m; \
+                     shorten formation.inspection_pass or widen the band",
+                    range[0], range[1]
+                ));
+            }
+            Ok((radius, range))
+        };
+        let (radius_left, range_left) = side(1.0)?;
+        let (radius_right, range_right) = side(-1.0)?;
+        Ok(PassGeometry {
+            radius_left,
+            radius_right,
+            pass_length: length,
+            range_left,
+            range_right,
+        })
+    }
+}
+
+/// The pass geometry of every inspected obstacle, or the first reason one
+/// cannot be flown, with its obstacle index.
+pub fn pass_geometries(mission: &Mission) -> Result<Vec<(usize, PassGeometry)>, (usize, String)> {
+    let f = &mission.formation;
+    mission
+        .obstacles
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| o.inspect)
+        .map(|(k, o)| {
+            PassGeometry::new(&f.slots, o.radius, o.stand_off_band(f), f.inspection_pass)
+                .map(|g| (k, g))
+                .map_err(|e| (k, e))
+        })
+        .collect()
+}
+
+/// Eq. 8 as flown, for one inspected obstacle.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct InspectionResult {
+    pub obstacle: String,
+    /// [d_min^s, d_max^s], metres.
+    pub band: [f64; 2],
+    /// Pass length required, metres of centroid path.
+    pub required: f64,
+    /// Longest stretch over which the facing UAV stayed in the band, metres.
+    pub achieved: f64,
+    /// The facing UAV's distance range over that stretch, metres.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distance: Option<[f64; 2]>,
+    /// When that stretch starts and ends, seconds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<[f64; 2]>,
+    /// 0-based UAV facing the surface in the middle of the stretch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uav: Option<usize>,
+    pub ok: bool,
+}
+
+/// Checks eq. 8 on the flown trajectories for every inspected obstacle:
+/// the longest run of samples where the nearest UAV is within the band must
+/// cover the pass (less one sample's travel, the resolution of the check).
+pub fn verify(mission: &Mission, trajectories: &[Trajectory]) -> Vec<InspectionResult> {
+    let f = &mission.formation;
+    let samples = trajectories
+        .iter()
+        .map(|t| t.samples.len())
+        .min()
+        .unwrap_or(0);
+    let step = trajectories
+        .first()
+        .and_then(|t| t.samples.get(1).map(|s| s.t - t.samples[0].t))
+        .unwrap_or(0.0);
+    let resolution = step * f.ground_speed;
+    mission
+        .obstacles
+        .iter()
+        .filter(|o| o.inspect)
+        .map(|o| {
+            let band = o.stand_off_band(f);
+            let cylinder = o.cylinder();
+            // (start, end) sample indices of the current and the best run.
+            let mut run: Option<usize> = None;
+            let mut best: Option<(usize, usize)> = None;
+            let facing = |k: usize| {
+                trajectories
+                    .iter()
+                    .enumerate()
+                    .map(|(n, t)| (n, cylinder.clearance(&t.samples[k].position)))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+            };
+            for k in 0..=samples {
+                let inside =
+                    k < samples && facing(k).is_some_and(|(_, d)| band[0] <= d && d <= band[1]);
+                match (inside, run) {
+                    (true, None) => run = Some(k),
+                    (false, Some(first)) => {
+                        let last = k - 1;
+                        if best.is_none_or(|(a, b)| last - first > b - a) {
+                            best = Some((first, last));
+                        }
+                        run = None;
+                    }
+                    _ => {}
+                }
+            }
+            let time = |k: usize| trajectories[0].samples[k].t;
+            let achieved = best.map_or(0.0, |(a, b)| (time(b) - time(a)) * f.ground_speed);
+            let distance = best.map(|(a, b)| {
+                (a..=b).fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], k| {
+                    let d = facing(k).map_or(f64::NAN, |(_, d)| d);
+                    [lo.min(d), hi.max(d)]
+                })
+            });
+            InspectionResult {
+                obstacle: o.name.clone(),
+                band,
+                required: f.inspection_pass,
+                achieved,
+                distance,
+                time: best.map(|(a, b)| [time(a), time(b)]),
+                uav: best.and_then(|(a, b)| facing((a + b) / 2).map(|(n, _)| n)),
+                ok: achieved + resolution + 1e-9 >= f.inspection_pass,
+            }
+        })
+        .collect()
+}
