@@ -42,7 +42,7 @@ fn benches(c: &mut Criterion) {
         group.bench_function(format!("{name}/full_simulation"), |b| {
             b.iter(|| {
                 flatlo::plan(black_box(&m), 3, &mut Silent, &CancelToken::new())
-                    .map(|o| o.verification.max_spacing_error)
+                    .map(|o| o.verification.map(|v| v.max_spacing_error))
             })
         });
     }

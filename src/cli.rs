@@ -224,7 +224,7 @@ pub fn main() -> ExitCode {
 /// The TUI; errors (not a terminal, a file that is not a mission) go to stderr.
 fn edit(file: Option<PathBuf>) -> u8 {
     match crate::tui::run(file) {
-        Ok(()) => exit::OK,
+        Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e}");
             exit::ERROR
@@ -258,7 +258,7 @@ fn record_mission(path: &std::path::Path, sinks: &Sinks) -> u8 {
 
 /// Loads a mission for a command: its warnings and errors go to stderr.
 fn load_reporting(path: &std::path::Path) -> Option<mission::Mission> {
-    match mission::load(path) {
+    match crate::diagnose::load(path) {
         Ok(loaded) => {
             eprint!("{}", loaded.warnings);
             Some(loaded.mission)
@@ -654,7 +654,19 @@ pub fn flatlo_summary(o: &FlatloOutcome) -> String {
             p.a, p.b, p.min_distance, p.time
         );
     }
-    let v = &o.verification;
+    let closest = o.closest.map_or("-".to_owned(), |c| {
+        format!(
+            "aircraft {} and {} at {:.1} m (t = {:.0} s)",
+            c.a, c.b, c.min_distance, c.time
+        )
+    });
+    let Some(v) = &o.verification else {
+        let _ = writeln!(
+            s,
+            "  result       CANCELLED: no verdict on a partial flight; closest so far {closest}"
+        );
+        return s;
+    };
     let spacing: Vec<String> = v
         .final_spacing
         .iter()
@@ -668,9 +680,6 @@ pub fn flatlo_summary(o: &FlatloOutcome) -> String {
         v.lateral_spread
     );
     let verdict = if v.passed { "PASS" } else { "FAIL" };
-    let closest = v.closest.map_or("-".to_owned(), |c| {
-        format!("aircraft {} and {} at {:.1} m", c.a, c.b, c.min_distance)
-    });
     let _ = writeln!(
         s,
         "  result       {verdict}: closest {closest}, minimum separation {:.0} m",

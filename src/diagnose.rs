@@ -2,8 +2,10 @@
 //!
 //! `mission::validate` holds the rules of the file itself; the pipelines know
 //! more (an IWP no shape can pass, an inspection pass eq. 8 cannot hold).
-//! Every reader of a mission (`check`, `run`, the designer) asks here, so
-//! all of them see the same findings.
+//! Each pipeline also predicts the size of a run and refuses one over the
+//! documented limits (`pipeline::limits`). Every reader of a mission
+//! (`check`, `run`, the designer) asks here, so all of them see the same
+//! findings.
 
 use crate::mission::{self, Checked, Diagnostic, Mission, Report, SourceMap};
 
@@ -13,9 +15,19 @@ pub fn diagnose(mission: &Mission) -> Vec<Diagnostic> {
     // A pipeline's findings only mean something on a mission that follows the
     // rules; on one that does not, the rules' errors are the news.
     if !all.iter().any(Diagnostic::is_error) {
-        all.extend(crate::planner::diagnostics(mission));
+        all.extend(pipeline_findings(mission));
     }
     all
+}
+
+/// What the pipelines say of a mission that follows the rules: their budgets
+/// first (a run too large to start), then θ-PSO's IWPs and inspections.
+fn pipeline_findings(mission: &Mission) -> Vec<Diagnostic> {
+    let mut out = crate::planner::budget(mission);
+    out.extend(crate::flatlo::budget(mission));
+    out.extend(crate::fleet::budget(mission));
+    out.extend(crate::planner::diagnostics(mission));
+    out
 }
 
 /// `mission::check_str` with the pipelines' findings, located in `text`.
@@ -25,7 +37,7 @@ pub fn check_text(text: &str, file: Option<&str>) -> Checked {
         && !checked.report.has_errors()
     {
         let source = SourceMap::new(text);
-        let extra: Vec<Diagnostic> = crate::planner::diagnostics(m)
+        let extra: Vec<Diagnostic> = pipeline_findings(m)
             .into_iter()
             .map(|d| d.locate(file, &source))
             .collect();
@@ -36,4 +48,20 @@ pub fn check_text(text: &str, file: Option<&str>) -> Checked {
         }
     }
     checked
+}
+
+/// `mission::load` with the pipelines' findings: a mission over a run's
+/// budget, or with an inspection eq. 8 cannot hold, is refused here, before
+/// any run starts.
+pub fn load(path: &std::path::Path) -> Result<mission::Loaded, mission::MissionError> {
+    let text = mission::read(path)?;
+    let origin = path.display().to_string();
+    let Checked { mission, report } = check_text(&text, Some(&origin));
+    match mission {
+        Some(mission) if !report.has_errors() => Ok(mission::Loaded {
+            mission,
+            warnings: report,
+        }),
+        _ => Err(mission::MissionError::Invalid { origin, report }),
+    }
 }

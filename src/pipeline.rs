@@ -120,6 +120,9 @@ pub enum PipelineError {
     InvalidMission(String),
     #[error("{0}")]
     Unsupported(String),
+    /// The run would exceed a documented limit (`limits`).
+    #[error("the run is too large to start:\n{0}")]
+    OverBudget(String),
 }
 
 /// Every pipeline's first step: a mission with errors is refused, naming them.
@@ -134,4 +137,80 @@ pub fn require_valid(mission: &crate::mission::Mission) -> Result<(), PipelineEr
     } else {
         Err(PipelineError::InvalidMission(errors.join("\n")))
     }
+}
+
+/// A run's predicted size over its documented limit: refused before it starts.
+pub fn require_within_budget(
+    findings: Vec<crate::mission::Diagnostic>,
+) -> Result<(), PipelineError> {
+    let errors: Vec<String> = findings
+        .into_iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.to_string())
+        .collect();
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(PipelineError::OverBudget(errors.join("\n")))
+    }
+}
+
+/// The documented limits on what one run may cost (README, "Limits").
+///
+/// Every pipeline predicts its work and memory from the mission alone
+/// (`planner::budget`, `flatlo::budget`, `fleet::budget`) and refuses a
+/// mission over these figures before it starts. They sit far above every
+/// realistic mission (the shipped ones use under 1 % of each) and keep the
+/// largest allowed run within a few minutes and a few GiB on a 2-core,
+/// 24 GiB machine: an allocation failure or an OOM kill cannot be caught,
+/// so the only safe large run is one never started.
+pub mod limits {
+    /// θ-PSO particles (memory: particles × dimensions × 4 vectors).
+    pub const THETA_PSO_PARTICLES: usize = 100_000;
+    /// θ-PSO free waypoints (decision dimensions grow with them).
+    pub const THETA_PSO_WAYPOINTS: usize = 1_000;
+    /// θ-PSO path segments L (each cost evaluation walks them).
+    pub const THETA_PSO_SEGMENTS: usize = 100_000;
+    /// θ-PSO cost evaluations: particles × iterations × (1 + restarts)
+    /// (about 10 µs each on one core: 2e7 is a few minutes on two).
+    pub const THETA_PSO_EVALUATIONS: f64 = 2e7;
+    /// Trajectory samples kept for every UAV together (duration / 0.1 s × UAVs).
+    pub const TRAJECTORY_SAMPLES: f64 = 1e7;
+    /// FLATLO aircraft.
+    pub const FLATLO_AIRCRAFT: usize = 4_096;
+    /// FLATLO integration steps: aircraft × simulated duration / sim_step
+    /// (about 7e6 per second on this machine's two cores).
+    pub const FLATLO_STEPS: f64 = 1e9;
+    /// FLATLO sample instants scanned by verification: aircraft × duration /
+    /// sample_period.
+    pub const FLATLO_SAMPLES: f64 = 1e9;
+    /// Fleet agents.
+    pub const FLEET_AGENTS: usize = 256;
+    /// Fleet cost evaluations: agents × re-plans × particles × iterations.
+    pub const FLEET_EVALUATIONS: f64 = 2e8;
+    /// Fleet dynamics steps: agents × duration / sim_step.
+    pub const FLEET_STEPS: f64 = 1e9;
+    /// Fleet samples kept: agents × duration × 20 Hz.
+    pub const FLEET_SAMPLES: f64 = 1e7;
+}
+
+/// A figure for budget messages: `1.2e8` beyond 10⁵, `1e-6` below 10⁻⁴,
+/// plain between.
+pub fn figure(x: f64) -> String {
+    if !x.is_finite() {
+        "∞".to_owned()
+    } else if x.abs() >= 1e5 {
+        format!("{x:.1e}").replace(".0e", "e")
+    } else if x != 0.0 && x.abs() < 1e-4 {
+        format!("{x:e}")
+    } else if x == x.trunc() {
+        format!("{x:.0}")
+    } else {
+        format!("{}", (x * 1e3).round() / 1e3)
+    }
+}
+
+/// A predicted figure over its limit; NaN or infinite figures are over.
+pub fn exceeds(figure: f64, limit: f64) -> bool {
+    !figure.is_finite() || figure > limit
 }

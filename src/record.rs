@@ -786,12 +786,12 @@ fn log_theta_pso(
 /// on `sim_time`, their airspeed, γ, χ and controls as series, the closest
 /// approaches as events.
 fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingStreamResult<()> {
-    let v = &o.verification;
+    let min_separation = o.verification.as_ref().map_or(0.0, |v| v.min_separation);
     stream.send_property(
         "flatlo",
         &rerun::TextDocument::from_markdown(format!(
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\naircraft: {}\n\
-             arrival: {:.1} s\nduration: {:.1} s\nclosest: {}\nspacing error: {:.3e}\n\
+             arrival: {:.1} s\nduration: {:.1} s\nclosest: {}\nspacing error: {}\n\
              passed: {}\nskyform: {}",
             o.mission,
             o.pipeline,
@@ -800,12 +800,18 @@ fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingSt
             o.aircraft.len(),
             o.arrival_time,
             o.duration,
-            v.closest.map_or("-".to_owned(), |c| format!(
+            o.closest.map_or("-".to_owned(), |c| format!(
                 "{} and {} at {:.0} m",
                 c.a, c.b, c.min_distance
             )),
-            v.max_spacing_error,
-            v.passed,
+            o.verification
+                .as_ref()
+                .map_or("-".to_owned(), |v| format!("{:.3e}", v.max_spacing_error)),
+            o.verification
+                .as_ref()
+                .map_or("no verdict (cancelled)".to_owned(), |v| v
+                    .passed
+                    .to_string()),
             env!("CARGO_PKG_VERSION")
         )),
     )?;
@@ -863,9 +869,15 @@ fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingSt
         ))
         .with_level(rerun::TextLogLevel::INFO),
     )?;
-    for p in &o.pairs {
+    let closest_only: Vec<_> = o.closest.into_iter().collect();
+    let pairs = if o.pairs.is_empty() {
+        &closest_only
+    } else {
+        &o.pairs
+    };
+    for p in pairs {
         stream.set_duration_secs("sim_time", p.time);
-        let level = if p.min_distance < v.min_separation {
+        let level = if p.min_distance < min_separation {
             rerun::TextLogLevel::WARN
         } else {
             rerun::TextLogLevel::INFO

@@ -114,7 +114,7 @@ fn the_paper_case_flies_into_line_without_coming_close() {
     assert_eq!(m.flatlo.noise, 0.0025);
     let out = flatlo::plan(&m, m.seed, &mut Silent, &CancelToken::new()).unwrap();
     assert_eq!(out.completion, Completion::Finished);
-    let v = &out.verification;
+    let v = out.verification.as_ref().unwrap();
     assert!(v.passed);
     assert!(
         v.max_spacing_error < 0.01,
@@ -129,9 +129,16 @@ fn the_paper_case_flies_into_line_without_coming_close() {
         "lateral spread {} m",
         v.lateral_spread
     );
-    let closest = v.closest.unwrap();
+    let closest = out.closest.unwrap();
     assert!(closest.min_distance > 15_000.0, "{closest:?}");
     assert_eq!(out.pairs.len(), 6);
+    // The closest pair overall is the closest of the pair table.
+    let table_min = out
+        .pairs
+        .iter()
+        .map(|p| p.min_distance)
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(closest.min_distance, table_min);
     // The aircraft do follow their references.
     for a in &out.aircraft {
         assert!(
@@ -178,7 +185,7 @@ fn an_odd_squadron_puts_its_middle_aircraft_in_front() {
     m.flatlo.aircraft = 5;
     m.flatlo.noise = 0.0;
     let out = flatlo::plan(&m, 0, &mut Silent, &CancelToken::new()).unwrap();
-    let v = &out.verification;
+    let v = out.verification.as_ref().unwrap();
     assert_eq!(v.final_spacing[0].front, 0);
     assert!(v.max_spacing_error < 0.01, "{v:?}");
     assert!(v.passed);
@@ -191,7 +198,7 @@ fn a_too_small_separation_threshold_is_a_failed_verification_not_an_error() {
     m.flatlo.final_leg = 1_000.0;
     let out = flatlo::plan(&m, 1, &mut Silent, &CancelToken::new()).unwrap();
     assert!(!out.passed());
-    assert!(out.verification.closest.unwrap().min_distance < 20_000.0);
+    assert!(out.closest.unwrap().min_distance < 20_000.0);
 }
 
 #[test]
@@ -203,4 +210,64 @@ fn cancel_stops_the_simulation_early() {
     assert_eq!(out.completion, Completion::Cancelled);
     let flown = out.aircraft[0].flown.last().unwrap().t;
     assert!(flown < 120.0, "stopped after the first chunk, at {flown} s");
+    // A partial flight gets no verdict, pass or fail.
+    assert!(out.verification.is_none());
+    assert!(!out.passed());
+}
+
+/// What is kept per aircraft is bounded however long the flight: the paper
+/// case flies ~5,800 s sampled every second; with a 0.1 s sample period
+/// that is 58,000 samples, decimated to at most `KEPT_SAMPLES` (+ the last).
+#[test]
+fn kept_samples_are_bounded_and_include_the_end() {
+    let mut m = paper_mission();
+    m.flatlo.sample_period = 0.1;
+    let out = flatlo::plan(&m, 1, &mut Silent, &CancelToken::new()).unwrap();
+    assert!(out.sample_stride > 1, "stride {}", out.sample_stride);
+    for a in &out.aircraft {
+        assert!(
+            a.flown.len() <= flatlo::KEPT_SAMPLES + 1,
+            "{}",
+            a.flown.len()
+        );
+        assert!(
+            a.reference.len() <= flatlo::KEPT_SAMPLES + 2,
+            "{}",
+            a.reference.len()
+        );
+        let end = a.flown.last().unwrap().t;
+        assert!(
+            (end - out.duration).abs() <= m.flatlo.sim_step,
+            "{end} vs {}",
+            out.duration
+        );
+    }
+}
+
+/// Large squadrons keep no pair table; the swept closest pair must be the
+/// brute-force minimum over every pair at every sample instant. With the
+/// stride at 1 (short flight) the kept samples are all the samples.
+#[test]
+fn a_large_squadron_finds_the_same_closest_pair_as_brute_force() {
+    let mut m = paper_mission();
+    m.flatlo.aircraft = 16;
+    m.flatlo.spacing = 500.0;
+    m.flatlo.turn_radius = 150.0;
+    m.flatlo.final_leg = 500.0;
+    let out = flatlo::plan(&m, 2, &mut Silent, &CancelToken::new()).unwrap();
+    assert!(out.pairs.is_empty());
+    assert_eq!(out.sample_stride, 1);
+    let mut best = (f64::INFINITY, 0, 0, 0.0);
+    for a in 0..out.aircraft.len() {
+        for b in a + 1..out.aircraft.len() {
+            for (sa, sb) in out.aircraft[a].flown.iter().zip(&out.aircraft[b].flown) {
+                let d = (sa.position - sb.position).norm();
+                if d < best.0 {
+                    best = (d, a, b, sa.t);
+                }
+            }
+        }
+    }
+    let c = out.closest.unwrap();
+    assert_eq!((c.min_distance, c.a, c.b, c.time), best);
 }

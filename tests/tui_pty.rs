@@ -1,7 +1,6 @@
 //! End to end: the real binary in a pseudo-terminal, driven by keystrokes,
-//! its screen read back through a terminal emulator (vt100). Opens a copy of
-//! a mission, adds an obstacle, runs θ-PSO to the end, saves and quits; then
-//! checks the saved file and that the terminal is back in cooked mode.
+//! its screen read back through a terminal emulator (vt100): edit, run, save
+//! and quit; a `kill -9` and the recovery copy; SIGTERM during a run.
 
 #![cfg(unix)]
 
@@ -10,7 +9,7 @@ use std::sync::{Arc, Mutex};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use portable_pty::{CommandBuilder, MasterPty, PtySize, native_pty_system};
+use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
 use skyform::mission;
 
 const ROWS: u16 = 40;
@@ -20,6 +19,7 @@ struct Session {
     master: Box<dyn MasterPty + Send>,
     writer: Box<dyn Write + Send>,
     screen: Arc<Mutex<vt100::Parser>>,
+    child: Box<dyn Child + Send + Sync>,
 }
 
 impl Session {
@@ -44,6 +44,36 @@ impl Session {
         self.writer.flush().unwrap();
     }
 
+    /// Waits for the process to end; its exit code.
+    fn wait_exit(&mut self, timeout: Duration) -> u32 {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if let Some(status) = self.child.try_wait().unwrap() {
+                return status.exit_code();
+            }
+            assert!(
+                Instant::now() < deadline,
+                "skyform did not exit; the screen:\n{}",
+                self.contents()
+            );
+            thread::sleep(Duration::from_millis(50));
+        }
+    }
+
+    fn signal(&self, signal: &str) {
+        let pid = self.child.process_id().expect("a pid");
+        let status = std::process::Command::new("kill")
+            .args([signal, &pid.to_string()])
+            .status()
+            .unwrap();
+        assert!(status.success());
+    }
+
+    fn cooked(&self) -> bool {
+        let flags = self.local_flags();
+        flags.iter().any(|f| f == "ICANON") && flags.iter().any(|f| f == "ECHO")
+    }
+
     /// Local flags of the terminal (ICANON, ECHO, …) as their names.
     fn local_flags(&self) -> Vec<String> {
         let termios = self.master.get_termios().expect("termios of the pty");
@@ -55,20 +85,9 @@ impl Session {
     }
 }
 
-#[test]
-fn edit_run_save_quit_in_a_real_terminal() {
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("bridge.toml");
-    std::fs::copy(
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/missions/bridge-inspection.toml"
-        ),
-        &file,
-    )
-    .unwrap();
-    let before = mission::load(&file).unwrap().mission;
-
+/// Starts skyform on `file` in a fresh pseudo-terminal, recovery copies
+/// kept in `state`.
+fn launch(file: &std::path::Path, state: &std::path::Path) -> Session {
     let pair = native_pty_system()
         .openpty(PtySize {
             rows: ROWS,
@@ -77,14 +96,14 @@ fn edit_run_save_quit_in_a_real_terminal() {
             pixel_height: 0,
         })
         .unwrap();
-    let cooked =
-        |flags: &[String]| flags.iter().any(|f| f == "ICANON") && flags.iter().any(|f| f == "ECHO");
-
     let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_skyform"));
-    cmd.arg(&file);
-    cmd.cwd(dir.path());
+    cmd.arg(file);
+    if let Some(dir) = file.parent() {
+        cmd.cwd(dir);
+    }
     cmd.env("TERM", "xterm-256color");
-    let mut child = pair.slave.spawn_command(cmd).unwrap();
+    cmd.env("SKYFORM_STATE_DIR", state);
+    let child = pair.slave.spawn_command(cmd).unwrap();
     drop(pair.slave);
 
     let screen = Arc::new(Mutex::new(vt100::Parser::new(
@@ -104,16 +123,39 @@ fn edit_run_save_quit_in_a_real_terminal() {
         }
     });
     let writer = pair.master.take_writer().unwrap();
-    let mut s = Session {
+    Session {
         master: pair.master,
         writer,
         screen,
-    };
+        child,
+    }
+}
+
+fn bridge_copy(dir: &std::path::Path) -> std::path::PathBuf {
+    let file = dir.join("bridge.toml");
+    std::fs::copy(
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/missions/bridge-inspection.toml"
+        ),
+        &file,
+    )
+    .unwrap();
+    file
+}
+
+#[test]
+fn edit_run_save_quit_in_a_real_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    let state = tempfile::tempdir().unwrap();
+    let file = bridge_copy(dir.path());
+    let before = mission::load(&file).unwrap().mission;
+    let mut s = launch(&file, state.path());
 
     s.wait_for("Inspector", Duration::from_secs(30));
     s.wait_for("bridge.toml", Duration::from_secs(5));
     assert!(
-        !cooked(&s.local_flags()),
+        !s.cooked(),
         "the TUI runs in raw mode: {:?}",
         s.local_flags()
     );
@@ -130,21 +172,9 @@ fn edit_run_save_quit_in_a_real_terminal() {
     s.wait_for("saved", Duration::from_secs(10));
 
     s.send("q");
-    let deadline = Instant::now() + Duration::from_secs(20);
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status;
-        }
-        assert!(
-            Instant::now() < deadline,
-            "skyform did not quit; the screen:\n{}",
-            s.contents()
-        );
-        thread::sleep(Duration::from_millis(50));
-    };
-    assert!(status.success(), "exit status {status:?}");
+    assert_eq!(s.wait_exit(Duration::from_secs(20)), 0);
     assert!(
-        cooked(&s.local_flags()),
+        s.cooked(),
         "terminal left in raw mode: {:?}",
         s.local_flags()
     );
@@ -157,4 +187,103 @@ fn edit_run_save_quit_in_a_real_terminal() {
         after.obstacles[..before.obstacles.len()],
         before.obstacles[..]
     );
+    // Saved and quit cleanly: no recovery copy is left.
+    assert_eq!(std::fs::read_dir(state.path()).unwrap().count(), 0);
+    // The save edited the file in place: only the new obstacle was added.
+    let original = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/missions/bridge-inspection.toml"
+    ))
+    .unwrap();
+    let saved = std::fs::read_to_string(&file).unwrap();
+    assert!(saved.starts_with(&original), "the file's own text stays");
+}
+
+/// Issue 12: an obstacle added, the process killed with SIGKILL (nothing can
+/// run on the way out), started again on the same file: the recovery is
+/// offered, accepted and saved; the file has the obstacle.
+#[test]
+fn a_killed_designer_offers_its_unsaved_edits_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let state = tempfile::tempdir().unwrap();
+    let file = bridge_copy(dir.path());
+    let before = mission::load(&file).unwrap().mission;
+
+    let mut s = launch(&file, state.path());
+    s.wait_for("Inspector", Duration::from_secs(30));
+    s.send("a");
+    s.wait_for("added 'obstacle 10'", Duration::from_secs(10));
+    // The copy is written within about a second of the edit.
+    let deadline = Instant::now() + Duration::from_secs(5);
+    while std::fs::read_dir(state.path()).unwrap().count() == 0 {
+        assert!(Instant::now() < deadline, "no recovery copy was written");
+        thread::sleep(Duration::from_millis(50));
+    }
+    s.signal("-KILL");
+    s.wait_exit(Duration::from_secs(10));
+    assert_eq!(
+        mission::load(&file).unwrap().mission,
+        before,
+        "nothing saved"
+    );
+
+    let mut s = launch(&file, state.path());
+    s.wait_for("Recover unsaved changes?", Duration::from_secs(30));
+    s.wait_for("1 change(s)", Duration::from_secs(5));
+    s.send("y");
+    s.wait_for("restored 1 unsaved change(s)", Duration::from_secs(10));
+    s.send("\x13"); // Ctrl-s
+    s.wait_for("saved", Duration::from_secs(10));
+    s.send("q");
+    assert_eq!(s.wait_exit(Duration::from_secs(20)), 0);
+
+    let after = mission::load(&file).unwrap().mission;
+    assert_eq!(after.obstacles.len(), before.obstacles.len() + 1);
+    assert_eq!(after.obstacles.last().unwrap().name, "obstacle 10");
+    assert_eq!(std::fs::read_dir(state.path()).unwrap().count(), 0);
+}
+
+/// Issue 12: SIGTERM while a recorded job runs: the designer cancels the
+/// job, closes its recording, gives the terminal back (ICANON and ECHO on)
+/// and exits with 128 + 15.
+#[test]
+fn sigterm_during_a_run_restores_the_terminal_and_closes_the_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let state = tempfile::tempdir().unwrap();
+    let file = bridge_copy(dir.path());
+    // A run long enough to be interrupted.
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &file,
+        text.replace("iterations = 150", "iterations = 20000"),
+    )
+    .unwrap();
+
+    let mut s = launch(&file, state.path());
+    s.wait_for("Inspector", Duration::from_secs(30));
+    s.send("e"); // record runs to an .rrd beside the mission
+    s.wait_for("recorded to an .rrd", Duration::from_secs(10));
+    s.send("r");
+    s.wait_for("started with seed", Duration::from_secs(10));
+    thread::sleep(Duration::from_millis(1500));
+    s.signal("-TERM");
+    assert_eq!(s.wait_exit(Duration::from_secs(30)), 128 + 15);
+    assert!(
+        s.cooked(),
+        "terminal left in raw mode: {:?}",
+        s.local_flags()
+    );
+
+    let rrd: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rrd"))
+        .collect();
+    assert_eq!(rrd.len(), 1, "{rrd:?}");
+    let file = std::fs::File::open(&rrd[0]).unwrap();
+    let messages: Vec<_> = re_log_encoding::DecoderApp::decode_eager(std::io::BufReader::new(file))
+        .expect("an rrd")
+        .collect::<Result<_, _>>()
+        .expect("every message decodes: the recording was closed");
+    assert!(messages.len() > 3, "{} messages", messages.len());
 }

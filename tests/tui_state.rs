@@ -202,7 +202,8 @@ fn cancel_keeps_the_best_so_far() {
     let mut app = app_in(dir.path());
     type_into(&mut app, "seed", "3"); // any edit; then a long run
     app.update(Action::Select(Item::ThetaPso));
-    type_into(&mut app, "iterations", "1000000");
+    // Long, but inside the budget (100 × 40,000 × 4 runs = 1.6e7 evaluations).
+    type_into(&mut app, "iterations", "40000");
     app.update(Action::Run);
     // Let it get going, then cancel.
     while app.jobs[0].convergence.len() < 3 {
@@ -217,7 +218,7 @@ fn cancel_keeps_the_best_so_far() {
     let job = &app.jobs[0];
     assert_eq!(job.state, JobState::Cancelled);
     let outcome = job.outcome.as_ref().and_then(|o| o.theta_pso()).unwrap();
-    assert!(outcome.iterations < 1_000_000);
+    assert!(outcome.iterations < 40_000);
     assert!(!outcome.trajectories.is_empty());
 }
 
@@ -233,6 +234,38 @@ fn an_invalid_mission_is_not_run() {
     assert!(status.error);
     assert!(
         status.text.contains("obstacles[0].radius"),
+        "{}",
+        status.text
+    );
+}
+
+/// Issue 12: a mission over a run's budget is refused before any job
+/// starts, with the field and the predicted figure in the status line.
+#[test]
+fn a_run_over_its_budget_is_not_started() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Select(Item::Formation));
+    type_into(&mut app, "ground speed (m/s)", "0.000001");
+    app.update(Action::Run);
+    assert!(app.jobs.is_empty());
+    let status = app.status.clone().unwrap();
+    assert!(status.error);
+    assert!(
+        status.text.contains("formation.ground_speed")
+            && status.text.contains("1.2e8 s")
+            && status.text.contains("limit 1e7"),
+        "{}",
+        status.text
+    );
+    type_into(&mut app, "ground speed (m/s)", "3");
+    app.update(Action::Select(Item::ThetaPso));
+    type_into(&mut app, "swarm size", "100000000");
+    app.update(Action::Run);
+    assert!(app.jobs.is_empty());
+    let status = app.status.clone().unwrap();
+    assert!(
+        status.text.contains("theta_pso.swarm_size"),
         "{}",
         status.text
     );
@@ -620,4 +653,143 @@ fn a_release_over_a_window_still_ends_the_drag() {
     );
     app.update(Action::Undo);
     assert_eq!(app.mission().obstacles[0].center, at);
+}
+
+#[test]
+fn save_as_onto_an_existing_file_asks_before_replacing_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let other = dir.path().join("other.toml");
+    std::fs::write(&other, "# someone else's file\n").unwrap();
+    app.update(Action::SaveAs);
+    for _ in 0..200 {
+        app.update(Action::PromptBackspace);
+    }
+    for c in "other.toml".chars() {
+        app.update(Action::PromptInput(c));
+    }
+    app.update(Action::Confirm);
+    assert!(
+        matches!(&app.overlay, Some(Overlay::Overwrite { path, .. }) if path == &other),
+        "{:?}",
+        app.overlay
+    );
+    assert_eq!(
+        std::fs::read_to_string(&other).unwrap(),
+        "# someone else's file\n"
+    );
+    // Esc keeps the file; asking again and answering y replaces it.
+    app.update(Action::Dismiss);
+    assert!(app.overlay.is_none());
+    assert_eq!(
+        app.doc.path(),
+        Some(dir.path().join("bridge.toml").as_path())
+    );
+    app.update(Action::SaveAs);
+    for _ in 0..200 {
+        app.update(Action::PromptBackspace);
+    }
+    for c in "other.toml".chars() {
+        app.update(Action::PromptInput(c));
+    }
+    app.update(Action::Confirm);
+    app.update(Action::Confirm);
+    assert_eq!(app.doc.path(), Some(other.as_path()));
+    assert_eq!(mission::load(&other).unwrap().mission, *app.mission());
+}
+
+#[test]
+fn renaming_an_obstacle_carries_its_iwp_choices_along() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let choice = app.mission().reconfiguration.waypoints[0].clone();
+    let k = app
+        .mission()
+        .obstacles
+        .iter()
+        .position(|o| o.name == choice.between[0])
+        .unwrap();
+    app.update(Action::Select(Item::Obstacle(k)));
+    type_into(&mut app, "name", "renamed pier");
+    let after = &app.mission().reconfiguration.waypoints[0];
+    assert_eq!(after.between[0], "renamed pier");
+    assert_eq!(after.between[1], choice.between[1]);
+    assert_eq!(app.doc.error_count(), 0, "{:?}", app.doc.error_lines());
+}
+
+#[test]
+fn a_dangling_iwp_choice_can_be_selected_and_deleted() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dangling.toml");
+    let mut m = default_mission().mission;
+    m.reconfiguration.waypoints[0].between[0] = "no such pier".into();
+    let pair = m.reconfiguration.waypoints[0].between.clone();
+    mission::save(&m, &path).unwrap();
+    let mut app = App::new(Document::new(m, Some(path)), dir.path().to_path_buf());
+    assert!(app.doc.error_count() > 0);
+    let items = skyform::tui::fields::formation_items(app.mission(), &app.iwps);
+    let item = Item::Waypoint(pair.clone());
+    assert!(items.contains(&item), "{items:?}");
+    app.update(Action::Select(item));
+    assert_eq!(app.selected, Item::Waypoint(pair));
+    app.update(Action::Delete);
+    assert_eq!(app.doc.error_count(), 0, "{:?}", app.doc.error_lines());
+}
+
+#[test]
+fn unsaved_edits_are_kept_in_a_recovery_copy_and_offered_back() {
+    use skyform::tui::recovery::{Origin, Recovery};
+    let dir = tempfile::tempdir().unwrap();
+    let state = tempfile::tempdir().unwrap();
+    let file = dir.path().join("bridge.toml");
+    let origin = Origin::File(file.clone());
+    let recovery = || Recovery::in_dir(Some(state.path().to_path_buf()), &origin);
+    let copies = || std::fs::read_dir(state.path()).unwrap().count();
+
+    let mut app = app_in(dir.path());
+    app.use_recovery(recovery());
+    app.update(Action::AddObstacle(Some(Point2::new(12.0, 34.0))));
+    let edited = app.mission().clone();
+    let t0 = std::time::Instant::now();
+    app.keep_recovery(t0, false);
+    assert_eq!(copies(), 1, "written at the first edit");
+    // A second edit within the interval waits for the tick after it.
+    app.update(Action::Nudge(1.0, 0.0));
+    app.keep_recovery(t0 + Duration::from_millis(300), false);
+    assert!(app.wants_tick(), "a write is pending");
+    app.keep_recovery(t0 + Duration::from_millis(1100), false);
+    assert!(!app.wants_tick());
+    let moved = app.mission().clone();
+    assert_ne!(moved, edited);
+    drop(app); // as a kill -9 would: nothing saved, the copy stays
+
+    let mut app = app_in(dir.path());
+    app.use_recovery(recovery());
+    match &app.overlay {
+        Some(Overlay::Recover(copy)) => {
+            assert_eq!(copy.mission, moved);
+            assert_eq!(copy.changes, 2);
+        }
+        other => panic!("expected the recovery question, got {other:?}"),
+    }
+    app.update(Action::Confirm);
+    assert_eq!(app.mission(), &moved);
+    assert!(app.doc.is_modified());
+    app.update(Action::Save);
+    app.keep_recovery(std::time::Instant::now(), false);
+    assert_eq!(copies(), 0, "saved: the copy is gone");
+    assert_eq!(mission::load(&file).unwrap().mission, moved);
+
+    // Declining drops the copy.
+    let mut app = app_in(dir.path());
+    app.use_recovery(recovery());
+    app.update(Action::AddObstacle(None));
+    app.keep_recovery(std::time::Instant::now(), true);
+    assert_eq!(copies(), 1);
+    let mut app = app_in(dir.path());
+    app.use_recovery(recovery());
+    assert!(matches!(app.overlay, Some(Overlay::Recover(_))));
+    app.update(Action::Dismiss);
+    assert_eq!(copies(), 0);
+    assert!(!app.doc.is_modified());
 }

@@ -17,7 +17,7 @@ use rand_distr::StandardNormal;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::mission::{FlatloParams, Mission};
+use crate::mission::{Diagnostic, FieldPath, FlatloParams, Mission};
 use crate::ode::rk4_step;
 use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError};
 
@@ -27,6 +27,16 @@ use maneuver::{Path, Primitive};
 
 /// Simulated seconds between progress reports and cancellation checks.
 const CHUNK_SECONDS: f64 = 60.0;
+
+/// Samples kept per aircraft for views and recordings (every k-th sample of
+/// the `sample_period` grid, k chosen to stay under this, plus the last one).
+/// Verification sees every sample as it is produced, so memory stays bounded
+/// whatever the squadron and its flight time.
+pub const KEPT_SAMPLES: usize = 2_000;
+
+/// Squadrons up to this size get every pair's closest approach
+/// (`FlatloOutcome::pairs`); larger ones only the closest pair overall.
+pub const MAX_PAIR_TABLE: usize = 12;
 
 /// One aircraft's reference: the manoeuvres and the speed along them.
 #[derive(Debug, Clone, PartialEq)]
@@ -205,11 +215,11 @@ pub struct Spacing {
     pub spacing: f64,
 }
 
+/// The verdict on a squadron that flew the whole transition.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FlatloVerification {
     /// The mission's threshold, metres.
     pub min_separation: f64,
-    pub closest: Option<PairDistance>,
     /// Every pair kept at least `min_separation` apart.
     pub passed: bool,
     /// Flown, at the end of the simulation.
@@ -234,15 +244,23 @@ pub struct FlatloOutcome {
     pub arrival_time: f64,
     /// Simulated time, s.
     pub duration: f64,
+    /// Every `sample_stride`-th sample of the `sample_period` grid is kept in
+    /// `AircraftOutcome::flown` and `reference` (1 for small runs).
+    pub sample_stride: usize,
     pub aircraft: Vec<AircraftOutcome>,
-    /// Every pair's closest approach (flown, on the sample grid).
+    /// The closest two aircraft came over what was flown (every sample).
+    pub closest: Option<PairDistance>,
+    /// Every pair's closest approach, for squadrons of at most
+    /// `MAX_PAIR_TABLE` aircraft; empty for larger ones.
     pub pairs: Vec<PairDistance>,
-    pub verification: FlatloVerification,
+    /// `None` when the run was cancelled: a partial flight has no verdict.
+    pub verification: Option<FlatloVerification>,
 }
 
 impl FlatloOutcome {
+    /// The whole transition was flown and verified, and passed.
     pub fn passed(&self) -> bool {
-        self.verification.passed
+        self.verification.as_ref().is_some_and(|v| v.passed)
     }
 }
 
@@ -256,26 +274,38 @@ struct Flight {
     noise: f64,
     hint: usize,
     step: usize,
+    /// Samples taken so far (every `every` steps, and the last step).
+    samples: usize,
+    /// Positions sampled in the current chunk, for verification; cleared by it.
+    fresh: Vec<(f64, Point3<f64>)>,
     flown: Vec<FlownSample>,
     error_max: f64,
     error_sq: f64,
 }
 
 impl Flight {
-    fn record(&mut self, t: f64, controls: Controls) {
+    /// A sample on the grid: always to verification, every `keep`-th (and
+    /// the last) to `flown`.
+    fn record(&mut self, t: f64, controls: Controls, keep: usize, is_last: bool) {
         let s = &self.state;
-        self.flown.push(FlownSample {
-            t,
-            position: aircraft::position(s),
-            airspeed: s[aircraft::V],
-            gamma: s[aircraft::GAMMA],
-            chi: s[aircraft::CHI],
-            controls,
-        });
+        let position = aircraft::position(s);
+        self.fresh.push((t, position));
+        if self.samples.is_multiple_of(keep) || is_last {
+            self.flown.push(FlownSample {
+                t,
+                position,
+                airspeed: s[aircraft::V],
+                gamma: s[aircraft::GAMMA],
+                chi: s[aircraft::CHI],
+                controls,
+            });
+        }
+        self.samples += 1;
     }
 
-    /// Flies steps up to (not including) `until`, recording every `every` steps.
-    fn fly(&mut self, until: usize, dt: f64, every: usize, last: usize) {
+    /// Flies steps up to (not including) `until`, sampling every `every`
+    /// steps and keeping every `keep`-th sample.
+    fn fly(&mut self, until: usize, dt: f64, every: usize, keep: usize, last: usize) {
         while self.step < until {
             let t = self.step as f64 * dt;
             let target = self.reference.at(t, &mut self.hint);
@@ -284,7 +314,7 @@ impl Flight {
             self.error_sq += error * error;
             let u = self.pilot.command(&self.airframe, &self.state, &target, dt);
             if self.step.is_multiple_of(every) {
-                self.record(t, u);
+                self.record(t, u, keep, false);
             }
             let airframe = self.airframe;
             self.state = rk4_step(|_, x| airframe.derivative(x, &u), t, &self.state, dt);
@@ -305,10 +335,68 @@ impl Flight {
                 let t = last as f64 * dt;
                 let target = self.reference.at(t, &mut self.hint);
                 let u = self.pilot.command(&self.airframe, &self.state, &target, dt);
-                self.record(t, u);
+                self.record(t, u, keep, true);
             }
         }
     }
+}
+
+/// FLATLO's predicted size against `pipeline::limits`: aircraft, integration
+/// steps (aircraft × duration / sim_step) and sample instants verification
+/// scans (aircraft × duration / sample_period). The duration comes from
+/// Algorithm 1's references (cheap: no simulation), so the figure is exact.
+pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
+    use crate::pipeline::{figure, limits};
+    let p = &mission.flatlo;
+    let at = |key: &str| FieldPath::root().key("flatlo").key(key);
+    if p.aircraft > limits::FLATLO_AIRCRAFT {
+        return vec![Diagnostic::error(
+            at("aircraft"),
+            format!(
+                "{} aircraft is over the limit of {}",
+                figure(p.aircraft as f64),
+                limits::FLATLO_AIRCRAFT
+            ),
+        )];
+    }
+    let mut out = Vec::new();
+    let duration = references(p).duration;
+    let n = p.aircraft as f64;
+    let steps = n * (duration / p.sim_step).ceil();
+    if crate::pipeline::exceeds(steps, limits::FLATLO_STEPS) {
+        // The step is the usual typo; a long flight comes from the squadron.
+        let key = if p.sim_step < 1e-3 {
+            "sim_step"
+        } else {
+            "aircraft"
+        };
+        out.push(Diagnostic::error(
+            at(key),
+            format!(
+                "{} aircraft fly {} s in steps of {} s: {} integration steps (limit {})",
+                p.aircraft,
+                figure(duration),
+                figure(p.sim_step),
+                figure(steps),
+                figure(limits::FLATLO_STEPS)
+            ),
+        ));
+    }
+    let samples = n * (duration / p.sample_period).ceil();
+    if crate::pipeline::exceeds(samples, limits::FLATLO_SAMPLES) {
+        out.push(Diagnostic::error(
+            at("sample_period"),
+            format!(
+                "{} aircraft sampled every {} s over {} s: {} samples to verify (limit {})",
+                p.aircraft,
+                figure(p.sample_period),
+                figure(duration),
+                figure(samples),
+                figure(limits::FLATLO_SAMPLES)
+            ),
+        ));
+    }
+    out
 }
 
 /// Plans and simulates the mission's squadron with `seed` (the noise). Fails
@@ -321,6 +409,7 @@ pub fn plan(
     cancel: &CancelToken,
 ) -> Result<FlatloOutcome, PipelineError> {
     crate::pipeline::require_valid(mission)?;
+    crate::pipeline::require_within_budget(budget(mission))?;
     let p = &mission.flatlo;
     let n = p.aircraft;
 
@@ -340,6 +429,7 @@ pub fn plan(
     let dt = p.sim_step;
     let every = ((p.sample_period / dt).round() as usize).max(1);
     let last = (plan.duration / dt).ceil() as usize;
+    let keep = (last / every + 1).div_ceil(KEPT_SAMPLES).max(1);
     let airframe = Airframe::from_params(p);
     let mut flights: Vec<Flight> = plan
         .references
@@ -361,7 +451,9 @@ pub fn plan(
                 noise: p.noise,
                 hint: 0,
                 step: 0,
-                flown: Vec::with_capacity(last / every + 2),
+                samples: 0,
+                fresh: Vec::new(),
+                flown: Vec::with_capacity((last / every) / keep + 2),
                 error_max: 0.0,
                 error_sq: 0.0,
             }
@@ -370,11 +462,13 @@ pub fn plan(
     let chunk = ((CHUNK_SECONDS / dt).round() as usize).max(1);
     let mut done = 0;
     let mut completion = Completion::Finished;
+    let mut separation = Separation::new(n);
     while done < last {
         let until = (done + chunk).min(last);
         flights
             .par_iter_mut()
-            .for_each(|f| f.fly(until, dt, every, last));
+            .for_each(|f| f.fly(until, dt, every, keep, last));
+        separation.scan(&mut flights);
         done = until;
         observer.on_event(Event::Progress(0.95 * done as f64 / last as f64));
         if cancel.is_cancelled() && done < last {
@@ -390,6 +484,7 @@ pub fn plan(
     }
 
     observer.on_event(Event::Stage("verification"));
+    let reference_period = p.sample_period * keep as f64;
     let aircraft: Vec<AircraftOutcome> = flights
         .into_iter()
         .enumerate()
@@ -404,16 +499,17 @@ pub fn plan(
                 airspeed: f.reference.airspeed,
                 transition_length: f.reference.transition_length,
                 manoeuvres: f.reference.path.primitives.clone(),
-                reference: sample(&f.reference, p.sample_period, plan.duration),
+                reference: sample(&f.reference, reference_period, plan.duration),
                 tracking_max: f.error_max,
                 tracking_rms: (f.error_sq / steps).sqrt(),
                 flown: f.flown,
             }
         })
         .collect();
-    let pairs = closest_approaches(&aircraft);
-    let verification = verify(p, &plan, &aircraft, &pairs);
-    if let Some(c) = verification.closest {
+    let closest = separation.closest;
+    let verification =
+        (completion == Completion::Finished).then(|| verify(p, &plan, &aircraft, closest));
+    if let (Some(c), Some(v)) = (closest, &verification) {
         let text = format!(
             "closest approach: aircraft {} and {} at {:.0} m (t = {:.0} s); minimum separation {:.0} m: {}",
             c.a,
@@ -421,13 +517,9 @@ pub fn plan(
             c.min_distance,
             c.time,
             p.min_separation,
-            if verification.passed { "pass" } else { "FAIL" }
+            if v.passed { "pass" } else { "FAIL" }
         );
-        let level = if verification.passed {
-            Level::Info
-        } else {
-            Level::Warn
-        };
+        let level = if v.passed { Level::Info } else { Level::Warn };
         observer.on_event(Event::Log(level, &text));
     }
     observer.on_event(Event::Progress(1.0));
@@ -438,34 +530,101 @@ pub fn plan(
         completion,
         arrival_time: plan.arrival,
         duration: plan.duration,
+        sample_stride: keep,
         aircraft,
-        pairs,
+        closest,
+        pairs: separation.pairs,
         verification,
     })
 }
 
-/// Every pair's closest approach over the flown samples.
-fn closest_approaches(aircraft: &[AircraftOutcome]) -> Vec<PairDistance> {
-    let mut pairs = Vec::new();
-    for a in 0..aircraft.len() {
-        for b in a + 1..aircraft.len() {
-            let mut best = PairDistance {
-                a,
-                b,
-                min_distance: f64::INFINITY,
-                time: 0.0,
-            };
-            for (sa, sb) in aircraft[a].flown.iter().zip(&aircraft[b].flown) {
-                let d = (sa.position - sb.position).norm();
-                if d < best.min_distance {
-                    best.min_distance = d;
-                    best.time = sa.t;
+/// Closest approaches, scanned chunk by chunk as the squadron flies: no
+/// per-pair series is kept. Small squadrons keep every pair's minimum; for
+/// larger ones a sweep along x over each sample instant finds the closest
+/// pair in O(n log n), pruned by the closest distance seen so far.
+struct Separation {
+    closest: Option<PairDistance>,
+    pairs: Vec<PairDistance>,
+    order: Vec<usize>,
+}
+
+impl Separation {
+    fn new(n: usize) -> Self {
+        let mut pairs = Vec::new();
+        if n <= MAX_PAIR_TABLE {
+            for a in 0..n {
+                for b in a + 1..n {
+                    pairs.push(PairDistance {
+                        a,
+                        b,
+                        min_distance: f64::INFINITY,
+                        time: 0.0,
+                    });
                 }
             }
-            pairs.push(best);
+        }
+        Separation {
+            closest: None,
+            pairs,
+            order: (0..n).collect(),
         }
     }
-    pairs
+
+    /// Takes every flight's fresh samples (all on the same instants).
+    fn scan(&mut self, flights: &mut [Flight]) {
+        let instants = flights.first().map_or(0, |f| f.fresh.len());
+        let mut points = Vec::with_capacity(flights.len());
+        for k in 0..instants {
+            points.clear();
+            points.extend(flights.iter().map(|f| f.fresh[k].1));
+            let t = flights[0].fresh[k].0;
+            if self.pairs.is_empty() {
+                self.sweep(&points, t);
+            } else {
+                for pair in &mut self.pairs {
+                    let d = (points[pair.a] - points[pair.b]).norm();
+                    if d < pair.min_distance {
+                        pair.min_distance = d;
+                        pair.time = t;
+                    }
+                }
+            }
+        }
+        if !self.pairs.is_empty() {
+            self.closest = self
+                .pairs
+                .iter()
+                .copied()
+                .min_by(|a, b| a.min_distance.total_cmp(&b.min_distance));
+        }
+        for f in flights {
+            f.fresh.clear();
+        }
+    }
+
+    /// The closest pair of one instant, if closer than any so far.
+    fn sweep(&mut self, points: &[Point3<f64>], t: f64) {
+        self.order
+            .sort_by(|&a, &b| points[a].x.total_cmp(&points[b].x));
+        let mut best = self.closest.map_or(f64::INFINITY, |c| c.min_distance);
+        for (i, &a) in self.order.iter().enumerate() {
+            for &b in &self.order[i + 1..] {
+                if points[b].x - points[a].x >= best {
+                    break;
+                }
+                let d = (points[a] - points[b]).norm();
+                if d < best {
+                    best = d;
+                    self.closest = Some(PairDistance {
+                        a: a.min(b),
+                        b: a.max(b),
+                        min_distance: d,
+                        time: t,
+                    });
+                }
+            }
+        }
+    }
 }
 
 /// Spacing along `line` of consecutive points (front first) and their spread across it.
@@ -498,12 +657,8 @@ fn verify(
     p: &FlatloParams,
     plan: &Plan,
     aircraft: &[AircraftOutcome],
-    pairs: &[PairDistance],
+    closest: Option<PairDistance>,
 ) -> FlatloVerification {
-    let closest = pairs
-        .iter()
-        .copied()
-        .min_by(|a, b| a.min_distance.total_cmp(&b.min_distance));
     let passed = closest.is_none_or(|c| c.min_distance >= p.min_separation);
     let line = algorithm::line_direction(p.heading_deg.to_radians(), p.climb_deg.to_radians());
     let flown_end: Vec<Point3<f64>> = aircraft
@@ -523,7 +678,6 @@ fn verify(
     let (reference_spacing, reference_lateral_spread) = line_spacing(&reference_end, &line);
     FlatloVerification {
         min_separation: p.min_separation,
-        closest,
         passed,
         final_spacing,
         max_spacing_error,

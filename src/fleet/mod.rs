@@ -19,7 +19,7 @@ use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::mission::{FleetParams, Mission};
+use crate::mission::{Diagnostic, FieldPath, FleetParams, Mission};
 use crate::ode::rk4_step;
 use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError};
 
@@ -274,6 +274,85 @@ struct Flight {
     reference: Point3<f64>,
 }
 
+/// The fleet's predicted size against `pipeline::limits`: agents, cost
+/// evaluations (agents × re-plans × particles × iterations), dynamics steps
+/// (agents × duration / sim_step) and kept samples (agents × duration × 20 Hz).
+pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
+    use crate::pipeline::{figure, limits};
+    let p = &mission.fleet;
+    let at = |key: &str| FieldPath::root().key("fleet").key(key);
+    let mut out = Vec::new();
+    let n = p.agents as f64;
+    if p.agents > limits::FLEET_AGENTS {
+        out.push(Diagnostic::error(
+            at("agents"),
+            format!(
+                "{} agents is over the limit of {}",
+                figure(n),
+                limits::FLEET_AGENTS
+            ),
+        ));
+        return out;
+    }
+    let replans = (p.duration / p.replan_period).ceil();
+    let evaluations = n * replans * p.swarm_size as f64 * p.iterations as f64;
+    if crate::pipeline::exceeds(evaluations, limits::FLEET_EVALUATIONS) {
+        let key = if p.replan_period < 1e-3 {
+            "replan_period"
+        } else if p.swarm_size >= p.iterations {
+            "swarm_size"
+        } else {
+            "iterations"
+        };
+        out.push(Diagnostic::error(
+            at(key),
+            format!(
+                "{} agents × {} re-plans × {} particles × {} iterations make {} cost \
+                 evaluations (limit {})",
+                p.agents,
+                figure(replans),
+                figure(p.swarm_size as f64),
+                figure(p.iterations as f64),
+                figure(evaluations),
+                figure(limits::FLEET_EVALUATIONS)
+            ),
+        ));
+    }
+    let steps = n * (p.duration / p.sim_step).ceil();
+    if crate::pipeline::exceeds(steps, limits::FLEET_STEPS) {
+        let key = if p.sim_step < 1e-4 {
+            "sim_step"
+        } else {
+            "duration"
+        };
+        out.push(Diagnostic::error(
+            at(key),
+            format!(
+                "{} agents over {} s in steps of {} s: {} dynamics steps (limit {})",
+                p.agents,
+                figure(p.duration),
+                figure(p.sim_step),
+                figure(steps),
+                figure(limits::FLEET_STEPS)
+            ),
+        ));
+    }
+    let samples = n * p.duration * SAMPLE_RATE;
+    if crate::pipeline::exceeds(samples, limits::FLEET_SAMPLES) {
+        out.push(Diagnostic::error(
+            at("duration"),
+            format!(
+                "{} agents over {} s at {SAMPLE_RATE} Hz: {} samples kept (limit {})",
+                p.agents,
+                figure(p.duration),
+                figure(samples),
+                figure(limits::FLEET_SAMPLES)
+            ),
+        ));
+    }
+    out
+}
+
 /// Simulates the mission's fleet with `seed` (starts, PSO streams). Fails
 /// only on an invalid mission.
 pub fn plan(
@@ -283,6 +362,7 @@ pub fn plan(
     cancel: &CancelToken,
 ) -> Result<FleetOutcome, PipelineError> {
     crate::pipeline::require_valid(mission)?;
+    crate::pipeline::require_within_budget(budget(mission))?;
     let p = &mission.fleet;
     let n = p.agents;
     observer.on_event(Event::Stage("scenario"));

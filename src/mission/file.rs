@@ -134,6 +134,27 @@ pub fn save(mission: &Mission, path: &Path) -> Result<(), MissionError> {
     })
 }
 
+/// Saves atomically into the user's file: with `original` (the text the
+/// mission was read from), only the values that changed are rewritten, and
+/// comments, order and layout stay (`edit::edit_in_place`); without it, or
+/// when it is not a mission, the whole mission is written. Returns the text
+/// written, the next save's `original`.
+pub fn save_edited(
+    mission: &Mission,
+    original: Option<&str>,
+    path: &Path,
+) -> Result<String, MissionError> {
+    let text = match original.and_then(|o| super::edit::edit_in_place(mission, o)) {
+        Some(text) => text,
+        None => to_toml_string(mission)?,
+    };
+    write_atomically(path, text.as_bytes()).map_err(|source| MissionError::Write {
+        path: path.display().to_string(),
+        source,
+    })?;
+    Ok(text)
+}
+
 /// Writes `bytes` to `path` through a synced temporary file and a rename.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let dir = match path.parent() {

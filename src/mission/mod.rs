@@ -3,6 +3,7 @@
 
 mod builtin;
 mod diagnostic;
+mod edit;
 mod file;
 mod model;
 mod presets;
@@ -11,11 +12,12 @@ mod validate;
 
 pub use builtin::{BUILTIN, Builtin, default_mission};
 pub use diagnostic::{Diagnostic, Report, Severity};
+pub use edit::edit_in_place;
 pub use file::{
-    Checked, Loaded, MissionError, check_str, load, parse_str, read, save, to_toml_string,
-    write_atomically,
+    Checked, Loaded, MissionError, check_str, load, parse_str, read, save, save_edited,
+    to_toml_string, write_atomically,
 };
 pub use model::*;
 pub use presets::Preset;
 pub use source::{FieldPath, LineCol, PathSegment, SourceMap};
-pub use validate::validate;
+pub use validate::{compact, validate};

@@ -38,7 +38,25 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
     c.flatlo(&root.key("flatlo"), &mission.flatlo);
     c.fleet(&root.key("fleet"), &mission.fleet, &mission.bounds);
     c.obstacles(&root.key("obstacles"), mission);
+    c.physical(mission);
     c.out
+}
+
+/// What no UAV mission needs: beyond these a value is a typo or a unit
+/// mistake, and the pipelines would spend minutes or gigabytes on it. The
+/// ENU frame is a local tangent plane: a few hundred km across is already
+/// far from flat, so a span of 1,000 km is refused.
+mod physical {
+    /// Metres across any axis of the bounds, and the FLATLO distances.
+    pub const SPAN: f64 = 1e6;
+    /// Metres above the ground: far above any UAV's ceiling (~20 km).
+    pub const CEILING: f64 = 5e4;
+    /// m/s: the speed of sound at sea level.
+    pub const SPEED: f64 = 343.0;
+    /// m/s above which a multirotor formation speed gets a warning.
+    pub const FORMATION_SPEED_WARNING: f64 = 50.0;
+    /// Metres: a "UAV" bigger than this is not one.
+    pub const UAV_RADIUS: f64 = 50.0;
 }
 
 #[derive(Default)]
@@ -82,16 +100,129 @@ impl Checker {
         }
     }
 
+    /// An error when `value` exceeds what any UAV mission uses (`physical`).
+    fn at_most(&mut self, path: FieldPath, value: f64, max: f64, unit: &str, why: &str) {
+        if value.is_finite() && value > max {
+            self.error(
+                path,
+                format!(
+                    "{}{unit} is beyond {}{unit}: {why}",
+                    compact(value),
+                    compact(max)
+                ),
+            );
+        }
+    }
+
+    /// Physically absurd values: errors that say why (`physical`).
+    fn physical(&mut self, mission: &Mission) {
+        use physical::*;
+        let root = FieldPath::root();
+        let b = &mission.bounds;
+        for (key, [lo, hi]) in [("x", b.x), ("y", b.y)] {
+            self.at_most(
+                root.key("bounds").key(key),
+                hi - lo,
+                SPAN,
+                " m",
+                "the ENU frame is a local plane and no UAV mission spans more",
+            );
+        }
+        self.at_most(
+            root.key("bounds").key("z"),
+            b.z[1],
+            CEILING,
+            " m",
+            "far above any UAV's ceiling",
+        );
+        let f = &mission.formation;
+        self.at_most(
+            root.key("formation").key("ground_speed"),
+            f.ground_speed,
+            SPEED,
+            " m/s",
+            "faster than sound",
+        );
+        if f.ground_speed.is_finite()
+            && f.ground_speed > FORMATION_SPEED_WARNING
+            && f.ground_speed <= SPEED
+        {
+            self.warning(
+                root.key("formation").key("ground_speed"),
+                format!(
+                    "{} m/s is fast for a multirotor formation (typically 1-20 m/s): check the unit",
+                    compact(f.ground_speed)
+                ),
+            );
+        }
+        self.at_most(
+            root.key("formation").key("uav_radius"),
+            f.uav_radius,
+            UAV_RADIUS,
+            " m",
+            "no UAV is that large",
+        );
+        self.at_most(
+            root.key("formation").key("comm_range"),
+            f.comm_range,
+            SPAN,
+            " m",
+            "no formation link reaches that far",
+        );
+        let p = &mission.flatlo;
+        let flatlo = root.key("flatlo");
+        self.at_most(
+            flatlo.key("airspeed"),
+            p.airspeed,
+            SPEED,
+            " m/s",
+            "faster than sound",
+        );
+        for (key, value) in [
+            ("spacing", p.spacing),
+            ("turn_radius", p.turn_radius),
+            ("final_leg", p.final_leg),
+        ] {
+            self.at_most(
+                flatlo.key(key),
+                value,
+                SPAN,
+                " m",
+                "the ENU frame is a local plane and no squadron spans more",
+            );
+        }
+        self.at_most(
+            flatlo.key("altitude"),
+            p.altitude,
+            CEILING,
+            " m",
+            "far above any aircraft's ceiling",
+        );
+        self.at_most(
+            root.key("fleet").key("altitude"),
+            mission.fleet.altitude,
+            CEILING,
+            " m",
+            "far above any UAV's ceiling",
+        );
+    }
+
     /// `value > 0`; non-finite values are reported once, by `finite_everywhere`.
     fn positive(&mut self, path: FieldPath, value: f64, unit: &str) {
         if value.is_finite() && value <= 0.0 {
-            self.error(path, format!("must be positive, got {value}{unit}"));
+            self.error(
+                path,
+                format!("must be positive, got {}{unit}", compact(value)),
+            );
         }
     }
 
     fn non_negative(&mut self, path: FieldPath, value: f64, unit: &str) {
         if value.is_finite() && value < 0.0 {
-            self.error(path, format!("must not be negative, got {value}{unit}"));
+            self.error(
+                path,
+                format!("must not be negative, got {}{unit}", compact(value)),
+            );
         }
     }
 
@@ -108,10 +239,16 @@ impl Checker {
             return false;
         }
         if lo > hi {
-            self.error(path, format!("is inverted: {lo}{unit} > {hi}{unit}"));
+            self.error(
+                path,
+                format!("is inverted: {}{unit} > {}{unit}", compact(lo), compact(hi)),
+            );
             false
         } else if lo == hi {
-            self.error(path, format!("is empty: both ends are {lo}{unit}"));
+            self.error(
+                path,
+                format!("is empty: both ends are {}{unit}", compact(lo)),
+            );
             false
         } else {
             true
@@ -121,7 +258,10 @@ impl Checker {
     /// An open interval (lo, hi].
     fn in_half_open(&mut self, path: FieldPath, value: f64, lo: f64, hi: f64) {
         if value.is_finite() && !(value > lo && value <= hi) {
-            self.error(path, format!("must be in ({lo}, {hi}], got {value}"));
+            self.error(
+                path,
+                format!("must be in ({lo}, {hi}], got {}", compact(value)),
+            );
         }
     }
 
@@ -689,5 +829,15 @@ impl Checker {
                 }
             }
         }
+    }
+}
+
+/// A number for a message: shortest form, in scientific notation when huge
+/// or tiny, so `1e300` is not printed as 301 digits.
+pub fn compact(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e6).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
     }
 }

@@ -194,6 +194,94 @@ pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
     out
 }
 
+/// θ-PSO's predicted size against `pipeline::limits`: particles, decision
+/// dimensions, cost evaluations (particles × iterations × (1 + restarts)) and
+/// trajectory samples. The flight is at least the straight start-goal
+/// distance long, so its samples are at least that distance over the ground
+/// speed, every 0.1 s, for every UAV; `plan` checks the real figure again
+/// before it samples the planned path.
+pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
+    use crate::pipeline::{figure, limits};
+    let p = &mission.theta_pso;
+    let at = |key: &str| FieldPath::root().key("theta_pso").key(key);
+    let mut out = Vec::new();
+    if p.swarm_size > limits::THETA_PSO_PARTICLES {
+        out.push(Diagnostic::error(
+            at("swarm_size"),
+            format!(
+                "{} particles is over the limit of {} (memory grows with particles × dimensions)",
+                figure(p.swarm_size as f64),
+                figure(limits::THETA_PSO_PARTICLES as f64)
+            ),
+        ));
+    }
+    if p.waypoints > limits::THETA_PSO_WAYPOINTS {
+        out.push(Diagnostic::error(
+            at("waypoints"),
+            format!(
+                "{} free waypoints is over the limit of {}",
+                figure(p.waypoints as f64),
+                limits::THETA_PSO_WAYPOINTS
+            ),
+        ));
+    }
+    if p.segments > limits::THETA_PSO_SEGMENTS {
+        out.push(Diagnostic::error(
+            at("segments"),
+            format!(
+                "{} segments is over the limit of {} (every cost evaluation walks them)",
+                figure(p.segments as f64),
+                figure(limits::THETA_PSO_SEGMENTS as f64)
+            ),
+        ));
+    }
+    let evaluations = p.swarm_size as f64 * p.iterations as f64 * (1.0 + p.restarts as f64);
+    if crate::pipeline::exceeds(evaluations, limits::THETA_PSO_EVALUATIONS) {
+        // Name the largest factor: that is the field the user most likely mistyped.
+        let key = if p.restarts as f64 >= p.swarm_size.max(p.iterations) as f64 {
+            "restarts"
+        } else if p.swarm_size >= p.iterations {
+            "swarm_size"
+        } else {
+            "iterations"
+        };
+        out.push(Diagnostic::error(
+            at(key),
+            format!(
+                "{} particles × {} iterations × {} runs make {} cost evaluations (limit {})",
+                figure(p.swarm_size as f64),
+                figure(p.iterations as f64),
+                figure(1.0 + p.restarts as f64),
+                figure(evaluations),
+                figure(limits::THETA_PSO_EVALUATIONS)
+            ),
+        ));
+    }
+    let distance = (mission.route.goal - mission.route.start).norm();
+    let speed = mission.formation.ground_speed;
+    let duration = distance / speed;
+    let samples = trajectory_samples(duration, mission.formation.slots.len());
+    if crate::pipeline::exceeds(samples, limits::TRAJECTORY_SAMPLES) {
+        out.push(Diagnostic::error(
+            FieldPath::root().key("formation").key("ground_speed"),
+            format!(
+                "{} m/s makes a flight of at least {} s ({} trajectory samples for {} UAVs, limit {})",
+                figure(speed),
+                figure(duration),
+                figure(samples),
+                mission.formation.slots.len(),
+                figure(limits::TRAJECTORY_SAMPLES)
+            ),
+        ));
+    }
+    out
+}
+
+/// Samples of every UAV's trajectory over `duration` seconds.
+fn trajectory_samples(duration: f64, uavs: usize) -> f64 {
+    (duration / trajectory::SAMPLE_PERIOD + 1.0) * uavs as f64
+}
+
 /// One run of the swarm, built into a plan and verified.
 struct Attempt {
     swarm: swarm::SwarmResult,
@@ -220,6 +308,7 @@ pub fn plan(
     cancel: &CancelToken,
 ) -> Result<ThetaPsoOutcome, PipelineError> {
     crate::pipeline::require_valid(mission)?;
+    crate::pipeline::require_within_budget(budget(mission))?;
     let errors: Vec<String> = diagnostics(mission)
         .into_iter()
         .filter(|d| d.is_error())
@@ -324,6 +413,18 @@ pub fn plan(
         observer.on_event(Event::Stage("trajectories"));
         let path = problem.path(&result.best.position);
         let cost = problem.cost.terms(&path);
+        // The budget checked the straight distance; the planned path is longer.
+        let samples = trajectory_samples(cost.length / speed, mission.formation.slots.len());
+        if crate::pipeline::exceeds(samples, crate::pipeline::limits::TRAJECTORY_SAMPLES) {
+            return Err(PipelineError::OverBudget(format!(
+                "formation.ground_speed: the planned path ({:.1} m at {} m/s) needs {} \
+                 trajectory samples (limit {})",
+                cost.length,
+                crate::pipeline::figure(speed),
+                crate::pipeline::figure(samples),
+                crate::pipeline::figure(crate::pipeline::limits::TRAJECTORY_SAMPLES)
+            )));
+        }
         let (trajectories, reconfigurations) =
             trajectory::generate(&path, &problem.iwps, &mission.formation, span);
         observer.on_event(Event::Stage("verification"));

@@ -14,10 +14,11 @@ use super::action::Action;
 use super::document::Document;
 use super::fields::{self, Field, Item};
 use super::jobs::{self, Job, JobId, JobMsg, Pipeline, RecordSettings, Viewer};
+use super::recovery::{self, Origin, Recovery};
 use crate::geometry::farthest_offset;
 use crate::mission::{self, Mission, Preset, Severity};
 use crate::pipeline::Level;
-use crate::planner::iwp::min_pair_distance;
+use crate::planner::iwp::{self, min_pair_distance};
 use crate::planner::{Iwp, find_iwps};
 
 /// Which panel takes the keys that are not global.
@@ -89,6 +90,13 @@ pub enum Overlay {
     },
     /// Unsaved changes would be lost by opening `entry`.
     Discard(Entry),
+    /// "Save as" onto a file that exists: replace it?
+    Overwrite {
+        path: PathBuf,
+        then: AfterSave,
+    },
+    /// An earlier session left unsaved changes: restore them?
+    Recover(Box<recovery::Copy>),
 }
 
 /// The status line's message.
@@ -146,6 +154,8 @@ pub struct App {
     pub should_quit: bool,
     /// Where relative paths (save as, open) start.
     pub cwd: PathBuf,
+    /// The recovery copy of unsaved edits; `None` unless enabled.
+    recovery: Option<Recovery>,
     drag: Option<Drag>,
     job_tx: Sender<JobMsg>,
     job_rx: Receiver<JobMsg>,
@@ -181,6 +191,7 @@ impl App {
             should_quit: false,
             cwd,
             drag: None,
+            recovery: None,
             job_tx,
             job_rx,
         };
@@ -252,11 +263,72 @@ impl App {
 
     /// The loop needs to wake up by itself (running jobs, a playing replay).
     pub fn wants_tick(&self) -> bool {
-        self.any_running() || self.playing
+        self.any_running() || self.playing || self.recovery_pending()
     }
 
-    /// Time passed: a playing replay advances at real speed.
+    /// Keeps a recovery copy of unsaved edits (`recovery.rs`) for the
+    /// document from `origin`; offers an earlier session's copy. The
+    /// designer turns this on; tests and headless uses of `App` leave it off.
+    pub fn enable_recovery(&mut self, origin: Origin) {
+        self.use_recovery(Recovery::new(&origin));
+    }
+
+    /// `enable_recovery` with the copy kept where `recovery` says (tests).
+    pub fn use_recovery(&mut self, recovery: Recovery) {
+        let existing = recovery.existing();
+        self.recovery = Some(recovery);
+        match existing {
+            Some(copy) if &copy.mission != self.mission() => {
+                self.overlay = Some(Overlay::Recover(Box::new(copy)));
+            }
+            Some(_) => {
+                if let Some(r) = &mut self.recovery {
+                    r.discard();
+                }
+            }
+            None => {}
+        }
+    }
+
+    /// Where this document's recovery copy is kept, when one is.
+    pub fn recovery_path(&self) -> Option<&Path> {
+        self.recovery.as_ref().and_then(Recovery::path)
+    }
+
+    fn recovery_pending(&self) -> bool {
+        self.recovery
+            .as_ref()
+            .is_some_and(|r| r.pending(self.doc.mission(), self.doc.is_modified()))
+    }
+
+    /// Brings the recovery copy in line with the document (after every
+    /// action and tick; `force` on the way out). Left alone while the
+    /// restore question is open, so an earlier copy is never overwritten
+    /// before the user answers.
+    pub fn keep_recovery(&mut self, now: Instant, force: bool) {
+        if matches!(self.overlay, Some(Overlay::Recover(_))) {
+            return;
+        }
+        let Some(r) = &mut self.recovery else {
+            return;
+        };
+        let had_failed = r.failed.is_some();
+        r.keep(
+            self.doc.mission(),
+            self.doc.is_modified(),
+            self.doc.changes(),
+            now,
+            force,
+        );
+        if let (false, Some(e)) = (had_failed, r.failed.clone()) {
+            self.set_error(e);
+        }
+    }
+
+    /// Time passed: a playing replay advances at real speed; a held-back
+    /// recovery write goes out.
     pub fn tick(&mut self, elapsed: Duration) {
+        self.keep_recovery(Instant::now(), false);
         if self.playing
             && let Some(end) = self.replay_end()
         {
@@ -334,6 +406,13 @@ impl App {
                     Some(Overlay::Help) => None,
                     _ => Some(Overlay::Help),
                 }
+            }
+            Dismiss if matches!(self.overlay, Some(Overlay::Recover(_))) => {
+                self.overlay = None;
+                if let Some(r) = &mut self.recovery {
+                    r.discard();
+                }
+                self.set_status("the recovery copy was discarded");
             }
             Dismiss => {
                 if self.editing.is_some() {
@@ -738,6 +817,13 @@ impl App {
         }
     }
 
+    /// Quits without asking (a signal: the terminal is closing or the
+    /// process is told to stop). Unsaved edits stay in the recovery copy.
+    pub fn quit_now(&mut self) {
+        self.keep_recovery(Instant::now(), true);
+        self.shutdown();
+    }
+
     /// Cancels running jobs (they return their best at once) and stops.
     fn shutdown(&mut self) {
         for job in self.jobs.iter().filter(|j| j.is_running()) {
@@ -846,10 +932,9 @@ impl App {
             }
             Item::Waypoint(between) => {
                 self.edit(|m| {
-                    m.reconfiguration.waypoints.retain(|w| {
-                        !(w.between == between
-                            || (w.between[0] == between[1] && w.between[1] == between[0]))
-                    })
+                    m.reconfiguration
+                        .waypoints
+                        .retain(|w| !iwp::same_pair(&w.between, &between[0], &between[1]))
                 });
                 self.set_status("IWP back to the mission's default shape");
             }
@@ -991,18 +1076,26 @@ impl App {
                             "INFEASIBLE"
                         }
                     ),
-                    Some(jobs::Outcome::Flatlo(o)) => format!(
-                        "job {id} {verb}: closest {} m, spacing error {:.2} %, {}",
-                        o.verification
+                    Some(jobs::Outcome::Flatlo(o)) => {
+                        let closest = o
                             .closest
-                            .map_or("-".into(), |c| format!("{:.0}", c.min_distance)),
-                        o.verification.max_spacing_error * 100.0,
-                        if o.passed() {
-                            "separation kept"
-                        } else {
-                            "SEPARATION LOST"
+                            .map_or("-".into(), |c| format!("{:.0}", c.min_distance));
+                        match &o.verification {
+                            Some(v) => format!(
+                                "job {id} {verb}: closest {closest} m, spacing error {:.2} %, {}",
+                                v.max_spacing_error * 100.0,
+                                if v.passed {
+                                    "separation kept"
+                                } else {
+                                    "SEPARATION LOST"
+                                }
+                            ),
+                            None => format!(
+                                "job {id} {verb}: no verdict on a partial flight \
+                                 (closest so far {closest} m)"
+                            ),
                         }
-                    ),
+                    }
                     Some(jobs::Outcome::Fleet(o)) => format!(
                         "job {id} {verb}: {} of {} targets formed, closest {}, {}",
                         o.targets
@@ -1097,7 +1190,11 @@ impl App {
     fn confirm(&mut self) {
         match self.overlay.clone() {
             Some(Overlay::Quit) => {
+                // Quit without saving: the user chose to drop the changes.
                 self.overlay = None;
+                if let Some(r) = &mut self.recovery {
+                    r.discard();
+                }
                 self.shutdown();
             }
             Some(Overlay::SaveAs { input, then }) => {
@@ -1106,7 +1203,23 @@ impl App {
                     self.set_error("type a file name");
                     return;
                 }
-                self.save(Some(PathBuf::from(input)), then, false);
+                let path = self.cwd.join(input);
+                let current = self.doc.path().map(|p| self.cwd.join(p));
+                if path.exists() && current.as_ref() != Some(&path) {
+                    self.overlay = Some(Overlay::Overwrite { path, then });
+                    return;
+                }
+                self.save(Some(path), then, false);
+            }
+            Some(Overlay::Overwrite { path, then }) => self.save(Some(path), then, false),
+            Some(Overlay::Recover(copy)) => {
+                self.overlay = None;
+                let changes = copy.changes;
+                self.doc.edit(|m| *m = copy.mission);
+                self.refresh();
+                self.set_status(format!(
+                    "restored {changes} unsaved change(s); Ctrl-s saves them, u undoes the restore"
+                ));
             }
             Some(Overlay::SaveInvalid { path, then, .. }) => self.save(path, then, true),
             Some(Overlay::Open { entries, cursor }) => {
@@ -1141,7 +1254,16 @@ impl App {
         let checked = crate::diagnose::check_text(&text, Some(&name));
         match checked.mission {
             Some(m) => {
-                self.doc = Document::new(m, path);
+                self.doc = Document::new(m, path).with_source(text);
+                if let Some(r) = &mut self.recovery {
+                    // Opening another mission drops this one's unsaved edits
+                    // (the user was asked); its copy goes with them.
+                    r.discard();
+                    self.enable_recovery(match &entry {
+                        Entry::File(p) => Origin::File(p.clone()),
+                        Entry::Builtin(name) => Origin::Builtin((*name).to_owned()),
+                    });
+                }
                 self.selected = Item::Mission;
                 self.field = 0;
                 self.editing = None;

@@ -27,6 +27,11 @@ pub struct Document {
     gesture: Option<Mission>,
     /// `validate(mission)`, refreshed after every change.
     diagnostics: Vec<Diagnostic>,
+    /// The text the mission was read from (or last saved as): saves edit it
+    /// in place, so the user's comments and layout stay.
+    source: Option<String>,
+    /// Changes (edits, gestures, undos, redos) since the last save.
+    changes: usize,
 }
 
 impl Document {
@@ -41,7 +46,24 @@ impl Document {
             redo: Vec::new(),
             gesture: None,
             diagnostics,
+            source: None,
+            changes: 0,
         }
+    }
+
+    /// The text the mission was read from: saves keep its comments and layout.
+    pub fn with_source(mut self, text: impl Into<String>) -> Self {
+        self.source = Some(text.into());
+        self
+    }
+
+    pub fn source(&self) -> Option<&str> {
+        self.source.as_deref()
+    }
+
+    /// Changes since the last save (what a recovery copy holds).
+    pub fn changes(&self) -> usize {
+        self.changes
     }
 
     /// A document for a file that does not exist yet: the content of
@@ -174,7 +196,9 @@ impl Document {
                 });
             }
         };
-        mission::save(&self.mission, &target)?;
+        let text = mission::save_edited(&self.mission, self.source.as_deref(), &target)?;
+        self.source = Some(text);
+        self.changes = 0;
         self.saved = self.mission.clone();
         self.never_saved = false;
         self.path = Some(target.clone());
@@ -190,6 +214,7 @@ impl Document {
     }
 
     fn changed(&mut self) {
+        self.changes += 1;
         self.diagnostics = crate::diagnose::diagnose(&self.mission);
     }
 }

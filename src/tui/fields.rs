@@ -9,6 +9,7 @@ use nalgebra::{Point2, Vector3};
 
 use crate::mission::{Mission, Obstacle, ShapeChoice, WaypointChoice};
 use crate::planner::Iwp;
+use crate::planner::iwp::same_pair;
 
 /// Something the operator can select on the map, in the formation editor or
 /// in the item list.
@@ -61,7 +62,12 @@ impl Item {
             Item::FleetTarget(i) => *i < mission.fleet.targets.len(),
             Item::Waypoint([a, b]) => {
                 let named = |n: &String| mission.obstacles.iter().any(|o| &o.name == n);
-                named(a) && named(b)
+                (named(a) && named(b))
+                    || mission
+                        .reconfiguration
+                        .waypoints
+                        .iter()
+                        .any(|w| same_pair(&w.between, a, b))
             }
             _ => true,
         }
@@ -79,12 +85,38 @@ pub fn map_items(mission: &Mission) -> Vec<Item> {
     items
 }
 
-/// The items of the formation editor: the formation, its slots, the IWPs.
+/// The items of the formation editor: the formation, its slots, the IWPs,
+/// and every IWP choice of the file that is not one of them (it names a
+/// missing obstacle, or has an invalid value): listed so it can be fixed or
+/// deleted rather than leave the mission invalid beyond repair.
 pub fn formation_items(mission: &Mission, iwps: &[Iwp]) -> Vec<Item> {
     let mut items = vec![Item::Formation];
     items.extend((0..mission.formation.slots.len()).map(Item::Slot));
     items.extend(iwps.iter().map(|w| Item::Waypoint(w.between.clone())));
+    for choice in &mission.reconfiguration.waypoints {
+        let listed = iwps
+            .iter()
+            .any(|w| same_pair(&w.between, &choice.between[0], &choice.between[1]));
+        if !listed {
+            items.push(Item::Waypoint(choice.between.clone()));
+        }
+    }
     items
+}
+
+/// An obstacle renamed from `old` to `new`: the IWP choices that named it
+/// follow, unless another obstacle still carries the old name.
+fn rename_references(m: &mut Mission, old: &str, new: &str) {
+    if old == new || m.obstacles.iter().any(|o| o.name == old) {
+        return;
+    }
+    for choice in &mut m.reconfiguration.waypoints {
+        for name in &mut choice.between {
+            if name == old {
+                *name = new.to_owned();
+            }
+        }
+    }
 }
 
 type Setter = fn(&mut Mission, &Item, &str) -> Result<(), String>;
@@ -228,10 +260,7 @@ pub fn waypoint_choice<'m>(
     let Item::Waypoint(between) = item else {
         return Err("not an IWP".into());
     };
-    let same = |w: &WaypointChoice| {
-        (w.between[0] == between[0] && w.between[1] == between[1])
-            || (w.between[0] == between[1] && w.between[1] == between[0])
-    };
+    let same = |w: &WaypointChoice| same_pair(&w.between, &between[0], &between[1]);
     let list = &mut m.reconfiguration.waypoints;
     let index = match list.iter().position(same) {
         Some(i) => i,
@@ -249,10 +278,10 @@ pub fn waypoint_choice<'m>(
 }
 
 fn find_choice<'m>(m: &'m Mission, between: &[String; 2]) -> Option<&'m WaypointChoice> {
-    m.reconfiguration.waypoints.iter().find(|w| {
-        (w.between[0] == between[0] && w.between[1] == between[1])
-            || (w.between[0] == between[1] && w.between[1] == between[0])
-    })
+    m.reconfiguration
+        .waypoints
+        .iter()
+        .find(|w| same_pair(&w.between, &between[0], &between[1]))
 }
 
 /// The inspector's fields for `item`, with the values they have in `mission`.
@@ -345,7 +374,8 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
             let at = |key: &str| format!("obstacles[{i}].{key}");
             vec![
                 field("name", at("name"), &o.name, |m, item, t| {
-                    obstacle(m, item)?.name = t.to_owned();
+                    let old = std::mem::replace(&mut obstacle(m, item)?.name, t.to_owned());
+                    rename_references(m, &old, t);
                     Ok(())
                 }),
                 field(

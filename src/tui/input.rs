@@ -251,11 +251,18 @@ fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
             KeyCode::Char(c) if !ctrl => Some(Action::PromptInput(c)),
             _ => None,
         },
-        Overlay::SaveInvalid { .. } | Overlay::Discard(_) => match key.code {
+        Overlay::Recover(_) => match key.code {
             KeyCode::Char('y') => Some(Action::Confirm),
-            KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
+            KeyCode::Char('n') => Some(Action::Dismiss),
             _ => None,
         },
+        Overlay::SaveInvalid { .. } | Overlay::Discard(_) | Overlay::Overwrite { .. } => {
+            match key.code {
+                KeyCode::Char('y') => Some(Action::Confirm),
+                KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
+                _ => None,
+            }
+        }
         Overlay::Open { .. } => match key.code {
             KeyCode::Up => Some(Action::PickerMove(-1)),
             KeyCode::Down => Some(Action::PickerMove(1)),

@@ -15,6 +15,7 @@ pub mod fields;
 pub mod fixtures;
 pub mod input;
 pub mod jobs;
+pub mod recovery;
 pub mod view;
 
 use std::io::{self, IsTerminal};
@@ -42,14 +43,16 @@ const TICK: Duration = Duration::from_millis(100);
 /// unsaved document to be written there when it does not. A file that is not
 /// a mission at all is an error naming each problem with its line.
 pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), String> {
+    let builtin = mission::BUILTIN[0].text;
     let Some(path) = path else {
         return Ok((
-            Document::new(mission::default_mission().mission, None),
+            Document::new(mission::default_mission().mission, None).with_source(builtin),
             None,
         ));
     };
     if !path.exists() {
-        let doc = Document::new_file(mission::default_mission().mission, path.to_path_buf());
+        let doc = Document::new_file(mission::default_mission().mission, path.to_path_buf())
+            .with_source(builtin);
         let note = format!("{} does not exist yet: Ctrl-s creates it", path.display());
         return Ok((doc, Some(note)));
     }
@@ -61,7 +64,10 @@ pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), 
             let errors = checked.report.error_count();
             let note =
                 (errors > 0).then(|| format!("{name}: {errors} error(s) to fix before running"));
-            Ok((Document::new(m, Some(path.to_path_buf())), note))
+            Ok((
+                Document::new(m, Some(path.to_path_buf())).with_source(text),
+                note,
+            ))
         }
         None => Err(format!(
             "{name} is not a valid mission:\n{}",
@@ -70,8 +76,10 @@ pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), 
     }
 }
 
-/// Runs the TUI on `path` (or the built-in mission) until the operator quits.
-pub fn run(path: Option<PathBuf>) -> Result<(), String> {
+/// Runs the TUI on `path` (or the built-in mission) until the operator
+/// quits; returns the exit code (128 + the signal's number when a signal
+/// ended it, as shells expect).
+pub fn run(path: Option<PathBuf>) -> Result<u8, String> {
     let (doc, note) = open_document(path.as_deref())?;
     if !io::stdout().is_terminal() || !io::stdin().is_terminal() {
         return Err("the mission designer needs a terminal; for scripts use `skyform run` or `skyform check` (see --help)".into());
@@ -84,19 +92,64 @@ pub fn run(path: Option<PathBuf>) -> Result<(), String> {
             error: true,
         });
     }
+    app.enable_recovery(match &path {
+        Some(p) => recovery::Origin::File(p.clone()),
+        None => recovery::Origin::Builtin(mission::BUILTIN[0].file_name.to_owned()),
+    });
+    let signals = spawn_signals();
 
     let mut terminal =
         ratatui::try_init().map_err(|e| format!("cannot set up the terminal: {e}"))?;
     install_panic_hook();
     // Mouse is a convenience: a terminal without it still works by keyboard.
     let _ = execute!(io::stdout(), EnableMouseCapture);
-    let result = event_loop(&mut terminal, &mut app);
+    let result = event_loop(&mut terminal, &mut app, &signals);
+    // Whatever ended the loop, unsaved edits are on disk before anything else.
+    app.keep_recovery(Instant::now(), true);
     // Cancelled jobs stop at their next iteration; let them finish their
     // recordings before the process ends.
     app.wait_for_jobs(Duration::from_secs(5));
     let _ = execute!(io::stdout(), DisableMouseCapture);
     ratatui::restore();
-    result.map_err(|e| format!("terminal error: {e}"))
+    let code = result.map_err(|e| format!("terminal error: {e}"))?;
+    if code != 0
+        && let Some(copy) = app.recovery_path().filter(|p| p.exists())
+    {
+        eprintln!(
+            "skyform: stopped by a signal; unsaved changes are kept in {}",
+            copy.display()
+        );
+    }
+    Ok(code)
+}
+
+/// SIGTERM, SIGHUP (the terminal window closed) and SIGINT (from `kill`:
+/// in the designer Ctrl-c is a key) end the designer as `q` does, without
+/// the unsaved-changes question: the recovery copy keeps the edits.
+#[cfg(unix)]
+fn spawn_signals() -> Receiver<i32> {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let (tx, rx) = unbounded();
+    match signal_hook::iterator::Signals::new([SIGTERM, SIGHUP, SIGINT]) {
+        Ok(mut signals) => {
+            let _ = thread::Builder::new()
+                .name("skyform-signals".into())
+                .spawn(move || {
+                    for signal in signals.forever() {
+                        if tx.send(signal).is_err() {
+                            break;
+                        }
+                    }
+                });
+        }
+        Err(e) => eprintln!("warning: signals will not restore the terminal: {e}"),
+    }
+    rx
+}
+
+#[cfg(not(unix))]
+fn spawn_signals() -> Receiver<i32> {
+    never()
 }
 
 /// ratatui's hook restores the terminal on a panic; only a panic of the UI
@@ -131,16 +184,22 @@ fn spawn_input() -> Receiver<io::Result<Event>> {
     rx
 }
 
-fn event_loop(terminal: &mut DefaultTerminal, app: &mut App) -> io::Result<()> {
+/// Returns the exit code: 0, or 128 + a signal that ended it.
+fn event_loop(
+    terminal: &mut DefaultTerminal,
+    app: &mut App,
+    signals: &Receiver<i32>,
+) -> io::Result<u8> {
     let input = spawn_input();
     let job_messages = app.job_messages().clone();
     let mut redraw = true;
+    let mut code = 0u8;
     loop {
         if redraw {
             terminal.draw(|frame| view::draw(frame, app, Instant::now()))?;
         }
         if app.should_quit {
-            return Ok(());
+            return Ok(code);
         }
         let tick = if app.wants_tick() {
             after(TICK)
@@ -162,6 +221,13 @@ fn event_loop(terminal: &mut DefaultTerminal, app: &mut App) -> io::Result<()> {
             recv(tick) -> _ => {
                 app.tick(TICK);
                 redraw = true;
+            },
+            recv(signals) -> signal => {
+                if let Ok(signal) = signal {
+                    code = 128u8.saturating_add(u8::try_from(signal).unwrap_or(0));
+                    app.quit_now();
+                    redraw = true;
+                }
             },
         }
         // Take what else is waiting before drawing once.
@@ -186,6 +252,7 @@ fn handle(terminal: &DefaultTerminal, app: &mut App, event: Event) -> io::Result
     Ok(match action {
         Some(action) => {
             app.update(action);
+            app.keep_recovery(Instant::now(), false);
             true
         }
         None => false,

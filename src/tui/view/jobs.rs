@@ -271,27 +271,33 @@ fn fleet_table(o: &crate::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>
 
 /// FLATLO's verification: every pair's closest approach, the final line, the verdict.
 fn flatlo_table(o: &crate::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'static>> {
-    let v = &o.verification;
+    let verdict = match &o.verification {
+        Some(v) if v.passed => Span::styled("✓ separation kept", Style::default().green()),
+        Some(_) => Span::styled("✗ SEPARATION LOST", Style::default().red().bold()),
+        None => Span::styled("cancelled: no verdict", Style::default().yellow()),
+    };
     let mut lines = vec![Line::from(vec![
         Span::raw(format!(
             "{} aircraft · on the line at {:.0} s · ",
             o.aircraft.len(),
             o.arrival_time
         )),
-        if v.passed {
-            Span::styled("✓ separation kept", Style::default().green())
-        } else {
-            Span::styled("✗ SEPARATION LOST", Style::default().red().bold())
-        },
+        verdict,
     ])];
+    let min_separation = o.verification.as_ref().map_or(0.0, |v| v.min_separation);
     lines.push(Line::styled(
         format!("{:<6} {:>11} {:>8}", "pair", "closest m", "at s"),
         Style::default().bold(),
     ));
-    let mut pairs = o.pairs.clone();
+    // Large squadrons keep only the closest pair overall.
+    let mut pairs = if o.pairs.is_empty() {
+        o.closest.into_iter().collect()
+    } else {
+        o.pairs.clone()
+    };
     pairs.sort_by(|a, b| a.min_distance.total_cmp(&b.min_distance));
     for p in pairs.iter().take(8) {
-        let style = if p.min_distance < v.min_separation {
+        let style = if p.min_distance < min_separation {
             Style::default().red()
         } else {
             Style::default()
@@ -309,11 +315,13 @@ fn flatlo_table(o: &crate::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'stat
     if pairs.len() > 8 {
         lines.push(Line::raw(format!("… {} more pairs", pairs.len() - 8)));
     }
-    lines.push(Line::raw(format!(
-        "final spacing error {:.3} % · lateral spread {:.1} m",
-        v.max_spacing_error * 100.0,
-        v.lateral_spread
-    )));
+    if let Some(v) = &o.verification {
+        lines.push(Line::raw(format!(
+            "final spacing error {:.3} % · lateral spread {:.1} m",
+            v.max_spacing_error * 100.0,
+            v.lateral_spread
+        )));
+    }
     let worst = o
         .aircraft
         .iter()

@@ -326,6 +326,33 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
             let title = ("Open a mission (missions/, ./, built-in)", Color::Cyan);
             popup(frame, area, (72, height + 2), title, Paragraph::new(lines));
         }
+        Overlay::Overwrite { path, .. } => {
+            let lines = vec![
+                Line::raw(format!("{} exists. Replace it?", path.display())),
+                hints(&[("y", " replace   "), ("Esc", " cancel")]),
+            ];
+            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+            popup(frame, area, (80, 5), ("Replace file?", Color::Yellow), body);
+        }
+        Overlay::Recover(copy) => {
+            let lines = vec![
+                Line::raw("An earlier session left unsaved changes to this mission:"),
+                Line::raw(copy.describe(std::time::SystemTime::now())),
+                Line::raw(""),
+                hints(&[
+                    ("y", " restore them (then Ctrl-s to save)   "),
+                    ("n", " discard them"),
+                ]),
+            ];
+            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+            popup(
+                frame,
+                area,
+                (80, 7),
+                ("Recover unsaved changes?", Color::Yellow),
+                body,
+            );
+        }
         Overlay::Discard(entry) => {
             let lines = vec![
                 Line::raw(format!(
