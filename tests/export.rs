@@ -57,7 +57,8 @@ fn planned(path: &str, pipeline: &str) -> (Mission, Planned) {
             Planned::theta_pso(&m, &o)
         }
         "flatlo" => {
-            let o = flatlo::plan(&m, m.seed, &mut Silent, &cancel).unwrap_or_else(|e| panic!("{e}"));
+            let o =
+                flatlo::plan(&m, m.seed, &mut Silent, &cancel).unwrap_or_else(|e| panic!("{e}"));
             Planned::flatlo(&m, &o)
         }
         _ => {
@@ -178,7 +179,11 @@ fn a_change_of_speed_on_a_straight_line_is_kept() {
     let samples: Vec<TrackSample> = (0..=200)
         .map(|k| {
             let t = k as f64 * 0.1;
-            let x = if t <= 10.0 { t } else { 10.0 + 3.0 * (t - 10.0) };
+            let x = if t <= 10.0 {
+                t
+            } else {
+                10.0 + 3.0 * (t - 10.0)
+            };
             TrackSample {
                 t,
                 position: Point3::new(x, 0.0, 5.0),
@@ -297,7 +302,10 @@ fn check_plan_file(m: &Mission, p: &Planned, path: &Path) {
     assert_eq!(mission["version"], 2);
     assert_eq!(mission["firmwareType"], if fixed_wing { 3 } else { 12 });
     assert_eq!(mission["vehicleType"], if fixed_wing { 1 } else { 2 });
-    assert_eq!(mission["plannedHomePosition"].as_array().map(Vec::len), Some(3));
+    assert_eq!(
+        mission["plannedHomePosition"].as_array().map(Vec::len),
+        Some(3)
+    );
     let items = mission["items"].as_array().cloned().unwrap_or_default();
     let commands: Vec<i64> = items.iter().filter_map(|i| i["command"].as_i64()).collect();
     assert_eq!(commands.first(), Some(&22), "takeoff first");
@@ -319,7 +327,10 @@ fn check_plan_file(m: &Mission, p: &Planned, path: &Path) {
         .filter(|i| i["command"] == 178)
         .filter_map(|i| i["params"][1].as_f64())
         .collect();
-    assert!(speeds.windows(2).all(|w| (w[0] - w[1]).abs() > 1e-9), "{speeds:?}");
+    assert!(
+        speeds.windows(2).all(|w| (w[0] - w[1]).abs() > 1e-9),
+        "{speeds:?}"
+    );
     let fence = &v["geoFence"];
     assert_eq!(fence["version"], 2);
     let polygon = &fence["polygons"][0];
@@ -391,7 +402,10 @@ fn the_files_agree_with_each_other_and_with_the_geodesy() {
     let plan = &done.plans[0];
     let first = plan.waypoints[0].position;
     let g = frame.to_geodetic(&first);
-    let wpl = read(&dir.path().join("bridge-inspection-theta-pso-uav1.waypoints"));
+    let wpl = read(
+        &dir.path()
+            .join("bridge-inspection-theta-pso-uav1.waypoints"),
+    );
     // Line 3 (after header, home, takeoff) is the first waypoint.
     let fields: Vec<f64> = wpl
         .lines()
@@ -424,7 +438,10 @@ fn a_coarse_tolerance_that_cuts_an_obstacle_is_refused_naming_it() {
     let message = ExportError::Refused(r.clone()).to_string();
     assert!(message.contains("obstacle clearance: UAV "), "{message}");
     assert!(message.contains("leg to waypoint"), "{message}");
-    assert_eq!(std::fs::read_dir(dir.path()).map(|d| d.count()).ok(), Some(0));
+    assert_eq!(
+        std::fs::read_dir(dir.path()).map(|d| d.count()).ok(),
+        Some(0)
+    );
 }
 
 #[test]
@@ -450,7 +467,11 @@ fn the_binary_refuses_with_exit_2_and_writes_with_force() {
     assert!(stderr.contains("export refused"), "{stderr}");
     assert!(stderr.contains("obstacle clearance: UAV"), "{stderr}");
     assert!(stderr.contains("leg to waypoint"), "{stderr}");
-    assert!(!out_dir.join("bridge-inspection-theta-pso-uav1.plan").exists());
+    assert!(
+        !out_dir
+            .join("bridge-inspection-theta-pso-uav1.plan")
+            .exists()
+    );
 
     let mut forced_args = args.to_vec();
     forced_args.push("--force");
@@ -460,7 +481,11 @@ fn the_binary_refuses_with_exit_2_and_writes_with_force() {
     assert!(stderr.contains("warning: written with --force"), "{stderr}");
     for n in 1..=3 {
         for ext in ["plan", "waypoints"] {
-            assert!(out_dir.join(format!("bridge-inspection-theta-pso-uav{n}.{ext}")).exists());
+            assert!(
+                out_dir
+                    .join(format!("bridge-inspection-theta-pso-uav{n}.{ext}"))
+                    .exists()
+            );
         }
     }
     let stdout = text(&forced.stdout);
@@ -472,8 +497,12 @@ fn the_binary_refuses_with_exit_2_and_writes_with_force() {
 fn without_an_origin_csv_works_in_enu_and_geodetic_formats_say_to_add_it() {
     let dir = tempdir();
     let source = read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("missions/narrow-passage.toml"));
-    let start = source.find("[origin]").unwrap_or_else(|| panic!("no origin"));
-    let end = source.find("[bounds]").unwrap_or_else(|| panic!("no bounds"));
+    let start = source
+        .find("[origin]")
+        .unwrap_or_else(|| panic!("no origin"));
+    let end = source
+        .find("[bounds]")
+        .unwrap_or_else(|| panic!("no bounds"));
     let stripped = format!("{}{}", &source[..start], &source[end..]);
     let path = dir.path().join("no-origin.toml");
     std::fs::write(&path, stripped).unwrap_or_else(|e| panic!("{e}"));
@@ -488,7 +517,9 @@ fn without_an_origin_csv_works_in_enu_and_geodetic_formats_say_to_add_it() {
     let csv = skyform(&["export", &mission, "--format", "csv", "--out", &out]);
     assert_eq!(csv.status.code(), Some(0), "{}", text(&csv.stderr));
     let (m, p) = {
-        let m = mission::load(&path).unwrap_or_else(|e| panic!("{e}")).mission;
+        let m = mission::load(&path)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .mission;
         let o = planner::plan(
             &m,
             m.seed,
@@ -528,9 +559,16 @@ fn expectations(m: &Mission, p: &Planned, done: &Exported, dir: &Path) -> (PathB
                     let params: Vec<Value> = i
                         .params
                         .iter()
-                        .map(|&v| if zero_nan && !v.is_finite() { json!(0.0) } else { num(v) })
+                        .map(|&v| {
+                            if zero_nan && !v.is_finite() {
+                                json!(0.0)
+                            } else {
+                                num(v)
+                            }
+                        })
                         .collect();
-                    let mut e = json!({"command": i.command, "frame": frame_of(i.frame), "params": params});
+                    let mut e =
+                        json!({"command": i.command, "frame": frame_of(i.frame), "params": params});
                     if let Some([lat, lon, alt]) = i.at {
                         e["lat"] = json!(lat);
                         e["lon"] = json!(lon);
@@ -585,7 +623,11 @@ fn reader_python() -> Option<PathBuf> {
     match std::env::var_os("SKYFORM_EXPORT_VENV") {
         Some(venv) => {
             let python = PathBuf::from(venv).join("bin").join("python");
-            assert!(python.exists(), "SKYFORM_EXPORT_VENV has no {}", python.display());
+            assert!(
+                python.exists(),
+                "SKYFORM_EXPORT_VENV has no {}",
+                python.display()
+            );
             Some(python)
         }
         None => {
@@ -593,7 +635,9 @@ fn reader_python() -> Option<PathBuf> {
                 std::env::var_os("CI").is_none(),
                 "CI is set but SKYFORM_EXPORT_VENV is not: .ci/run must create the readers' venv"
             );
-            eprintln!("skipped: set SKYFORM_EXPORT_VENV to a venv with tests/export_readers/requirements.txt");
+            eprintln!(
+                "skipped: set SKYFORM_EXPORT_VENV to a venv with tests/export_readers/requirements.txt"
+            );
             None
         }
     }
@@ -609,13 +653,21 @@ fn pymavlink_and_mavsdk_read_every_exported_file_as_written() {
         let dir = tempdir();
         let (m, p, done) = export_shipped(s, dir.path());
         let (plan_expect, wpl_expect) = expectations(&m, &p, &done, dir.path());
-        for (script, expect) in [("check_wpl.py", &wpl_expect), ("check_plan.py", &plan_expect)] {
+        for (script, expect) in [
+            ("check_wpl.py", &wpl_expect),
+            ("check_plan.py", &plan_expect),
+        ] {
             let out = std::process::Command::new(&python)
                 .arg(readers.join(script))
                 .arg(expect)
                 .output()
                 .unwrap_or_else(|e| panic!("cannot run {script}: {e}"));
-            eprint!("{script} on {} {}: {}", s.stem, s.pipeline, text(&out.stdout));
+            eprint!(
+                "{script} on {} {}: {}",
+                s.stem,
+                s.pipeline,
+                text(&out.stdout)
+            );
             assert!(
                 out.status.success(),
                 "{script} on {} {}: {}{}",
@@ -626,4 +678,70 @@ fn pymavlink_and_mavsdk_read_every_exported_file_as_written() {
             );
         }
     }
+}
+
+// ------------------------------------------------------------ designer
+
+#[test]
+fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin() {
+    use skyform::tui::fields::Item;
+    use skyform::tui::{Action, App, Document};
+
+    let dir = tempdir();
+    let path = dir.path().join("bridge.toml");
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("missions/bridge-inspection.toml"),
+        &path,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let m = mission::load(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    let mut app = App::new(Document::new(m, Some(path.clone())), dir.path().to_owned());
+
+    app.update(Action::Export);
+    let status = app.status.clone().unwrap_or_else(|| panic!("no status"));
+    assert!(
+        status.error && status.text.contains("no result"),
+        "{}",
+        status.text
+    );
+
+    app.update(Action::Run);
+    assert!(app.wait_for_jobs(std::time::Duration::from_secs(120)));
+    app.update(Action::ShowJob);
+    app.update(Action::Export);
+    let status = app.status.clone().unwrap_or_else(|| panic!("no status"));
+    assert!(!status.error, "{}", status.text);
+    let folder = dir.path().join("bridge-export");
+    assert!(
+        status.text.contains(&folder.display().to_string()),
+        "{}",
+        status.text
+    );
+    for ext in ["plan", "waypoints", "csv"] {
+        assert!(folder.join(format!("bridge-theta-pso-uav1.{ext}")).exists());
+    }
+
+    // The inspector edits [origin] (Mission item): its three fields.
+    let fields = skyform::tui::fields::fields(&Item::Mission, app.mission());
+    let labels: Vec<&str> = fields.iter().map(|f| f.label).collect();
+    for label in ["origin lat (°)", "origin lon (°)", "origin alt (m)"] {
+        assert!(labels.contains(&label), "{labels:?}");
+    }
+    let lat = fields
+        .iter()
+        .find(|f| f.label == "origin lat (°)")
+        .unwrap_or_else(|| panic!("no field"));
+    assert_eq!(lat.value, "-33.87601");
+    let mut edited = app.mission().clone();
+    lat.set(&mut edited, &Item::Mission, "-34.5")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(edited.origin.as_ref().map(|o| o.latitude), Some(-34.5));
+    lat.set(&mut edited, &Item::Mission, "")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        edited.origin.is_none(),
+        "an empty latitude removes [origin]"
+    );
 }
