@@ -503,7 +503,9 @@ pub fn items(
             waypoint: Some(i),
         });
         let next = plan.waypoints.get(i + 1).map(|n| n.speed);
-        if let Some(v) = next.filter(|v| *v > 0.0 && !((*v - speed).abs() < SPEED_STEP / 2.0)) {
+        if let Some(v) =
+            next.filter(|v| *v > 0.0 && (speed.is_nan() || (*v - speed).abs() >= SPEED_STEP / 2.0))
+        {
             speed = v;
             out.push(change_speed(speed_type, v));
         }

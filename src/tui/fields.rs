@@ -984,6 +984,34 @@ pub fn duplicate_obstacle(mission: &Mission, original: &Obstacle) -> Obstacle {
     copy
 }
 
+/// An `[origin]` value for the inspector: empty when the mission has none.
+fn origin_value(m: &Mission, get: fn(&crate::mission::GeoOrigin) -> f64) -> String {
+    m.origin
+        .as_ref()
+        .map_or_else(String::new, |o| fmt_num(get(o)))
+}
+
+/// Sets one `[origin]` value (creating the section at 0°, 0°, 0 m); an empty
+/// text removes the section (exports then offer CSV in ENU only).
+fn set_origin(
+    m: &mut Mission,
+    text: &str,
+    set: fn(&mut crate::mission::GeoOrigin, f64),
+) -> Result<(), String> {
+    if text.trim().is_empty() {
+        m.origin = None;
+        return Ok(());
+    }
+    let v = number(text)?;
+    let origin = m.origin.get_or_insert(crate::mission::GeoOrigin {
+        latitude: 0.0,
+        longitude: 0.0,
+        altitude: 0.0,
+    });
+    set(origin, v);
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1053,32 +1081,4 @@ mod tests {
         assert_eq!(fmt_num(12.345678), "12.345678");
         assert_eq!(fmt_num(0.1 + 0.2), "0.3", "long ones rounded");
     }
-}
-
-/// An `[origin]` value for the inspector: empty when the mission has none.
-fn origin_value(m: &Mission, get: fn(&crate::mission::GeoOrigin) -> f64) -> String {
-    m.origin
-        .as_ref()
-        .map_or_else(String::new, |o| fmt_num(get(o)))
-}
-
-/// Sets one `[origin]` value (creating the section at 0°, 0°, 0 m); an empty
-/// text removes the section (exports then offer CSV in ENU only).
-fn set_origin(
-    m: &mut Mission,
-    text: &str,
-    set: fn(&mut crate::mission::GeoOrigin, f64),
-) -> Result<(), String> {
-    if text.trim().is_empty() {
-        m.origin = None;
-        return Ok(());
-    }
-    let v = number(text)?;
-    let origin = m.origin.get_or_insert(crate::mission::GeoOrigin {
-        latitude: 0.0,
-        longitude: 0.0,
-        altitude: 0.0,
-    });
-    set(origin, v);
-    Ok(())
 }
