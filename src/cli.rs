@@ -13,6 +13,8 @@ use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineE
 use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
 use crate::record::{self, Recorder, Sinks};
 
+pub mod export_cmd;
+
 /// Terminal mission designer for multi-UAV formations.
 ///
 /// Without a command, opens the mission designer (TUI) on FILE, or on the
@@ -58,6 +60,21 @@ pub enum Command {
         #[command(flatten)]
         record: RecordArgs,
     },
+    /// Plan a mission and write one autopilot mission file per vehicle
+    /// (.plan, .waypoints, CSV), re-verified as it will be flown.
+    ///
+    /// Files: `<mission-stem>-<pipeline>-uav<N>.<ext>` in DIR. Each vehicle's
+    /// track becomes waypoints within the tolerance of where the plan has it
+    /// at each instant, with a commanded speed per leg so that it reaches
+    /// each waypoint on time. The plans are flown as an autopilot flies them
+    /// (straight legs at the commanded speeds, all vehicles starting
+    /// together) and checked with the pipeline's own verification; a flown
+    /// plan that breaks a constraint is refused unless --force. `plan` and
+    /// `wpl` need the mission's [origin]; `csv` works without it (ENU only).
+    /// Prints the files, their waypoint counts, the largest deviation and
+    /// timing error. Exit status: 0 written, 1 error, 2 refused, 130
+    /// cancelled (Ctrl-C). See docs/export.md.
+    Export(export_cmd::ExportArgs),
 }
 
 #[derive(Debug, Subcommand)]
@@ -218,6 +235,7 @@ pub fn main() -> ExitCode {
         Command::Record { mission, record } => {
             ExitCode::from(record_mission(&mission, &record.sinks()))
         }
+        Command::Export(args) => ExitCode::from(export_cmd::export_command(&args)),
     }
 }
 

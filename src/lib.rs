@@ -7,6 +7,7 @@
 #[cfg(feature = "rerun")]
 pub mod cli;
 pub mod diagnose;
+pub mod export;
 pub mod flatlo;
 pub mod fleet;
 pub mod geometry;
@@ -17,4 +18,5 @@ pub mod planner;
 #[cfg(feature = "rerun")]
 pub mod record;
 pub mod swarm;
+pub mod tracks;
 pub mod tui;

@@ -143,13 +143,54 @@ impl Tracker {
     }
 }
 
+/// The limits a verification holds trajectories to. θ-PSO's are
+/// [`Limits::theta_pso`]; the exports re-verify FLATLO and fleet plans with
+/// their own pipeline's thresholds through the same checks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Least clearance to every obstacle's surface, metres (θ-PSO: r_Q).
+    pub clearance: f64,
+    /// Least distance between two vehicles at the same instant, metres (eq. 7: 2 r_Q).
+    pub closest: f64,
+    /// Largest distance between two vehicles, metres (eq. 7: d_com); `None`: no such limit.
+    pub farthest: Option<f64>,
+    /// Check eq. 8 over each inspected obstacle's pass.
+    pub inspections: bool,
+}
+
+impl Limits {
+    /// θ-PSO's hard constraints: r_Q, [2 r_Q, d_com] (eq. 7), eq. 8.
+    pub fn theta_pso(mission: &Mission) -> Self {
+        let f = &mission.formation;
+        Limits {
+            clearance: f.uav_radius,
+            closest: 2.0 * f.uav_radius,
+            farthest: Some(f.comm_range),
+            inspections: true,
+        }
+    }
+}
+
 /// Verifies trajectories sampled at common times.
 pub fn verify(mission: &Mission, trajectories: &[Trajectory]) -> Verification {
-    let f = &mission.formation;
+    verify_within(mission, &Limits::theta_pso(mission), trajectories)
+}
+
+/// Verifies trajectories sampled at common times against `limits`, the
+/// altitude band and the x-y bounds of `mission`.
+pub fn verify_within(
+    mission: &Mission,
+    limits: &Limits,
+    trajectories: &[Trajectory],
+) -> Verification {
     let b = &mission.bounds;
-    let mut clearance = Tracker::new("obstacle clearance", true, f.uav_radius);
-    let mut closest = Tracker::new("inter-UAV distance (closest)", true, 2.0 * f.uav_radius);
-    let mut farthest = Tracker::new("inter-UAV distance (farthest)", false, f.comm_range);
+    let mut clearance = Tracker::new("obstacle clearance", true, limits.clearance);
+    let mut closest = Tracker::new("inter-UAV distance (closest)", true, limits.closest);
+    let mut farthest = Tracker::new(
+        "inter-UAV distance (farthest)",
+        false,
+        limits.farthest.unwrap_or(f64::INFINITY),
+    );
     let mut low = Tracker::new("altitude (lowest)", true, b.z[0]);
     let mut high = Tracker::new("altitude (highest)", false, b.z[1]);
     let mut inside = Tracker::new("distance inside the x-y bounds", true, 0.0);
@@ -213,8 +254,13 @@ pub fn verify(mission: &Mission, trajectories: &[Trajectory]) -> Verification {
     let checks: Vec<Check> = [clearance, closest, farthest, low, high, inside]
         .into_iter()
         .map(|t| t.check)
+        .filter(|c| c.limit.is_finite())
         .collect();
-    let inspections = inspection::verify(mission, trajectories);
+    let inspections = if limits.inspections {
+        inspection::verify(mission, trajectories)
+    } else {
+        Vec::new()
+    };
     Verification {
         feasible: checks.iter().all(|c| c.ok) && inspections.iter().all(|i| i.ok),
         checks,

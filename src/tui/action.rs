@@ -102,4 +102,8 @@ pub enum Action {
     DragStart(Item, Point2<f64>),
     DragTo(Point2<f64>),
     DragEnd,
+
+    /// Export the shown job's result, one file per vehicle and format,
+    /// beside the mission (re-verified as flown; refused if it breaks a constraint).
+    Export,
 }

@@ -798,6 +798,27 @@ impl App {
                     self.refresh();
                 }
             }
+            Export => self.export_shown(),
+        }
+    }
+
+    /// Exports the shown job's result beside the mission; the status line
+    /// says where, or why not.
+    fn export_shown(&mut self) {
+        let Some(job) = self.shown() else {
+            self.set_error("no result on the map to export: run a pipeline, or Enter on a job");
+            return;
+        };
+        let stem = self
+            .doc
+            .path()
+            .and_then(Path::file_stem)
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| slug(&job.mission.name));
+        let dir = super::export::folder(self.doc.path(), &self.cwd, &stem);
+        match super::export::export_job(job, &dir, &stem) {
+            Ok(text) => self.set_status(text),
+            Err(text) => self.set_error(text),
         }
     }
 

@@ -303,6 +303,24 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
                     .map_err(|_| format!("'{t}' is not a seed (0 … 2⁶⁴-1)"))?;
                 Ok(())
             }),
+            field(
+                "origin lat (°)",
+                "origin.latitude",
+                origin_value(m, |o| o.latitude),
+                |m, _, t| set_origin(m, t, |o, v| o.latitude = v),
+            ),
+            field(
+                "origin lon (°)",
+                "origin.longitude",
+                origin_value(m, |o| o.longitude),
+                |m, _, t| set_origin(m, t, |o, v| o.longitude = v),
+            ),
+            field(
+                "origin alt (m)",
+                "origin.altitude",
+                origin_value(m, |o| o.altitude),
+                |m, _, t| set_origin(m, t, |o, v| o.altitude = v),
+            ),
         ],
         Item::Bounds => {
             let b = &m.bounds;
@@ -994,6 +1012,34 @@ pub fn duplicate_obstacle(mission: &Mission, original: &Obstacle) -> Obstacle {
     }
     copy.name = format!("{} ({k})", original.name);
     copy
+}
+
+/// An `[origin]` value for the inspector: empty when the mission has none.
+fn origin_value(m: &Mission, get: fn(&crate::mission::GeoOrigin) -> f64) -> String {
+    m.origin
+        .as_ref()
+        .map_or_else(String::new, |o| fmt_num(get(o)))
+}
+
+/// Sets one `[origin]` value (creating the section at 0°, 0°, 0 m); an empty
+/// text removes the section (exports then offer CSV in ENU only).
+fn set_origin(
+    m: &mut Mission,
+    text: &str,
+    set: fn(&mut crate::mission::GeoOrigin, f64),
+) -> Result<(), String> {
+    if text.trim().is_empty() {
+        m.origin = None;
+        return Ok(());
+    }
+    let v = number(text)?;
+    let origin = m.origin.get_or_insert(crate::mission::GeoOrigin {
+        latitude: 0.0,
+        longitude: 0.0,
+        altitude: 0.0,
+    });
+    set(origin, v);
+    Ok(())
 }
 
 #[cfg(test)]

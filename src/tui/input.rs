@@ -117,6 +117,11 @@ pub const KEYS: &[(&str, &str, &str)] = &[
         "e  E",
         "record runs to .rrd beside the mission / Rerun viewer: off, connect, spawn",
     ),
+    (
+        "Run",
+        "X",
+        "export the shown result per vehicle (.plan, .waypoints, CSV) to <mission>-export/",
+    ),
 ];
 
 /// The action for a key press, given what is on screen.
@@ -193,6 +198,7 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
         KeyCode::Char('x') => Some(Action::Cancel),
         KeyCode::Char('e') => Some(Action::ToggleRecording),
         KeyCode::Char('E') => Some(Action::CycleViewer),
+        KeyCode::Char('X') => Some(Action::Export),
         KeyCode::Left | KeyCode::Right | KeyCode::Up | KeyCode::Down
             if shift && app.pane == Pane::Map =>
         {

@@ -10,6 +10,7 @@
 pub mod action;
 pub mod app;
 pub mod document;
+pub mod export;
 pub mod fields;
 #[doc(hidden)]
 pub mod fixtures;

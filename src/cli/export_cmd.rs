@@ -1,0 +1,266 @@
+//! `skyform export`: plan, re-verify as flown, write one file per vehicle.
+
+use std::path::{Path, PathBuf};
+
+use super::{StderrProgress, cancel_on_ctrl_c, exit, load_reporting};
+use crate::export::{self, ExportError, Exported, Format, Options, Planned};
+use crate::mission::Mission;
+use crate::pipeline::{CancelToken, Completion, Observer, PipelineError};
+use crate::planner::{self, PlanOptions};
+use crate::tracks::Pipeline;
+use crate::{flatlo, fleet};
+
+/// A pipeline on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PipelineArg {
+    ThetaPso,
+    Flatlo,
+    Fleet,
+}
+
+impl From<PipelineArg> for Pipeline {
+    fn from(p: PipelineArg) -> Self {
+        match p {
+            PipelineArg::ThetaPso => Pipeline::ThetaPso,
+            PipelineArg::Flatlo => Pipeline::Flatlo,
+            PipelineArg::Fleet => Pipeline::Fleet,
+        }
+    }
+}
+
+/// A format on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FormatArg {
+    /// QGroundControl .plan (JSON).
+    Plan,
+    /// QGC WPL 110 .waypoints (MAVProxy, Mission Planner).
+    Wpl,
+    /// Timed samples t,x,y,z,vx,vy,vz[,lat,lon,alt].
+    Csv,
+}
+
+impl From<FormatArg> for Format {
+    fn from(f: FormatArg) -> Self {
+        match f {
+            FormatArg::Plan => Format::Plan,
+            FormatArg::Wpl => Format::Wpl,
+            FormatArg::Csv => Format::Csv,
+        }
+    }
+}
+
+/// The arguments of `skyform export` (its help is on `Command::Export`).
+#[derive(Debug, clap::Args)]
+pub struct ExportArgs {
+    /// Mission TOML file.
+    pub mission: PathBuf,
+    /// File format; repeat for several (plan, wpl, csv).
+    #[arg(long, value_enum, required = true)]
+    pub format: Vec<FormatArg>,
+    /// Folder for the files (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Pipeline that plans the mission.
+    #[arg(long, value_enum, default_value = "theta-pso")]
+    pub pipeline: PipelineArg,
+    /// Seed of the pipeline (default: the mission's `seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Largest distance, metres, between where a waypoint plan puts a vehicle
+    /// and where the plan has it at the same instant (default: the plan's
+    /// clearance margin, or less when the plan has less slack).
+    #[arg(long, value_name = "METRES")]
+    pub tolerance: Option<f64>,
+    /// Write the files even when the flown plans break a constraint (warns).
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Runs a pipeline with progress on stderr and Ctrl-C.
+fn run<O>(
+    mission: &Mission,
+    seed: u64,
+    cancel: &CancelToken,
+    plan: impl FnOnce(&Mission, u64, &mut dyn Observer, &CancelToken) -> Result<O, PipelineError>,
+) -> Result<O, PipelineError> {
+    let mut progress = StderrProgress::new();
+    let result = plan(mission, seed, &mut progress, cancel);
+    if progress.terminal {
+        eprintln!();
+    }
+    result
+}
+
+/// Plans `mission` with `pipeline`; `None` (after saying why) on error or Ctrl-C.
+pub fn planned(mission: &Mission, pipeline: Pipeline, seed: u64) -> Result<Planned, u8> {
+    let cancel = cancel_on_ctrl_c();
+    let fail = |e: PipelineError| {
+        eprintln!("error: {e}");
+        exit::ERROR
+    };
+    let (planned, completion, ok) = match pipeline {
+        Pipeline::ThetaPso => {
+            let o = run(mission, seed, &cancel, |m, s, obs, c| {
+                planner::plan(m, s, PlanOptions::default(), obs, c)
+            })
+            .map_err(fail)?;
+            (Planned::theta_pso(mission, &o), o.completion, o.feasible())
+        }
+        Pipeline::Flatlo => {
+            let o = run(mission, seed, &cancel, flatlo::plan).map_err(fail)?;
+            (Planned::flatlo(mission, &o), o.completion, o.passed())
+        }
+        Pipeline::Fleet => {
+            let o = run(mission, seed, &cancel, fleet::plan).map_err(fail)?;
+            let ok = o.kept_apart() && o.obstacles_clear() && o.converged();
+            (Planned::fleet(mission, &o), o.completion, ok)
+        }
+    };
+    if completion == Completion::Cancelled {
+        eprintln!("cancelled: nothing written");
+        return Err(exit::CANCELLED);
+    }
+    if !ok {
+        eprintln!(
+            "warning: the {} result itself fails its verification (see `skyform run {}`)",
+            pipeline.slug(),
+            pipeline.slug()
+        );
+    }
+    Ok(planned)
+}
+
+/// `skyform export`.
+pub fn export_command(args: &ExportArgs) -> u8 {
+    let Some(mission) = load_reporting(&args.mission) else {
+        return exit::ERROR;
+    };
+    let mut formats: Vec<Format> = Vec::new();
+    for f in &args.format {
+        let f = Format::from(*f);
+        if !formats.contains(&f) {
+            formats.push(f);
+        }
+    }
+    // Refuse a geodetic format before planning, not after.
+    if mission.origin.is_none()
+        && let Some(f) = formats.iter().find(|f| f.geodetic())
+    {
+        eprintln!("error: {}", ExportError::NoOrigin(f.name()));
+        return exit::ERROR;
+    }
+    let pipeline = Pipeline::from(args.pipeline);
+    let seed = args.seed.unwrap_or(mission.seed);
+    let planned = match planned(&mission, pipeline, seed) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let options = Options {
+        formats,
+        out_dir: args.out.clone(),
+        tolerance: args.tolerance,
+        force: args.force,
+    };
+    match export::export(&mission, &stem(&args.mission), &planned, &options) {
+        Ok(done) => {
+            print!("{}", summary(&done));
+            if done.forced {
+                eprintln!(
+                    "warning: written with --force although the plans as flown break a constraint:\n{}",
+                    done.reverification.failure_text()
+                );
+            }
+            exit::OK
+        }
+        Err(e @ ExportError::Refused(_)) => {
+            eprintln!("error: {e}");
+            eprintln!(
+                "(a smaller --tolerance keeps the plans closer to the tracks; --force writes anyway)"
+            );
+            exit::INFEASIBLE
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            exit::ERROR
+        }
+    }
+}
+
+/// The mission file's stem, for file names.
+pub fn stem(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "mission".to_owned())
+}
+
+/// What was written, the waypoint counts, the deviation and timing error.
+pub fn summary(done: &Exported) -> String {
+    let r = &done.reverification;
+    let mut out = format!(
+        "export {}: tolerance {:.3} m ({})\n",
+        done.pipeline.slug(),
+        done.tolerance,
+        done.tolerance_source
+    );
+    for p in &done.plans {
+        out.push_str(&format!(
+            "  UAV {}: {} waypoints\n",
+            p.vehicle + 1,
+            p.waypoints.len()
+        ));
+    }
+    let at = |a: Option<export::reverify::At>| {
+        a.map_or_else(String::new, |a| {
+            format!(
+                " (UAV {}, waypoint {}, t = {:.1} s)",
+                a.vehicle + 1,
+                a.waypoint,
+                a.time
+            )
+        })
+    };
+    out.push_str(&format!(
+        "as flown: largest deviation {:.3} m{}, largest timing error {:.3} s{}\n",
+        r.max_deviation,
+        at(r.deviation_at),
+        r.max_timing_error,
+        at(r.timing_at)
+    ));
+    for c in &r.verification.checks {
+        out.push_str(&format!(
+            "  {} {:<32} worst {} {} {}\n",
+            if c.ok { "✓" } else { "✗" },
+            c.name,
+            c.worst
+                .map_or_else(|| "n/a".to_owned(), |w| format!("{w:.3}")),
+            c.relation,
+            c.limit
+        ));
+    }
+    for i in &r.verification.inspections {
+        out.push_str(&format!(
+            "  {} inspection of '{}': {:.1} m of {} m in [{}, {}] m (eq. 8)\n",
+            if i.ok { "✓" } else { "✗" },
+            i.obstacle,
+            i.achieved,
+            i.required,
+            i.band[0],
+            i.band[1]
+        ));
+    }
+    for f in &done.files {
+        out.push_str(&format!(
+            "wrote {} ({} waypoints, {} {})\n",
+            f.path.display(),
+            f.waypoints,
+            f.items,
+            if f.format == Format::Csv {
+                "samples"
+            } else {
+                "items"
+            }
+        ));
+    }
+    out
+}

@@ -1,0 +1,136 @@
+//! Per-vehicle timed tracks: the common shape of every pipeline's result.
+//!
+//! A track is what one vehicle is planned to do: its position and velocity
+//! (metres and m/s, ENU) at increasing times (seconds from the common start).
+//! θ-PSO gives each UAV's trajectory (eqs. 12-15); FLATLO each aircraft's
+//! reference (Algorithms 1-2 at its common-arrival airspeed: the plan, not the
+//! one noisy simulated flight of it); the fleet each quadrotor's simulated
+//! flight (its only plan: the references jump every τ). Exports, views and
+//! recordings read tracks instead of each outcome's own fields.
+
+use nalgebra::{Point3, Vector3};
+use serde::Serialize;
+
+use crate::flatlo::FlatloOutcome;
+use crate::fleet::FleetOutcome;
+use crate::planner::ThetaPsoOutcome;
+
+/// The pipelines a track can come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum Pipeline {
+    ThetaPso,
+    Flatlo,
+    Fleet,
+}
+
+impl Pipeline {
+    pub const ALL: [Pipeline; 3] = [Pipeline::ThetaPso, Pipeline::Flatlo, Pipeline::Fleet];
+
+    /// As on the command line and in file names: `theta-pso`, `flatlo`, `fleet`.
+    pub fn slug(self) -> &'static str {
+        match self {
+            Pipeline::ThetaPso => "theta-pso",
+            Pipeline::Flatlo => "flatlo",
+            Pipeline::Fleet => "fleet",
+        }
+    }
+
+    /// The vehicles it plans fly with fixed wings (FLATLO's aircraft).
+    pub fn fixed_wing(self) -> bool {
+        matches!(self, Pipeline::Flatlo)
+    }
+}
+
+/// One instant of a track. Seconds, metres ENU, m/s.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TrackSample {
+    pub t: f64,
+    pub position: Point3<f64>,
+    pub velocity: Vector3<f64>,
+}
+
+/// One vehicle's timed track.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Track {
+    /// 0-based vehicle index (UAV n + 1 in messages and file names).
+    pub vehicle: usize,
+    pub samples: Vec<TrackSample>,
+}
+
+impl Track {
+    /// The track from positions at `times`, velocities by central differences.
+    pub fn from_positions(vehicle: usize, times: &[f64], positions: &[Point3<f64>]) -> Self {
+        let n = times.len().min(positions.len());
+        let samples = (0..n)
+            .map(|k| {
+                let (a, b) = (k.saturating_sub(1), (k + 1).min(n - 1));
+                let dt = times[b] - times[a];
+                let velocity = if dt > 0.0 {
+                    (positions[b] - positions[a]) / dt
+                } else {
+                    Vector3::zeros()
+                };
+                TrackSample {
+                    t: times[k],
+                    position: positions[k],
+                    velocity,
+                }
+            })
+            .collect();
+        Track { vehicle, samples }
+    }
+
+    /// Seconds from the first to the last sample.
+    pub fn duration(&self) -> f64 {
+        match (self.samples.first(), self.samples.last()) {
+            (Some(a), Some(b)) => b.t - a.t,
+            _ => 0.0,
+        }
+    }
+}
+
+/// Every UAV's trajectory of a θ-PSO plan.
+pub fn theta_pso(outcome: &ThetaPsoOutcome) -> Vec<Track> {
+    outcome
+        .trajectories
+        .iter()
+        .map(|t| Track {
+            vehicle: t.uav,
+            samples: t
+                .samples
+                .iter()
+                .map(|s| TrackSample {
+                    t: s.t,
+                    position: s.position,
+                    velocity: s.velocity,
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+/// Every aircraft's reference of a FLATLO run, on the sample grid.
+pub fn flatlo(outcome: &FlatloOutcome) -> Vec<Track> {
+    outcome
+        .aircraft
+        .iter()
+        .map(|a| {
+            let times: Vec<f64> = a.reference.iter().map(|s| s.t).collect();
+            let positions: Vec<Point3<f64>> = a.reference.iter().map(|s| s.position).collect();
+            Track::from_positions(a.index, &times, &positions)
+        })
+        .collect()
+}
+
+/// Every quadrotor's flight of a fleet run.
+pub fn fleet(outcome: &FleetOutcome) -> Vec<Track> {
+    outcome
+        .agents
+        .iter()
+        .map(|a| {
+            let times: Vec<f64> = a.samples.iter().map(|s| s.t).collect();
+            let positions: Vec<Point3<f64>> = a.samples.iter().map(|s| s.position).collect();
+            Track::from_positions(a.index, &times, &positions)
+        })
+        .collect()
+}
