@@ -70,5 +70,30 @@ fn full_run(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, cost_evaluation, full_run);
+/// Issue 12: what every pipeline's budget check (and the whole `diagnose`,
+/// run on every edit in the designer) costs on the bridge and on a
+/// 4,096-aircraft squadron (the largest FLATLO budget: its references are
+/// computed to know the flight time).
+fn budget_check(c: &mut Criterion) {
+    let bridge = mission::default_mission().mission;
+    let mut squadron = bridge.clone();
+    squadron.flatlo.aircraft = 4_096;
+    squadron.flatlo.spacing = 500.0;
+    squadron.flatlo.turn_radius = 150.0;
+    for (name, m) in [("bridge", &bridge), ("squadron_4096", &squadron)] {
+        c.bench_function(&format!("budget_check/{name}"), |b| {
+            b.iter(|| {
+                let m = black_box(m);
+                skyform::planner::budget(m).len()
+                    + skyform::flatlo::budget(m).len()
+                    + skyform::fleet::budget(m).len()
+            })
+        });
+    }
+    c.bench_function("diagnose/bridge", |b| {
+        b.iter(|| skyform::diagnose::diagnose(black_box(&bridge)).len())
+    });
+}
+
+criterion_group!(benches, cost_evaluation, full_run, budget_check);
 criterion_main!(benches);
