@@ -6,11 +6,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::flatlo::{self, FlatloOutcome};
-use crate::fleet::{self, FleetOutcome};
 use crate::mission::{self, Checked, Report};
-use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError, Tee};
-use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
+use crate::outcome;
+use crate::pipeline::{CancelToken, Completion, Event, Kind, Level, Observer, Tee};
+use crate::planner::PlanOptions;
 use crate::record::{self, Recorder, Sinks};
 
 pub mod export_cmd;
@@ -206,19 +205,21 @@ pub fn main() -> ExitCode {
                 parallel: !sequential,
             };
             ExitCode::from(run_pipeline(
+                Kind::ThetaPso,
                 &mission,
                 seed,
                 json.as_deref(),
                 &record.sinks(),
-                |m, seed, observer, cancel| planner::plan(m, seed, options, observer, cancel),
+                options,
             ))
         }
         Command::Run(RunCommand::Fleet(a)) => ExitCode::from(run_pipeline(
+            Kind::Fleet,
             &a.mission,
             a.seed,
             a.json.as_deref(),
             &a.record.sinks(),
-            fleet::plan,
+            PlanOptions::default(),
         )),
         Command::Run(RunCommand::Flatlo {
             mission,
@@ -226,11 +227,12 @@ pub fn main() -> ExitCode {
             json,
             record,
         }) => ExitCode::from(run_pipeline(
+            Kind::Flatlo,
             &mission,
             seed,
             json.as_deref(),
             &record.sinks(),
-            flatlo::plan,
+            PlanOptions::default(),
         )),
         Command::Record { mission, record } => {
             ExitCode::from(record_mission(&mission, &record.sinks()))
@@ -394,74 +396,19 @@ impl Observer for StderrProgress {
     }
 }
 
-/// What `skyform run` needs of any pipeline's outcome.
-trait RunOutcome: serde::Serialize {
-    fn summary(&self) -> String;
-    fn completion(&self) -> Completion;
-    /// The result meets its hard constraints (exit 0 rather than 2).
-    fn ok(&self) -> bool;
-    fn record(&self, recorder: &mut Recorder);
-}
-
-impl RunOutcome for ThetaPsoOutcome {
-    fn summary(&self) -> String {
-        theta_pso_summary(self)
-    }
-    fn completion(&self) -> Completion {
-        self.completion
-    }
-    fn ok(&self) -> bool {
-        self.feasible()
-    }
-    fn record(&self, recorder: &mut Recorder) {
-        recorder.log_theta_pso(self);
-    }
-}
-
-impl RunOutcome for FlatloOutcome {
-    fn summary(&self) -> String {
-        flatlo_summary(self)
-    }
-    fn completion(&self) -> Completion {
-        self.completion
-    }
-    fn ok(&self) -> bool {
-        self.passed()
-    }
-    fn record(&self, recorder: &mut Recorder) {
-        recorder.log_flatlo(self);
-    }
-}
-
-impl RunOutcome for FleetOutcome {
-    fn summary(&self) -> String {
-        fleet_summary(self)
-    }
-    fn completion(&self) -> Completion {
-        self.completion
-    }
-    fn ok(&self) -> bool {
-        self.kept_apart() && self.obstacles_clear() && self.converged()
-    }
-    fn record(&self, recorder: &mut Recorder) {
-        recorder.log_fleet(self);
-    }
-}
-
 /// `skyform run PIPELINE`: load, record, run with progress and Ctrl-C,
 /// summarise, write JSON, choose the exit status.
-fn run_pipeline<O: RunOutcome>(
+fn run_pipeline(
+    kind: Kind,
     path: &std::path::Path,
     seed: Option<u64>,
     json: Option<&std::path::Path>,
     sinks: &Sinks,
-    plan: impl FnOnce(
-        &mission::Mission,
-        u64,
-        &mut dyn Observer,
-        &CancelToken,
-    ) -> Result<O, PipelineError>,
+    options: PlanOptions,
 ) -> u8 {
+    let plan = |m: &mission::Mission, seed, observer: &mut dyn Observer, cancel: &CancelToken| {
+        outcome::run(kind, m, seed, options, observer, cancel)
+    };
     let Some(mission) = load_reporting(path) else {
         return exit::ERROR;
     };
@@ -494,7 +441,7 @@ fn run_pipeline<O: RunOutcome>(
         }
     };
     if let Some(r) = recorder.as_mut() {
-        outcome.record(r);
+        r.log_outcome(&outcome);
     }
     // Every clone of the stream is dropped here, so the file is complete
     // (with its footer) before anything else is printed or the process ends.
@@ -511,7 +458,7 @@ fn run_pipeline<O: RunOutcome>(
         print!("{summary}");
     }
     if let Some(target) = json {
-        let text = match serde_json::to_string_pretty(&outcome) {
+        let text = match outcome.to_json() {
             Ok(t) => t,
             Err(e) => {
                 eprintln!("error: cannot write the outcome as JSON: {e}");
@@ -532,246 +479,6 @@ fn run_pipeline<O: RunOutcome>(
     } else {
         exit::INFEASIBLE
     }
-}
-
-/// The human summary of a θ-PSO outcome.
-pub fn theta_pso_summary(o: &ThetaPsoOutcome) -> String {
-    use std::fmt::Write as _;
-    let mut s = String::new();
-    let _ = writeln!(s, "θ-PSO plan for \"{}\" (seed {})", o.mission, o.seed);
-    let restarts = match o.restarts {
-        0 => String::new(),
-        n => format!(" ({n} restart(s): the best plan failed verification)"),
-    };
-    let _ = writeln!(
-        s,
-        "  run          {:?} after {} iterations, {} cost evaluations{restarts}",
-        o.completion, o.iterations, o.evaluations
-    );
-    let c = &o.cost;
-    let _ = writeln!(
-        s,
-        "  cost         J = {:.3}  (J1 length {:.2} m, J2 obstacles {:.5}, J3 altitude {:.3}, J_R waypoints {:.2} m, J_B bounds {:.3}, J_T turning {:.3})",
-        c.total, c.length, c.obstacle, c.altitude, c.waypoints, c.bounds, c.turning
-    );
-    let reference = match (o.reference_length, o.length_ratio) {
-        (Some(r), Some(ratio)) => format!("; J1 / reference {ratio:.3} (shortest route {r:.1} m)"),
-        _ => "; no reference route reaches the goal".to_owned(),
-    };
-    let _ = writeln!(
-        s,
-        "  path         {:.1} m in {:.1} s, {} free waypoints{reference}",
-        o.path_length,
-        o.duration,
-        o.waypoints.len()
-    );
-    let enabled = o.iwps.iter().filter(|i| i.enabled).count();
-    let _ = writeln!(
-        s,
-        "  IWPs         {} found, {enabled} enabled",
-        o.iwps.len()
-    );
-    for i in o.iwps.iter().filter(|i| i.enabled && i.unusable.is_some()) {
-        let _ = writeln!(
-            s,
-            "  IWP          '{}' | '{}' unusable: {}",
-            i.between[0],
-            i.between[1],
-            i.unusable.as_deref().unwrap_or_default()
-        );
-    }
-    for r in &o.reconfigurations {
-        let _ = writeln!(
-            s,
-            "  reconfig     {} between '{}' and '{}': t1 {:.1} s, t2 {:.1} s, t3 {:.1} s, t4 {:.1} s",
-            r.shape.name(),
-            r.between[0],
-            r.between[1],
-            r.t1,
-            r.t2,
-            r.t3,
-            r.t4
-        );
-    }
-    let _ = writeln!(s, "  verification");
-    for check in &o.verification.checks {
-        let worst = check
-            .worst
-            .map_or_else(|| "n/a".to_owned(), |w| format!("{w:.3}"));
-        let at = check.at.as_ref().map_or_else(String::new, |a| {
-            let other = a
-                .other
-                .as_deref()
-                .map_or_else(String::new, |o| format!(" vs {o}"));
-            format!("  (UAV {} at t = {:.1} s{other})", a.uav + 1, a.time)
-        });
-        let verdict = if check.ok { "ok  " } else { "FAIL" };
-        let _ = writeln!(
-            s,
-            "    {verdict} {:<32} worst {worst:>9} {} {}{at}",
-            check.name, check.relation, check.limit
-        );
-    }
-    for i in &o.verification.inspections {
-        let verdict = if i.ok { "ok  " } else { "FAIL" };
-        let band = i.distance.map_or_else(
-            || "never within the band".to_owned(),
-            |[lo, hi]| format!("facing UAV at {lo:.2}-{hi:.2} m"),
-        );
-        let _ = writeln!(
-            s,
-            "    {verdict} inspection of {:<19} {:>5.1} m ≥ {} m within [{}, {}] m, {band}",
-            format!("'{}'", i.obstacle),
-            i.achieved,
-            i.required,
-            i.band[0],
-            i.band[1]
-        );
-    }
-    let verdict = if o.feasible() {
-        "FEASIBLE"
-    } else {
-        "INFEASIBLE"
-    };
-    let _ = writeln!(s, "  result       {verdict}");
-    s
-}
-
-/// The human summary of a FLATLO outcome.
-pub fn flatlo_summary(o: &FlatloOutcome) -> String {
-    use std::fmt::Write as _;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "FLATLO transition for \"{}\" (seed {})",
-        o.mission, o.seed
-    );
-    let _ = writeln!(
-        s,
-        "  run          {:?}, {:.1} s simulated; every aircraft on the line at t = {:.1} s",
-        o.completion, o.duration, o.arrival_time
-    );
-    for a in &o.aircraft {
-        let _ = writeln!(
-            s,
-            "  aircraft {:<3} {:<6} Δm {:>8.0} m  Δ {:>7.0} m  transition {:>8.0} m at {:>6.2} m/s  tracking max {:>7.1} m, RMS {:>6.1} m",
-            a.index,
-            format!("{:?}", a.side).to_lowercase(),
-            a.advance,
-            a.lateral_distance,
-            a.transition_length,
-            a.airspeed,
-            a.tracking_max,
-            a.tracking_rms
-        );
-    }
-    for p in &o.pairs {
-        let _ = writeln!(
-            s,
-            "  pair {:>2}-{:<2}    closest {:>9.1} m at t = {:.0} s",
-            p.a, p.b, p.min_distance, p.time
-        );
-    }
-    let closest = o.closest.map_or("-".to_owned(), |c| {
-        format!(
-            "aircraft {} and {} at {:.1} m (t = {:.0} s)",
-            c.a, c.b, c.min_distance, c.time
-        )
-    });
-    let Some(v) = &o.verification else {
-        let _ = writeln!(
-            s,
-            "  result       CANCELLED: no verdict on a partial flight; closest so far {closest}"
-        );
-        return s;
-    };
-    let spacing: Vec<String> = v
-        .final_spacing
-        .iter()
-        .map(|x| format!("{}→{} {:.1} m", x.front, x.back, x.spacing))
-        .collect();
-    let _ = writeln!(s, "  final line   {}", spacing.join(", "));
-    let _ = writeln!(
-        s,
-        "               spacing error {:.3} % of Δd, lateral spread {:.1} m",
-        v.max_spacing_error * 100.0,
-        v.lateral_spread
-    );
-    let verdict = if v.passed { "PASS" } else { "FAIL" };
-    let _ = writeln!(
-        s,
-        "  result       {verdict}: closest {closest}, minimum separation {:.0} m",
-        v.min_separation
-    );
-    s
-}
-
-/// The human summary of a fleet outcome.
-pub fn fleet_summary(o: &FleetOutcome) -> String {
-    use std::fmt::Write as _;
-    let mut s = String::new();
-    let _ = writeln!(s, "Fleet for \"{}\" (seed {})", o.mission, o.seed);
-    let _ = writeln!(
-        s,
-        "  run          {:?}, {:.1} s simulated, {} agents",
-        o.completion,
-        o.duration,
-        o.agents.len()
-    );
-    for (k, t) in o.targets.iter().enumerate() {
-        let reached = t.converged_after.map_or("NOT REACHED".to_owned(), |a| {
-            format!("formed {a:.2} s after it appeared")
-        });
-        let _ = writeln!(
-            s,
-            "  target {:<5} ({:.2}, {:.2}) at t = {:.1} s: {reached}",
-            k + 1,
-            t.position.x,
-            t.position.y,
-            t.time
-        );
-    }
-    for d in &o.distances {
-        let last = d.values.last().copied().unwrap_or(f64::NAN);
-        let min = d.values.iter().copied().fold(f64::INFINITY, f64::min);
-        let _ = writeln!(
-            s,
-            "  pair {:>2}-{:<3}   final {last:.3} m (desired {:.3}), min {min:.3} m",
-            d.a, d.b, d.desired
-        );
-    }
-    let agents = o.closest_agents.as_ref().map_or("-".to_owned(), |c| {
-        format!(
-            "agents {} and {} at {:.3} m (t = {:.2} s)",
-            c.a, c.b, c.distance, c.time
-        )
-    });
-    let obstacle = o.closest_obstacle.as_ref().map_or("-".to_owned(), |c| {
-        format!(
-            "agent {} to '{}' at {:.3} m (t = {:.2} s)",
-            c.a, c.b, c.distance, c.time
-        )
-    });
-    let _ = writeln!(
-        s,
-        "  closest      {agents}; safety distance c = {} m",
-        o.safety_distance
-    );
-    let _ = writeln!(s, "  obstacles    {obstacle}");
-    let decisions: usize = o.agents.iter().map(|a| a.decisions).sum();
-    let evaluations: usize = o.agents.iter().map(|a| a.evaluations).sum();
-    let _ = writeln!(
-        s,
-        "  PSO effort   {decisions} decisions, {evaluations} cost evaluations ({:.0} per agent per second)",
-        evaluations as f64 / (o.agents.len().max(1) as f64 * o.duration.max(1e-9))
-    );
-    let verdict = if o.kept_apart() && o.obstacles_clear() && o.converged() {
-        "PASS"
-    } else {
-        "FAIL"
-    };
-    let _ = writeln!(s, "  result       {verdict}");
-    s
 }
 
 /// `skyform check`: one report per file, then a one-line verdict.

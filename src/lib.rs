@@ -13,6 +13,7 @@ pub mod fleet;
 pub mod geometry;
 pub mod mission;
 pub mod ode;
+pub mod outcome;
 pub mod pipeline;
 pub mod planner;
 #[cfg(feature = "rerun")]

@@ -11,6 +11,51 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use nalgebra::Point3;
 use serde::Serialize;
 
+/// The planning pipelines: what `outcome::run` runs, what a track came
+/// from, what the CLI's `--pipeline` and the designer's run keys name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum Kind {
+    ThetaPso,
+    Flatlo,
+    Fleet,
+}
+
+impl Kind {
+    pub const ALL: [Kind; 3] = [Kind::ThetaPso, Kind::Flatlo, Kind::Fleet];
+
+    /// For people: `θ-PSO`, `FLATLO`, `fleet`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::ThetaPso => "θ-PSO",
+            Kind::Flatlo => "FLATLO",
+            Kind::Fleet => "fleet",
+        }
+    }
+
+    /// As on the command line and in file names: `theta-pso`, `flatlo`, `fleet`.
+    pub fn slug(self) -> &'static str {
+        match self {
+            Kind::ThetaPso => "theta-pso",
+            Kind::Flatlo => "flatlo",
+            Kind::Fleet => "fleet",
+        }
+    }
+
+    /// The vehicles it plans fly with fixed wings (FLATLO's aircraft).
+    pub fn fixed_wing(self) -> bool {
+        matches!(self, Kind::Flatlo)
+    }
+
+    /// What its vehicles are called in messages.
+    pub fn vehicle(self) -> &'static str {
+        match self {
+            Kind::ThetaPso => "UAV",
+            Kind::Flatlo => "aircraft",
+            Kind::Fleet => "agent",
+        }
+    }
+}
+
 /// Severity of a log event.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]

@@ -25,6 +25,7 @@ use rerun::{RecordingStream, RecordingStreamBuilder};
 use crate::flatlo::FlatloOutcome;
 use crate::fleet::FleetOutcome;
 use crate::mission::{Mission, to_toml_string};
+use crate::outcome::Outcome;
 use crate::pipeline::{CostTerms, Event, Level, Observer};
 use crate::planner::{ThetaPsoOutcome, find_iwps};
 
@@ -72,9 +73,7 @@ enum Message {
         path: Vec<[f32; 3]>,
     },
     Log(Level, String),
-    ThetaPso(Box<ThetaPsoOutcome>),
-    Flatlo(Box<FlatloOutcome>),
-    Fleet(Box<FleetOutcome>),
+    Outcome(Box<Outcome>),
 }
 
 /// A recording in progress. `finish` (or drop) flushes it and closes the file.
@@ -189,19 +188,9 @@ impl Recorder {
         self.send(Message::Scene(Box::new(mission.clone())));
     }
 
-    /// Logs a θ-PSO result.
-    pub fn log_theta_pso(&mut self, outcome: &ThetaPsoOutcome) {
-        self.send(Message::ThetaPso(Box::new(outcome.clone())));
-    }
-
-    /// Logs a FLATLO result.
-    pub fn log_flatlo(&mut self, outcome: &FlatloOutcome) {
-        self.send(Message::Flatlo(Box::new(outcome.clone())));
-    }
-
-    /// Logs a distributed-fleet result.
-    pub fn log_fleet(&mut self, outcome: &FleetOutcome) {
-        self.send(Message::Fleet(Box::new(outcome.clone())));
+    /// Logs a pipeline's result in its layout.
+    pub fn log_outcome(&mut self, outcome: &Outcome) {
+        self.send(Message::Outcome(Box::new(outcome.clone())));
     }
 
     /// Flushes everything and closes the sinks; the `.rrd` is complete after this.
@@ -256,6 +245,29 @@ impl Observer for Recorder {
 
 fn f32x3(p: &Point3<f64>) -> [f32; 3] {
     [p.x as f32, p.y as f32, p.z as f32]
+}
+
+/// Why streaming to a viewer would not work now, if it would not: nothing
+/// listens at the default port (`connect`), or no `rerun` on PATH
+/// (`spawn`). A quick check for the designer's status bar.
+pub fn viewer_problem(spawn: bool) -> Option<String> {
+    let port = rerun::DEFAULT_SERVER_PORT;
+    if viewer_listening("127.0.0.1", port) {
+        return None;
+    }
+    if !spawn {
+        return Some(format!(
+            "no Rerun viewer listens on port {port}: start one with `rerun --port {port}` \
+             (runs go on without it)"
+        ));
+    }
+    let on_path = std::env::var_os("PATH")
+        .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join("rerun").is_file()));
+    (!on_path).then(|| {
+        "`rerun` is not on PATH: install it with `pip install rerun-sdk==0.36.3` \
+         (runs go on without it)"
+            .to_owned()
+    })
 }
 
 /// Is something listening at host:port? A short TCP connect, nothing more.
@@ -337,17 +349,19 @@ fn run_worker(stream: RecordingStream, inbox: Receiver<Message>) {
 fn log_message(stream: &RecordingStream, message: Message) {
     let result = match message {
         Message::Scene(mission) => log_scene(stream, &mission),
-        Message::ThetaPso(outcome) => log_theta_pso(stream, &outcome),
-        Message::Flatlo(outcome) => {
-            let _ = layout(Layout::Flatlo)
-                .send(stream, rerun::blueprint::BlueprintActivation::default());
-            log_flatlo(stream, &outcome)
-        }
-        Message::Fleet(outcome) => {
-            let _ = layout(Layout::Fleet)
-                .send(stream, rerun::blueprint::BlueprintActivation::default());
-            log_fleet(stream, &outcome)
-        }
+        Message::Outcome(outcome) => match *outcome {
+            Outcome::ThetaPso(o) => log_theta_pso(stream, &o),
+            Outcome::Flatlo(o) => {
+                let _ = layout(Layout::Flatlo)
+                    .send(stream, rerun::blueprint::BlueprintActivation::default());
+                log_flatlo(stream, &o)
+            }
+            Outcome::Fleet(o) => {
+                let _ = layout(Layout::Fleet)
+                    .send(stream, rerun::blueprint::BlueprintActivation::default());
+                log_fleet(stream, &o)
+            }
+        },
         Message::Log(level, text) => {
             let level = match level {
                 Level::Info => rerun::TextLogLevel::INFO,
@@ -572,17 +586,9 @@ fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamRes
     Ok(())
 }
 
-/// UAV colours, one per slot, cycling.
+/// Vehicle `n`'s colour, the same as on the designer's map.
 fn uav_color(n: usize) -> rerun::Color {
-    const PALETTE: [(u8, u8, u8); 6] = [
-        (31, 119, 180),
-        (255, 127, 14),
-        (44, 160, 44),
-        (214, 39, 40),
-        (148, 103, 189),
-        (23, 190, 207),
-    ];
-    let (r, g, b) = PALETTE[n % PALETTE.len()];
+    let [r, g, b] = crate::tracks::vehicle_color(n);
     rerun::Color::from_rgb(r, g, b)
 }
 
@@ -802,7 +808,9 @@ fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingSt
             o.duration,
             o.closest.map_or("-".to_owned(), |c| format!(
                 "{} and {} at {:.0} m",
-                c.a, c.b, c.min_distance
+                c.a + 1,
+                c.b + 1,
+                c.min_distance
             )),
             o.verification
                 .as_ref()
@@ -836,14 +844,14 @@ fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingSt
                 .map(|s| f32x3(&s.position))
                 .collect::<Vec<_>>()])
             .with_colors([color])
-            .with_labels([format!("aircraft {}", a.index)]),
+            .with_labels([format!("aircraft {}", a.index + 1)]),
         )?;
         let times = rerun::TimeColumn::new_duration_secs("sim_time", a.flown.iter().map(|s| s.t));
         let entity = format!("flatlo/aircraft/{name}");
         let style = rerun::Points3D::update_fields()
             .with_colors([color])
             .with_radii([150.0f32])
-            .with_labels([format!("aircraft {}", a.index)]);
+            .with_labels([format!("aircraft {}", a.index + 1)]);
         let positions = a.flown.iter().map(|s| f32x3(&s.position)).collect();
         log_moving_point(stream, &entity, &times, style, positions)?;
         type Series = fn(&crate::flatlo::FlownSample) -> f64;
@@ -886,7 +894,9 @@ fn log_flatlo(stream: &RecordingStream, o: &FlatloOutcome) -> rerun::RecordingSt
             "flatlo/events",
             &rerun::TextLog::new(format!(
                 "closest approach of aircraft {} and {}: {:.0} m",
-                p.a, p.b, p.min_distance
+                p.a + 1,
+                p.b + 1,
+                p.min_distance
             ))
             .with_level(level),
         )?;
@@ -981,7 +991,9 @@ fn log_fleet(stream: &RecordingStream, o: &FleetOutcome) -> rerun::RecordingStre
                 "fleet/events",
                 &rerun::TextLog::new(format!(
                     "closest approach ({label}): agent {} and {} at {:.3} m",
-                    c.a, c.b, c.distance
+                    c.a + 1,
+                    c.b,
+                    c.distance
                 ))
                 .with_level(level),
             )?;

@@ -15,30 +15,22 @@ use crate::flatlo::FlatloOutcome;
 use crate::fleet::FleetOutcome;
 use crate::planner::ThetaPsoOutcome;
 
-/// The pipelines a track can come from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-pub enum Pipeline {
-    ThetaPso,
-    Flatlo,
-    Fleet,
-}
+/// One colour per vehicle (RGB), in vehicle order, cycling: the designer's
+/// map and the Rerun recording draw UAV n in the same colour. Chosen to
+/// stay apart on dark terminals and in the viewer (cyan first, as the map
+/// always drew UAV 1).
+pub const VEHICLE_COLORS: [[u8; 3]; 6] = [
+    [23, 190, 207],
+    [227, 119, 194],
+    [44, 200, 44],
+    [80, 140, 255],
+    [255, 200, 60],
+    [240, 80, 70],
+];
 
-impl Pipeline {
-    pub const ALL: [Pipeline; 3] = [Pipeline::ThetaPso, Pipeline::Flatlo, Pipeline::Fleet];
-
-    /// As on the command line and in file names: `theta-pso`, `flatlo`, `fleet`.
-    pub fn slug(self) -> &'static str {
-        match self {
-            Pipeline::ThetaPso => "theta-pso",
-            Pipeline::Flatlo => "flatlo",
-            Pipeline::Fleet => "fleet",
-        }
-    }
-
-    /// The vehicles it plans fly with fixed wings (FLATLO's aircraft).
-    pub fn fixed_wing(self) -> bool {
-        matches!(self, Pipeline::Flatlo)
-    }
+/// Vehicle `i`'s colour (0-based).
+pub fn vehicle_color(i: usize) -> [u8; 3] {
+    VEHICLE_COLORS[i % VEHICLE_COLORS.len()]
 }
 
 /// One instant of a track. Seconds, metres ENU, m/s.
@@ -118,6 +110,31 @@ pub fn flatlo(outcome: &FlatloOutcome) -> Vec<Track> {
             let times: Vec<f64> = a.reference.iter().map(|s| s.t).collect();
             let positions: Vec<Point3<f64>> = a.reference.iter().map(|s| s.position).collect();
             Track::from_positions(a.index, &times, &positions)
+        })
+        .collect()
+}
+
+/// Every aircraft's simulated flight of a FLATLO run (the samples it kept:
+/// `FlatloOutcome::sample_stride`), velocity from V, γ, χ (eqs. 4-6).
+pub fn flatlo_flown(outcome: &FlatloOutcome) -> Vec<Track> {
+    outcome
+        .aircraft
+        .iter()
+        .map(|a| Track {
+            vehicle: a.index,
+            samples: a
+                .flown
+                .iter()
+                .map(|s| {
+                    let (sg, cg) = s.gamma.sin_cos();
+                    let (sc, cc) = s.chi.sin_cos();
+                    TrackSample {
+                        t: s.t,
+                        position: s.position,
+                        velocity: nalgebra::Vector3::new(cg * cc, cg * sc, sg) * s.airspeed,
+                    }
+                })
+                .collect(),
         })
         .collect()
 }

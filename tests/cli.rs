@@ -150,7 +150,7 @@ fn run_flatlo_summarises_the_squadron_and_exits_by_its_verdict() {
         stdout.contains("FLATLO transition for \"FLATLO squadron transition\" (seed 3)"),
         "{stdout}"
     );
-    assert!(stdout.contains("aircraft 3   right"), "{stdout}");
+    assert!(stdout.contains("aircraft 4   right"), "{stdout}");
     assert!(stdout.contains("result       PASS"), "{stdout}");
 
     // A separation the squadron cannot keep: exit 2, and the summary says why.
@@ -163,7 +163,7 @@ fn run_flatlo_summarises_the_squadron_and_exits_by_its_verdict() {
     let out = skyform(&["run", "flatlo", strict.to_str().unwrap_or_default()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(
-        text(&out.stdout).contains("result       FAIL: closest aircraft 1 and 3"),
+        text(&out.stdout).contains("result       FAIL: closest aircraft 2 and 4"),
         "{}",
         text(&out.stdout)
     );

@@ -88,10 +88,14 @@ impl Session {
 /// Starts skyform on `file` in a fresh pseudo-terminal, recovery copies
 /// kept in `state`.
 fn launch(file: &std::path::Path, state: &std::path::Path) -> Session {
+    launch_sized(file, state, ROWS, COLS)
+}
+
+fn launch_sized(file: &std::path::Path, state: &std::path::Path, rows: u16, cols: u16) -> Session {
     let pair = native_pty_system()
         .openpty(PtySize {
-            rows: ROWS,
-            cols: COLS,
+            rows,
+            cols,
             pixel_width: 0,
             pixel_height: 0,
         })
@@ -107,8 +111,8 @@ fn launch(file: &std::path::Path, state: &std::path::Path) -> Session {
     drop(pair.slave);
 
     let screen = Arc::new(Mutex::new(vt100::Parser::new(
-        std::num::NonZero::new(ROWS).unwrap(),
-        std::num::NonZero::new(COLS).unwrap(),
+        std::num::NonZero::new(rows).unwrap(),
+        std::num::NonZero::new(cols).unwrap(),
         0,
     )));
     let mut reader = pair.master.try_clone_reader().unwrap();
@@ -286,4 +290,63 @@ fn sigterm_during_a_run_restores_the_terminal_and_closes_the_recording() {
         .collect::<Result<_, _>>()
         .expect("every message decodes: the recording was closed");
     assert!(messages.len() > 3, "{} messages", messages.len());
+}
+
+/// Issue 16 at 80×24, the smallest screen the designer takes: the help
+/// scrolls to the Run keys, a run starts, is cancelled, and the jobs panel
+/// shows the share it got through (not a full bar).
+#[test]
+fn at_80_by_24_help_scrolls_to_the_run_keys_and_a_cancel_shows_its_share() {
+    let dir = tempfile::tempdir().unwrap();
+    let state = tempfile::tempdir().unwrap();
+    let file = bridge_copy(dir.path());
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &file,
+        text.replace("iterations = 150", "iterations = 20000"),
+    )
+    .unwrap();
+    let mut s = launch_sized(&file, state.path(), 24, 80);
+    s.wait_for("Inspector", Duration::from_secs(30));
+
+    s.send("?");
+    s.wait_for("Keys", Duration::from_secs(5));
+    let mut found = false;
+    for _ in 0..60 {
+        if s.contents().contains("run θ-PSO") {
+            found = true;
+            break;
+        }
+        s.send("\x1b[B"); // ↓
+        thread::sleep(Duration::from_millis(60));
+    }
+    assert!(
+        found,
+        "the Run keys never scrolled into view:\n{}",
+        s.contents()
+    );
+    s.send("q"); // any other key closes the help
+    thread::sleep(Duration::from_millis(200));
+
+    s.send("r");
+    s.wait_for("started with seed", Duration::from_secs(10));
+    thread::sleep(Duration::from_millis(1500));
+    s.send("x");
+    s.wait_for("cancelled", Duration::from_secs(30));
+    let screen = s.contents();
+    assert!(screen.contains("job 1 cancelled"), "{screen}");
+    let line = screen
+        .lines()
+        .find(|l| l.contains("θ-PSO s") && l.contains('%'))
+        .unwrap_or_else(|| panic!("no job line:\n{screen}"));
+    let percent: u32 = line
+        .split('%')
+        .next()
+        .and_then(|head| head.split_whitespace().last())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no percentage in {line:?}"));
+    assert!(percent < 100, "a cancelled job shows {percent}%: {line}");
+    s.send("q");
+    assert_eq!(s.wait_exit(Duration::from_secs(20)), 0);
+    assert!(s.cooked());
 }

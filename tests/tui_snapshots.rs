@@ -13,7 +13,7 @@ use skyform::mission::default_mission;
 use skyform::tui::app::Focus;
 use skyform::tui::fields::Item;
 use skyform::tui::fixtures::{app_with_flatlo_result, app_with_result};
-use skyform::tui::jobs::{Job, JobMsg, Pipeline};
+use skyform::tui::jobs::{Job, JobMsg, Kind};
 use skyform::tui::{Action, App, Document, view};
 
 const WIDTH: u16 = 140;
@@ -71,7 +71,7 @@ fn jobs_panel_mid_run() {
     let started = Instant::now();
     let m = app.mission().clone();
     app.jobs
-        .push(Job::new(1, Pipeline::ThetaPso, 7, m.clone(), started));
+        .push(Job::new(1, Kind::ThetaPso, 7, m.clone(), started));
     app.shown_job = Some(1);
     app.update(Action::FocusOn(Focus::Jobs));
     let path = vec![m.route.start, Point3::new(60.0, 45.0, 8.0), m.route.goal];

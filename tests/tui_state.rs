@@ -177,7 +177,7 @@ fn a_run_in_the_background_gives_the_same_result_as_the_pipeline() {
     assert_eq!(app.jobs.len(), 1);
     assert!(app.wait_for_jobs(Duration::from_secs(60)));
     let job = &app.jobs[0];
-    assert_eq!(job.state, JobState::Done { feasible: true });
+    assert_eq!(job.state, JobState::Done { passed: true });
     let direct = skyform::planner::plan(
         app.mission(),
         app.mission().seed,
@@ -567,7 +567,7 @@ mod mouse {
 fn the_readme_lists_every_key_the_help_overlay_shows() {
     let readme =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
-    for (_, keys, what) in skyform::tui::input::KEYS {
+    for (_, keys, what) in skyform::tui::keys::KEYS {
         let row = format!("| `{keys}` | {what} |");
         assert!(readme.contains(&row), "README.md lacks the key row {row}");
     }
@@ -581,7 +581,7 @@ fn a_fleet_run_replays_on_the_map() {
     let mut app = App::new(Document::new(m, None), std::env::temp_dir());
     app.update(Action::RunFleet);
     assert!(app.wait_for_jobs(Duration::from_secs(60)));
-    assert_eq!(app.jobs[0].pipeline, skyform::tui::jobs::Pipeline::Fleet);
+    assert_eq!(app.jobs[0].pipeline, skyform::pipeline::Kind::Fleet);
     assert_eq!(app.replay_end(), Some(6.0));
     assert_eq!(app.replay_time(), Some(6.0), "the end until scrubbed");
     app.update(Action::Scrub(-2.5));
@@ -792,4 +792,98 @@ fn unsaved_edits_are_kept_in_a_recovery_copy_and_offered_back() {
     app.update(Action::Dismiss);
     assert_eq!(copies(), 0);
     assert!(!app.doc.is_modified());
+}
+
+/// Issue 16: the friction fixes that a state can hold.
+#[test]
+fn enter_applies_and_stays_and_a_good_edit_clears_an_old_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Select(Item::Bounds));
+    type_into(&mut app, "x min (m)", "abc");
+    assert!(app.status.as_ref().is_some_and(|s| s.error));
+    app.update(Action::Dismiss);
+    let field = app.field;
+    type_into(&mut app, "x min (m)", "-5");
+    assert_eq!(app.field, field, "Enter stays on the field");
+    assert_eq!(app.mission().bounds.x[0], -5.0);
+    let status = app.status.clone().unwrap();
+    assert!(!status.error, "the old error is gone: {}", status.text);
+    app.update(Action::FieldDown);
+    assert_eq!(app.field, field + 1, "↓ goes to the very next field");
+}
+
+#[test]
+fn s_outside_an_iwp_row_says_what_it_needs() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let before = app.mission().clone();
+    app.update(Action::CycleShape);
+    assert_eq!(app.mission(), &before);
+    let status = app.status.clone().unwrap();
+    assert!(status.text.contains("select one of the"), "{}", status.text);
+}
+
+#[test]
+fn the_formation_title_follows_undo_back_to_the_original_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let original = app.current_preset();
+    app.update(Action::CyclePreset);
+    let first = app.current_preset();
+    assert!(
+        first.is_some() && first != original,
+        "{first:?} {original:?}"
+    );
+    app.update(Action::Undo);
+    assert_eq!(app.current_preset(), original);
+}
+
+#[test]
+fn opening_another_mission_drops_the_jobs_of_the_first() {
+    let mut app = app_with_result(default_mission().mission, 7, 5);
+    assert_eq!(app.jobs.len(), 1);
+    let b = mission::BUILTIN
+        .iter()
+        .find(|b| b.file_name == "narrow-passage.toml")
+        .unwrap();
+    app.open(skyform::tui::app::Entry::Builtin(b.file_name));
+    assert!(app.jobs.is_empty());
+    assert_eq!(app.doc.title(), "(built-in) narrow-passage.toml");
+}
+
+#[test]
+fn drags_snap_to_the_nudge_step_and_huge_values_show_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let start = app.mission().obstacles[0].center;
+    app.update(Action::DragStart(Item::Obstacle(0), start));
+    app.update(Action::DragTo(
+        start + nalgebra::Vector2::new(3.2718, -1.0409),
+    ));
+    app.update(Action::DragEnd);
+    let c = app.mission().obstacles[0].center;
+    let step = app.step_size();
+    for v in [c.x, c.y] {
+        assert!(
+            ((v / step).round() * step - v).abs() < 1e-9,
+            "{v} is off the {step} m grid"
+        );
+    }
+    assert_eq!(skyform::tui::fields::fmt_num(1e300), "1e300");
+    assert_eq!(skyform::tui::fields::fmt_num(-2.5e-7), "-2.5e-7");
+    assert_eq!(skyform::tui::fields::fmt_num(4.080851063829786), "4.0809");
+}
+
+#[test]
+fn a_duplicate_obstacle_name_is_flagged_on_the_renamed_one_while_typing() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let other = app.mission().obstacles[4].name.clone();
+    app.update(Action::Select(Item::Obstacle(1)));
+    type_into(&mut app, "name", &other);
+    let at = |i: usize| format!("obstacles[{i}].name");
+    let lines = app.doc.error_lines();
+    assert!(lines.iter().any(|l| l.starts_with(&at(1))), "{lines:?}");
+    assert!(lines.iter().any(|l| l.starts_with(&at(4))), "{lines:?}");
 }

@@ -5,10 +5,9 @@ use std::path::{Path, PathBuf};
 use super::{StderrProgress, cancel_on_ctrl_c, exit, load_reporting};
 use crate::export::{self, ExportError, Exported, Format, Options, Planned};
 use crate::mission::Mission;
-use crate::pipeline::{CancelToken, Completion, Observer, PipelineError};
-use crate::planner::{self, PlanOptions};
-use crate::tracks::Pipeline;
-use crate::{flatlo, fleet};
+use crate::outcome;
+use crate::pipeline::{Completion, Kind};
+use crate::planner::PlanOptions;
 
 /// A pipeline on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -18,12 +17,12 @@ pub enum PipelineArg {
     Fleet,
 }
 
-impl From<PipelineArg> for Pipeline {
+impl From<PipelineArg> for Kind {
     fn from(p: PipelineArg) -> Self {
         match p {
-            PipelineArg::ThetaPso => Pipeline::ThetaPso,
-            PipelineArg::Flatlo => Pipeline::Flatlo,
-            PipelineArg::Fleet => Pipeline::Fleet,
+            PipelineArg::ThetaPso => Kind::ThetaPso,
+            PipelineArg::Flatlo => Kind::Flatlo,
+            PipelineArg::Fleet => Kind::Fleet,
         }
     }
 }
@@ -60,7 +59,7 @@ pub struct ExportArgs {
     /// Folder for the files (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Pipeline that plans the mission.
+    /// The pipeline that plans the mission.
     #[arg(long, value_enum, default_value = "theta-pso")]
     pub pipeline: PipelineArg,
     /// Seed of the pipeline (default: the mission's `seed`).
@@ -76,46 +75,27 @@ pub struct ExportArgs {
     pub force: bool,
 }
 
-/// Runs a pipeline with progress on stderr and Ctrl-C.
-fn run<O>(
-    mission: &Mission,
-    seed: u64,
-    cancel: &CancelToken,
-    plan: impl FnOnce(&Mission, u64, &mut dyn Observer, &CancelToken) -> Result<O, PipelineError>,
-) -> Result<O, PipelineError> {
+/// Plans `mission` with `pipeline`; `None` (after saying why) on error or Ctrl-C.
+pub fn planned(mission: &Mission, pipeline: Kind, seed: u64) -> Result<Planned, u8> {
+    let cancel = cancel_on_ctrl_c();
     let mut progress = StderrProgress::new();
-    let result = plan(mission, seed, &mut progress, cancel);
+    let result = outcome::run(
+        pipeline,
+        mission,
+        seed,
+        PlanOptions::default(),
+        &mut progress,
+        &cancel,
+    );
     if progress.terminal {
         eprintln!();
     }
-    result
-}
-
-/// Plans `mission` with `pipeline`; `None` (after saying why) on error or Ctrl-C.
-pub fn planned(mission: &Mission, pipeline: Pipeline, seed: u64) -> Result<Planned, u8> {
-    let cancel = cancel_on_ctrl_c();
-    let fail = |e: PipelineError| {
+    let outcome = result.map_err(|e| {
         eprintln!("error: {e}");
         exit::ERROR
-    };
-    let (planned, completion, ok) = match pipeline {
-        Pipeline::ThetaPso => {
-            let o = run(mission, seed, &cancel, |m, s, obs, c| {
-                planner::plan(m, s, PlanOptions::default(), obs, c)
-            })
-            .map_err(fail)?;
-            (Planned::theta_pso(mission, &o), o.completion, o.feasible())
-        }
-        Pipeline::Flatlo => {
-            let o = run(mission, seed, &cancel, flatlo::plan).map_err(fail)?;
-            (Planned::flatlo(mission, &o), o.completion, o.passed())
-        }
-        Pipeline::Fleet => {
-            let o = run(mission, seed, &cancel, fleet::plan).map_err(fail)?;
-            let ok = o.kept_apart() && o.obstacles_clear() && o.converged();
-            (Planned::fleet(mission, &o), o.completion, ok)
-        }
-    };
+    })?;
+    let planned = Planned::from_outcome(mission, &outcome);
+    let (completion, ok) = (outcome.completion(), outcome.ok());
     if completion == Completion::Cancelled {
         eprintln!("cancelled: nothing written");
         return Err(exit::CANCELLED);
@@ -149,7 +129,7 @@ pub fn export_command(args: &ExportArgs) -> u8 {
         eprintln!("error: {}", ExportError::NoOrigin(f.name()));
         return exit::ERROR;
     }
-    let pipeline = Pipeline::from(args.pipeline);
+    let pipeline = Kind::from(args.pipeline);
     let seed = args.seed.unwrap_or(mission.seed);
     let planned = match planned(&mission, pipeline, seed) {
         Ok(p) => p,

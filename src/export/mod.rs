@@ -27,9 +27,10 @@ use serde::Serialize;
 use crate::flatlo::FlatloOutcome;
 use crate::fleet::FleetOutcome;
 use crate::mission::Mission;
+use crate::pipeline::Kind;
 use crate::planner::ThetaPsoOutcome;
 use crate::planner::verify::Limits;
-use crate::tracks::{self, Pipeline, Track};
+use crate::tracks::{self, Track};
 
 pub use geodesy::{Frame, Geodetic};
 pub use reverify::Reverification;
@@ -90,7 +91,7 @@ pub const MIN_TOLERANCE: f64 = 1e-3;
 /// limits its verification holds, and the deviation it allows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Planned {
-    pub pipeline: Pipeline,
+    pub pipeline: Kind,
     pub seed: u64,
     pub tracks: Vec<Track>,
     pub limits: Limits,
@@ -104,12 +105,22 @@ pub struct Planned {
 }
 
 impl Planned {
+    /// What the export needs of any pipeline's outcome.
+    pub fn from_outcome(mission: &Mission, outcome: &crate::outcome::Outcome) -> Self {
+        use crate::outcome::Outcome;
+        match outcome {
+            Outcome::ThetaPso(o) => Planned::theta_pso(mission, o),
+            Outcome::Flatlo(o) => Planned::flatlo(mission, o),
+            Outcome::Fleet(o) => Planned::fleet(mission, o),
+        }
+    }
+
     /// θ-PSO: the UAVs' trajectories, held to r_Q, [2 r_Q, d_com], the band,
     /// the bounds and eq. 8; the margin is `theta_pso.clearance_margin`, the
     /// room the cost keeps for a real autopilot.
     pub fn theta_pso(mission: &Mission, outcome: &ThetaPsoOutcome) -> Self {
         Planned {
-            pipeline: Pipeline::ThetaPso,
+            pipeline: Kind::ThetaPso,
             seed: outcome.seed,
             tracks: tracks::theta_pso(outcome),
             limits: Limits::theta_pso(mission),
@@ -131,7 +142,7 @@ impl Planned {
             .map(|a| a.tracking_max)
             .fold(0.0, f64::max);
         Planned {
-            pipeline: Pipeline::Flatlo,
+            pipeline: Kind::Flatlo,
             seed: outcome.seed,
             tracks: tracks::flatlo(outcome),
             limits: Limits {
@@ -152,7 +163,7 @@ impl Planned {
     pub fn fleet(mission: &Mission, outcome: &FleetOutcome) -> Self {
         let p = &mission.fleet;
         Planned {
-            pipeline: Pipeline::Fleet,
+            pipeline: Kind::Fleet,
             seed: outcome.seed,
             tracks: tracks::fleet(outcome),
             limits: Limits {
@@ -307,7 +318,7 @@ pub struct Written {
 /// What an export did.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Exported {
-    pub pipeline: Pipeline,
+    pub pipeline: Kind,
     pub tolerance: f64,
     pub tolerance_source: String,
     pub plans: Vec<VehiclePlan>,
@@ -339,7 +350,7 @@ pub enum ExportError {
 }
 
 /// File name of one vehicle's export: `<mission-stem>-<pipeline>-uav<N>.<ext>`.
-pub fn file_name(stem: &str, pipeline: Pipeline, vehicle: usize, format: Format) -> String {
+pub fn file_name(stem: &str, pipeline: Kind, vehicle: usize, format: Format) -> String {
     format!(
         "{stem}-{}-uav{}.{}",
         pipeline.slug(),

@@ -12,7 +12,7 @@ use serde::Serialize;
 use crate::mission::FlatloParams;
 
 /// Standard gravity, m/s².
-pub const G: f64 = 9.80665;
+pub const G: f64 = crate::mission::GRAVITY;
 
 /// Below this airspeed the model's 1/V terms are held (a stalled model is
 /// meaningless anyway; the controller never asks for it).

@@ -417,7 +417,8 @@ pub fn plan(
     let plan = references(p);
     for (i, r) in plan.references.iter().enumerate() {
         let text = format!(
-            "aircraft {i}: Δm {:.0} m, transition {:.0} m at {:.2} m/s",
+            "aircraft {}: Δm {:.0} m, transition {:.0} m at {:.2} m/s",
+            i + 1,
             algorithm::move_forward(i, n, p.spacing),
             r.transition_length,
             r.airspeed
@@ -512,8 +513,8 @@ pub fn plan(
     if let (Some(c), Some(v)) = (closest, &verification) {
         let text = format!(
             "closest approach: aircraft {} and {} at {:.0} m (t = {:.0} s); minimum separation {:.0} m: {}",
-            c.a,
-            c.b,
+            c.a + 1,
+            c.b + 1,
             c.min_distance,
             c.time,
             p.min_separation,
@@ -522,7 +523,10 @@ pub fn plan(
         let level = if v.passed { Level::Info } else { Level::Warn };
         observer.on_event(Event::Log(level, &text));
     }
-    observer.on_event(Event::Progress(1.0));
+    // A cancelled run stays at the share it got through.
+    if completion == Completion::Finished {
+        observer.on_event(Event::Progress(1.0));
+    }
     Ok(FlatloOutcome {
         pipeline: "flatlo",
         mission: mission.name.clone(),

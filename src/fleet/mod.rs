@@ -59,14 +59,33 @@ pub struct TargetOutcome {
     pub converged_after: Option<f64>,
 }
 
-/// A closest approach.
+/// A closest approach of agent `a` (0-based) to another agent or an obstacle.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Closest {
     pub a: usize,
-    /// The other agent, or the obstacle's name.
-    pub b: String,
+    pub b: Other,
     pub distance: f64,
     pub time: f64,
+}
+
+/// What an agent came close to.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Other {
+    /// Another agent, 0-based.
+    Agent(usize),
+    /// An obstacle, by name.
+    Obstacle(String),
+}
+
+impl std::fmt::Display for Other {
+    /// As people read it: agents from 1, obstacles by name in quotes.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Other::Agent(j) => write!(f, "{}", j + 1),
+            Other::Obstacle(name) => write!(f, "'{name}'"),
+        }
+    }
 }
 
 /// The inter-agent distances over time (fleet paper, Fig. 13), for fleets
@@ -180,7 +199,7 @@ pub fn scenario(m: &Mission, seed: u64) -> Scenario {
         starts
     };
     let targets = if p.targets.is_empty() {
-        vec![(0.0, m.bounds.center_xy())]
+        vec![(0.0, default_target(m))]
     } else {
         p.targets.iter().map(|t| (t.time, t.position)).collect()
     };
@@ -194,6 +213,51 @@ pub fn scenario(m: &Mission, seed: u64) -> Scenario {
         targets,
         desired,
     }
+}
+
+/// Where the fleet forms when the mission names no target: the free spot
+/// nearest the bounds' centre, where the formation (agents d_ip round it,
+/// each keeping c) stays inside the bounds and keeps c from every obstacle
+/// taller than the flight altitude. A grid of at most 200 × 200 candidates;
+/// the centre itself when nothing is free.
+pub fn default_target(m: &Mission) -> Point2<f64> {
+    let p = &m.fleet;
+    let b = &m.bounds;
+    let centre = b.center_xy();
+    let reach = p.target_distance + p.safety_distance;
+    let free = |q: &Point2<f64>| {
+        q.x - reach >= b.x[0]
+            && q.x + reach <= b.x[1]
+            && q.y - reach >= b.y[0]
+            && q.y + reach <= b.y[1]
+            && m.obstacles
+                .iter()
+                .filter(|o| o.height > p.altitude)
+                .all(|o| (o.center - q).norm() - o.radius >= reach + p.safety_distance)
+    };
+    if free(&centre) {
+        return centre;
+    }
+    let span = (b.x[1] - b.x[0]).max(b.y[1] - b.y[0]);
+    let step = (reach / 2.0).max(span / 200.0).max(1e-3);
+    let (nx, ny) = (
+        ((b.x[1] - b.x[0]) / step).ceil().min(200.0) as usize,
+        ((b.y[1] - b.y[0]) / step).ceil().min(200.0) as usize,
+    );
+    let mut best: Option<(f64, Point2<f64>)> = None;
+    for i in 0..=nx {
+        for j in 0..=ny {
+            let q = Point2::new(
+                b.x[0] + (b.x[1] - b.x[0]) * i as f64 / nx.max(1) as f64,
+                b.y[0] + (b.y[1] - b.y[0]) * j as f64 / ny.max(1) as f64,
+            );
+            let d = (q - centre).norm();
+            if best.is_none_or(|(bd, _)| d < bd) && free(&q) {
+                best = Some((d, q));
+            }
+        }
+    }
+    best.map_or(centre, |(_, q)| q)
 }
 
 /// Agents within `radius` of each agent (eq. 2), by a uniform grid of that
@@ -466,7 +530,7 @@ pub fn plan(
                     if closest_agents.as_ref().is_none_or(|c| d < c.distance) {
                         closest_agents = Some(Closest {
                             a: i,
-                            b: j.to_string(),
+                            b: Other::Agent(j),
                             distance: d,
                             time: t,
                         });
@@ -478,7 +542,7 @@ pub fn plan(
                     if closest_obstacle.as_ref().is_none_or(|c| d < c.distance) {
                         closest_obstacle = Some(Closest {
                             a: i,
-                            b: o.name.clone(),
+                            b: Other::Obstacle(o.name.clone()),
                             distance: d,
                             time: t,
                         });
@@ -607,7 +671,10 @@ pub fn plan(
         };
         observer.on_event(Event::Log(Level::Info, &text));
     }
-    observer.on_event(Event::Progress(1.0));
+    // A cancelled run stays at the share it got through.
+    if completion == Completion::Finished {
+        observer.on_event(Event::Progress(1.0));
+    }
     let agents = flights
         .into_iter()
         .zip(samples)

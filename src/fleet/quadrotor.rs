@@ -14,7 +14,7 @@ use nalgebra::{Matrix3, Point3, Quaternion, SVector, UnitQuaternion, Vector3};
 use crate::mission::FleetParams;
 
 /// Standard gravity, m/s².
-pub const G: f64 = 9.80665;
+pub const G: f64 = crate::mission::GRAVITY;
 
 /// p (0..3), ṗ (3..6), q = (w, x, y, z) (6..10), ω (10..13).
 pub type State = SVector<f64, 13>;

@@ -20,4 +20,4 @@ pub use file::{
 pub use model::*;
 pub use presets::Preset;
 pub use source::{FieldPath, LineCol, PathSegment, SourceMap};
-pub use validate::{compact, validate};
+pub use validate::{compact, compact_digits, validate};

@@ -42,6 +42,10 @@ pub struct Mission {
     pub obstacles: Vec<Obstacle>,
 }
 
+/// Standard gravity, m/s² (ISO 80000-3): one constant for validation and
+/// every vehicle model.
+pub const GRAVITY: f64 = 9.80665;
+
 /// WGS-84 position of the ENU origin.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -12,8 +12,7 @@ use super::model::{
 };
 use super::source::FieldPath;
 
-/// Standard gravity, m/s².
-const G: f64 = 9.81;
+use super::model::GRAVITY as G;
 
 /// Checks every rule; errors and warnings in the order of the file.
 pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
@@ -36,7 +35,7 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
     );
     c.theta_pso(&root.key("theta_pso"), &mission.theta_pso);
     c.flatlo(&root.key("flatlo"), &mission.flatlo);
-    c.fleet(&root.key("fleet"), &mission.fleet, &mission.bounds);
+    c.fleet(&root.key("fleet"), &mission.fleet, mission);
     c.obstacles(&root.key("obstacles"), mission);
     c.physical(mission);
     c.out
@@ -394,8 +393,10 @@ impl Checker {
                     self.error(
                         at,
                         format!(
-                            "{what}: slots {i} and {j} are {d:.3} m apart, closer than \
+                            "{what}: slots {} and {} are {d:.3} m apart, closer than \
                              2 r_Q = {:.3} m (eq. 7)",
+                            i + 1,
+                            j + 1,
                             2.0 * f.uav_radius
                         ),
                     );
@@ -403,8 +404,10 @@ impl Checker {
                     self.error(
                         at,
                         format!(
-                            "{what}: slots {i} and {j} are {d:.3} m apart, beyond the \
+                            "{what}: slots {} and {} are {d:.3} m apart, beyond the \
                              communication range d_com = {} m (eq. 7)",
+                            i + 1,
+                            j + 1,
                             f.comm_range
                         ),
                     );
@@ -599,7 +602,9 @@ impl Checker {
         }
     }
 
-    fn fleet(&mut self, path: &FieldPath, p: &FleetParams, bounds: &Bounds) {
+    fn fleet(&mut self, path: &FieldPath, p: &FleetParams, mission: &Mission) {
+        let bounds = &mission.bounds;
+        let obstacles = &mission.obstacles;
         self.at_least_one(path.key("agents"), p.agents, "agent");
         self.at_least_one(path.key("swarm_size"), p.swarm_size, "particle");
         self.at_least_one(path.key("iterations"), p.iterations, "iteration");
@@ -697,6 +702,19 @@ impl Checker {
                     at.key("position"),
                     format!("({}, {}) is outside the bounds", t.position.x, t.position.y),
                 );
+            }
+            for o in obstacles.iter().filter(|o| o.height > p.altitude) {
+                let gap = (o.center - t.position).norm() - o.radius;
+                if gap < p.safety_distance {
+                    self.warning(
+                        at.key("position"),
+                        format!(
+                            "({}, {}) is within the safety distance c = {} m of obstacle '{}' \
+                             ({gap:.2} m from it): the agents cannot form around it",
+                            t.position.x, t.position.y, p.safety_distance, o.name
+                        ),
+                    );
+                }
             }
         }
         for (i, push) in p.pushes.iter().enumerate() {
@@ -797,12 +815,18 @@ impl Checker {
             }
             if o.name.trim().is_empty() {
                 self.error(at.key("name"), "must not be empty");
-            } else if obstacles[..i].iter().any(|p| p.name == o.name) {
+            } else if let Some(j) = obstacles
+                .iter()
+                .enumerate()
+                .position(|(j, p)| j != i && p.name == o.name)
+            {
+                // Both carry the error: the one just renamed shows it too.
                 self.error(
                     at.key("name"),
                     format!(
-                        "'{}' is used by an earlier obstacle; names must be unique",
-                        o.name
+                        "'{}' is also the name of obstacle {}; names must be unique",
+                        o.name,
+                        j + 1
                     ),
                 );
             }
@@ -839,5 +863,15 @@ pub fn compact(x: f64) -> String {
         format!("{x:e}")
     } else {
         format!("{x}")
+    }
+}
+
+/// `x` with `digits` decimals, in scientific notation when huge (a chart
+/// label, a field shown in the inspector).
+pub fn compact_digits(x: f64, digits: usize) -> String {
+    if x.is_finite() && x.abs() >= 1e6 {
+        format!("{x:.2e}")
+    } else {
+        format!("{x:.digits$}")
     }
 }

@@ -11,11 +11,8 @@
 //! is chosen so that the facing UAV's distance, which grows toward the pass's
 //! ends, sits in the middle of the band.
 
-use serde::Serialize;
-
 use nalgebra::Vector3;
 
-use super::trajectory::Trajectory;
 use crate::mission::Mission;
 
 /// Where a pass runs, for one obstacle and the nominal shape: the distance of
@@ -113,97 +110,6 @@ pub fn pass_geometries(mission: &Mission) -> Result<Vec<(usize, PassGeometry)>, 
             PassGeometry::new(&f.slots, o.radius, o.stand_off_band(f), f.inspection_pass)
                 .map(|g| (k, g))
                 .map_err(|e| (k, e))
-        })
-        .collect()
-}
-
-/// Eq. 8 as flown, for one inspected obstacle.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct InspectionResult {
-    pub obstacle: String,
-    /// [d_min^s, d_max^s], metres.
-    pub band: [f64; 2],
-    /// Pass length required, metres of centroid path.
-    pub required: f64,
-    /// Longest stretch over which the facing UAV stayed in the band, metres.
-    pub achieved: f64,
-    /// The facing UAV's distance range over that stretch, metres.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub distance: Option<[f64; 2]>,
-    /// When that stretch starts and ends, seconds.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub time: Option<[f64; 2]>,
-    /// 0-based UAV facing the surface in the middle of the stretch.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub uav: Option<usize>,
-    pub ok: bool,
-}
-
-/// Checks eq. 8 on the flown trajectories for every inspected obstacle:
-/// the longest run of samples where the nearest UAV is within the band must
-/// cover the pass (less one sample's travel, the resolution of the check).
-pub fn verify(mission: &Mission, trajectories: &[Trajectory]) -> Vec<InspectionResult> {
-    let f = &mission.formation;
-    let samples = trajectories
-        .iter()
-        .map(|t| t.samples.len())
-        .min()
-        .unwrap_or(0);
-    let step = trajectories
-        .first()
-        .and_then(|t| t.samples.get(1).map(|s| s.t - t.samples[0].t))
-        .unwrap_or(0.0);
-    let resolution = step * f.ground_speed;
-    mission
-        .obstacles
-        .iter()
-        .filter(|o| o.inspect)
-        .map(|o| {
-            let band = o.stand_off_band(f);
-            let cylinder = o.cylinder();
-            // (start, end) sample indices of the current and the best run.
-            let mut run: Option<usize> = None;
-            let mut best: Option<(usize, usize)> = None;
-            let facing = |k: usize| {
-                trajectories
-                    .iter()
-                    .enumerate()
-                    .map(|(n, t)| (n, cylinder.clearance(&t.samples[k].position)))
-                    .min_by(|a, b| a.1.total_cmp(&b.1))
-            };
-            for k in 0..=samples {
-                let inside =
-                    k < samples && facing(k).is_some_and(|(_, d)| band[0] <= d && d <= band[1]);
-                match (inside, run) {
-                    (true, None) => run = Some(k),
-                    (false, Some(first)) => {
-                        let last = k - 1;
-                        if best.is_none_or(|(a, b)| last - first > b - a) {
-                            best = Some((first, last));
-                        }
-                        run = None;
-                    }
-                    _ => {}
-                }
-            }
-            let time = |k: usize| trajectories[0].samples[k].t;
-            let achieved = best.map_or(0.0, |(a, b)| (time(b) - time(a)) * f.ground_speed);
-            let distance = best.map(|(a, b)| {
-                (a..=b).fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], k| {
-                    let d = facing(k).map_or(f64::NAN, |(_, d)| d);
-                    [lo.min(d), hi.max(d)]
-                })
-            });
-            InspectionResult {
-                obstacle: o.name.clone(),
-                band,
-                required: f.inspection_pass,
-                achieved,
-                distance,
-                time: best.map(|(a, b)| [time(a), time(b)]),
-                uav: best.and_then(|(a, b)| facing((a + b) / 2).map(|(n, _)| n)),
-                ok: achieved + resolution + 1e-9 >= f.inspection_pass,
-            }
         })
         .collect()
 }

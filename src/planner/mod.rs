@@ -25,11 +25,11 @@ use crate::pipeline::{CancelToken, Completion, CostTerms, Event, Level, Observer
 use crate::swarm::{self, SearchSpace, SwarmConfig};
 
 pub use cost::CostModel;
-pub use inspection::{InspectionResult, PassGeometry};
+pub use inspection::PassGeometry;
 pub use iwp::{Iwp, Shape, find_iwps};
 pub use path::{CentroidPath, PathBuilder};
 pub use trajectory::{Reconfiguration, Sample, Trajectory};
-pub use verify::{Check, Verification};
+pub use verify::{Check, InspectionResult, Verification};
 
 /// How to run (not what to plan: that is the mission).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -472,7 +472,10 @@ pub fn plan(
         );
         observer.on_event(Event::Log(Level::Warn, &message));
     }
-    observer.on_event(Event::Progress(1.0));
+    // A cancelled run stays at the share it got through.
+    if completion == Completion::Finished {
+        observer.on_event(Event::Progress(1.0));
+    }
 
     let waypoints = problem.builder.decode(&best.swarm.best.position);
     let passes = best

@@ -3,13 +3,12 @@
 //! The cost only penalises; this decides. For every UAV and every sample:
 //! clearance to every obstacle ≥ r_Q, every pair within [2 r_Q, d_com]
 //! (eq. 7), altitude inside the band (eq. 5), position inside the bounds;
-//! and for every inspected obstacle, eq. 8 over its pass (`inspection`).
+//! and for every inspected obstacle, eq. 8 over its pass (`verify_inspections`, with the pass geometry of `inspection`).
 //! A plan that fails any of them is infeasible.
 
 use nalgebra::Point3;
 use serde::Serialize;
 
-use super::inspection::{self, InspectionResult};
 use super::trajectory::Trajectory;
 use crate::mission::Mission;
 
@@ -257,7 +256,7 @@ pub fn verify_within(
         .filter(|c| c.limit.is_finite())
         .collect();
     let inspections = if limits.inspections {
-        inspection::verify(mission, trajectories)
+        verify_inspections(mission, trajectories)
     } else {
         Vec::new()
     };
@@ -268,4 +267,95 @@ pub fn verify_within(
         violation_count: count,
         inspections,
     }
+}
+
+/// Eq. 8 as flown, for one inspected obstacle.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct InspectionResult {
+    pub obstacle: String,
+    /// [d_min^s, d_max^s], metres.
+    pub band: [f64; 2],
+    /// Pass length required, metres of centroid path.
+    pub required: f64,
+    /// Longest stretch over which the facing UAV stayed in the band, metres.
+    pub achieved: f64,
+    /// The facing UAV's distance range over that stretch, metres.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distance: Option<[f64; 2]>,
+    /// When that stretch starts and ends, seconds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<[f64; 2]>,
+    /// 0-based UAV facing the surface in the middle of the stretch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uav: Option<usize>,
+    pub ok: bool,
+}
+
+/// Checks eq. 8 on the flown trajectories for every inspected obstacle:
+/// the longest run of samples where the nearest UAV is within the band must
+/// cover the pass (less one sample's travel, the resolution of the check).
+pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec<InspectionResult> {
+    let f = &mission.formation;
+    let samples = trajectories
+        .iter()
+        .map(|t| t.samples.len())
+        .min()
+        .unwrap_or(0);
+    let step = trajectories
+        .first()
+        .and_then(|t| t.samples.get(1).map(|s| s.t - t.samples[0].t))
+        .unwrap_or(0.0);
+    let resolution = step * f.ground_speed;
+    mission
+        .obstacles
+        .iter()
+        .filter(|o| o.inspect)
+        .map(|o| {
+            let band = o.stand_off_band(f);
+            let cylinder = o.cylinder();
+            // (start, end) sample indices of the current and the best run.
+            let mut run: Option<usize> = None;
+            let mut best: Option<(usize, usize)> = None;
+            let facing = |k: usize| {
+                trajectories
+                    .iter()
+                    .enumerate()
+                    .map(|(n, t)| (n, cylinder.clearance(&t.samples[k].position)))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+            };
+            for k in 0..=samples {
+                let inside =
+                    k < samples && facing(k).is_some_and(|(_, d)| band[0] <= d && d <= band[1]);
+                match (inside, run) {
+                    (true, None) => run = Some(k),
+                    (false, Some(first)) => {
+                        let last = k - 1;
+                        if best.is_none_or(|(a, b)| last - first > b - a) {
+                            best = Some((first, last));
+                        }
+                        run = None;
+                    }
+                    _ => {}
+                }
+            }
+            let time = |k: usize| trajectories[0].samples[k].t;
+            let achieved = best.map_or(0.0, |(a, b)| (time(b) - time(a)) * f.ground_speed);
+            let distance = best.map(|(a, b)| {
+                (a..=b).fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], k| {
+                    let d = facing(k).map_or(f64::NAN, |(_, d)| d);
+                    [lo.min(d), hi.max(d)]
+                })
+            });
+            InspectionResult {
+                obstacle: o.name.clone(),
+                band,
+                required: f.inspection_pass,
+                achieved,
+                distance,
+                time: best.map(|(a, b)| [time(a), time(b)]),
+                uav: best.and_then(|(a, b)| facing((a + b) / 2).map(|(n, _)| n)),
+                ok: achieved + resolution + 1e-9 >= f.inspection_pass,
+            }
+        })
+        .collect()
 }

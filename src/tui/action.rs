@@ -5,14 +5,32 @@
 
 use nalgebra::Point2;
 
-use super::app::Focus;
 use super::fields::Item;
+
+/// Which panel takes the keys that are not global.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Focus {
+    Map,
+    Inspector,
+    Jobs,
+}
+
+/// What the large left pane shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pane {
+    Map,
+    Formation,
+}
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Action {
     /// Quit, asking first when there are unsaved changes.
     Quit,
     ToggleHelp,
+    /// Scroll the help overlay by this many lines.
+    ScrollHelp(i32),
+    /// Clear the text of a prompt (Ctrl-u).
+    PromptClear,
     /// Close the overlay (or cancel the prompt) on top.
     Dismiss,
     FocusNext,

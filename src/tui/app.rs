@@ -11,30 +11,16 @@ use crossbeam_channel::{Receiver, Sender, unbounded};
 use nalgebra::{Point2, Vector3};
 
 use super::action::Action;
+pub use super::action::{Focus, Pane};
 use super::document::Document;
 use super::fields::{self, Field, Item};
-use super::jobs::{self, Job, JobId, JobMsg, Pipeline, RecordSettings, Viewer};
+use super::jobs::{self, Job, JobId, JobMsg, Kind, RecordSettings, Viewer};
 use super::recovery::{self, Origin, Recovery};
 use crate::geometry::farthest_offset;
 use crate::mission::{self, Mission, Preset, Severity};
 use crate::pipeline::Level;
 use crate::planner::iwp::{self, min_pair_distance};
 use crate::planner::{Iwp, find_iwps};
-
-/// Which panel takes the keys that are not global.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Focus {
-    Map,
-    Inspector,
-    Jobs,
-}
-
-/// What the large left pane shows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Pane {
-    Map,
-    Formation,
-}
 
 /// A line of text being typed into an inspector field.
 #[derive(Debug, Clone, PartialEq)]
@@ -154,6 +140,8 @@ pub struct App {
     pub should_quit: bool,
     /// Where relative paths (save as, open) start.
     pub cwd: PathBuf,
+    /// First line of the help overlay shown (it scrolls on small screens).
+    pub help_scroll: u16,
     /// The recovery copy of unsaved edits; `None` unless enabled.
     recovery: Option<Recovery>,
     drag: Option<Drag>,
@@ -192,6 +180,7 @@ impl App {
             cwd,
             drag: None,
             recovery: None,
+            help_scroll: 0,
             job_tx,
             job_rx,
         };
@@ -393,6 +382,10 @@ impl App {
 
     fn edit(&mut self, change: impl FnOnce(&mut Mission)) {
         self.doc.edit(change);
+        // An error message is about what was; a change moves on from it.
+        if self.status.as_ref().is_some_and(|s| s.error) {
+            self.status = None;
+        }
         self.refresh();
     }
 
@@ -401,7 +394,12 @@ impl App {
         use Action::*;
         match action {
             Quit => self.quit(),
+            ScrollHelp(by) => {
+                self.help_scroll =
+                    (i64::from(self.help_scroll) + i64::from(by)).clamp(0, 500) as u16;
+            }
             ToggleHelp => {
+                self.help_scroll = 0;
                 self.overlay = match self.overlay {
                     Some(Overlay::Help) => None,
                     _ => Some(Overlay::Help),
@@ -530,7 +528,7 @@ impl App {
                     },
                     None => crate::mission::FleetTarget {
                         time: 0.0,
-                        position: self.mission().bounds.center_xy(),
+                        position: crate::fleet::default_target(self.mission()),
                     },
                 };
                 self.edit(|m| m.fleet.targets.push(next));
@@ -592,6 +590,17 @@ impl App {
                         if let Ok(choice) = fields::waypoint_choice(m, &item) {
                             choice.shape = fields::next_shape(choice.shape);
                         }
+                    });
+                } else {
+                    // Say what `s` needs rather than do nothing.
+                    let iwps = self.iwps.len();
+                    self.set_error(if iwps == 0 {
+                        "s changes an IWP's shape: this mission has no IWP".to_owned()
+                    } else {
+                        format!(
+                            "s changes an IWP's shape: select one of the {iwps} IWP row(s) \
+                             first (2 formation editor, then n)"
+                        )
                     });
                 }
             }
@@ -663,9 +672,9 @@ impl App {
                     self.set_status("nothing to redo");
                 }
             }
-            Run => self.run(Pipeline::ThetaPso, self.mission().seed),
-            RunFlatlo => self.run(Pipeline::Flatlo, self.mission().seed),
-            RunFleet => self.run(Pipeline::Fleet, self.mission().seed),
+            Run => self.run(Kind::ThetaPso, self.mission().seed),
+            RunFlatlo => self.run(Kind::Flatlo, self.mission().seed),
+            RunFleet => self.run(Kind::Fleet, self.mission().seed),
             Scrub(seconds) => {
                 if let Some(end) = self.replay_end() {
                     let t = self.replay.unwrap_or(end) + seconds;
@@ -688,7 +697,7 @@ impl App {
                     .map(|j| j.seed)
                     .max()
                     .map_or(self.mission().seed.wrapping_add(1), |s| s.wrapping_add(1));
-                let pipeline = self.jobs.last().map_or(Pipeline::ThetaPso, |j| j.pipeline);
+                let pipeline = self.jobs.last().map_or(Kind::ThetaPso, |j| j.pipeline);
                 self.run(pipeline, seed);
             }
             Cancel => {
@@ -733,16 +742,25 @@ impl App {
                     }
                     Viewer::Spawn => "runs start a Rerun viewer (`rerun` on PATH)".to_owned(),
                 });
+                // Say now when the viewer cannot be reached, not at the run.
+                #[cfg(feature = "rerun")]
+                if self.viewer != Viewer::Off
+                    && let Some(problem) =
+                        crate::record::viewer_problem(self.viewer == Viewer::Spawn)
+                {
+                    self.set_error(format!("warning: {problem}"));
+                }
             }
             Save => match self.overlay {
                 Some(Overlay::Quit) => self.save(None, AfterSave::Quit, false),
                 _ => self.save(None, AfterSave::Stay, false),
             },
             SaveAs => {
+                // Pre-filled relative to the working directory when it can be.
                 let input = self
                     .doc
                     .path()
-                    .map(|p| p.display().to_string())
+                    .map(|p| p.strip_prefix(&self.cwd).unwrap_or(p).display().to_string())
                     .unwrap_or_else(|| format!("{}.toml", slug(&self.mission().name)));
                 self.overlay = Some(Overlay::SaveAs {
                     input,
@@ -757,6 +775,11 @@ impl App {
             PromptInput(c) => {
                 if let Some(Overlay::SaveAs { input, .. }) = &mut self.overlay {
                     input.push(c);
+                }
+            }
+            PromptClear => {
+                if let Some(Overlay::SaveAs { input, .. }) = &mut self.overlay {
+                    input.clear();
                 }
             }
             PromptBackspace => {
@@ -788,7 +811,11 @@ impl App {
             }
             DragTo(at) => {
                 if let Some(drag) = self.drag.clone() {
+                    // Dragged positions snap to the nudge step, as the keys move.
+                    let step = self.step_size();
+                    let snap = |v: f64| (v / step).round() * step;
                     let p = at + drag.grab;
+                    let p = Point2::new(snap(p.x), snap(p.y));
                     self.doc.gesture_edit(|m| set_position(m, &drag.item, p));
                 }
             }
@@ -851,6 +878,16 @@ impl App {
             job.cancel.cancel();
         }
         self.should_quit = true;
+    }
+
+    /// The preset the slots are now (after any undo), if they are one.
+    pub fn current_preset(&self) -> Option<Preset> {
+        let slots = &self.mission().formation.slots;
+        let spacing = self.preset_spacing();
+        Preset::ALL.into_iter().find(|p| {
+            let made = p.slots(slots.len().max(1), spacing);
+            made.len() == slots.len() && made.iter().zip(slots).all(|(a, b)| (a - b).norm() < 1e-9)
+        })
     }
 
     fn preset_spacing(&self) -> f64 {
@@ -994,18 +1031,17 @@ impl App {
         let Some(field) = fields.get(self.field) else {
             return;
         };
+        // Enter applies and stays on the field: ↓ goes to the next one (a
+        // move on Enter as well made the next ↓ skip a field).
         if editing.buffer.trim() == field.value {
             // Nothing typed: no change, no undo step (and no rounding).
-            let n = self.fields().len();
-            self.field = (self.field + 1).min(n.saturating_sub(1));
             return;
         }
         let mut trial = self.mission().clone();
         match field.set(&mut trial, &self.selected, &editing.buffer) {
             Ok(()) => {
                 self.edit(|m| *m = trial);
-                let n = self.fields().len();
-                self.field = (self.field + 1).min(n.saturating_sub(1));
+                self.set_status(format!("{} = {}", field.label, editing.buffer.trim()));
             }
             Err(e) => {
                 // Keep the text so it can be corrected.
@@ -1018,7 +1054,7 @@ impl App {
         }
     }
 
-    fn run(&mut self, pipeline: Pipeline, seed: u64) {
+    fn run(&mut self, pipeline: Kind, seed: u64) {
         let errors = self.doc.error_lines();
         if let Some(first) = errors.first() {
             self.set_error(format!(
@@ -1071,9 +1107,14 @@ impl App {
         let id = msg.job();
         let note = match &msg {
             JobMsg::Log(_, Level::Warn, text) => Some((true, format!("job {id}: {text}"))),
-            JobMsg::Log(_, Level::Info, text) if text.starts_with("recorded") => {
-                Some((false, format!("job {id}: {text}")))
-            }
+            JobMsg::Recorded { path, bytes, .. } => Some((
+                false,
+                format!(
+                    "job {id}: recorded {} ({:.1} MB)",
+                    path.display(),
+                    *bytes as f64 / 1e6
+                ),
+            )),
             JobMsg::Done(_, Err(e)) => Some((true, format!("job {id} failed: {e}"))),
             _ => None,
         };
@@ -1087,52 +1128,7 @@ impl App {
                     "done"
                 };
                 let text = match &job.outcome {
-                    Some(jobs::Outcome::ThetaPso(o)) => format!(
-                        "job {id} {verb}: J = {:.2}, {:.1} m, {}",
-                        o.cost.total,
-                        o.path_length,
-                        if o.feasible() {
-                            "feasible"
-                        } else {
-                            "INFEASIBLE"
-                        }
-                    ),
-                    Some(jobs::Outcome::Flatlo(o)) => {
-                        let closest = o
-                            .closest
-                            .map_or("-".into(), |c| format!("{:.0}", c.min_distance));
-                        match &o.verification {
-                            Some(v) => format!(
-                                "job {id} {verb}: closest {closest} m, spacing error {:.2} %, {}",
-                                v.max_spacing_error * 100.0,
-                                if v.passed {
-                                    "separation kept"
-                                } else {
-                                    "SEPARATION LOST"
-                                }
-                            ),
-                            None => format!(
-                                "job {id} {verb}: no verdict on a partial flight \
-                                 (closest so far {closest} m)"
-                            ),
-                        }
-                    }
-                    Some(jobs::Outcome::Fleet(o)) => format!(
-                        "job {id} {verb}: {} of {} targets formed, closest {}, {}",
-                        o.targets
-                            .iter()
-                            .filter(|t| t.converged_after.is_some())
-                            .count(),
-                        o.targets.len(),
-                        o.closest_agents
-                            .as_ref()
-                            .map_or("-".into(), |c| format!("{:.2} m", c.distance)),
-                        if o.kept_apart() && o.obstacles_clear() {
-                            "safety distance kept"
-                        } else {
-                            "SAFETY DISTANCE LOST"
-                        }
-                    ),
+                    Some(o) => format!("job {id} {verb}: {}", o.headline()),
                     None => format!("job {id} {verb}"),
                 };
                 self.shown_job = Some(id);
@@ -1193,6 +1189,16 @@ impl App {
         } else {
             target
         };
+        // "Save as" into a folder that does not exist yet creates it.
+        if let Some(dir) = target.parent()
+            && !dir.as_os_str().is_empty()
+            && !dir.exists()
+            && let Err(e) = std::fs::create_dir_all(dir)
+        {
+            self.overlay = None;
+            self.set_error(format!("not saved: cannot create {}: {e}", dir.display()));
+            return;
+        }
         match self.doc.save(Some(target)) {
             Ok(p) => {
                 self.overlay = None;
@@ -1275,7 +1281,15 @@ impl App {
         let checked = crate::diagnose::check_text(&text, Some(&name));
         match checked.mission {
             Some(m) => {
-                self.doc = Document::new(m, path).with_source(text);
+                self.doc = Document::new(m, path)
+                    .with_source(text)
+                    .with_label(entry.label());
+                // The jobs were of the other mission: not "stale", gone.
+                for job in self.jobs.iter().filter(|j| j.is_running()) {
+                    job.cancel.cancel();
+                }
+                self.jobs.clear();
+                self.job_cursor = 0;
                 if let Some(r) = &mut self.recovery {
                     // Opening another mission drops this one's unsaved edits
                     // (the user was asked); its copy goes with them.

@@ -32,6 +32,8 @@ pub struct Document {
     source: Option<String>,
     /// Changes (edits, gestures, undos, redos) since the last save.
     changes: usize,
+    /// What to call a document without a file ("(built-in) NAME").
+    label: Option<String>,
 }
 
 impl Document {
@@ -48,7 +50,14 @@ impl Document {
             diagnostics,
             source: None,
             changes: 0,
+            label: None,
         }
+    }
+
+    /// Names a document that has no file yet (a built-in mission).
+    pub fn with_label(mut self, label: impl Into<String>) -> Self {
+        self.label = Some(label.into());
+        self
     }
 
     /// The text the mission was read from: saves keep its comments and layout.
@@ -87,7 +96,10 @@ impl Document {
     pub fn title(&self) -> String {
         match &self.path {
             Some(p) => p.display().to_string(),
-            None => "(built-in) bridge-inspection.toml".to_owned(),
+            None => self
+                .label
+                .clone()
+                .unwrap_or_else(|| format!("(built-in) {}", mission::BUILTIN[0].file_name)),
         }
     }
 

@@ -10,11 +10,7 @@ use crate::pipeline::Completion;
 
 /// What the export needs of a finished job's outcome.
 pub fn planned(mission: &Mission, outcome: &Outcome) -> Planned {
-    match outcome {
-        Outcome::ThetaPso(o) => Planned::theta_pso(mission, o),
-        Outcome::Flatlo(o) => Planned::flatlo(mission, o),
-        Outcome::Fleet(o) => Planned::fleet(mission, o),
-    }
+    Planned::from_outcome(mission, outcome)
 }
 
 /// The folder beside the mission file (or in `cwd` for an unsaved mission).

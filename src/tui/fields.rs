@@ -209,6 +209,11 @@ fn yes_no(text: &str) -> Result<bool, String> {
 /// Formats a number the way it would be typed: exactly when that is short
 /// (so opening a field and applying it changes nothing), else to 4 decimals.
 pub fn fmt_num(v: f64) -> String {
+    // Huge and tiny values in scientific notation: `1e300`, not 301 digits
+    // (it reads back as typed).
+    if v.is_finite() && v != 0.0 && !(1e-4..1e9).contains(&v.abs()) {
+        return format!("{v:e}");
+    }
     let exact = format!("{v}");
     let s = if exact.len() <= 12 {
         exact
@@ -611,11 +616,16 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
                     waypoint_choice(m, item)?.shape = shape(t)?;
                     Ok(())
                 }),
-                field("shrink scale", at("scale"), scale, |m, item, t| {
-                    waypoint_choice(m, item)?.scale =
-                        if t.is_empty() { None } else { Some(number(t)?) };
-                    Ok(())
-                }),
+                field(
+                    "scale (blank: default)",
+                    at("scale"),
+                    scale,
+                    |m, item, t| {
+                        waypoint_choice(m, item)?.scale =
+                            if t.is_empty() { None } else { Some(number(t)?) };
+                        Ok(())
+                    },
+                ),
             ]
         }
         Item::Squadron => squadron_fields(m),

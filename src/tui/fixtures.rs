@@ -7,7 +7,7 @@ use nalgebra::{Point2, Point3};
 
 use super::app::App;
 use super::document::Document;
-use super::jobs::{Job, JobMsg, Outcome, Pipeline};
+use super::jobs::{Job, JobError, JobMsg, Kind, Outcome};
 use crate::flatlo;
 use crate::mission::{self, Mission, Obstacle};
 use crate::pipeline::{CancelToken, Silent};
@@ -63,10 +63,10 @@ pub fn app_with_result(mut mission: Mission, seed: u64, iterations: usize) -> Ap
     );
     let started = Instant::now();
     app.jobs
-        .push(Job::new(1, Pipeline::ThetaPso, seed, mission, started));
+        .push(Job::new(1, Kind::ThetaPso, seed, mission, started));
     let result = outcome
         .map(|o| Outcome::ThetaPso(Box::new(o)))
-        .map_err(|e| e.to_string());
+        .map_err(JobError::from);
     app.on_job_msg(JobMsg::Done(1, result), started);
     app
 }
@@ -80,10 +80,10 @@ pub fn app_with_flatlo_result(mission: Mission, seed: u64) -> App {
     );
     let started = Instant::now();
     app.jobs
-        .push(Job::new(1, Pipeline::Flatlo, seed, mission, started));
+        .push(Job::new(1, Kind::Flatlo, seed, mission, started));
     let result = outcome
         .map(|o| Outcome::Flatlo(Box::new(o)))
-        .map_err(|e| e.to_string());
+        .map_err(JobError::from);
     app.on_job_msg(JobMsg::Done(1, result), started);
     app
 }

@@ -1,5 +1,5 @@
-//! Keys and mouse events to actions. The keymap is also data ([`KEYS`]) so
-//! the help overlay and the README list exactly what the code does.
+//! Keys and mouse events to actions. The keymap is also listed as data
+//! (`keys::KEYS`) for the help overlay and the README.
 
 use ratatui::crossterm::event::{
     KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind,
@@ -11,118 +11,6 @@ use super::app::{App, Focus, Overlay, Pane, formation_extent};
 use super::fields::Item;
 use super::view::map::{Viewport, formation_split};
 use super::view::{Areas, layout};
-
-/// Every key, grouped as the help overlay shows them: (group, keys, what).
-pub const KEYS: &[(&str, &str, &str)] = &[
-    ("General", "?", "this help"),
-    (
-        "General",
-        "q  Ctrl-c",
-        "quit (asks when there are unsaved changes)",
-    ),
-    ("General", "Tab  Shift-Tab", "focus map → inspector → jobs"),
-    ("General", "1  2", "map / formation editor"),
-    (
-        "General",
-        "v",
-        "side view: distance along the path vs altitude",
-    ),
-    ("General", "u  Ctrl-z", "undo"),
-    ("General", "Ctrl-r  Ctrl-y", "redo"),
-    ("General", "Ctrl-s", "save (atomic); W save as; o open"),
-    (
-        "Select & move",
-        "n  p",
-        "next / previous item (map: mission, bounds, start, goal, obstacles, θ-PSO; formation: slots, IWPs)",
-    ),
-    (
-        "Select & move",
-        "← → ↑ ↓",
-        "nudge the selection one step (map & formation focus)",
-    ),
-    ("Select & move", "[  ]", "smaller / larger nudge step"),
-    ("Select & move", "+  -  0", "zoom in / out / fit"),
-    ("Select & move", "Shift-arrows", "pan the map"),
-    (
-        "Select & move",
-        "mouse",
-        "click selects, drag moves, wheel zooms",
-    ),
-    (
-        "Edit",
-        "a",
-        "add an obstacle at the view's centre (formation: add a slot)",
-    ),
-    (
-        "Edit",
-        "A",
-        "add tool: click an empty spot to place an obstacle",
-    ),
-    ("Edit", "d", "duplicate the selected obstacle"),
-    (
-        "Edit",
-        "i",
-        "inspect the selected obstacle (eq. 8) or stop inspecting it",
-    ),
-    (
-        "Edit",
-        "Del  D",
-        "delete the selected obstacle / slot / IWP choice",
-    ),
-    (
-        "Edit",
-        "Enter",
-        "edit the field (inspector); type a number to replace it",
-    ),
-    (
-        "Edit",
-        "Esc",
-        "cancel typing, close a window, leave the add tool",
-    ),
-    (
-        "Formation",
-        "P",
-        "apply the next preset: triangle, line abreast, column, V, diamond",
-    ),
-    (
-        "Formation",
-        "s  Space",
-        "cycle the IWP's shape / enable or disable it",
-    ),
-    ("Run", "r", "run θ-PSO with the mission's seed"),
-    (
-        "Run",
-        "F",
-        "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
-    ),
-    (
-        "Run",
-        "T",
-        "run the distributed fleet (select Fleet and its targets with n/p to edit them; d adds a target)",
-    ),
-    (
-        "Run",
-        ",  .  >",
-        "fleet replay: back / forward one second, play or pause",
-    ),
-    ("Run", "N", "re-run the last pipeline with a new seed"),
-    ("Run", "x", "cancel the selected (or latest) running job"),
-    (
-        "Run",
-        "Enter",
-        "jobs focus: show that job's result on the map",
-    ),
-    (
-        "Run",
-        "e  E",
-        "record runs to .rrd beside the mission / Rerun viewer: off, connect, spawn",
-    ),
-    (
-        "Run",
-        "X",
-        "export the shown result per vehicle (.plan, .waypoints, CSV) to <mission>-export/",
-    ),
-];
 
 /// The action for a key press, given what is on screen.
 pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
@@ -241,7 +129,13 @@ fn arrow(code: KeyCode) -> (f64, f64) {
 
 fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
     match overlay {
-        Overlay::Help => Some(Action::Dismiss),
+        Overlay::Help => match key.code {
+            KeyCode::Down | KeyCode::Char('j') => Some(Action::ScrollHelp(1)),
+            KeyCode::Up | KeyCode::Char('k') => Some(Action::ScrollHelp(-1)),
+            KeyCode::PageDown | KeyCode::Char(' ') => Some(Action::ScrollHelp(10)),
+            KeyCode::PageUp => Some(Action::ScrollHelp(-10)),
+            _ => Some(Action::Dismiss),
+        },
         Overlay::Quit => match key.code {
             KeyCode::Char('y') | KeyCode::Char('d') => Some(Action::Confirm),
             KeyCode::Char('s') => Some(Action::Save),
@@ -251,6 +145,7 @@ fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
             _ => None,
         },
         Overlay::SaveAs { .. } => match key.code {
+            KeyCode::Char('u') if ctrl => Some(Action::PromptClear),
             KeyCode::Enter => Some(Action::Confirm),
             KeyCode::Esc => Some(Action::Dismiss),
             KeyCode::Backspace => Some(Action::PromptBackspace),

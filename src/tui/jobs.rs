@@ -14,88 +14,14 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::Sender;
 use nalgebra::Point3;
 
-use crate::flatlo::{self, FlatloOutcome};
-use crate::fleet::{self, FleetOutcome};
 use crate::mission::Mission;
+pub use crate::outcome::Outcome;
+use crate::outcome::{self, Verdict};
+pub use crate::pipeline::Kind;
 use crate::pipeline::{CancelToken, Completion, Event, Level, Observer};
-use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
+use crate::planner::PlanOptions;
 
 pub type JobId = usize;
-
-/// The pipelines the TUI can launch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Pipeline {
-    ThetaPso,
-    Flatlo,
-    Fleet,
-}
-
-impl Pipeline {
-    pub fn name(self) -> &'static str {
-        match self {
-            Pipeline::ThetaPso => "θ-PSO",
-            Pipeline::Flatlo => "FLATLO",
-            Pipeline::Fleet => "fleet",
-        }
-    }
-
-    /// For file names (`<mission>-<slug>-seed<N>.rrd`).
-    pub fn slug(self) -> &'static str {
-        match self {
-            Pipeline::ThetaPso => "theta-pso",
-            Pipeline::Flatlo => "flatlo",
-            Pipeline::Fleet => "fleet",
-        }
-    }
-}
-
-/// A finished run's result.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Outcome {
-    ThetaPso(Box<ThetaPsoOutcome>),
-    Flatlo(Box<FlatloOutcome>),
-    Fleet(Box<FleetOutcome>),
-}
-
-impl Outcome {
-    pub fn completion(&self) -> Completion {
-        match self {
-            Outcome::ThetaPso(o) => o.completion,
-            Outcome::Flatlo(o) => o.completion,
-            Outcome::Fleet(o) => o.completion,
-        }
-    }
-
-    /// Meets its hard constraints: a feasible plan, a squadron that kept apart.
-    pub fn ok(&self) -> bool {
-        match self {
-            Outcome::ThetaPso(o) => o.feasible(),
-            Outcome::Flatlo(o) => o.passed(),
-            Outcome::Fleet(o) => o.kept_apart() && o.obstacles_clear() && o.converged(),
-        }
-    }
-
-    pub fn theta_pso(&self) -> Option<&ThetaPsoOutcome> {
-        match self {
-            Outcome::ThetaPso(o) => Some(o),
-            _ => None,
-        }
-    }
-
-    pub fn fleet(&self) -> Option<&FleetOutcome> {
-        match self {
-            Outcome::Fleet(o) => Some(o),
-            _ => None,
-        }
-    }
-
-    pub fn flatlo(&self) -> Option<&FlatloOutcome> {
-        match self {
-            Outcome::Flatlo(o) => Some(o),
-            _ => None,
-        }
-    }
-}
 
 /// Where a job's Rerun recording goes.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -146,8 +72,27 @@ pub enum JobMsg {
         path: Option<Vec<Point3<f64>>>,
     },
     Log(JobId, Level, String),
+    /// The run's recording was written.
+    Recorded {
+        id: JobId,
+        path: PathBuf,
+        bytes: u64,
+    },
     /// The run ended with an outcome, or an error (or a caught panic).
-    Done(JobId, Result<Outcome, String>),
+    Done(JobId, Result<Outcome, JobError>),
+}
+
+/// Why a job produced no outcome.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum JobError {
+    /// The pipeline refused the mission (invalid, over its budget).
+    #[error("{0}")]
+    Pipeline(#[from] crate::pipeline::PipelineError),
+    /// The pipeline panicked; the designer lives on.
+    #[error("the pipeline panicked: {0}")]
+    Panicked(String),
+    #[error("cannot start a thread: {0}")]
+    Thread(String),
 }
 
 /// How a job stands.
@@ -156,9 +101,10 @@ pub enum JobState {
     Running,
     /// Cancelled; an outcome (the best so far) may still be there.
     Cancelled,
-    Failed(String),
+    Failed(JobError),
+    /// Finished; `passed` is the outcome's verdict.
     Done {
-        feasible: bool,
+        passed: bool,
     },
 }
 
@@ -166,7 +112,7 @@ pub enum JobState {
 #[derive(Debug)]
 pub struct Job {
     pub id: JobId,
-    pub pipeline: Pipeline,
+    pub pipeline: Kind,
     pub seed: u64,
     /// The mission as it was at launch: the result is stale when the
     /// document no longer equals it.
@@ -187,13 +133,7 @@ pub struct Job {
 }
 
 impl Job {
-    pub fn new(
-        id: JobId,
-        pipeline: Pipeline,
-        seed: u64,
-        mission: Mission,
-        started: Instant,
-    ) -> Self {
+    pub fn new(id: JobId, pipeline: Kind, seed: u64, mission: Mission, started: Instant) -> Self {
         Job {
             id,
             pipeline,
@@ -226,8 +166,7 @@ impl Job {
     pub fn best_cost(&self) -> Option<f64> {
         self.outcome
             .as_ref()
-            .and_then(Outcome::theta_pso)
-            .map(|o| o.cost.total)
+            .and_then(Outcome::best_cost)
             .or(self.convergence.last().copied())
     }
 
@@ -243,20 +182,23 @@ impl Job {
                 }
             }
             JobMsg::Log(_, Level::Warn, text) => self.last_warning = Some(text),
-            JobMsg::Log(_, Level::Info, _) => {}
+            JobMsg::Log(_, Level::Info, _) | JobMsg::Recorded { .. } => {}
             JobMsg::Done(_, result) => {
                 self.ended = Some(now);
                 match result {
                     Ok(outcome) => {
-                        self.progress = 1.0;
+                        // A cancelled run keeps the share it got through.
+                        if outcome.completion() == Completion::Finished {
+                            self.progress = 1.0;
+                        }
                         self.state = match outcome.completion() {
                             Completion::Cancelled => JobState::Cancelled,
                             Completion::Finished => JobState::Done {
-                                feasible: outcome.ok(),
+                                passed: outcome.verdict() == Verdict::Passed,
                             },
                         };
-                        if let Some(o) = outcome.theta_pso() {
-                            self.convergence = o.convergence.clone();
+                        if !outcome.convergence().is_empty() {
+                            self.convergence = outcome.convergence().to_vec();
                         }
                         self.live_path.clear();
                         self.outcome = Some(outcome);
@@ -275,7 +217,7 @@ impl JobMsg {
             | JobMsg::Progress(id, _)
             | JobMsg::Log(id, _, _)
             | JobMsg::Done(id, _) => *id,
-            JobMsg::Iteration { id, .. } => *id,
+            JobMsg::Iteration { id, .. } | JobMsg::Recorded { id, .. } => *id,
         }
     }
 }
@@ -311,7 +253,7 @@ impl Observer for Forward {
 /// Starts a run of `pipeline` on `mission` on a worker thread.
 pub fn spawn_pipeline(
     id: JobId,
-    pipeline: Pipeline,
+    pipeline: Kind,
     mission: Mission,
     seed: u64,
     cancel: CancelToken,
@@ -327,7 +269,7 @@ pub fn spawn_pipeline(
 /// its result, or its panic as an error.
 pub fn spawn<F>(id: JobId, tx: Sender<JobMsg>, work: F)
 where
-    F: FnOnce(&Sender<JobMsg>) -> Result<Outcome, String> + Send + 'static,
+    F: FnOnce(&Sender<JobMsg>) -> Result<Outcome, JobError> + Send + 'static,
 {
     let worker_tx = tx.clone();
     let spawned = thread::Builder::new()
@@ -338,42 +280,37 @@ where
             let _ = worker_tx.send(JobMsg::Done(id, result));
         });
     if let Err(e) = spawned {
-        let _ = tx.send(JobMsg::Done(id, Err(format!("cannot start a thread: {e}"))));
+        let _ = tx.send(JobMsg::Done(id, Err(JobError::Thread(e.to_string()))));
     }
 }
 
 /// The pipeline itself, on the worker thread.
 fn plan(
-    pipeline: Pipeline,
+    pipeline: Kind,
     mission: &Mission,
     seed: u64,
     observer: &mut dyn Observer,
     cancel: &CancelToken,
-) -> Result<Outcome, String> {
-    match pipeline {
-        Pipeline::ThetaPso => {
-            planner::plan(mission, seed, PlanOptions::default(), observer, cancel)
-                .map(|o| Outcome::ThetaPso(Box::new(o)))
-        }
-        Pipeline::Flatlo => {
-            flatlo::plan(mission, seed, observer, cancel).map(|o| Outcome::Flatlo(Box::new(o)))
-        }
-        Pipeline::Fleet => {
-            fleet::plan(mission, seed, observer, cancel).map(|o| Outcome::Fleet(Box::new(o)))
-        }
-    }
-    .map_err(|e| e.to_string())
+) -> Result<Outcome, JobError> {
+    Ok(outcome::run(
+        pipeline,
+        mission,
+        seed,
+        PlanOptions::default(),
+        observer,
+        cancel,
+    )?)
 }
 
 fn run(
     id: JobId,
-    pipeline: Pipeline,
+    pipeline: Kind,
     mission: &Mission,
     seed: u64,
     cancel: &CancelToken,
     record: &RecordSettings,
     tx: &Sender<JobMsg>,
-) -> Result<Outcome, String> {
+) -> Result<Outcome, JobError> {
     let mut forward = Forward {
         id,
         tx: tx.clone(),
@@ -390,15 +327,10 @@ fn run(
             None => plan(pipeline, mission, seed, &mut forward, cancel),
         }?;
         if let Some(mut r) = recorder {
-            match &outcome {
-                Outcome::ThetaPso(o) => r.log_theta_pso(o),
-                Outcome::Flatlo(o) => r.log_flatlo(o),
-                Outcome::Fleet(o) => r.log_fleet(o),
-            }
+            r.log_outcome(&outcome);
             let finished = r.finish();
-            if let Some((file, bytes)) = finished.file {
-                let text = format!("recorded {} ({:.1} MB)", file.display(), bytes as f64 / 1e6);
-                let _ = tx.send(JobMsg::Log(id, Level::Info, text));
+            if let Some((path, bytes)) = finished.file {
+                let _ = tx.send(JobMsg::Recorded { id, path, bytes });
             }
         }
         Ok(outcome)
@@ -448,13 +380,13 @@ fn start_recording(
     }
 }
 
-fn panic_message(panic: &(dyn std::any::Any + Send)) -> String {
+fn panic_message(panic: &(dyn std::any::Any + Send)) -> JobError {
     let text = panic
         .downcast_ref::<&str>()
         .map(|s| s.to_string())
         .or_else(|| panic.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "unknown panic".into());
-    format!("the pipeline panicked: {text}")
+    JobError::Panicked(text)
 }
 
 #[cfg(test)]
@@ -468,7 +400,7 @@ mod tests {
         let msg = rx.recv_timeout(Duration::from_secs(10)).unwrap();
         let mut job = Job::new(
             4,
-            Pipeline::ThetaPso,
+            Kind::ThetaPso,
             0,
             crate::mission::default_mission().mission,
             Instant::now(),
@@ -476,7 +408,7 @@ mod tests {
         job.apply(msg, Instant::now());
         assert_eq!(
             job.state,
-            JobState::Failed("the pipeline panicked: boom".into())
+            JobState::Failed(JobError::Panicked("boom".into()))
         );
         assert!(job.ended.is_some());
     }
@@ -485,7 +417,7 @@ mod tests {
     fn a_panic_payload_becomes_a_readable_error() {
         let caught = catch_unwind(|| panic!("index out of bounds")).unwrap_err();
         assert_eq!(
-            panic_message(&*caught),
+            panic_message(&*caught).to_string(),
             "the pipeline panicked: index out of bounds"
         );
     }

@@ -16,6 +16,7 @@ pub mod fields;
 pub mod fixtures;
 pub mod input;
 pub mod jobs;
+pub mod keys;
 pub mod recovery;
 pub mod view;
 
@@ -241,7 +242,14 @@ fn event_loop(
 
 /// Applies one terminal event; returns whether the screen must be redrawn.
 fn handle(terminal: &DefaultTerminal, app: &mut App, event: Event) -> io::Result<bool> {
+    let size = terminal.size()?;
+    let too_small = view::layout(Rect::new(0, 0, size.width, size.height)).is_none();
     let action = match event {
+        // The "too small" screen hides the designer: only quitting acts.
+        Event::Key(key) if too_small => {
+            input::key_action(app, key).filter(|a| matches!(a, Action::Quit))
+        }
+        Event::Mouse(_) if too_small => None,
         Event::Key(key) => input::key_action(app, key),
         Event::Mouse(mouse) => {
             let size = terminal.size()?;

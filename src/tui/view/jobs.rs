@@ -26,17 +26,18 @@ fn bar(progress: f64, width: usize) -> String {
 }
 
 fn state_span(job: &Job) -> Span<'static> {
-    let flatlo = job.pipeline != crate::tui::jobs::Pipeline::ThetaPso;
+    // A θ-PSO plan is feasible or not; a flown run passes or fails.
+    let plan = job.pipeline == crate::pipeline::Kind::ThetaPso;
     match &job.state {
         JobState::Running => Span::styled(job.stage.clone(), Style::default().cyan()),
         JobState::Cancelled => Span::styled("cancelled", Style::default().yellow()),
         JobState::Failed(_) => Span::styled("FAILED", Style::default().red().bold()),
-        JobState::Done { feasible: true } => Span::styled(
-            if flatlo { "pass" } else { "feasible" },
+        JobState::Done { passed: true } => Span::styled(
+            if plan { "feasible" } else { "pass" },
             Style::default().green(),
         ),
-        JobState::Done { feasible: false } => Span::styled(
-            if flatlo { "FAIL" } else { "INFEASIBLE" },
+        JobState::Done { passed: false } => Span::styled(
+            if plan { "INFEASIBLE" } else { "FAIL" },
             Style::default().red().bold(),
         ),
     }
@@ -81,6 +82,10 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
             Line::from(vec![
                 Span::styled("F", Style::default().yellow().bold()),
                 Span::raw(" run FLATLO (the squadron transition)"),
+            ]),
+            Line::from(vec![
+                Span::styled("T", Style::default().yellow().bold()),
+                Span::raw(" run the distributed fleet"),
             ]),
             Line::from(vec![
                 Span::styled("N", Style::default().yellow().bold()),
@@ -237,20 +242,26 @@ fn fleet_table(o: &crate::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>
     if let Some(c) = &o.closest_agents {
         lines.push(Line::raw(format!(
             "closest agents {}-{}: {:.3} m at {:.1} s (c {})",
-            c.a, c.b, c.distance, c.time, o.safety_distance
+            c.a + 1,
+            c.b,
+            c.distance,
+            c.time,
+            o.safety_distance
         )));
     }
     if let Some(c) = &o.closest_obstacle {
         lines.push(Line::raw(format!(
             "closest obstacle: agent {} to {} {:.3} m",
-            c.a, c.b, c.distance
+            c.a + 1,
+            c.b,
+            c.distance
         )));
     }
     for d in o.distances.iter().take(6) {
         lines.push(Line::raw(format!(
             "d{}{} final {:.3} m (want {:.3})",
-            d.a,
-            d.b,
+            d.a + 1,
+            d.b + 1,
             d.values.last().copied().unwrap_or(f64::NAN),
             d.desired
         )));
@@ -305,7 +316,7 @@ fn flatlo_table(o: &crate::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'stat
         lines.push(Line::styled(
             format!(
                 "{:<6} {:>11.0} {:>8.0}",
-                format!("{}-{}", p.a, p.b),
+                format!("{}-{}", p.a + 1, p.b + 1),
                 p.min_distance,
                 p.time
             ),
@@ -329,7 +340,9 @@ fn flatlo_table(o: &crate::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'stat
     if let Some(a) = worst {
         lines.push(Line::raw(format!(
             "worst tracking: aircraft {} max {:.1} m, RMS {:.1} m",
-            a.index, a.tracking_max, a.tracking_rms
+            a.index + 1,
+            a.tracking_max,
+            a.tracking_rms
         )));
     }
     if stale {
@@ -357,24 +370,13 @@ fn draw_chart(frame: &mut Frame, job: &Job, area: Rect) {
         return;
     }
     let n = points.len() as f64;
-    let last = points[points.len() - 1].1;
-    // The first iterations can cost orders of magnitude more (penalties):
-    // scale to the last half so the end of the curve is readable.
-    let tail = &points[points.len() / 2..];
-    let hi = tail
-        .iter()
-        .map(|p| p.1)
-        .fold(f64::MIN, f64::max)
-        .max(last * 1.001);
-    let lo = tail.iter().map(|p| p.1).fold(f64::MAX, f64::min).min(last);
-    let pad = ((hi - lo) * 0.1).max(1e-6);
-    let (lo, hi) = (lo - pad, hi + pad);
-    let clipped: Vec<(f64, f64)> = points.iter().map(|&(x, y)| (x, y.min(hi))).collect();
+    let scale = ChartScale::of(&points);
+    let plotted: Vec<(f64, f64)> = points.iter().map(|&(x, y)| (x, scale.to_axis(y))).collect();
     let dataset = Dataset::default()
         .marker(Marker::Braille)
         .graph_type(GraphType::Line)
         .style(Style::default().fg(Color::LightBlue))
-        .data(&clipped);
+        .data(&plotted);
     let chart = Chart::new(vec![dataset])
         .x_axis(
             Axis::default()
@@ -384,16 +386,96 @@ fn draw_chart(frame: &mut Frame, job: &Job, area: Rect) {
         )
         .y_axis(
             Axis::default()
-                .bounds([lo, hi])
-                .labels([format!("{lo:.1}"), format!("{hi:.1}")])
+                .bounds(scale.bounds)
+                .labels(scale.labels())
                 .style(Style::default().fg(Color::DarkGray)),
         );
     frame.render_widget(chart, area);
 }
 
+/// The convergence chart's y axis: every cost from the first iteration to
+/// the last is on it (none clipped). Costs spanning more than 20× (the
+/// penalties of the first iterations) go on a log scale so the end of the
+/// curve stays readable; labels always show costs, with enough digits to
+/// tell the two ends apart.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChartScale {
+    log: bool,
+    /// Axis bounds (log10 of the cost on a log scale).
+    bounds: [f64; 2],
+}
+
+impl ChartScale {
+    pub fn of(points: &[(f64, f64)]) -> Self {
+        let lo = points.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+        let hi = points.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+        let log = lo > 0.0 && hi / lo > 20.0;
+        let (a, b) = if log {
+            (lo.log10(), hi.log10())
+        } else {
+            (lo, hi)
+        };
+        let pad = ((b - a) * 0.05).max(if log { 1e-3 } else { 1e-6 * b.abs().max(1.0) });
+        ChartScale {
+            log,
+            bounds: [a - pad, b + pad],
+        }
+    }
+
+    pub fn to_axis(&self, y: f64) -> f64 {
+        if self.log { y.log10() } else { y }
+    }
+
+    fn cost(&self, axis: f64) -> f64 {
+        if self.log { 10f64.powf(axis) } else { axis }
+    }
+
+    /// Bottom, middle and top, as costs.
+    pub fn labels(&self) -> [String; 3] {
+        let [a, b] = self.bounds;
+        let values = [self.cost(a), self.cost((a + b) / 2.0), self.cost(b)];
+        let spread = (values[2] - values[0]).abs();
+        let digits = if spread >= 10.0 {
+            1
+        } else {
+            (2.0 - spread.max(1e-9).log10().floor()).clamp(1.0, 9.0) as usize
+        };
+        values.map(|v| crate::mission::compact_digits(v, digits))
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::bar;
+    use super::{ChartScale, bar};
+
+    /// Issue 16: no cost is clipped, and the labels tell the ends apart.
+    #[test]
+    fn the_chart_axis_holds_every_cost() {
+        // A run from 150.8 down to 49.7: linear (under 20×), first point on it.
+        let points: Vec<(f64, f64)> = (0..100)
+            .map(|i| (i as f64, 49.7 + 101.1 * (-(i as f64) / 10.0).exp()))
+            .collect();
+        let s = ChartScale::of(&points);
+        for &(_, y) in &points {
+            let a = s.to_axis(y);
+            assert!(
+                a >= s.bounds[0] && a <= s.bounds[1],
+                "{y} off {:?}",
+                s.bounds
+            );
+        }
+        let [lo, _, hi] = s.labels();
+        assert!(lo.parse::<f64>().unwrap() < 49.7 && hi.parse::<f64>().unwrap() > 150.8);
+        // Penalties 1000× the end: log scale, still every point on it.
+        let points = [(0.0, 1e5), (1.0, 300.0), (2.0, 120.0), (3.0, 119.9)];
+        let s = ChartScale::of(&points);
+        assert!(s.log);
+        assert!(s.to_axis(1e5) <= s.bounds[1] && s.to_axis(119.9) >= s.bounds[0]);
+        // A flat tail: two different labels.
+        let s = ChartScale::of(&[(0.0, 49.71), (1.0, 49.70)]);
+        let [lo, _, hi] = s.labels();
+        assert_ne!(lo, hi);
+    }
 
     #[test]
     fn the_bar_fills_in_proportion() {

@@ -16,24 +16,16 @@ use ratatui::widgets::{Block, BorderType, Borders, Cell, Row, Table};
 use crate::flatlo::FlatloOutcome;
 use crate::fleet::FleetOutcome;
 use crate::geometry::segment_projection;
-use crate::mission::{Mission, ShapeChoice};
+use crate::mission::{Mission, Preset, ShapeChoice};
 use crate::planner::ThetaPsoOutcome;
 use crate::tui::app::{App, Focus, formation_extent};
 use crate::tui::fields::{Item, shape_name};
 use crate::tui::jobs::Outcome;
 
-/// Colours of the UAVs, in slot order.
-pub const UAV_COLORS: [Color; 6] = [
-    Color::Cyan,
-    Color::Magenta,
-    Color::LightGreen,
-    Color::LightBlue,
-    Color::LightYellow,
-    Color::LightRed,
-];
-
+/// UAV `i`'s colour (0-based), the same as in the Rerun recording.
 pub fn uav_color(i: usize) -> Color {
-    UAV_COLORS[i % UAV_COLORS.len()]
+    let [r, g, b] = crate::tracks::vehicle_color(i);
+    Color::Rgb(r, g, b)
 }
 
 /// A rectangle of the screen and the piece of the plane it shows.
@@ -236,7 +228,10 @@ fn paint_fleet(ctx: &mut Context, app: &App, o: &FleetOutcome, stale: bool, dot:
             ctx.print(
                 s.position.x,
                 s.position.y,
-                Span::styled(format!("●{}", a.index), Style::default().fg(color).bold()),
+                Span::styled(
+                    format!("●{}", a.index + 1),
+                    Style::default().fg(color).bold(),
+                ),
             );
         }
     }
@@ -585,7 +580,7 @@ fn paint_squadron(ctx: &mut Context, o: &FlatloOutcome, stale: bool, dot: f64) {
             ctx.print(
                 end.position.x,
                 end.position.y,
-                Span::styled(format!("✈{}", a.index), style),
+                Span::styled(format!("✈{}", a.index + 1), style),
             );
         }
     }
@@ -753,7 +748,7 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect) {
             "· {} UAVs · r_F {:.2} m · forward ↑ · P preset ({}) · a add · Del remove ",
             m.formation.slots.len(),
             m.formation.radius(),
-            app.preset.name()
+            app.current_preset().map_or("custom", Preset::name)
         )),
     ]);
     let dot = vp.metres_per_column() / 2.0;

@@ -14,7 +14,7 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, BorderType, Borders, Clear, Paragraph, Wrap};
 
 use super::app::{App, Focus, Overlay, Pane};
-use super::input::KEYS;
+use super::keys::KEYS;
 
 /// Below this the layout cannot show a usable map and inspector.
 pub const MIN_WIDTH: u16 = 80;
@@ -222,20 +222,38 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
             } else {
                 (inner_width, inner_width)
             };
-            let height = rows(&left, left_width).max(rows(&right, right_width)) + 2;
+            let content = rows(&left, left_width).max(rows(&right, right_width));
+            let height = content + 2;
             let r = centred(area, width, height);
             frame.render_widget(Clear, r);
-            let block = boxed("Keys · any key closes", Color::Cyan);
+            // Taller than the screen: it scrolls (↑ ↓ PgUp PgDn), and says so.
+            let fits = height <= r.height;
+            let max_scroll = content.saturating_sub(r.height.saturating_sub(2));
+            let scroll = app.help_scroll.min(max_scroll);
+            let title = if fits {
+                "Keys · any key closes".to_owned()
+            } else {
+                format!(
+                    "Keys · ↑↓ PgUp PgDn scroll ({}/{}) · other keys close",
+                    scroll, max_scroll
+                )
+            };
+            let block = boxed(&title, Color::Cyan);
             let inner = block.inner(r);
             frame.render_widget(block, r);
+            let text = |lines: Vec<Line<'static>>| {
+                Paragraph::new(lines)
+                    .wrap(Wrap { trim: false })
+                    .scroll((scroll, 0))
+            };
             if wide {
                 let [a, b] =
                     Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)])
                         .areas(inner);
-                frame.render_widget(Paragraph::new(left).wrap(Wrap { trim: false }), a);
-                frame.render_widget(Paragraph::new(right).wrap(Wrap { trim: false }), b);
+                frame.render_widget(text(left), a);
+                frame.render_widget(text(right), b);
             } else {
-                frame.render_widget(Paragraph::new(left).wrap(Wrap { trim: false }), inner);
+                frame.render_widget(text(left), inner);
             }
         }
         Overlay::Quit => {

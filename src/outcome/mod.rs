@@ -1,0 +1,254 @@
+//! One pipeline interface from run to view.
+//!
+//! [`run`] runs any [`Kind`] of pipeline on a mission and a seed; every
+//! caller (the CLI's `run` and `export`, the designer's jobs, the recorder,
+//! the tests) gets one [`Outcome`] back and reads it through the same
+//! methods: its verdict, a one-line headline, its summary, its convergence
+//! series and its vehicles' tracks. What only one pipeline has (θ-PSO's
+//! cost terms, FLATLO's pair table, the fleet's distance series) is reached
+//! through `theta_pso()`, `flatlo()`, `fleet()`.
+//!
+//! Adding a pipeline: its module (a `plan` function and an outcome type), a
+//! `Kind` variant and an `Outcome` variant with their arms here, its
+//! recorder layout (`record.rs`) and its export limits (`export::Planned`).
+
+pub mod summary;
+
+use serde::Serialize;
+
+use crate::flatlo::{self, FlatloOutcome};
+use crate::fleet::{self, FleetOutcome};
+use crate::mission::Mission;
+use crate::pipeline::{CancelToken, Completion, Kind, Observer, PipelineError};
+use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
+use crate::tracks::{self, Track};
+
+/// A finished (or cancelled) run's result.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Outcome {
+    ThetaPso(Box<ThetaPsoOutcome>),
+    Flatlo(Box<FlatloOutcome>),
+    Fleet(Box<FleetOutcome>),
+}
+
+/// What a run says of its plan.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Verdict {
+    /// Every hard constraint holds.
+    Passed,
+    /// The first broken constraint, in words.
+    Failed(String),
+    /// Cancelled: a partial result gets no verdict.
+    Cancelled,
+}
+
+/// Runs `kind` on `mission` with `seed`. `options` only matters to θ-PSO.
+pub fn run(
+    kind: Kind,
+    mission: &Mission,
+    seed: u64,
+    options: PlanOptions,
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> Result<Outcome, PipelineError> {
+    Ok(match kind {
+        Kind::ThetaPso => Outcome::ThetaPso(Box::new(planner::plan(
+            mission, seed, options, observer, cancel,
+        )?)),
+        Kind::Flatlo => Outcome::Flatlo(Box::new(flatlo::plan(mission, seed, observer, cancel)?)),
+        Kind::Fleet => Outcome::Fleet(Box::new(fleet::plan(mission, seed, observer, cancel)?)),
+    })
+}
+
+impl Outcome {
+    pub fn kind(&self) -> Kind {
+        match self {
+            Outcome::ThetaPso(_) => Kind::ThetaPso,
+            Outcome::Flatlo(_) => Kind::Flatlo,
+            Outcome::Fleet(_) => Kind::Fleet,
+        }
+    }
+
+    pub fn seed(&self) -> u64 {
+        match self {
+            Outcome::ThetaPso(o) => o.seed,
+            Outcome::Flatlo(o) => o.seed,
+            Outcome::Fleet(o) => o.seed,
+        }
+    }
+
+    pub fn completion(&self) -> Completion {
+        match self {
+            Outcome::ThetaPso(o) => o.completion,
+            Outcome::Flatlo(o) => o.completion,
+            Outcome::Fleet(o) => o.completion,
+        }
+    }
+
+    /// Pass, or fail with the first broken constraint. A cancelled θ-PSO run
+    /// still has a verdict on its best plan so far (it is a whole plan); a
+    /// cancelled FLATLO or fleet run has flown only part of the way.
+    pub fn verdict(&self) -> Verdict {
+        match self {
+            Outcome::ThetaPso(o) => match o.verification.first_failure() {
+                None if o.feasible() => Verdict::Passed,
+                None => Verdict::Failed("a constraint is broken".into()),
+                Some(reason) => Verdict::Failed(reason),
+            },
+            Outcome::Flatlo(o) => match (&o.verification, o.closest) {
+                (None, _) => Verdict::Cancelled,
+                (Some(v), _) if v.passed => Verdict::Passed,
+                (Some(v), Some(c)) => Verdict::Failed(format!(
+                    "aircraft {} and {} came {:.0} m apart (t = {:.0} s), closer than {:.0} m",
+                    c.a + 1,
+                    c.b + 1,
+                    c.min_distance,
+                    c.time,
+                    v.min_separation
+                )),
+                (Some(_), None) => Verdict::Failed("separation lost".into()),
+            },
+            Outcome::Fleet(o) => {
+                if o.completion == Completion::Cancelled {
+                    Verdict::Cancelled
+                } else if !o.kept_apart() {
+                    Verdict::Failed("two agents came closer than the safety distance".into())
+                } else if !o.obstacles_clear() {
+                    Verdict::Failed("an agent came closer to an obstacle than c".into())
+                } else if !o.converged() {
+                    Verdict::Failed("a target's formation was never reached".into())
+                } else {
+                    Verdict::Passed
+                }
+            }
+        }
+    }
+
+    /// Meets its hard constraints (a cancelled run never does).
+    pub fn ok(&self) -> bool {
+        self.verdict() == Verdict::Passed
+    }
+
+    /// One line for the status bar and the job list.
+    pub fn headline(&self) -> String {
+        let verdict = match self.verdict() {
+            Verdict::Passed => match self.kind() {
+                Kind::ThetaPso => "feasible",
+                Kind::Flatlo => "separation kept",
+                Kind::Fleet => "formed, safety distance kept",
+            }
+            .to_owned(),
+            Verdict::Failed(reason) => format!("FAILED: {reason}"),
+            Verdict::Cancelled => "no verdict on a partial run".to_owned(),
+        };
+        match self {
+            Outcome::ThetaPso(o) => {
+                format!("J = {:.2}, {:.1} m, {verdict}", o.cost.total, o.path_length)
+            }
+            Outcome::Flatlo(o) => {
+                let closest = o
+                    .closest
+                    .map_or("-".into(), |c| format!("{:.0} m", c.min_distance));
+                match &o.verification {
+                    Some(v) => format!(
+                        "closest {closest}, spacing error {:.2} %, {verdict}",
+                        v.max_spacing_error * 100.0
+                    ),
+                    None => format!("closest so far {closest}, {verdict}"),
+                }
+            }
+            Outcome::Fleet(o) => format!(
+                "{} of {} targets formed, closest {}, {verdict}",
+                o.targets
+                    .iter()
+                    .filter(|t| t.converged_after.is_some())
+                    .count(),
+                o.targets.len(),
+                o.closest_agents
+                    .as_ref()
+                    .map_or("-".into(), |c| format!("{:.2} m", c.distance)),
+            ),
+        }
+    }
+
+    /// The multi-line summary `skyform run` prints.
+    pub fn summary(&self) -> String {
+        match self {
+            Outcome::ThetaPso(o) => summary::theta_pso(o),
+            Outcome::Flatlo(o) => summary::flatlo(o),
+            Outcome::Fleet(o) => summary::fleet(o),
+        }
+    }
+
+    /// The best cost after each iteration (θ-PSO); empty for the others.
+    pub fn convergence(&self) -> &[f64] {
+        match self {
+            Outcome::ThetaPso(o) => &o.convergence,
+            _ => &[],
+        }
+    }
+
+    /// θ-PSO's best J; `None` for the pipelines without one.
+    pub fn best_cost(&self) -> Option<f64> {
+        self.theta_pso().map(|o| o.cost.total)
+    }
+
+    /// Every vehicle's timed track as planned and flown (`tracks.rs`):
+    /// θ-PSO's UAV trajectories, FLATLO's simulated aircraft (their
+    /// references are `reference_tracks`), the fleet's simulated quadrotors.
+    pub fn tracks(&self) -> Vec<Track> {
+        match self {
+            Outcome::ThetaPso(o) => tracks::theta_pso(o),
+            Outcome::Flatlo(o) => tracks::flatlo_flown(o),
+            Outcome::Fleet(o) => tracks::fleet(o),
+        }
+    }
+
+    /// The references the vehicles tracked, where they differ from the
+    /// flight (FLATLO); the tracks themselves otherwise.
+    pub fn reference_tracks(&self) -> Vec<Track> {
+        match self {
+            Outcome::Flatlo(o) => tracks::flatlo(o),
+            _ => self.tracks(),
+        }
+    }
+
+    /// The outcome as JSON: the pipeline's own fields and `tracks`.
+    pub fn to_json(&self) -> serde_json::Result<String> {
+        #[derive(Serialize)]
+        struct WithTracks<'a> {
+            #[serde(flatten)]
+            outcome: &'a Outcome,
+            tracks: Vec<Track>,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            reference_tracks: Option<Vec<Track>>,
+        }
+        serde_json::to_string_pretty(&WithTracks {
+            outcome: self,
+            tracks: self.tracks(),
+            reference_tracks: (self.kind() == Kind::Flatlo).then(|| self.reference_tracks()),
+        })
+    }
+
+    pub fn theta_pso(&self) -> Option<&ThetaPsoOutcome> {
+        match self {
+            Outcome::ThetaPso(o) => Some(o),
+            _ => None,
+        }
+    }
+
+    pub fn flatlo(&self) -> Option<&FlatloOutcome> {
+        match self {
+            Outcome::Flatlo(o) => Some(o),
+            _ => None,
+        }
+    }
+
+    pub fn fleet(&self) -> Option<&FleetOutcome> {
+        match self {
+            Outcome::Fleet(o) => Some(o),
+            _ => None,
+        }
+    }
+}
