@@ -153,3 +153,23 @@ fn a_flatlo_result_on_the_kilometre_map_with_its_verification_table() {
     );
     insta::assert_snapshot!(screen);
 }
+
+/// The README's screenshot is what the designer draws (issue 16): the
+/// finished-result snapshot above, character for character.
+#[test]
+fn the_readme_screenshot_is_the_finished_result_snapshot() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let snap = std::fs::read_to_string(format!(
+        "{root}/tests/snapshots/tui_snapshots__jobs_panel_with_a_finished_result.snap"
+    ))
+    .unwrap();
+    let screen: Vec<String> = snap
+        .lines()
+        .filter(|l| l.starts_with('"'))
+        .map(|l| l[1..l.len() - 1].replace("\\\"", "\""))
+        .collect();
+    let readme = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
+    let start = readme.find("```text\n╭ Map").expect("the README shows the designer") + 8;
+    let shown: Vec<&str> = readme[start..].lines().take(screen.len()).collect();
+    assert_eq!(shown, screen, "refresh the README screenshot from the snapshot");
+}
