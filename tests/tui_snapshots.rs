@@ -169,7 +169,13 @@ fn the_readme_screenshot_is_the_finished_result_snapshot() {
         .map(|l| l[1..l.len() - 1].replace("\\\"", "\""))
         .collect();
     let readme = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
-    let start = readme.find("```text\n╭ Map").expect("the README shows the designer") + 8;
+    let start = readme
+        .find("```text\n╭ Map")
+        .expect("the README shows the designer")
+        + 8;
     let shown: Vec<&str> = readme[start..].lines().take(screen.len()).collect();
-    assert_eq!(shown, screen, "refresh the README screenshot from the snapshot");
+    assert_eq!(
+        shown, screen,
+        "refresh the README screenshot from the snapshot"
+    );
 }

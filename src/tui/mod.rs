@@ -71,10 +71,25 @@ pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), 
                 note,
             ))
         }
-        None => Err(format!(
-            "{name} is not a valid mission:\n{}",
-            checked.report
-        )),
+        None => {
+            // A file that is not TOML at all can give hundreds of errors:
+            // the first few say what it is, `check` lists them all.
+            const SHOWN: usize = 8;
+            let all: Vec<String> = checked.report.errors().map(|d| d.to_string()).collect();
+            let mut text = all
+                .iter()
+                .take(SHOWN)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join("\n");
+            if all.len() > SHOWN {
+                text.push_str(&format!(
+                    "\n… and {} more error(s); `skyform check {name}` lists them all",
+                    all.len() - SHOWN
+                ));
+            }
+            Err(format!("{name} is not a valid mission:\n{text}"))
+        }
     }
 }
 

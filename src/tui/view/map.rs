@@ -479,6 +479,11 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
     }
 
     // IWPs (eq. 9): enabled ones bright, disabled ones dim.
+    // A FLATLO result is drawn at kilometre scale: the θ-PSO route, IWPs and
+    // obstacle names would be letters piled on a few cells.
+    if shown_outcome(app, Outcome::flatlo).is_some() {
+        return;
+    }
     for w in &app.iwps {
         let (glyph, style) = if w.enabled {
             ("◆", Style::default().fg(Color::LightCyan))
@@ -574,7 +579,7 @@ fn paint_squadron(ctx: &mut Context, o: &FlatloOutcome, stale: bool, dot: f64) {
         ctx.print(
             a.start.x,
             a.start.y,
-            Span::styled(format!("{}", a.index), style),
+            Span::styled(format!("{}", a.index + 1), style),
         );
         if let Some(end) = a.flown.last() {
             ctx.print(

@@ -304,7 +304,9 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                 "It can be saved, but not run until they are fixed.",
             ));
             lines.push(hints(&[("y", " save anyway   "), ("Esc", " cancel")]));
-            let size = (90, lines.len() as u16 + 2);
+            // Tall enough for the wrapped error lines, so the hints stay in view.
+            let width = 90.min(area.width);
+            let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
             let body = Paragraph::new(lines).wrap(Wrap { trim: false });
             popup(
                 frame,
