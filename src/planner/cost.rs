@@ -390,6 +390,17 @@ impl CostModel {
                     }
                 }
             }
+            // Over terrain, sample the band at the map's resolution (at most
+            // 4096 samples a window): the ground changes between vertices.
+            if let Some(g) = &self.ground {
+                let pixel = g.map.pixel[0].abs().min(g.map.pixel[1].abs());
+                let step = pixel.max((w1 - w0) / 4096.0);
+                let mut s = w0 + step;
+                while s < w1 {
+                    knots.push(s);
+                    s += step;
+                }
+            }
             knots.sort_by(f64::total_cmp);
             knots.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
 
