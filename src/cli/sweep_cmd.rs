@@ -265,10 +265,23 @@ pub fn table(s: &Summary, figure: &str) -> String {
             "cost evaluations",
             format!(
                 "{} ({} per CPU-second)",
-                s.evaluations,
-                crate::pipeline::figure(per.round())
+                thousands(s.evaluations as f64),
+                thousands(per)
             ),
         );
+    }
+    out
+}
+
+/// A whole number with thousands separators: 1,234,567.
+pub fn thousands(x: f64) -> String {
+    let digits = format!("{:.0}", x.max(0.0));
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
     }
     out
 }
@@ -380,6 +393,13 @@ pub fn sweep_command(args: &SweepArgs) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn thousands_are_separated() {
+        assert_eq!(thousands(1_006_000.0), "1,006,000");
+        assert_eq!(thousands(999.4), "999");
+        assert_eq!(thousands(0.0), "0");
+    }
 
     #[test]
     fn seeds_parse_as_an_inclusive_range() {

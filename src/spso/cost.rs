@@ -19,7 +19,7 @@ use crate::terrain::HeightMap;
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
 /// Most points (start, free nodes, goal) a path may have.
-pub const MAX_POINTS: usize = 64;
+pub const MAX_POINTS: usize = 32;
 
 /// A vertical cylinder threat: centre (x, y) and radius; only the x-y
 /// distance counts.
@@ -93,9 +93,19 @@ impl Model {
     /// H(round(y), round(x)) with negative heights set to 0, or `None` outside.
     #[inline]
     pub fn ground(&self, x: f64, y: f64) -> Option<f32> {
-        self.map
-            .nearest(x, y)
-            .map(|h| if h < 0.0 { 0.0 } else { h })
+        let m = &*self.map;
+        let h = if m.origin == [1.0, 1.0] && m.pixel == [1.0, 1.0] {
+            // The benchmark's own convention: the 1-based pixel is round(x).
+            let (c, r) = (x.round(), y.round());
+            if c >= 1.0 && r >= 1.0 && c <= m.width as f64 && r <= m.height as f64 {
+                m.heights[(r as usize - 1) * m.width + (c as usize - 1)]
+            } else {
+                return None;
+            }
+        } else {
+            m.nearest(x, y)?
+        };
+        Some(if h < 0.0 { 0.0 } else { h })
     }
 
     /// J for free nodes given as x1..xn, y1..yn, z1..zn (z above the ground).

@@ -94,9 +94,11 @@ impl Decoder {
                 let (mut x, mut y, mut z) = (self.start[0], self.start[1], self.start[2]);
                 for i in 0..n {
                     let (r, psi, phi) = (position[i], position[n + i], position[2 * n + i]);
-                    x = clamp(x + r * psi.cos() * phi.sin(), bx);
-                    y = clamp(y + r * psi.cos() * phi.cos(), by);
-                    z = clamp(z + r * psi.sin(), bz);
+                    let (sin_psi, cos_psi) = psi.sin_cos();
+                    let (sin_phi, cos_phi) = phi.sin_cos();
+                    x = clamp(x + r * cos_psi * sin_phi, bx);
+                    y = clamp(y + r * cos_psi * cos_phi, by);
+                    z = clamp(z + r * sin_psi, bz);
                     out[i] = x;
                     out[n + i] = y;
                     out[2 * n + i] = z;
