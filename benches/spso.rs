@@ -23,8 +23,12 @@ fn mission() -> Mission {
 
 /// Path 3 of the parity set: the safe route, z = 150 everywhere.
 fn safe_route() -> Vec<f64> {
-    let x = [230.0, 250.0, 290.0, 380.0, 470.0, 560.0, 640.0, 760.0, 800.0, 810.0];
-    let y = [250.0, 420.0, 600.0, 640.0, 650.0, 660.0, 640.0, 660.0, 720.0, 770.0];
+    let x = [
+        230.0, 250.0, 290.0, 380.0, 470.0, 560.0, 640.0, 760.0, 800.0, 810.0,
+    ];
+    let y = [
+        250.0, 420.0, 600.0, 640.0, 650.0, 660.0, 640.0, 660.0, 720.0, 770.0,
+    ];
     let mut v = Vec::with_capacity(30);
     v.extend_from_slice(&x);
     v.extend_from_slice(&y);

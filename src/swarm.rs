@@ -296,8 +296,8 @@ where
     for _ in 0..config.init_passes.max(1) {
         personal.clear();
         for (i, rng) in rngs.iter_mut().enumerate() {
-            for d in 0..dims {
-                positions[i][d] = sample(rng, space.lower[d], space.upper[d]);
+            for (d, x) in positions[i].iter_mut().enumerate() {
+                *x = sample(rng, space.lower[d], space.upper[d]);
             }
             let c = guarded(&positions[i], f64::INFINITY);
             evaluations += 1;
@@ -572,24 +572,38 @@ mod tests {
             init_passes: 10,
         };
         let run = |seed| {
-            minimize_sequential(&space, &cfg, seed, |x, _| sphere(x), |_| {
-                ControlFlow::Continue(())
-            })
+            minimize_sequential(
+                &space,
+                &cfg,
+                seed,
+                |x, _| sphere(x),
+                |_| ControlFlow::Continue(()),
+            )
         };
         let a = run(1);
         assert!(a.best.cost < 1e-6, "cost {}", a.best.cost);
         assert_eq!(a.evaluations, 30 * 201);
         assert_eq!(a, run(1));
         let early = |seed| {
-            minimize_sequential(&space, &cfg, seed, |x, _| sphere(x), |r| {
-                if r.iteration == 3 {
-                    ControlFlow::Break(())
-                } else {
-                    ControlFlow::Continue(())
-                }
-            })
+            minimize_sequential(
+                &space,
+                &cfg,
+                seed,
+                |x, _| sphere(x),
+                |r| {
+                    if r.iteration == 3 {
+                        ControlFlow::Break(())
+                    } else {
+                        ControlFlow::Continue(())
+                    }
+                },
+            )
         };
-        assert_ne!(early(1).best.position, early(2).best.position, "the seed matters");
+        assert_ne!(
+            early(1).best.position,
+            early(2).best.position,
+            "the seed matters"
+        );
         // No finite cost at first: the initial pass is repeated.
         let mut calls = 0;
         let r = minimize_sequential(
@@ -601,7 +615,11 @@ mod tests {
             1,
             |x, _| {
                 calls += 1;
-                if calls <= 30 { f64::INFINITY } else { sphere(x) }
+                if calls <= 30 {
+                    f64::INFINITY
+                } else {
+                    sphere(x)
+                }
             },
             |_| ControlFlow::Continue(()),
         );

@@ -83,7 +83,7 @@ impl HeightMap {
         origin: [f64; 2],
         pixel: [f64; 2],
     ) -> Result<Self, String> {
-        if width == 0 || heights.is_empty() || heights.len() % width != 0 {
+        if width == 0 || heights.is_empty() || !heights.len().is_multiple_of(width) {
             return Err(format!(
                 "{} heights do not make rows of {width} pixels",
                 heights.len()
@@ -119,7 +119,8 @@ impl HeightMap {
     pub fn read_tiff(path: &Path, origin: [f64; 2], pixel: [f64; 2]) -> Result<Self, String> {
         use tiff::decoder::{Decoder, DecodingResult, Limits};
         let file = File::open(path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
-        let malformed = |e: tiff::TiffError| format!("{} is not a readable TIFF: {e}", path.display());
+        let malformed =
+            |e: tiff::TiffError| format!("{} is not a readable TIFF: {e}", path.display());
         let mut decoder = Decoder::new(BufReader::new(file)).map_err(malformed)?;
         let (w, h) = decoder.dimensions().map_err(malformed)?;
         if u64::from(w) * u64::from(h) > MAX_PIXELS {
@@ -331,7 +332,11 @@ mod tests {
         assert_eq!(m.bilinear(1.0, 1.0), Some(5.5));
         assert_eq!(m.bilinear(4.0, 4.0), Some(22.0));
         assert_eq!(m.bilinear(3.0, 2.0), Some(11.5));
-        assert_eq!(m.bilinear(4.9, 4.9), Some(22.0), "edge extended half a pixel");
+        assert_eq!(
+            m.bilinear(4.9, 4.9),
+            Some(22.0),
+            "edge extended half a pixel"
+        );
         assert_eq!(m.bilinear(5.1, 0.0), None);
         assert_eq!(m.ground_clamped(Lookup::Bilinear, 50.0, 1.0), 7.0);
     }

@@ -211,6 +211,7 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                 flatlo: Default::default(),
                 fleet: Default::default(),
                 obstacles,
+                terrain: None,
             };
             m.reconfiguration.default_shape = shape;
             m.formation.slots[0] = Vector3::new(0.0, 2.0, 0.0);

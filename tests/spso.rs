@@ -23,12 +23,12 @@ use skyform::terrain::HeightMap;
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spso");
 
 fn fixture(name: &str) -> String {
-    std::fs::read_to_string(format!("{FIXTURES}/{name}"))
-        .unwrap_or_else(|e| panic!("{name}: {e}"))
+    std::fs::read_to_string(format!("{FIXTURES}/{name}")).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 fn number(s: &str) -> f64 {
-    s.parse().unwrap_or_else(|_| panic!("'{s}' is not a number"))
+    s.parse()
+        .unwrap_or_else(|_| panic!("'{s}' is not a number"))
 }
 
 fn same(got: f64, want: f64, rel: f64) -> bool {
@@ -89,7 +89,11 @@ fn eval_gives_the_reference_costs_of_the_48_paths() {
         "tests/fixtures/spso/paths.csv",
         "--terms",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let got = String::from_utf8_lossy(&out.stdout).to_string();
     let want = fixture("costs_terms.txt");
     assert_eq!(got.lines().count(), 48);
@@ -100,10 +104,18 @@ fn eval_gives_the_reference_costs_of_the_48_paths() {
         }
         // 17 significant digits, `inf` as the reference prints it.
         let j = g.split_whitespace().next().unwrap_or_default();
-        assert!(j == "inf" || j.trim_start_matches('-').replace('.', "").len() <= 17, "{j}");
+        assert!(
+            j == "inf" || j.trim_start_matches('-').replace('.', "").len() <= 17,
+            "{j}"
+        );
     }
     // Path 3, the safe route: the float32 altitude rule decides the digits.
-    assert!(got.lines().nth(2).unwrap_or_default().starts_with("5925.8548228312056 "));
+    assert!(
+        got.lines()
+            .nth(2)
+            .unwrap_or_default()
+            .starts_with("5925.8548228312056 ")
+    );
 }
 
 #[test]
@@ -143,7 +155,10 @@ fn small_benchmark(dir: &std::path::Path, particles: usize, iterations: usize) -
         "/missions/spso-benchmark.toml"
     ))
     .expect("the shipped mission");
-    let terrain = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/terrain/ChrismasTerrain.tif");
+    let terrain = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/missions/terrain/ChrismasTerrain.tif"
+    );
     let text = text
         .replace("terrain/ChrismasTerrain.tif", terrain)
         .replace("swarm_size = 500", &format!("swarm_size = {particles}"))
@@ -169,10 +184,17 @@ fn sweep_writes_one_csv_row_per_seed_and_counts_them() {
         &csv.display().to_string(),
     ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = std::fs::read_to_string(&csv).expect("the CSV");
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines[0], "seed,feasible,passed,best J,evaluations,wall_s,cpu_s,error");
+    assert_eq!(
+        lines[0],
+        "seed,feasible,passed,best J,evaluations,wall_s,cpu_s,error"
+    );
     assert_eq!(lines.len(), 5);
     let mut finite = 0;
     for (line, seed) in lines[1..].iter().zip(3..) {
@@ -181,14 +203,20 @@ fn sweep_writes_one_csv_row_per_seed_and_counts_them() {
         // 40 particles × 10 iterations after the initial pass, which is
         // repeated while no particle has a finite cost (as the reference).
         let evaluations: usize = f[4].parse().expect("a count");
-        assert!(evaluations >= 440 && evaluations % 40 == 0, "{line}");
+        assert!(
+            evaluations >= 440 && evaluations.is_multiple_of(40),
+            "{line}"
+        );
         if f[1] == "true" {
             finite += 1;
             assert!(number(f[3]).is_finite());
         }
     }
     assert!(stdout.contains("runs                  4"), "{stdout}");
-    assert!(stdout.contains(&format!("feasible / passed     {finite} / ")), "{stdout}");
+    assert!(
+        stdout.contains(&format!("feasible / passed     {finite} / ")),
+        "{stdout}"
+    );
     assert!(stdout.contains("per CPU-second"), "{stdout}");
     // The same seeds give the same costs on any number of jobs.
     let csv1 = dir.path().join("sweep1.csv");
@@ -206,9 +234,15 @@ fn sweep_writes_one_csv_row_per_seed_and_counts_them() {
     ]);
     assert!(again.status.success());
     let costs = |t: &str| -> Vec<String> {
-        t.lines().skip(1).map(|l| l.split(',').take(5).collect::<Vec<_>>().join(",")).collect()
+        t.lines()
+            .skip(1)
+            .map(|l| l.split(',').take(5).collect::<Vec<_>>().join(","))
+            .collect()
     };
-    assert_eq!(costs(&text), costs(&std::fs::read_to_string(&csv1).expect("csv")));
+    assert_eq!(
+        costs(&text),
+        costs(&std::fs::read_to_string(&csv1).expect("csv"))
+    );
 }
 
 #[test]

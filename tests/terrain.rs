@@ -13,7 +13,11 @@ fn write_map(path: &std::path::Path, hill: bool) {
     let data: Vec<f32> = (0..w * h)
         .map(|i| {
             let x = (i % w) as f32;
-            if hill && (40.0..=60.0).contains(&x) { 20.0 } else { 0.0 }
+            if hill && (40.0..=60.0).contains(&x) {
+                20.0
+            } else {
+                0.0
+            }
         })
         .collect();
     let file = std::fs::File::create(path).expect("create");
@@ -53,15 +57,16 @@ fn judge(hill: bool) -> (f64, bool) {
     write_map(&dir.path().join("map.tif"), hill);
     let path = dir.path().join("m.toml");
     std::fs::write(&path, mission_text("map.tif")).expect("write");
-    let m = mission::load(&path).unwrap_or_else(|e| panic!("{e}")).mission;
+    let m = mission::load(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
     let points: Vec<Point3<f64>> = [m.route.start, m.route.goal]
         .iter()
         .map(|p| Point3::new(p.x, p.y, p.z + m.ground(p.x, p.y)))
         .collect();
     let path = CentroidPath::bare(points);
     let terms = CostModel::new(&m, &[]).terms(&path);
-    let (trajectories, _) =
-        trajectory::generate(&path, &[], &m.formation, heading_span(&m));
+    let (trajectories, _) = trajectory::generate(&path, &[], &m.formation, heading_span(&m));
     let v = verify::verify(&m, &trajectories);
     (terms.altitude, v.feasible)
 }
@@ -82,7 +87,9 @@ fn the_ground_is_read_with_the_missions_lookup() {
     write_map(&dir.path().join("map.tif"), true);
     let path = dir.path().join("m.toml");
     std::fs::write(&path, mission_text("map.tif")).expect("write");
-    let m = mission::load(&path).unwrap_or_else(|e| panic!("{e}")).mission;
+    let m = mission::load(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
     assert_eq!(m.ground(50.0, 10.0), 20.0);
     assert_eq!(m.ground(39.5, 10.0), 10.0, "bilinear between 0 and 20");
     assert_eq!(m.ground(10.0, 10.0), 0.0);
@@ -105,5 +112,8 @@ fn a_missing_or_malformed_terrain_file_is_a_located_error() {
     let text = mission_text("bad.tif");
     let checked = mission::check_str(&text, Some(&path.display().to_string()));
     let shown = checked.report.to_string();
-    assert!(shown.contains("terrain.file") && shown.contains("not a readable TIFF"), "{shown}");
+    assert!(
+        shown.contains("terrain.file") && shown.contains("not a readable TIFF"),
+        "{shown}"
+    );
 }

@@ -10,14 +10,20 @@ use ratatui::backend::TestBackend;
 use skyform::tui::{Action, App, Document, view};
 
 fn benchmark_app() -> App {
-    let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/missions/spso-benchmark.toml"));
+    let path = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/missions/spso-benchmark.toml"
+    ));
     let mission = skyform::mission::load(&path)
         .unwrap_or_else(|e| panic!("{e}"))
         .mission;
     assert!(mission.height_map().is_some(), "the terrain loaded");
     // A relative name, so the status bar (and the snapshot) is the same anywhere.
     let shown = PathBuf::from("missions/spso-benchmark.toml");
-    App::new(Document::new(mission, Some(shown)), PathBuf::from("/missions"))
+    App::new(
+        Document::new(mission, Some(shown)),
+        PathBuf::from("/missions"),
+    )
 }
 
 fn render(app: &App) -> String {

@@ -56,7 +56,10 @@ pub fn parse_paths(text: &str, n: usize) -> Result<Vec<Vec<f64>>, String> {
 /// The costs of `rows` under the mission's cost: J and its terms.
 /// The θ-PSO paper's cost sees the path start → nodes → goal (with the
 /// ground added under terrain), without IWP crossings or passes.
-pub fn evaluate(mission: &Mission, rows: &[Vec<f64>]) -> Result<Vec<(f64, [f64; 4], bool)>, String> {
+pub fn evaluate(
+    mission: &Mission,
+    rows: &[Vec<f64>],
+) -> Result<Vec<(f64, [f64; 4], bool)>, String> {
     match mission.theta_pso.cost {
         CostKind::Spso => {
             let model = spso::model(mission)?;
@@ -79,13 +82,19 @@ pub fn evaluate(mission: &Mission, rows: &[Vec<f64>]) -> Result<Vec<(f64, [f64; 
                 .iter()
                 .map(|r| {
                     let mut points = vec![mission.route.start];
-                    points.extend((0..n).map(|i| nalgebra::Point3::new(r[i], r[n + i], r[2 * n + i])));
+                    points.extend(
+                        (0..n).map(|i| nalgebra::Point3::new(r[i], r[n + i], r[2 * n + i])),
+                    );
                     points.push(mission.route.goal);
                     for p in &mut points {
                         p.z += mission.ground(p.x, p.y);
                     }
                     let t = cost.terms(&CentroidPath::bare(points));
-                    (t.total, [t.length, t.obstacle, t.altitude, t.turning], false)
+                    (
+                        t.total,
+                        [t.length, t.obstacle, t.altitude, t.turning],
+                        false,
+                    )
                 })
                 .collect())
         }

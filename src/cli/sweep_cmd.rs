@@ -50,10 +50,18 @@ pub fn parse_seeds(s: &str) -> Result<(u64, u64), String> {
         Some((a, b)) => (a, b.trim_start_matches('=')),
         None => (s, s),
     };
-    let a: u64 = a.trim().parse().map_err(|_| format!("'{a}' is not a seed"))?;
-    let b: u64 = b.trim().parse().map_err(|_| format!("'{b}' is not a seed"))?;
+    let a: u64 = a
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{a}' is not a seed"))?;
+    let b: u64 = b
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{b}' is not a seed"))?;
     if a > b {
-        return Err(format!("{a}..{b} is empty: the first seed must not exceed the last"));
+        return Err(format!(
+            "{a}..{b} is empty: the first seed must not exceed the last"
+        ));
     }
     if b - a >= 1_000_000 {
         return Err("at most a million seeds".into());
@@ -117,7 +125,13 @@ pub fn run_seed(mission: &Mission, pipeline: PipelineArg, seed: u64) -> SeedRow 
     };
     match pipeline {
         PipelineArg::ThetaPso => {
-            match planner::plan(mission, seed, PlanOptions { parallel: false }, &mut Silent, &cancel) {
+            match planner::plan(
+                mission,
+                seed,
+                PlanOptions { parallel: false },
+                &mut Silent,
+                &cancel,
+            ) {
                 Ok(o) => {
                     row.feasible = o.cost.total.is_finite();
                     row.passed = o.feasible();
@@ -184,7 +198,7 @@ pub fn stats(values: &[f64]) -> Option<[f64; 5]> {
         0.0
     };
     let mid = v.len() / 2;
-    let median = if v.len() % 2 == 0 {
+    let median = if v.len().is_multiple_of(2) {
         (v[mid - 1] + v[mid]) / 2.0
     } else {
         v[mid]
@@ -256,8 +270,16 @@ pub fn table(s: &Summary, figure: &str) -> String {
         }
         None => line(&mut out, figure, "no finite value".into()),
     }
-    line(&mut out, "wall time", format!("{:.2} s", s.wall.as_secs_f64()));
-    line(&mut out, "CPU time", format!("{:.2} s", s.cpu.as_secs_f64()));
+    line(
+        &mut out,
+        "wall time",
+        format!("{:.2} s", s.wall.as_secs_f64()),
+    );
+    line(
+        &mut out,
+        "CPU time",
+        format!("{:.2} s", s.cpu.as_secs_f64()),
+    );
     if s.evaluations > 0 {
         let per = s.evaluations as f64 / s.cpu.as_secs_f64().max(1e-9);
         line(

@@ -545,7 +545,11 @@ impl Checker {
                 let half = [map.pixel[0].abs() / 2.0, map.pixel[1].abs() / 2.0];
                 let [x0, x1] = map.x_extent();
                 let [y0, y1] = map.y_extent();
-                if b.x[0] < x0 - half[0] || b.x[1] > x1 + half[0] || b.y[0] < y0 - half[1] || b.y[1] > y1 + half[1] {
+                if b.x[0] < x0 - half[0]
+                    || b.x[1] > x1 + half[0]
+                    || b.y[0] < y0 - half[1]
+                    || b.y[1] > y1 + half[1]
+                {
                     self.error(
                         path.key("origin"),
                         format!(

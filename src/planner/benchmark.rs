@@ -90,9 +90,13 @@ pub fn plan(
     let points = spso::points(&model, &run.nodes);
     let centroid = path::CentroidPath::bare(points);
     let speed = mission.formation.ground_speed;
-    let length: f64 = centroid.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
-    let samples = (length / speed / trajectory::SAMPLE_PERIOD + 1.0)
-        * mission.formation.slots.len() as f64;
+    let length: f64 = centroid
+        .points
+        .windows(2)
+        .map(|w| (w[1] - w[0]).norm())
+        .sum();
+    let samples =
+        (length / speed / trajectory::SAMPLE_PERIOD + 1.0) * mission.formation.slots.len() as f64;
     if crate::pipeline::exceeds(samples, crate::pipeline::limits::TRAJECTORY_SAMPLES) {
         return Err(PipelineError::OverBudget(format!(
             "formation.ground_speed: the planned path ({length:.1} m at {} m/s) needs {} \

@@ -127,7 +127,11 @@ impl CostModel {
             .min((spare / 2.0).max(0.0));
         CostModel {
             params: mission.theta_pso.clone(),
-            obstacles: mission.obstacles.iter().map(|o| mission.cylinder(o)).collect(),
+            obstacles: mission
+                .obstacles
+                .iter()
+                .map(|o| mission.cylinder(o))
+                .collect(),
             slots: f.slots.clone(),
             uav_radius: f.uav_radius,
             margin,

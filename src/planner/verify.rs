@@ -206,7 +206,11 @@ pub fn verify_within(
             });
         }
     };
-    let cylinders: Vec<_> = mission.obstacles.iter().map(|o| mission.cylinder(o)).collect();
+    let cylinders: Vec<_> = mission
+        .obstacles
+        .iter()
+        .map(|o| mission.cylinder(o))
+        .collect();
     let ground = mission.ground_model();
     let samples = trajectories
         .iter()

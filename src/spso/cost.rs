@@ -180,7 +180,11 @@ impl Model {
         let mid = (self.band[1] + self.band[0]) / 2.0;
         let mut j3 = 0.0;
         for &z in &pz[1..=n] {
-            j3 += if z < 0.0 { f64::INFINITY } else { (z - mid).abs() };
+            j3 += if z < 0.0 {
+                f64::INFINITY
+            } else {
+                (z - mid).abs()
+            };
         }
         let [b1, b2, b3, b4] = self.weights;
         let mut terms = Terms {
@@ -309,14 +313,16 @@ fn det2(r1: [f64; 2], r2: [f64; 2]) -> f64 {
     sign * (p[0] * u22)
 }
 
+// The expected values are the reference's, printed with %.17g.
 #[cfg(test)]
+#[allow(clippy::excessive_precision)]
 mod tests {
     use super::*;
 
     /// Flat ground H ≡ `h` on 300 × 300 pixels, band [100, 200] (SPEC §9).
     fn flat(start: [f64; 3], goal: [f64; 3], n: usize, threats: &[[f64; 3]], h: f32) -> Model {
-        let map = HeightMap::new(300, vec![h; 300 * 300], [1.0, 1.0], [1.0, 1.0])
-            .expect("a flat map");
+        let map =
+            HeightMap::new(300, vec![h; 300 * 300], [1.0, 1.0], [1.0, 1.0]).expect("a flat map");
         let threats = threats
             .iter()
             .map(|t| Threat {
@@ -346,7 +352,11 @@ mod tests {
     #[test]
     fn e1_straight() {
         let m = flat(S, [100.0, 130.0, 150.0], 2, &[], 0.0);
-        check(&m, &[[40.0, 50.0, 150.0], [70.0, 90.0, 150.0]], [750.0, 150.0, 0.0, 0.0, 0.0]);
+        check(
+            &m,
+            &[[40.0, 50.0, 150.0], [70.0, 90.0, 150.0]],
+            [750.0, 150.0, 0.0, 0.0, 0.0],
+        );
     }
 
     #[test]

@@ -80,7 +80,8 @@ impl Decoder {
             Encoding::Angle => {
                 for (c, b) in [bx, by, bz].iter().enumerate() {
                     for i in 0..n {
-                        out[c * n + i] = crate::planner::path::decode_angle(position[c * n + i], b[0], b[1]);
+                        out[c * n + i] =
+                            crate::planner::path::decode_angle(position[c * n + i], b[0], b[1]);
                     }
                 }
             }

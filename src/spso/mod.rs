@@ -129,7 +129,11 @@ pub fn g17(x: f64) -> String {
         return if x > 0.0 { "inf".into() } else { "-inf".into() };
     }
     if x == 0.0 {
-        return if x.is_sign_negative() { "-0".into() } else { "0".into() };
+        return if x.is_sign_negative() {
+            "-0".into()
+        } else {
+            "0".into()
+        };
     }
     let sci = format!("{x:.16e}");
     let (mantissa, exponent) = sci.split_once('e').unwrap_or((sci.as_str(), "0"));
@@ -151,6 +155,7 @@ pub fn g17(x: f64) -> String {
 }
 
 #[cfg(test)]
+#[allow(clippy::excessive_precision)]
 mod tests {
     use super::g17;
 
