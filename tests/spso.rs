@@ -284,3 +284,56 @@ fn the_benchmark_mission_plans_with_theta_pso() {
     );
     assert!(stdout.contains("altitude"), "{stdout}");
 }
+
+/// Evaluations per CPU-second of the cost alone, on one thread (skyform is
+/// built at opt-level 3 in every profile; the cost uses std only):
+/// `cargo test --test spso -- --ignored --nocapture cost_throughput`.
+#[test]
+#[ignore]
+fn cost_throughput() {
+    use std::time::Instant;
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("missions/spso-benchmark.toml");
+    let m = skyform::mission::load(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    let model = skyform::spso::model(&m).expect("terrain");
+    let text = fixture("paths.csv");
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .map(|l| l.split(',').map(number).collect())
+        .collect();
+    let n = 2_000_000;
+    let start = Instant::now();
+    let mut sum = 0.0;
+    for i in 0..n {
+        let c = model.cost(&rows[i % rows.len()]);
+        if c.is_finite() {
+            sum += c;
+        }
+    }
+    let t = start.elapsed().as_secs_f64();
+    println!(
+        "cost only, the 48 parity paths in turn: {:.0} evaluations per second ({:.0} ns each; {sum:.0})",
+        n as f64 / t,
+        1e9 * t / n as f64
+    );
+    for encoding in [
+        skyform::mission::Encoding::Angle,
+        skyform::mission::Encoding::Spherical,
+    ] {
+        let decoder = skyform::spso::Decoder::new(&m, encoding);
+        let start = Instant::now();
+        let run = skyform::spso::optimise(&model, &decoder, 500, 200, 1, |_, _, _| {
+            std::ops::ControlFlow::Continue(())
+        });
+        let t = start.elapsed().as_secs_f64();
+        println!(
+            "full run {encoding:?} 500 × 200: {:.3} s, {} evaluations, {:.0} per second, J = {}",
+            t,
+            run.swarm.evaluations,
+            run.swarm.evaluations as f64 / t,
+            run.terms.total
+        );
+    }
+}
