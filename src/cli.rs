@@ -12,7 +12,9 @@ use crate::pipeline::{CancelToken, Completion, Event, Kind, Level, Observer, Tee
 use crate::planner::PlanOptions;
 use crate::record::{self, Recorder, Sinks};
 
+pub mod eval_cmd;
 pub mod export_cmd;
+pub mod sweep_cmd;
 
 /// Terminal mission designer for multi-UAV formations.
 ///
@@ -74,6 +76,19 @@ pub enum Command {
     /// timing error. Exit status: 0 written, 1 error, 2 refused, 130
     /// cancelled (Ctrl-C). See docs/export.md.
     Export(export_cmd::ExportArgs),
+    /// Print the cost of given paths under the mission's cost, one per line
+    /// with 17 significant digits (`inf` where infinite): the parity hook
+    /// with the SPSO benchmark's reference code (see docs/spso.md).
+    ///
+    /// Each CSV row holds 3 n numbers: the n free nodes' x, then y, then z
+    /// above the ground. Exit status: 0 printed, 1 error.
+    Eval(eval_cmd::EvalArgs),
+    /// Run a pipeline over many seeds in parallel and print a table:
+    /// feasible/passed counts, the best cost (or headline figure) mean ± sd,
+    /// median, min, max, wall and CPU time, cost evaluations per CPU-second.
+    ///
+    /// Exit status: 0 every run finished, 1 an error.
+    Sweep(sweep_cmd::SweepArgs),
 }
 
 #[derive(Debug, Subcommand)]
@@ -238,6 +253,8 @@ pub fn main() -> ExitCode {
             ExitCode::from(record_mission(&mission, &record.sinks()))
         }
         Command::Export(args) => ExitCode::from(export_cmd::export_command(&args)),
+        Command::Eval(args) => ExitCode::from(eval_cmd::eval_command(&args)),
+        Command::Sweep(args) => ExitCode::from(sweep_cmd::sweep_command(&args)),
     }
 }
 

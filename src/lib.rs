@@ -18,6 +18,8 @@ pub mod pipeline;
 pub mod planner;
 #[cfg(feature = "rerun")]
 pub mod record;
+pub mod spso;
 pub mod swarm;
+pub mod terrain;
 pub mod tracks;
 pub mod tui;

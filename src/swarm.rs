@@ -225,6 +225,164 @@ where
     }
 }
 
+/// The loop of the SPSO reference code (`SPSO_MAIN.m`), used by the SPSO
+/// benchmark for both of its encodings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SequentialConfig {
+    pub particles: usize,
+    pub iterations: usize,
+    /// w at the first iteration.
+    pub inertia: f64,
+    /// w is multiplied by this after each iteration (wdamp, 0.98).
+    pub damping: f64,
+    pub cognitive: f64,
+    pub social: f64,
+    /// As `SwarmConfig::streams`.
+    pub streams: u64,
+    /// The initial pass is repeated while no particle has a finite cost, at
+    /// most this many times (the reference repeats it without limit).
+    pub init_passes: usize,
+}
+
+/// Minimises `cost` the way the SPSO reference code does, with one seeded
+/// stream per particle:
+///
+/// - start uniformly in the box, velocities 0; repeat the initial pass while
+///   no particle has a finite cost;
+/// - per particle and dimension: v ← w v + c1 r1 (p − x) + c2 r2 (g − x), with
+///   r1, r2 drawn per dimension; v clamped to ±`max_step`; x ← x + v; v ← −v
+///   where x left the box; x clamped into the box;
+/// - the particle is evaluated at once; its personal best is replaced only
+///   when strictly better, and then the global best too when strictly better,
+///   so later particles of the same iteration already follow it;
+/// - w ← w · damping after each iteration.
+///
+/// The global best changes between particles, so the particles are updated
+/// in order on one thread: the result depends on the seed only. Parallelism
+/// is over runs (`skyform sweep`). `cost(position, bound)` may stop at a
+/// partial sum ≥ `bound`, the particle's personal best, as for `minimize`.
+pub fn minimize_sequential<F, C>(
+    space: &SearchSpace,
+    config: &SequentialConfig,
+    seed: u64,
+    mut cost: F,
+    mut on_iteration: C,
+) -> SwarmResult
+where
+    F: FnMut(&[f64], f64) -> f64,
+    C: FnMut(&IterationReport<'_>) -> ControlFlow<()>,
+{
+    let dims = space.dims();
+    let n = config.particles.max(1);
+    let mut rngs: Vec<ChaCha8Rng> = (0..n)
+        .map(|i| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            rng.set_stream((config.streams << 32) | i as u64);
+            rng
+        })
+        .collect();
+    let mut guarded = |x: &[f64], bound: f64| {
+        let c = cost(x, bound);
+        if c.is_nan() { f64::INFINITY } else { c }
+    };
+    let mut positions = vec![vec![0.0; dims]; n];
+    let mut velocities = vec![vec![0.0; dims]; n];
+    let mut personal: Vec<Best> = Vec::with_capacity(n);
+    let mut global = Best {
+        position: vec![0.0; dims],
+        cost: f64::INFINITY,
+    };
+    let mut evaluations = 0usize;
+    for _ in 0..config.init_passes.max(1) {
+        personal.clear();
+        for (i, rng) in rngs.iter_mut().enumerate() {
+            for (d, x) in positions[i].iter_mut().enumerate() {
+                *x = sample(rng, space.lower[d], space.upper[d]);
+            }
+            let c = guarded(&positions[i], f64::INFINITY);
+            evaluations += 1;
+            personal.push(Best {
+                position: positions[i].clone(),
+                cost: c,
+            });
+            if c < global.cost {
+                global = personal[i].clone();
+            }
+        }
+        if global.cost.is_finite() {
+            break;
+        }
+    }
+    if global.cost.is_infinite() {
+        // No finite cost anywhere: the first particle stands for the swarm.
+        global = personal[0].clone();
+    }
+    let report = IterationReport {
+        iteration: 0,
+        best: &global,
+        improved: true,
+    };
+    if on_iteration(&report).is_break() {
+        return SwarmResult {
+            best: global,
+            iterations: 0,
+            evaluations,
+            stopped: true,
+        };
+    }
+    let mut w = config.inertia;
+    for iteration in 1..=config.iterations {
+        let mut improved = false;
+        for (i, rng) in rngs.iter_mut().enumerate() {
+            let (x, v) = (&mut positions[i], &mut velocities[i]);
+            for d in 0..dims {
+                let r1: f64 = rng.random();
+                let r2: f64 = rng.random();
+                let step = w * v[d]
+                    + config.cognitive * r1 * (personal[i].position[d] - x[d])
+                    + config.social * r2 * (global.position[d] - x[d]);
+                v[d] = step.clamp(-space.max_step[d], space.max_step[d]);
+                x[d] += v[d];
+                if x[d] < space.lower[d] || x[d] > space.upper[d] {
+                    v[d] = -v[d];
+                }
+                x[d] = x[d].clamp(space.lower[d], space.upper[d]);
+            }
+            let c = guarded(x, personal[i].cost);
+            evaluations += 1;
+            if c < personal[i].cost {
+                personal[i].position.copy_from_slice(x);
+                personal[i].cost = c;
+                if c < global.cost {
+                    global.position.copy_from_slice(x);
+                    global.cost = c;
+                    improved = true;
+                }
+            }
+        }
+        w *= config.damping;
+        let report = IterationReport {
+            iteration,
+            best: &global,
+            improved,
+        };
+        if on_iteration(&report).is_break() {
+            return SwarmResult {
+                best: global,
+                iterations: iteration,
+                evaluations,
+                stopped: true,
+            };
+        }
+    }
+    SwarmResult {
+        best: global,
+        iterations: config.iterations,
+        evaluations,
+        stopped: false,
+    }
+}
+
 fn sample(rng: &mut ChaCha8Rng, lower: f64, upper: f64) -> f64 {
     if upper > lower {
         rng.random_range(lower..=upper)
@@ -398,6 +556,75 @@ mod tests {
         };
         assert_ne!(run(0).best.position, run(1).best.position);
         assert_eq!(run(1), run(1));
+    }
+
+    #[test]
+    fn the_sequential_loop_finds_a_minimum_and_repeats_with_its_seed() {
+        let space = SearchSpace::uniform(4, -1.0, 1.0, 1.0);
+        let cfg = SequentialConfig {
+            particles: 30,
+            iterations: 200,
+            inertia: 1.0,
+            damping: 0.98,
+            cognitive: 1.5,
+            social: 1.5,
+            streams: 0,
+            init_passes: 10,
+        };
+        let run = |seed| {
+            minimize_sequential(
+                &space,
+                &cfg,
+                seed,
+                |x, _| sphere(x),
+                |_| ControlFlow::Continue(()),
+            )
+        };
+        let a = run(1);
+        assert!(a.best.cost < 1e-6, "cost {}", a.best.cost);
+        assert_eq!(a.evaluations, 30 * 201);
+        assert_eq!(a, run(1));
+        let early = |seed| {
+            minimize_sequential(
+                &space,
+                &cfg,
+                seed,
+                |x, _| sphere(x),
+                |r| {
+                    if r.iteration == 3 {
+                        ControlFlow::Break(())
+                    } else {
+                        ControlFlow::Continue(())
+                    }
+                },
+            )
+        };
+        assert_ne!(
+            early(1).best.position,
+            early(2).best.position,
+            "the seed matters"
+        );
+        // No finite cost at first: the initial pass is repeated.
+        let mut calls = 0;
+        let r = minimize_sequential(
+            &space,
+            &SequentialConfig {
+                iterations: 0,
+                ..cfg.clone()
+            },
+            1,
+            |x, _| {
+                calls += 1;
+                if calls <= 30 {
+                    f64::INFINITY
+                } else {
+                    sphere(x)
+                }
+            },
+            |_| ControlFlow::Continue(()),
+        );
+        assert_eq!(r.evaluations, 60);
+        assert!(r.best.cost.is_finite());
     }
 
     #[test]

@@ -25,7 +25,7 @@ fn every_shipped_mission_is_valid_without_errors() {
             seen += 1;
         }
     }
-    assert_eq!(seen, 4, "the four shipped missions");
+    assert_eq!(seen, 5, "the five shipped missions");
 }
 
 #[test]
@@ -211,6 +211,7 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                 flatlo: Default::default(),
                 fleet: Default::default(),
                 obstacles,
+                terrain: None,
             };
             m.reconfiguration.default_shape = shape;
             m.formation.slots[0] = Vector3::new(0.0, 2.0, 0.0);

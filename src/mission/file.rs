@@ -53,7 +53,15 @@ pub fn check_str(text: &str, file: Option<&str>) -> Checked {
         };
     }
     match toml::from_str::<Mission>(text) {
-        Ok(mission) => {
+        Ok(mut mission) => {
+            // A terrain file is relative to the mission file (or to the
+            // current directory for a mission without one).
+            let base = file
+                .map(Path::new)
+                .and_then(Path::parent)
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or_else(|| Path::new("."));
+            mission.load_terrain(base);
             let report = Report::new(validate(&mission).into_iter().map(locate).collect());
             Checked {
                 mission: Some(mission),

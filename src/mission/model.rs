@@ -40,6 +40,106 @@ pub struct Mission {
     /// Vertical cylinders standing on the ground (z = 0).
     #[serde(default)]
     pub obstacles: Vec<Obstacle>,
+    /// A height map: the altitude band is then above the ground under each point.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub terrain: Option<Terrain>,
+}
+
+/// `[terrain]`: a GeoTIFF height map placed in the ENU frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Terrain {
+    /// The GeoTIFF, relative to the mission file (one sample per pixel, metres).
+    pub file: String,
+    /// ENU x, y of the centre of the first pixel (row 0, column 0), metres.
+    pub origin: [f64; 2],
+    /// ENU step from one column and from one row to the next, metres; a
+    /// north-up GeoTIFF has a negative y step.
+    pub pixel_size: [f64; 2],
+    /// How the ground between pixel centres is read.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub lookup: crate::terrain::Lookup,
+    /// The map as loaded when the mission was read (or why it could not be).
+    #[serde(skip)]
+    pub map: crate::terrain::Loaded,
+}
+
+fn is_default<T: Default + PartialEq>(v: &T) -> bool {
+    *v == T::default()
+}
+
+impl Mission {
+    /// The loaded height map, if the mission has one that loaded.
+    pub fn height_map(&self) -> Option<&std::sync::Arc<crate::terrain::HeightMap>> {
+        self.terrain
+            .as_ref()
+            .and_then(|t| t.map.0.as_ref())
+            .and_then(|m| m.as_ref().ok())
+    }
+
+    /// The ground height under (x, y), metres: 0 without terrain; with
+    /// terrain, the mission's lookup, at the map's edge outside it.
+    pub fn ground(&self, x: f64, y: f64) -> f64 {
+        match (self.terrain.as_ref(), self.height_map()) {
+            (Some(t), Some(map)) => map.ground_clamped(t.lookup, x, y),
+            _ => 0.0,
+        }
+    }
+
+    /// The loaded map with the mission's lookup.
+    pub fn ground_model(&self) -> Option<crate::terrain::Ground> {
+        let t = self.terrain.as_ref()?;
+        Some(crate::terrain::Ground {
+            map: self.height_map()?.clone(),
+            lookup: t.lookup,
+        })
+    }
+
+    /// Obstacle `o` as a cylinder in the ENU frame: with terrain, standing on
+    /// the ground under its centre (its height is above that ground).
+    pub fn cylinder(&self, o: &Obstacle) -> crate::geometry::Cylinder {
+        let mut c = o.cylinder();
+        if self.terrain.is_some() {
+            c.height += self.ground(o.center.x, o.center.y);
+        }
+        c
+    }
+
+    /// Loads the terrain file (relative to `base`) into `terrain.map`,
+    /// keeping the reason when it fails (validation reports it, located).
+    pub fn load_terrain(&mut self, base: &std::path::Path) {
+        if let Some(t) = self.terrain.as_mut() {
+            t.map = crate::terrain::Loaded(Some(crate::terrain::load_cached(
+                base,
+                &t.file,
+                t.origin,
+                t.pixel_size,
+            )));
+        }
+    }
+}
+
+/// The cost a θ-PSO run minimises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CostKind {
+    /// The θ-PSO paper's J (eqs. 2-5, 10-11) over every UAV.
+    #[default]
+    Paper,
+    /// The SPSO benchmark's J = 5 J1 + J2 + 10 J3 + J4, exactly as its
+    /// reference code computes it (`docs/spso.md`); needs `[terrain]`.
+    Spso,
+}
+
+/// How a particle encodes the path (with `cost = "spso"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Encoding {
+    /// θ-PSO eq. 1: one angle per coordinate of each free node.
+    #[default]
+    Angle,
+    /// SPSO: a spherical vector (r, ψ, φ) per node, relative to the one before.
+    Spherical,
 }
 
 /// Standard gravity, m/s² (ISO 80000-3): one constant for validation and
@@ -287,6 +387,13 @@ pub struct ThetaPsoParams {
     /// around the obstacles inflated by the formation's safe radius) instead
     /// of at random; 0 for the paper's purely random start (Fig. 3, line 9).
     pub seeded_particles: usize,
+    /// The cost: the paper's (default) or the SPSO benchmark's.
+    #[serde(skip_serializing_if = "is_default")]
+    pub cost: CostKind,
+    /// The encoding of a particle with `cost = "spso"`, each with its
+    /// published settings (gains, inertia damping, velocity limits).
+    #[serde(skip_serializing_if = "is_default")]
+    pub encoding: Encoding,
 }
 
 impl Default for ThetaPsoParams {
@@ -309,6 +416,8 @@ impl Default for ThetaPsoParams {
             clearance_margin: 0.1,
             restarts: 3,
             seeded_particles: 10,
+            cost: CostKind::Paper,
+            encoding: Encoding::Angle,
         }
     }
 }

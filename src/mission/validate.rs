@@ -37,6 +37,7 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
     c.flatlo(&root.key("flatlo"), &mission.flatlo);
     c.fleet(&root.key("fleet"), &mission.fleet, mission);
     c.obstacles(&root.key("obstacles"), mission);
+    c.terrain(&root.key("terrain"), mission);
     c.physical(mission);
     c.out
 }
@@ -502,6 +503,71 @@ impl Checker {
                 path.key("weight_obstacle"),
                 "is 0: the planner will ignore obstacles (the result is still verified)",
             );
+        }
+    }
+
+    /// `[terrain]`: the file loaded, its pixels placed, the bounds on it; and
+    /// what `cost = "spso"` and the spherical encoding need.
+    fn terrain(&mut self, path: &FieldPath, mission: &Mission) {
+        use super::model::{CostKind, Encoding};
+        let p = &mission.theta_pso;
+        let at = FieldPath::root().key("theta_pso");
+        if p.cost == CostKind::Spso {
+            if mission.terrain.is_none() {
+                self.error(
+                    at.key("cost"),
+                    "\"spso\" needs a [terrain] height map (its J3 and J4 read the ground)",
+                );
+            }
+            let most = crate::spso::cost::MAX_POINTS - 2;
+            if p.waypoints > most {
+                self.error(
+                    at.key("waypoints"),
+                    format!("the SPSO cost takes at most {most} free nodes"),
+                );
+            }
+        } else if p.encoding == Encoding::Spherical {
+            self.error(
+                at.key("encoding"),
+                "\"spherical\" encodes the SPSO benchmark's paths: it needs cost = \"spso\"",
+            );
+        }
+        let Some(t) = &mission.terrain else { return };
+        for (i, v) in t.pixel_size.iter().enumerate() {
+            if *v == 0.0 {
+                self.error(path.key("pixel_size").index(i), "must not be 0");
+            }
+        }
+        match &t.map.0 {
+            None => self.error(path.key("file"), "was not loaded"),
+            Some(Err(e)) => self.error(path.key("file"), e.clone()),
+            Some(Ok(map)) => {
+                let b = &mission.bounds;
+                // The bounds must lie on the map (half a pixel beyond the
+                // outer centres still reads the edge pixel).
+                let half = [map.pixel[0].abs() / 2.0, map.pixel[1].abs() / 2.0];
+                let [x0, x1] = map.x_extent();
+                let [y0, y1] = map.y_extent();
+                if b.x[0] < x0 - half[0]
+                    || b.x[1] > x1 + half[0]
+                    || b.y[0] < y0 - half[1]
+                    || b.y[1] > y1 + half[1]
+                {
+                    self.error(
+                        path.key("origin"),
+                        format!(
+                            "the map covers x [{}, {}], y [{}, {}] (pixel centres), \
+                             not the bounds x {:?}, y {:?}",
+                            compact(x0),
+                            compact(x1),
+                            compact(y0),
+                            compact(y1),
+                            b.x,
+                            b.y
+                        ),
+                    );
+                }
+            }
         }
     }
 

@@ -70,6 +70,8 @@ pub struct CostModel {
     iwp_points: Vec<Point2<f64>>,
     band: [f64; 2],
     bounds: Bounds,
+    /// With terrain, the band is above the ground under each UAV.
+    ground: Option<crate::terrain::Ground>,
     /// Cosine of the largest heading turn over one piece: the turn at which a
     /// UAV `reach` from the centroid strays `CHORD_TOLERANCE` from the chord.
     max_turn_cos: f64,
@@ -125,7 +127,11 @@ impl CostModel {
             .min((spare / 2.0).max(0.0));
         CostModel {
             params: mission.theta_pso.clone(),
-            obstacles: mission.obstacles.iter().map(|o| o.cylinder()).collect(),
+            obstacles: mission
+                .obstacles
+                .iter()
+                .map(|o| mission.cylinder(o))
+                .collect(),
             slots: f.slots.clone(),
             uav_radius: f.uav_radius,
             margin,
@@ -141,6 +147,7 @@ impl CostModel {
                 .collect(),
             band: mission.bounds.z,
             bounds: mission.bounds.clone(),
+            ground: mission.ground_model(),
             max_turn_cos: {
                 let half = (1.0 - CHORD_TOLERANCE / reach.max(CHORD_TOLERANCE)).max(0.0);
                 2.0 * half * half - 1.0
@@ -213,7 +220,8 @@ impl CostModel {
             }
             let low = a.z.min(b.z) - rise;
             let high = a.z.max(b.z) + rise;
-            let band = low < self.band[0] || high > self.band[1];
+            // Over terrain the band moves with the ground: follow every leg.
+            let band = self.ground.is_some() || low < self.band[0] || high > self.band[1];
             let edge = self
                 .bounds
                 .horizontal_margin(&a)
@@ -386,6 +394,17 @@ impl CostModel {
                     }
                 }
             }
+            // Over terrain, sample the band at the map's resolution (at most
+            // 4096 samples a window): the ground changes between vertices.
+            if let Some(g) = &self.ground {
+                let pixel = g.map.pixel[0].abs().min(g.map.pixel[1].abs());
+                let step = pixel.max((w1 - w0) / 4096.0);
+                let mut s = w0 + step;
+                while s < w1 {
+                    knots.push(s);
+                    s += step;
+                }
+            }
             knots.sort_by(f64::total_cmp);
             knots.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
 
@@ -442,7 +461,8 @@ impl CostModel {
             return;
         }
         for p in points {
-            sums.altitude += len * self.altitude_violation(p.z);
+            let ground = self.ground.as_ref().map_or(0.0, |g| g.at(p.x, p.y));
+            sums.altitude += len * self.altitude_violation(p.z - ground);
             let out = -self.bounds.horizontal_margin(p);
             if out > 0.0 {
                 sums.bounds += len * out;
@@ -450,7 +470,7 @@ impl CostModel {
         }
     }
 
-    /// δ of eq. 5 for a UAV at height z.
+    /// δ of eq. 5 for a UAV at height z above the ground.
     fn altitude_violation(&self, z: f64) -> f64 {
         let [z_min, z_max] = self.band;
         if z <= 0.0 {

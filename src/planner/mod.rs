@@ -4,6 +4,7 @@
 //! timed trajectory through the reconfigurations (eqs. 12-15), and verify the
 //! result against the hard constraints and the inspection passes (eq. 8).
 
+pub mod benchmark;
 pub mod cost;
 pub mod inspection;
 pub mod iwp;
@@ -307,6 +308,9 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<ThetaPsoOutcome, PipelineError> {
+    if mission.theta_pso.cost == crate::mission::CostKind::Spso {
+        return benchmark::plan(mission, seed, observer, cancel);
+    }
     crate::pipeline::require_valid(mission)?;
     crate::pipeline::require_within_budget(budget(mission))?;
     let errors: Vec<String> = diagnostics(mission)

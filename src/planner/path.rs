@@ -143,6 +143,9 @@ pub struct PathBuilder {
     free: usize,
     crossings: Vec<Crossing>,
     inspections: Vec<Inspection>,
+    /// With terrain, the path is planned above the ground and lifted onto it
+    /// at its vertices.
+    ground: Option<crate::terrain::Ground>,
 }
 
 /// A usable IWP as a via: its straight crossing.
@@ -260,6 +263,7 @@ impl PathBuilder {
             free: mission.theta_pso.waypoints,
             crossings,
             inspections,
+            ground: mission.ground_model(),
         }
     }
 
@@ -376,6 +380,11 @@ impl PathBuilder {
             passes.push((i, leg + 1, on_left));
         }
 
+        if let Some(g) = &self.ground {
+            for p in &mut points {
+                p.z += g.at(p.x, p.y);
+            }
+        }
         let arcs = cumulative_lengths(&points);
         let total = arcs.last().copied().unwrap_or(0.0);
         let zones = crossings

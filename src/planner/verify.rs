@@ -205,7 +205,12 @@ pub fn verify_within(
             });
         }
     };
-    let cylinders: Vec<_> = mission.obstacles.iter().map(|o| o.cylinder()).collect();
+    let cylinders: Vec<_> = mission
+        .obstacles
+        .iter()
+        .map(|o| mission.cylinder(o))
+        .collect();
+    let ground = mission.ground_model();
     let samples = trajectories
         .iter()
         .map(|t| t.samples.len())
@@ -228,11 +233,13 @@ pub fn verify_within(
                     note(clearance.check.name, d, here(Some(o.name.clone())));
                 }
             }
-            if low.observe(p.z, || here(None)) {
-                note(low.check.name, p.z, here(None));
+            // The band is above the ground under the UAV (z = 0 without terrain).
+            let h = p.z - ground.as_ref().map_or(0.0, |g| g.at(p.x, p.y));
+            if low.observe(h, || here(None)) {
+                note(low.check.name, h, here(None));
             }
-            if high.observe(p.z, || here(None)) {
-                note(high.check.name, p.z, here(None));
+            if high.observe(h, || here(None)) {
+                note(high.check.name, h, here(None));
             }
             let margin = b.horizontal_margin(&p);
             if inside.observe(margin, || here(None)) {

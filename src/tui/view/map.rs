@@ -624,11 +624,14 @@ fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
     };
     let along = cumulative(&centroid);
     let length = along.last().copied().unwrap_or(0.0).max(1.0);
+    // With terrain: the ground under the path, and the band above it.
+    let ground = super::terrain::ground_profile(m, &centroid, &along, 400);
+    let highest = ground.iter().map(|g| g.1).fold(0.0, f64::max);
     let top = m
         .obstacles
         .iter()
         .map(|o| o.height)
-        .fold(m.bounds.z[1], f64::max)
+        .fold(m.bounds.z[1] + highest, f64::max)
         .max(1.0)
         * 1.15;
     let title = TextLine::from(vec![
@@ -644,8 +647,27 @@ fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
         .x_bounds([-0.02 * length, 1.02 * length])
         .y_bounds([0.0, top])
         .paint(|ctx| {
-            for z in m.bounds.z {
-                ctx.draw(&Line::new(0.0, z, length, z, Color::DarkGray));
+            if ground.is_empty() {
+                for z in m.bounds.z {
+                    ctx.draw(&Line::new(0.0, z, length, z, Color::DarkGray));
+                }
+            } else {
+                for z in m.bounds.z {
+                    let band: Vec<(f64, f64)> = ground.iter().map(|&(s, g)| (s, g + z)).collect();
+                    ctx.draw(&Polyline {
+                        points: &band,
+                        color: Color::DarkGray,
+                    });
+                }
+                ctx.draw(&Polyline {
+                    points: &ground,
+                    color: Color::Yellow,
+                });
+                ctx.print(
+                    length * 0.85,
+                    highest,
+                    Span::styled("ground", Style::default().fg(Color::Yellow)),
+                );
             }
             ctx.print(
                 0.0,

@@ -4,6 +4,7 @@
 pub mod inspector;
 pub mod jobs;
 pub mod map;
+pub mod terrain;
 
 use std::time::Instant;
 

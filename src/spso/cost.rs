@@ -1,0 +1,487 @@
+//! The SPSO benchmark's cost (Phung & Ha 2021, reference code duongpm/SPSO,
+//! `MyCost.m`), bit for bit: J = ((5 J1 + J2) + 10 J3) + J4.
+//!
+//! Every MATLAB detail is kept (see `docs/spso.md`): the ground is
+//! H(round(y), round(x)) with 1-based pixel coordinates and round half away
+//! from zero, negative heights count as 0, the absolute altitude is a float32
+//! sum `(z as f32) + H` widened to f64, J2 is ∞ strictly below R + 1, J3 is ∞
+//! strictly below z = 0 (relative), J4 uses atan2-based angles in degrees with
+//! borrowed projections where a segment has no x-y extent, and strict `> 45`.
+//!
+//! Where the reference raises an index error (a point whose rounded pixel is
+//! outside the map) skyform returns J = +∞ ([`Terms::off_map`] is set).
+
+use std::sync::Arc;
+
+use crate::terrain::HeightMap;
+
+/// (180/π)·atan2(y, x): Octave 7.3's `atan2d`, the product 180/π first.
+const DEG: f64 = 180.0 / std::f64::consts::PI;
+
+/// Most points (start, free nodes, goal) a path may have.
+pub const MAX_POINTS: usize = 32;
+
+/// A vertical cylinder threat: centre (x, y) and radius; only the x-y
+/// distance counts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Threat {
+    pub x: f64,
+    pub y: f64,
+    pub radius: f64,
+}
+
+/// Everything the cost needs: the scenario of `CreateModel.m` and the
+/// constants of `MyCost.m`.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// Start and goal (x, y, z above the ground).
+    pub start: [f64; 3],
+    pub goal: [f64; 3],
+    /// n, the free nodes between them.
+    pub nodes: usize,
+    pub threats: Vec<Threat>,
+    /// [z_min, z_max], above the ground; J3 measures from their middle.
+    pub band: [f64; 2],
+    pub map: Arc<HeightMap>,
+    /// drone_size (1) and danger_dist (10).
+    pub drone_size: f64,
+    pub danger_distance: f64,
+    /// turning_max, climb_max, degrees (45, 45).
+    pub turning_max: f64,
+    pub climb_max: f64,
+    /// b1..b4 (5, 1, 10, 1).
+    pub weights: [f64; 4],
+}
+
+/// J and its four terms.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Terms {
+    pub total: f64,
+    pub length: f64,
+    pub threat: f64,
+    pub altitude: f64,
+    pub smoothness: f64,
+    /// A point's pixel is outside the map (the reference's index error): J = ∞.
+    pub off_map: bool,
+}
+
+impl Model {
+    /// The benchmark's constants around a scenario.
+    pub fn new(
+        start: [f64; 3],
+        goal: [f64; 3],
+        nodes: usize,
+        threats: Vec<Threat>,
+        band: [f64; 2],
+        map: Arc<HeightMap>,
+    ) -> Self {
+        Model {
+            start,
+            goal,
+            nodes,
+            threats,
+            band,
+            map,
+            drone_size: 1.0,
+            danger_distance: 10.0,
+            turning_max: 45.0,
+            climb_max: 45.0,
+            weights: [5.0, 1.0, 10.0, 1.0],
+        }
+    }
+
+    /// H(round(y), round(x)) with negative heights set to 0, or `None` outside.
+    #[inline]
+    pub fn ground(&self, x: f64, y: f64) -> Option<f32> {
+        let m = &*self.map;
+        let h = if m.origin == [1.0, 1.0] && m.pixel == [1.0, 1.0] {
+            // The benchmark's own convention: the 1-based pixel is round(x).
+            let (c, r) = (x.round(), y.round());
+            if c >= 1.0 && r >= 1.0 && c <= m.width as f64 && r <= m.height as f64 {
+                m.heights[(r as usize - 1) * m.width + (c as usize - 1)]
+            } else {
+                return None;
+            }
+        } else {
+            m.nearest(x, y)?
+        };
+        Some(if h < 0.0 { 0.0 } else { h })
+    }
+
+    /// J for free nodes given as x1..xn, y1..yn, z1..zn (z above the ground).
+    pub fn cost(&self, xyz: &[f64]) -> f64 {
+        self.cost_below(xyz, f64::INFINITY)
+    }
+
+    /// J, or a lower bound of it that is ≥ `bound` once J is known to reach
+    /// `bound` (a candidate that cannot beat a personal best).
+    pub fn cost_below(&self, xyz: &[f64], bound: f64) -> f64 {
+        self.evaluate(xyz, bound).total
+    }
+
+    /// J and its terms.
+    pub fn terms(&self, xyz: &[f64]) -> Terms {
+        self.evaluate(xyz, f64::INFINITY)
+    }
+
+    fn evaluate(&self, xyz: &[f64], bound: f64) -> Terms {
+        let n = self.nodes;
+        let points = n + 2;
+        assert!(
+            xyz.len() == 3 * n && points <= MAX_POINTS,
+            "an SPSO path has 3 n numbers, n ≤ {}",
+            MAX_POINTS - 2
+        );
+        let mut px = [0.0f64; MAX_POINTS];
+        let mut py = [0.0f64; MAX_POINTS];
+        let mut pz = [0.0f64; MAX_POINTS];
+        px[0] = self.start[0];
+        py[0] = self.start[1];
+        pz[0] = self.start[2];
+        px[1..=n].copy_from_slice(&xyz[..n]);
+        py[1..=n].copy_from_slice(&xyz[n..2 * n]);
+        pz[1..=n].copy_from_slice(&xyz[2 * n..]);
+        px[n + 1] = self.goal[0];
+        py[n + 1] = self.goal[1];
+        pz[n + 1] = self.goal[2];
+        let (px, py, pz) = (&px[..points], &py[..points], &pz[..points]);
+
+        // z_abs = z + H: single + double is single in MATLAB, then stored in
+        // a double array.
+        let mut za = [0.0f64; MAX_POINTS];
+        for i in 0..points {
+            let Some(h) = self.ground(px[i], py[i]) else {
+                return Terms {
+                    total: f64::INFINITY,
+                    off_map: true,
+                    ..Terms::default()
+                };
+            };
+            za[i] = f64::from(pz[i] as f32 + h);
+        }
+        let za = &za[..points];
+
+        // Per segment: x-y step, its length, Δz_abs.
+        let segments = points - 1;
+        let mut dx = [0.0f64; MAX_POINTS];
+        let mut dy = [0.0f64; MAX_POINTS];
+        let mut dz = [0.0f64; MAX_POINTS];
+        let mut flat = [0.0f64; MAX_POINTS];
+        let mut j1 = 0.0;
+        for k in 0..segments {
+            dx[k] = px[k + 1] - px[k];
+            dy[k] = py[k + 1] - py[k];
+            dz[k] = za[k + 1] - za[k];
+            flat[k] = (dx[k] * dx[k] + dy[k] * dy[k]).sqrt();
+            j1 += (dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]).sqrt();
+        }
+
+        // J3 over the free nodes, relative z.
+        let mid = (self.band[1] + self.band[0]) / 2.0;
+        let mut j3 = 0.0;
+        for &z in &pz[1..=n] {
+            j3 += if z < 0.0 {
+                f64::INFINITY
+            } else {
+                (z - mid).abs()
+            };
+        }
+        let [b1, b2, b3, b4] = self.weights;
+        let mut terms = Terms {
+            length: j1,
+            altitude: j3,
+            ..Terms::default()
+        };
+        // (5 J1 + J2) + 10 J3 ≥ 5 J1 + 10 J3 in floating point (rounding is
+        // monotone, J2, J4 ≥ 0): a lower bound that stops early. Without a
+        // bound every term is computed (`terms`).
+        let low = b1 * j1 + b3 * j3;
+        if bound.is_finite() && low >= bound {
+            terms.total = low;
+            return terms;
+        }
+
+        // J2, threat-major.
+        let mut j2 = 0.0;
+        for t in &self.threats {
+            let inner = t.radius + self.drone_size;
+            let outer = t.radius + self.drone_size + self.danger_distance;
+            for k in 0..segments {
+                // Far from the segment's box: certainly d > outer, cost 0.
+                let (x0, x1) = (px[k].min(px[k + 1]), px[k].max(px[k + 1]));
+                let (y0, y1) = (py[k].min(py[k + 1]), py[k].max(py[k + 1]));
+                let reach = outer * (1.0 + 1e-9) + 1e-9;
+                if t.x < x0 - reach || t.x > x1 + reach || t.y < y0 - reach || t.y > y1 + reach {
+                    continue;
+                }
+                let d = dist_p2s([t.x, t.y], [px[k], py[k]], [px[k + 1], py[k + 1]]);
+                j2 += if d > outer {
+                    0.0
+                } else if d < inner {
+                    f64::INFINITY
+                } else {
+                    outer - d
+                };
+            }
+        }
+        terms.threat = j2;
+        let partial = b1 * j1 + b2 * j2 + b3 * j3;
+        if bound.is_finite() && partial >= bound {
+            terms.total = partial;
+            return terms;
+        }
+
+        // J4: for each interior point, the borrowed projections.
+        let nonzero = |k: usize| dx[k] != 0.0 || dy[k] != 0.0;
+        let mut j4 = 0.0;
+        let mut before = 0usize; // last non-zero segment ≤ i, else 0
+        for i in 0..points - 2 {
+            if nonzero(i) {
+                before = i;
+            }
+            let s1 = if nonzero(i) { i } else { before };
+            let s2 = (i + 1..segments)
+                .find(|&k| nonzero(k))
+                .unwrap_or(segments - 1);
+            // Turning angle atan2d(|s1 × s2|, s1 · s2), exactly as printed.
+            let cz = (dx[s1] * dy[s2] - dy[s1] * dx[s2]).abs();
+            let dot = dx[s1] * dx[s2] + dy[s1] * dy[s2];
+            if !(dot > 0.0 && cz < dot * (1.0 - 1e-10)) {
+                let turning = DEG * cz.atan2(dot);
+                if turning.abs() > self.turning_max {
+                    j4 += turning.abs();
+                }
+            }
+            // Climb angles: Δz_abs of the adjacent segments over the
+            // (borrowed) horizontal length.
+            let (z1, h1, z2, h2) = (dz[i], flat[s1], dz[i + 1], flat[s2]);
+            let cross = h1 * z2 - z1 * h2;
+            let along = h1 * h2 + z1 * z2;
+            let slack = 1e-12 * ((h1 * z2).abs() + (z1 * h2).abs());
+            if !(along > 0.0 && cross.abs() + slack < along * (1.0 - 1e-9)) {
+                let change = DEG * z2.atan2(h2) - DEG * z1.atan2(h1);
+                if change.abs() > self.climb_max {
+                    j4 += change.abs();
+                }
+            }
+        }
+        terms.smoothness = j4;
+        terms.total = ((b1 * j1 + b2 * j2) + b3 * j3) + b4 * j4;
+        terms
+    }
+}
+
+/// `DistP2S.m`: x-y distance from `x` to the segment a-b, with Octave's
+/// branch on the dot products and LAPACK's 2×2 determinant.
+#[inline]
+pub fn dist_p2s(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let d_ab = norm2(a[0] - b[0], a[1] - b[1]);
+    let d_ax = norm2(a[0] - x[0], a[1] - x[1]);
+    if d_ab != 0.0 {
+        let dot1 = (a[0] - b[0]) * (x[0] - b[0]) + (a[1] - b[1]) * (x[1] - b[1]);
+        let dot2 = (b[0] - a[0]) * (x[0] - a[0]) + (b[1] - a[1]) * (x[1] - a[1]);
+        if dot1 * dot2 >= 0.0 {
+            det2([b[0] - a[0], b[1] - a[1]], [x[0] - a[0], x[1] - a[1]]).abs() / d_ab
+        } else {
+            let d_bx = norm2(b[0] - x[0], b[1] - x[1]);
+            d_ax.min(d_bx)
+        }
+    } else {
+        d_ax
+    }
+}
+
+#[inline]
+fn norm2(a: f64, b: f64) -> f64 {
+    (a * a + b * b).sqrt()
+}
+
+/// det([r1; r2]) as LAPACK's dgetrf does it: partial pivoting on the first
+/// column, l = a_21 · (1 / pivot), u22 = a_22 − l · a_12.
+#[inline]
+fn det2(r1: [f64; 2], r2: [f64; 2]) -> f64 {
+    let (p, q, sign) = if r2[0].abs() > r1[0].abs() {
+        (r2, r1, -1.0)
+    } else {
+        (r1, r2, 1.0)
+    };
+    if p[0] == 0.0 {
+        return 0.0;
+    }
+    let l = q[0] * (1.0 / p[0]);
+    let u22 = q[1] - l * p[1];
+    sign * (p[0] * u22)
+}
+
+// The expected values are the reference's, printed with %.17g.
+#[cfg(test)]
+#[allow(clippy::excessive_precision)]
+mod tests {
+    use super::*;
+
+    /// Flat ground H ≡ `h` on 300 × 300 pixels, band [100, 200] (SPEC §9).
+    fn flat(start: [f64; 3], goal: [f64; 3], n: usize, threats: &[[f64; 3]], h: f32) -> Model {
+        let map =
+            HeightMap::new(300, vec![h; 300 * 300], [1.0, 1.0], [1.0, 1.0]).expect("a flat map");
+        let threats = threats
+            .iter()
+            .map(|t| Threat {
+                x: t[0],
+                y: t[1],
+                radius: t[2],
+            })
+            .collect();
+        Model::new(start, goal, n, threats, [100.0, 200.0], Arc::new(map))
+    }
+
+    fn nodes(p: &[[f64; 3]]) -> Vec<f64> {
+        (0..3).flat_map(|c| p.iter().map(move |q| q[c])).collect()
+    }
+
+    fn check(m: &Model, p: &[[f64; 3]], want: [f64; 5]) {
+        let t = m.terms(&nodes(p));
+        let got = [t.total, t.length, t.threat, t.altitude, t.smoothness];
+        for (g, w) in got.iter().zip(&want) {
+            let ok = g == w || (g - w).abs() <= 1e-15 * w.abs();
+            assert!(ok, "got {got:?}, want {want:?}");
+        }
+    }
+
+    const S: [f64; 3] = [10.0, 10.0, 150.0];
+
+    #[test]
+    fn e1_straight() {
+        let m = flat(S, [100.0, 130.0, 150.0], 2, &[], 0.0);
+        check(
+            &m,
+            &[[40.0, 50.0, 150.0], [70.0, 90.0, 150.0]],
+            [750.0, 150.0, 0.0, 0.0, 0.0],
+        );
+    }
+
+    #[test]
+    fn e2_turns_above_and_at_45_degrees() {
+        let m = flat(S, [80.0, 20.0, 150.0], 1, &[], 0.0);
+        check(&m, &[[40.0, 50.0, 150.0]], [590.0, 100.0, 0.0, 0.0, 90.0]);
+        let m = flat([10.0, 60.0, 150.0], [40.0, 50.0, 150.0], 1, &[], 0.0);
+        check(
+            &m,
+            &[[40.0, 100.0, 150.0]],
+            [643.13010235415595, 100.0, 0.0, 0.0, 143.13010235415598],
+        );
+        let m = flat(S, [110.0, 260.0, 150.0], 1, &[], 0.0);
+        check(
+            &m,
+            &[[10.0, 160.0, 150.0]],
+            [1457.1067811865476, 291.42135623730951, 0.0, 0.0, 0.0],
+        );
+    }
+
+    #[test]
+    fn e3_climbs() {
+        let m = flat(S, [70.0, 90.0, 150.0], 1, &[], 0.0);
+        check(
+            &m,
+            &[[40.0, 50.0, 200.0]],
+            [1297.1067811865476, 141.42135623730951, 0.0, 50.0, 90.0],
+        );
+        let m = flat(S, [70.0, 90.0, 200.0], 1, &[], 0.0);
+        check(
+            &m,
+            &[[40.0, 50.0, 200.0]],
+            [1103.5533905932739, 120.71067811865476, 0.0, 50.0, 0.0],
+        );
+        // E8: the same over ground at 100 m: J3 stays relative.
+        let m = flat(S, [70.0, 90.0, 150.0], 1, &[], 100.0);
+        check(
+            &m,
+            &[[40.0, 50.0, 200.0]],
+            [1297.1067811865476, 141.42135623730951, 0.0, 50.0, 90.0],
+        );
+    }
+
+    #[test]
+    fn e4_threats_inside_on_the_boundaries_and_over_a_repeated_point() {
+        let m = flat(S, [100.0, 130.0, 150.0], 2, &[[25.0, 30.0, 5.0]], 0.0);
+        check(
+            &m,
+            &[[40.0, 50.0, 150.0], [70.0, 90.0, 150.0]],
+            [f64::INFINITY, 150.0, f64::INFINITY, 0.0, 0.0],
+        );
+        let g = [100.0, 10.0, 150.0];
+        let m = flat(S, g, 1, &[[55.0, 20.0, 5.0]], 0.0);
+        check(&m, &[[55.0, 10.0, 150.0]], [462.0, 90.0, 12.0, 0.0, 0.0]);
+        let m = flat(S, g, 1, &[[30.0, 16.0, 5.0], [80.0, 26.0, 5.0]], 0.0);
+        check(&m, &[[55.0, 10.0, 150.0]], [460.0, 90.0, 10.0, 0.0, 0.0]);
+        let m = flat(S, g, 2, &[[40.0, 17.0, 0.0]], 0.0);
+        check(
+            &m,
+            &[[40.0, 10.0, 150.0], [40.0, 10.0, 150.0]],
+            [462.0, 90.0, 12.0, 0.0, 0.0],
+        );
+    }
+
+    #[test]
+    fn e5_a_node_below_the_ground_is_infinite() {
+        let m = flat(S, [70.0, 90.0, 150.0], 1, &[], 0.0);
+        check(
+            &m,
+            &[[40.0, 50.0, -1.0]],
+            [
+                f64::INFINITY,
+                318.12576129574921,
+                0.0,
+                f64::INFINITY,
+                143.35791827474222,
+            ],
+        );
+    }
+
+    #[test]
+    fn e6_e7_repeated_x_y_points_borrow_projections() {
+        let m = flat(S, [70.0, 90.0, 150.0], 2, &[], 0.0);
+        check(
+            &m,
+            &[[40.0, 50.0, 150.0], [40.0, 50.0, 190.0]],
+            [
+                1247.4758283798226,
+                154.03124237432849,
+                0.0,
+                40.0,
+                77.319616508180175,
+            ],
+        );
+        let m = flat(S, [40.0, 50.0, 150.0], 1, &[], 0.0);
+        check(
+            &m,
+            &[[10.0, 10.0, 170.0]],
+            [
+                681.05964984307707,
+                73.851648071345039,
+                0.0,
+                20.0,
+                111.80140948635182,
+            ],
+        );
+    }
+
+    #[test]
+    fn a_point_off_the_map_is_infinite() {
+        let m = flat(S, [70.0, 90.0, 150.0], 1, &[], 0.0);
+        let t = m.terms(&nodes(&[[0.4999999999999999, 50.0, 150.0]]));
+        assert!(t.off_map && t.total.is_infinite());
+        assert!(!m.terms(&nodes(&[[0.5, 50.0, 150.0]])).off_map);
+        assert!(m.terms(&nodes(&[[300.5, 50.0, 150.0]])).off_map);
+        assert!(m.terms(&nodes(&[[f64::NAN, 50.0, 150.0]])).off_map);
+    }
+
+    #[test]
+    fn the_bound_gives_a_lower_bound_at_least_the_bound() {
+        let m = flat(S, [70.0, 90.0, 150.0], 1, &[], 0.0);
+        let p = nodes(&[[40.0, 50.0, 200.0]]);
+        let full = m.cost(&p);
+        assert_eq!(m.cost_below(&p, f64::INFINITY), full);
+        let partial = m.cost_below(&p, 100.0);
+        assert!(partial >= 100.0 && partial <= full);
+    }
+}

@@ -1,0 +1,131 @@
+//! The two encodings of a path for the SPSO benchmark, and each one's
+//! published swarm settings (the benchmark's README).
+//!
+//! A particle decodes into the n free nodes x1..xn, y1..yn, z1..zn (z above
+//! the ground), the order `Model::cost` takes.
+
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+
+use crate::mission::{Encoding, Mission};
+use crate::swarm::{SearchSpace, SequentialConfig};
+
+/// Decodes particles of one encoding for one scenario.
+#[derive(Debug, Clone)]
+pub struct Decoder {
+    pub encoding: Encoding,
+    pub nodes: usize,
+    /// [x_min, x_max], [y_min, y_max], [z_min, z_max] (z above the ground).
+    pub bounds: [[f64; 2]; 3],
+    pub start: [f64; 3],
+    pub goal: [f64; 3],
+}
+
+impl Decoder {
+    pub fn new(mission: &Mission, encoding: Encoding) -> Self {
+        let b = &mission.bounds;
+        let (s, g) = (mission.route.start, mission.route.goal);
+        Decoder {
+            encoding,
+            nodes: mission.theta_pso.waypoints,
+            bounds: [b.x, b.y, b.z],
+            start: [s.x, s.y, s.z],
+            goal: [g.x, g.y, g.z],
+        }
+    }
+
+    /// The box and velocity limits.
+    ///
+    /// Angle: θ ∈ [−π/2, π/2] per coordinate, |Δθ| ≤ π/2. Spherical
+    /// (`SPSO_MAIN.m`): r ∈ [0, 2 |goal − start| / n] (3-D norm),
+    /// ψ ∈ [−π/4, π/4], φ ∈ [φ0 − π/4, φ0 + π/4] with
+    /// φ0 = atan2(Δy, Δx); velocity limit half of each range.
+    pub fn space(&self) -> SearchSpace {
+        let n = self.nodes;
+        match self.encoding {
+            Encoding::Angle => SearchSpace::uniform(3 * n, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2),
+            Encoding::Spherical => {
+                let d: f64 = (0..3)
+                    .map(|c| (self.goal[c] - self.start[c]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                let r_max = 2.0 * d / n.max(1) as f64;
+                let phi0 = (self.goal[1] - self.start[1]).atan2(self.goal[0] - self.start[0]);
+                let ranges = [
+                    [0.0, r_max],
+                    [-FRAC_PI_4, FRAC_PI_4],
+                    [phi0 - FRAC_PI_4, phi0 + FRAC_PI_4],
+                ];
+                let mut space = SearchSpace {
+                    lower: Vec::with_capacity(3 * n),
+                    upper: Vec::with_capacity(3 * n),
+                    max_step: Vec::with_capacity(3 * n),
+                };
+                for [lo, hi] in ranges {
+                    for _ in 0..n {
+                        space.lower.push(lo);
+                        space.upper.push(hi);
+                        space.max_step.push(0.5 * (hi - lo));
+                    }
+                }
+                space
+            }
+        }
+    }
+
+    /// The particle's free nodes into `out` (3 n numbers: x…, y…, z…).
+    pub fn decode(&self, position: &[f64], out: &mut [f64]) {
+        let n = self.nodes;
+        let [bx, by, bz] = self.bounds;
+        match self.encoding {
+            Encoding::Angle => {
+                for (c, b) in [bx, by, bz].iter().enumerate() {
+                    for i in 0..n {
+                        out[c * n + i] =
+                            crate::planner::path::decode_angle(position[c * n + i], b[0], b[1]);
+                    }
+                }
+            }
+            Encoding::Spherical => {
+                // SphericalToCart.m: each node from the clamped one before,
+                // x with sin φ and y with cos φ, clamped max first, then min.
+                let clamp = |v: f64, b: [f64; 2]| {
+                    let v = if v > b[1] { b[1] } else { v };
+                    if v < b[0] { b[0] } else { v }
+                };
+                let (mut x, mut y, mut z) = (self.start[0], self.start[1], self.start[2]);
+                for i in 0..n {
+                    let (r, psi, phi) = (position[i], position[n + i], position[2 * n + i]);
+                    let (sin_psi, cos_psi) = psi.sin_cos();
+                    let (sin_phi, cos_phi) = phi.sin_cos();
+                    x = clamp(x + r * cos_psi * sin_phi, bx);
+                    y = clamp(y + r * cos_psi * cos_phi, by);
+                    z = clamp(z + r * sin_psi, bz);
+                    out[i] = x;
+                    out[n + i] = y;
+                    out[2 * n + i] = z;
+                }
+            }
+        }
+    }
+
+    /// The encoding's published settings (the benchmark's README) for a
+    /// swarm of `particles` × `iterations`: inertia 1 damped by 0.98 per
+    /// iteration, the global best updated after each particle; c1 = c2 = 2
+    /// for the angles, 1.5 for the spherical vectors.
+    pub fn published(&self, particles: usize, iterations: usize) -> SequentialConfig {
+        let gain = match self.encoding {
+            Encoding::Angle => 2.0,
+            Encoding::Spherical => 1.5,
+        };
+        SequentialConfig {
+            particles,
+            iterations,
+            inertia: 1.0,
+            damping: 0.98,
+            cognitive: gain,
+            social: gain,
+            streams: 0,
+            init_passes: 100,
+        }
+    }
+}
