@@ -1,6 +1,10 @@
 //! Rerun recordings: the mission scene, live θ-PSO progress and the results,
 //! saved to `.rrd` and/or streamed to a viewer.
 //!
+//! One file for the sinks, the worker and the three pipelines' layouts, so
+//! the layout documented in `docs/rerun.md` reads in one place; over 700
+//! lines for that reason (the layouts could move to `record/layout.rs`).
+//!
 //! Layout (see `docs/rerun.md`): `world` is right-handed, Z up, metres, with
 //! `world/bounds`, `world/obstacles`, `world/route`, `world/iwps` static.
 //! θ-PSO logs under `theta_pso/…`: the best path of each iteration and the

@@ -3,6 +3,8 @@
 //! Terminal cells are about twice as tall as wide, so a [`Viewport`] gives a
 //! row twice the metres of a column: circles stay round at any zoom. The same
 //! viewport turns a mouse position back into metres for hit-testing.
+//! Over 700 lines: the three pipelines' results and the formation editor
+//! share the viewport and painters here.
 
 use nalgebra::{Point2, Point3};
 use ratatui::Frame;
