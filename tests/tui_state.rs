@@ -887,3 +887,25 @@ fn a_duplicate_obstacle_name_is_flagged_on_the_renamed_one_while_typing() {
     assert!(lines.iter().any(|l| l.starts_with(&at(1))), "{lines:?}");
     assert!(lines.iter().any(|l| l.starts_with(&at(4))), "{lines:?}");
 }
+
+/// Quitting without saving is a choice: no recovery copy is left behind.
+#[test]
+fn quitting_without_saving_leaves_no_recovery_copy() {
+    use skyform::tui::recovery::{Origin, Recovery};
+    let dir = tempfile::tempdir().unwrap();
+    let state = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let origin = Origin::File(dir.path().join("bridge.toml"));
+    app.use_recovery(Recovery::in_dir(Some(state.path().to_path_buf()), &origin));
+    app.update(Action::AddObstacle(None));
+    app.keep_recovery(std::time::Instant::now(), true);
+    assert_eq!(std::fs::read_dir(state.path()).unwrap().count(), 1);
+    app.update(Action::Quit);
+    assert!(matches!(app.overlay, Some(Overlay::Quit)));
+    app.update(Action::Confirm); // quit without saving
+    // What the loop does after every action and on the way out:
+    app.keep_recovery(std::time::Instant::now(), false);
+    app.keep_recovery(std::time::Instant::now(), true);
+    assert!(app.should_quit);
+    assert_eq!(std::fs::read_dir(state.path()).unwrap().count(), 0);
+}

@@ -1204,8 +1204,18 @@ impl App {
             self.set_error(format!("not saved: cannot create {}: {e}", dir.display()));
             return;
         }
+        let before = self.doc.path().map(Path::to_path_buf);
         match self.doc.save(Some(target)) {
             Ok(p) => {
+                // Saved as another file: later edits are recovered for it.
+                if before.as_ref() != Some(&p)
+                    && let Some(mut old) = self.recovery.take()
+                {
+                    old.discard();
+                    let mut fresh = old.moved_to(&Origin::File(p.clone()));
+                    fresh.discard();
+                    self.recovery = Some(fresh);
+                }
                 self.overlay = None;
                 self.set_status(format!("saved {}", p.display()));
                 if then == AfterSave::Quit {
@@ -1222,9 +1232,10 @@ impl App {
     fn confirm(&mut self) {
         match self.overlay.clone() {
             Some(Overlay::Quit) => {
-                // Quit without saving: the user chose to drop the changes.
+                // Quit without saving: the user chose to drop the changes, so
+                // no copy may be written on the way out either.
                 self.overlay = None;
-                if let Some(r) = &mut self.recovery {
+                if let Some(mut r) = self.recovery.take() {
                     r.discard();
                 }
                 self.shutdown();

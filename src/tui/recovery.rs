@@ -119,6 +119,16 @@ impl Recovery {
         }
     }
 
+    /// The copy for another origin in the same directory ("save as").
+    pub fn moved_to(&self, origin: &Origin) -> Self {
+        let dir = self
+            .path
+            .as_deref()
+            .and_then(Path::parent)
+            .map(Path::to_path_buf);
+        Self::in_dir(dir, origin)
+    }
+
     /// Where the copy is kept.
     pub fn path(&self) -> Option<&Path> {
         self.path.as_deref()
