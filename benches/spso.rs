@@ -86,7 +86,9 @@ fn full_run(c: &mut Criterion) {
                 let run = spso::optimise(&model, &decoder, 500, 200, black_box(1), |_, _, _| {
                     ControlFlow::Continue(())
                 });
-                assert_eq!(run.swarm.evaluations, 100_500);
+                // 100,500, plus 500 per extra initial pass when the first
+                // draws no finite cost (the reference re-draws too).
+                assert!(run.swarm.evaluations >= 100_500 && run.swarm.evaluations % 500 == 0);
                 run.terms.total
             })
         });
