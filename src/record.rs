@@ -941,7 +941,7 @@ fn log_fleet(stream: &RecordingStream, o: &FleetOutcome) -> rerun::RecordingStre
         let style = rerun::Points3D::update_fields()
             .with_colors([color])
             .with_radii([0.15f32])
-            .with_labels([format!("agent {}", a.index)]);
+            .with_labels([format!("agent {}", a.index + 1)]);
         log_moving_point(stream, &agent, &times, style, positions.clone())?;
         let style = rerun::Points3D::update_fields()
             .with_colors([rerun::Color::from_rgb(200, 200, 200)])
