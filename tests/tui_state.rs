@@ -909,3 +909,24 @@ fn quitting_without_saving_leaves_no_recovery_copy() {
     assert!(app.should_quit);
     assert_eq!(std::fs::read_dir(state.path()).unwrap().count(), 0);
 }
+
+/// Issue 16: an error in an IWP choice alone still leaves the IWPs marked.
+#[test]
+fn an_iwp_choice_error_alone_keeps_the_iwps_on_the_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = default_mission().mission;
+    let n = skyform::planner::find_iwps(&m).len();
+    assert!(n > 0);
+    m.reconfiguration.waypoints[0].scale = Some(7.0); // not in (0, 1]
+    let app = App::new(
+        Document::new(m, Some(dir.path().join("m.toml"))),
+        dir.path().to_path_buf(),
+    );
+    assert!(app.doc.error_count() > 0);
+    assert_eq!(app.iwps.len(), n);
+    // Any other error: no IWPs (the geometry may be wrong).
+    let mut m = default_mission().mission;
+    m.obstacles[0].radius = -1.0;
+    let app = App::new(Document::new(m, None), dir.path().to_path_buf());
+    assert!(app.iwps.is_empty());
+}

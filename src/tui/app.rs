@@ -367,11 +367,7 @@ impl App {
     /// After any change to the mission: keep the selection valid, recompute IWPs.
     fn refresh(&mut self) {
         let m = self.doc.mission();
-        self.iwps = if self.doc.error_count() == 0 {
-            find_iwps(m)
-        } else {
-            Vec::new()
-        };
+        self.iwps = iwps_despite_choices(m, self.doc.diagnostics());
         if !self.selected.exists(m) {
             self.selected = match self.selected {
                 Item::Obstacle(_) if !m.obstacles.is_empty() => {
@@ -1348,6 +1344,35 @@ pub fn concerns(path: &str, field: &str) -> bool {
         || path
             .strip_prefix(field)
             .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('['))
+}
+
+/// The IWPs (eq. 9) of a mission whose only errors, if any, are in IWP
+/// choices: those choices are left out, so the map still marks every IWP
+/// while the user fixes the choice. Any other error: none.
+fn iwps_despite_choices(m: &Mission, diagnostics: &[mission::Diagnostic]) -> Vec<Iwp> {
+    use crate::mission::PathSegment;
+    let mut bad = Vec::new();
+    for d in diagnostics.iter().filter(|d| d.is_error()) {
+        match d.path.0.as_slice() {
+            [
+                PathSegment::Key(r),
+                PathSegment::Key(w),
+                PathSegment::Index(i),
+                ..,
+            ] if r == "reconfiguration" && w == "waypoints" => bad.push(*i),
+            _ => return Vec::new(),
+        }
+    }
+    if bad.is_empty() {
+        return find_iwps(m);
+    }
+    let mut clean = m.clone();
+    let mut k = 0;
+    clean.reconfiguration.waypoints.retain(|_| {
+        k += 1;
+        !bad.contains(&(k - 1))
+    });
+    find_iwps(&clean)
 }
 
 fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
