@@ -172,21 +172,23 @@ pub enum PipelineError {
 
 /// Every pipeline's first step: a mission with errors is refused, naming them.
 pub fn require_valid(mission: &crate::mission::Mission) -> Result<(), PipelineError> {
-    let errors: Vec<String> = crate::mission::validate(mission)
-        .into_iter()
-        .filter(|d| d.is_error())
-        .map(|d| d.to_string())
-        .collect();
-    if errors.is_empty() {
-        Ok(())
-    } else {
-        Err(PipelineError::InvalidMission(errors.join("\n")))
-    }
+    refuse_errors(
+        crate::mission::validate(mission),
+        PipelineError::InvalidMission,
+    )
 }
 
 /// A run's predicted size over its documented limit: refused before it starts.
 pub fn require_within_budget(
     findings: Vec<crate::mission::Diagnostic>,
+) -> Result<(), PipelineError> {
+    refuse_errors(findings, PipelineError::OverBudget)
+}
+
+/// The errors among `findings`, one per line, as the refusal `error` makes.
+fn refuse_errors(
+    findings: Vec<crate::mission::Diagnostic>,
+    error: fn(String) -> PipelineError,
 ) -> Result<(), PipelineError> {
     let errors: Vec<String> = findings
         .into_iter()
@@ -196,7 +198,7 @@ pub fn require_within_budget(
     if errors.is_empty() {
         Ok(())
     } else {
-        Err(PipelineError::OverBudget(errors.join("\n")))
+        Err(error(errors.join("\n")))
     }
 }
 

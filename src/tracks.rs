@@ -33,13 +33,9 @@ pub fn vehicle_color(i: usize) -> [u8; 3] {
     VEHICLE_COLORS[i % VEHICLE_COLORS.len()]
 }
 
-/// One instant of a track. Seconds, metres ENU, m/s.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct TrackSample {
-    pub t: f64,
-    pub position: Point3<f64>,
-    pub velocity: Vector3<f64>,
-}
+/// One instant of a track (seconds, metres ENU, m/s): the same sample as a
+/// θ-PSO trajectory's, so those tracks are the trajectories themselves.
+pub use crate::planner::Sample as TrackSample;
 
 /// One vehicle's timed track.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -88,15 +84,7 @@ pub fn theta_pso(outcome: &ThetaPsoOutcome) -> Vec<Track> {
         .iter()
         .map(|t| Track {
             vehicle: t.uav,
-            samples: t
-                .samples
-                .iter()
-                .map(|s| TrackSample {
-                    t: s.t,
-                    position: s.position,
-                    velocity: s.velocity,
-                })
-                .collect(),
+            samples: t.samples.clone(),
         })
         .collect()
 }
