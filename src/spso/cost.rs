@@ -51,6 +51,8 @@ pub struct Model {
     pub climb_max: f64,
     /// b1..b4 (5, 1, 10, 1).
     pub weights: [f64; 4],
+    /// The map uses the benchmark's own convention (origin 1, step 1).
+    unit_grid: bool,
 }
 
 /// J and its four terms.
@@ -75,6 +77,7 @@ impl Model {
         band: [f64; 2],
         map: Arc<HeightMap>,
     ) -> Self {
+        let unit_grid = map.origin == [1.0, 1.0] && map.pixel == [1.0, 1.0];
         Model {
             start,
             goal,
@@ -87,25 +90,34 @@ impl Model {
             turning_max: 45.0,
             climb_max: 45.0,
             weights: [5.0, 1.0, 10.0, 1.0],
+            unit_grid,
         }
     }
 
     /// H(round(y), round(x)) with negative heights set to 0, or `None` outside.
     #[inline]
     pub fn ground(&self, x: f64, y: f64) -> Option<f32> {
+        let h = self.pixel_index(x, y).map(|i| self.map.heights[i])?;
+        Some(if h < 0.0 { 0.0 } else { h })
+    }
+
+    /// The index into the height array of the pixel under (x, y), or `None`
+    /// off the map. With the benchmark's own convention (origin 1, step 1)
+    /// the 1-based pixel is round(x), round(y), rounded half away from zero
+    /// without a libm call ([`round_half_away`]).
+    #[inline(always)]
+    fn pixel_index(&self, x: f64, y: f64) -> Option<usize> {
         let m = &*self.map;
-        let h = if m.origin == [1.0, 1.0] && m.pixel == [1.0, 1.0] {
-            // The benchmark's own convention: the 1-based pixel is round(x).
-            let (c, r) = (x.round(), y.round());
+        if self.unit_grid {
+            let (c, r) = (round_half_away(x), round_half_away(y));
             if c >= 1.0 && r >= 1.0 && c <= m.width as f64 && r <= m.height as f64 {
-                m.heights[(r as usize - 1) * m.width + (c as usize - 1)]
+                Some((r as usize - 1) * m.width + (c as usize - 1))
             } else {
-                return None;
+                None
             }
         } else {
-            m.nearest(x, y)?
-        };
-        Some(if h < 0.0 { 0.0 } else { h })
+            m.nearest_index(x, y).map(|(c, r)| r * m.width + c)
+        }
     }
 
     /// J for free nodes given as x1..xn, y1..yn, z1..zn (z above the ground).
@@ -145,38 +157,10 @@ impl Model {
         py[n + 1] = self.goal[1];
         pz[n + 1] = self.goal[2];
         let (px, py, pz) = (&px[..points], &py[..points], &pz[..points]);
-
-        // z_abs = z + H: single + double is single in MATLAB, then stored in
-        // a double array.
-        let mut za = [0.0f64; MAX_POINTS];
-        for i in 0..points {
-            let Some(h) = self.ground(px[i], py[i]) else {
-                return Terms {
-                    total: f64::INFINITY,
-                    off_map: true,
-                    ..Terms::default()
-                };
-            };
-            za[i] = f64::from(pz[i] as f32 + h);
-        }
-        let za = &za[..points];
-
-        // Per segment: x-y step, its length, Δz_abs.
         let segments = points - 1;
-        let mut dx = [0.0f64; MAX_POINTS];
-        let mut dy = [0.0f64; MAX_POINTS];
-        let mut dz = [0.0f64; MAX_POINTS];
-        let mut flat = [0.0f64; MAX_POINTS];
-        let mut j1 = 0.0;
-        for k in 0..segments {
-            dx[k] = px[k + 1] - px[k];
-            dy[k] = py[k + 1] - py[k];
-            dz[k] = za[k + 1] - za[k];
-            flat[k] = (dx[k] * dx[k] + dy[k] * dy[k]).sqrt();
-            j1 += (dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]).sqrt();
-        }
+        let [b1, b2, b3, b4] = self.weights;
 
-        // J3 over the free nodes, relative z.
+        // J3 over the free nodes, relative z: no terrain needed.
         let mid = (self.band[1] + self.band[0]) / 2.0;
         let mut j3 = 0.0;
         for &z in &pz[1..=n] {
@@ -186,7 +170,58 @@ impl Model {
                 (z - mid).abs()
             };
         }
-        let [b1, b2, b3, b4] = self.weights;
+
+        // Per segment: the x-y step and its length.
+        let mut dx = [0.0f64; MAX_POINTS];
+        let mut dy = [0.0f64; MAX_POINTS];
+        let mut flat = [0.0f64; MAX_POINTS];
+        let mut flat_sum = 0.0;
+        for k in 0..segments {
+            dx[k] = px[k + 1] - px[k];
+            dy[k] = py[k + 1] - py[k];
+            flat[k] = (dx[k] * dx[k] + dy[k] * dy[k]).sqrt();
+            flat_sum += flat[k];
+        }
+        // Each 3-D length is ≥ its x-y length in floating point too (adding
+        // dz² ≥ 0, sqrt and sums are monotone), so 5 Σ|xy| + 10 J3 ≤ J: a
+        // candidate that cannot beat `bound` stops before touching the map,
+        // whose random reads are the slowest part of an evaluation.
+        if bound.is_finite() && b1 * flat_sum + b3 * j3 >= bound {
+            return Terms {
+                total: b1 * flat_sum + b3 * j3,
+                altitude: j3,
+                ..Terms::default()
+            };
+        }
+
+        // z_abs = z + H: single + double is single in MATLAB, then stored in
+        // a double array. Every pixel index first, then the reads, so the
+        // cache misses on the map overlap.
+        let mut index = [0usize; MAX_POINTS];
+        for i in 0..points {
+            let Some(k) = self.pixel_index(px[i], py[i]) else {
+                return Terms {
+                    total: f64::INFINITY,
+                    off_map: true,
+                    ..Terms::default()
+                };
+            };
+            index[i] = k;
+        }
+        let heights = &self.map.heights;
+        let mut za = [0.0f64; MAX_POINTS];
+        for i in 0..points {
+            let h = heights[index[i]];
+            let h = if h < 0.0 { 0.0 } else { h };
+            za[i] = f64::from(pz[i] as f32 + h);
+        }
+
+        let mut dz = [0.0f64; MAX_POINTS];
+        let mut j1 = 0.0;
+        for k in 0..segments {
+            dz[k] = za[k + 1] - za[k];
+            j1 += (dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]).sqrt();
+        }
         let mut terms = Terms {
             length: j1,
             altitude: j3,
@@ -235,6 +270,7 @@ impl Model {
         let nonzero = |k: usize| dx[k] != 0.0 || dy[k] != 0.0;
         let mut j4 = 0.0;
         let mut before = 0usize; // last non-zero segment ≤ i, else 0
+        let mut climb: Option<(f64, f64, f64)> = None; // (Δz, |xy|, angle)
         for i in 0..points - 2 {
             if nonzero(i) {
                 before = i;
@@ -259,7 +295,15 @@ impl Model {
             let along = h1 * h2 + z1 * z2;
             let slack = 1e-12 * ((h1 * z2).abs() + (z1 * h2).abs());
             if !(along > 0.0 && cross.abs() + slack < along * (1.0 - 1e-9)) {
-                let change = DEG * z2.atan2(h2) - DEG * z1.atan2(h1);
+                // This point's outgoing climb angle is usually the next
+                // point's incoming one: computed once.
+                let a1 = match climb {
+                    Some((z, h, a)) if z == z1 && h == h1 => a,
+                    _ => DEG * z1.atan2(h1),
+                };
+                let a2 = DEG * z2.atan2(h2);
+                climb = Some((z2, h2, a2));
+                let change = a2 - a1;
                 if change.abs() > self.climb_max {
                     j4 += change.abs();
                 }
@@ -288,6 +332,22 @@ pub fn dist_p2s(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
         }
     } else {
         d_ax
+    }
+}
+
+/// MATLAB's `round` (half away from zero) without a libm call: the integer
+/// part by conversion (exact below 2^52; larger, infinite and NaN inputs
+/// land off any map), then the half step from the exact fraction.
+#[inline]
+fn round_half_away(x: f64) -> f64 {
+    let whole = x as i64 as f64;
+    let fraction = x - whole;
+    if fraction >= 0.5 {
+        whole + 1.0
+    } else if fraction <= -0.5 {
+        whole - 1.0
+    } else {
+        whole
     }
 }
 
@@ -473,6 +533,32 @@ mod tests {
         assert!(!m.terms(&nodes(&[[0.5, 50.0, 150.0]])).off_map);
         assert!(m.terms(&nodes(&[[300.5, 50.0, 150.0]])).off_map);
         assert!(m.terms(&nodes(&[[f64::NAN, 50.0, 150.0]])).off_map);
+    }
+
+    #[test]
+    fn round_half_away_is_matlab_round() {
+        for x in [
+            0.0,
+            0.49999999999999994,
+            0.5,
+            1.5,
+            2.5,
+            -0.5,
+            -2.5,
+            -0.49999999999999994,
+            1044.5,
+            878.49999999999989,
+            4503599627370495.5,
+            9007199254740993.0,
+            -9007199254740993.0,
+        ] {
+            assert_eq!(round_half_away(x), x.round(), "round({x:e})");
+        }
+        // Beyond i64 the value only has to stay off any map.
+        assert!(round_half_away(1e300) > 1e18);
+        assert!(round_half_away(-1e300) < -1e18);
+        assert!(round_half_away(f64::INFINITY) > 1e18);
+        assert_eq!(round_half_away(f64::NAN), 0.0);
     }
 
     #[test]

@@ -9,6 +9,36 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 use crate::mission::{Encoding, Mission};
 use crate::swarm::{SearchSpace, SequentialConfig};
 
+/// (−1)^k / (2k + 1)!, k = 0..10: the Taylor coefficients of sine to θ²¹.
+const SINE_TAYLOR: [f64; 11] = [
+    1.0,
+    -1.0 / 6.0,
+    1.0 / 120.0,
+    -1.0 / 5040.0,
+    1.0 / 362_880.0,
+    -1.0 / 39_916_800.0,
+    1.0 / 6_227_020_800.0,
+    -1.0 / 1_307_674_368_000.0,
+    1.0 / 355_687_428_096_000.0,
+    -1.0 / 121_645_100_408_832_000.0,
+    1.0 / 51_090_942_171_709_440_000.0,
+];
+
+/// sin θ for |θ| ≤ π/2, the angle encoding's box: the Taylor series to θ²¹
+/// (its remainder there is below 2e-18) in Horner form. libm's `sin` is a
+/// call per angle and was an eighth of a whole run; this inlines and
+/// vectorises over a particle's angles, within a few ulp of `f64::sin`
+/// (tested).
+#[inline]
+fn sin_within_quarter_turn(theta: f64) -> f64 {
+    let t2 = theta * theta;
+    let mut p = SINE_TAYLOR[10];
+    for &c in SINE_TAYLOR[..10].iter().rev() {
+        p = p * t2 + c;
+    }
+    theta * p
+}
+
 /// Decodes particles of one encoding for one scenario.
 #[derive(Debug, Clone)]
 pub struct Decoder {
@@ -78,10 +108,13 @@ impl Decoder {
         let [bx, by, bz] = self.bounds;
         match self.encoding {
             Encoding::Angle => {
+                // Eq. 1, x = ½ [(max − min) sin θ + max + min], with a sine
+                // that inlines and vectorises (θ stays in the box).
                 for (c, b) in [bx, by, bz].iter().enumerate() {
-                    for i in 0..n {
-                        out[c * n + i] =
-                            crate::planner::path::decode_angle(position[c * n + i], b[0], b[1]);
+                    let (angles, xs) =
+                        (&position[c * n..(c + 1) * n], &mut out[c * n..(c + 1) * n]);
+                    for (x, &theta) in xs.iter_mut().zip(angles) {
+                        *x = 0.5 * ((b[1] - b[0]) * sin_within_quarter_turn(theta) + b[1] + b[0]);
                     }
                 }
             }
@@ -127,5 +160,23 @@ impl Decoder {
             streams: 0,
             init_passes: 100,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sin_within_quarter_turn;
+    use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn the_series_sine_matches_libm_on_the_box() {
+        let mut worst = 0.0f64;
+        for k in 0..=200_000 {
+            let theta = -FRAC_PI_2 + FRAC_PI_2 * 2.0 * k as f64 / 200_000.0;
+            worst = worst.max((sin_within_quarter_turn(theta) - theta.sin()).abs());
+        }
+        assert!(worst <= 4.5e-16, "worst error {worst:e}");
+        assert_eq!(sin_within_quarter_turn(0.0), 0.0);
+        assert_eq!(sin_within_quarter_turn(FRAC_PI_2), 1.0);
     }
 }
