@@ -83,9 +83,10 @@ fn full_run(c: &mut Criterion) {
         let decoder = Decoder::new(&m, encoding);
         group.bench_function(format!("full_run_{encoding:?}_500x200"), |b| {
             b.iter(|| {
-                let run = spso::optimise(&model, &decoder, 500, 200, black_box(1), |_, _, _| {
-                    ControlFlow::Continue(())
-                });
+                let run =
+                    spso::optimise(&model, &decoder, 500, 200, black_box(1), &[], |_, _, _| {
+                        ControlFlow::Continue(())
+                    });
                 // 100,500, plus 500 per extra initial pass when the first
                 // draws no finite cost (the reference re-draws too).
                 assert!(run.swarm.evaluations >= 100_500 && run.swarm.evaluations % 500 == 0);

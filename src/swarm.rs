@@ -245,7 +245,8 @@ pub struct SequentialConfig {
 }
 
 /// Minimises `cost` the way the SPSO reference code does, with one seeded
-/// stream per particle:
+/// stream per particle (particle i starts at `starts[i]`, clamped, when
+/// given, as in [`minimize`]):
 ///
 /// - start uniformly in the box, velocities 0; repeat the initial pass while
 ///   no particle has a finite cost;
@@ -265,6 +266,7 @@ pub fn minimize_sequential<F, C>(
     space: &SearchSpace,
     config: &SequentialConfig,
     seed: u64,
+    starts: &[Vec<f64>],
     mut cost: F,
     mut on_iteration: C,
 ) -> SwarmResult
@@ -293,11 +295,21 @@ where
         cost: f64::INFINITY,
     };
     let mut evaluations = 0usize;
-    for _ in 0..config.init_passes.max(1) {
+    for pass in 0..config.init_passes.max(1) {
         personal.clear();
         for (i, rng) in rngs.iter_mut().enumerate() {
             for (d, x) in positions[i].iter_mut().enumerate() {
                 *x = sample(rng, space.lower[d], space.upper[d]);
+            }
+            // A given start replaces the draw in the first pass only (drawn
+            // anyway, so no other particle's stream shifts).
+            match starts.get(i) {
+                Some(start) if pass == 0 && start.len() == dims => {
+                    for (d, x) in positions[i].iter_mut().enumerate() {
+                        *x = start[d].clamp(space.lower[d], space.upper[d]);
+                    }
+                }
+                _ => {}
             }
             let c = guarded(&positions[i], f64::INFINITY);
             evaluations += 1;
@@ -576,6 +588,7 @@ mod tests {
                 &space,
                 &cfg,
                 seed,
+                &[],
                 |x, _| sphere(x),
                 |_| ControlFlow::Continue(()),
             )
@@ -589,6 +602,7 @@ mod tests {
                 &space,
                 &cfg,
                 seed,
+                &[],
                 |x, _| sphere(x),
                 |r| {
                     if r.iteration == 3 {
@@ -613,6 +627,7 @@ mod tests {
                 ..cfg.clone()
             },
             1,
+            &[],
             |x, _| {
                 calls += 1;
                 if calls <= 30 {
@@ -625,6 +640,26 @@ mod tests {
         );
         assert_eq!(r.evaluations, 60);
         assert!(r.best.cost.is_finite());
+        // A given start is where its particle begins (clamped into the box).
+        let start = |s: Vec<f64>| {
+            minimize_sequential(
+                &space,
+                &SequentialConfig {
+                    iterations: 0,
+                    ..cfg.clone()
+                },
+                1,
+                &[s],
+                |x, _| sphere(x),
+                |_| ControlFlow::Continue(()),
+            )
+        };
+        let on_minimum = start(vec![0.3; 4]);
+        assert_eq!((on_minimum.best.cost, on_minimum.evaluations), (0.0, 30));
+        assert_eq!(
+            start(vec![-5.0, 0.0, 0.0, 0.0]),
+            start(vec![-1.0, 0.0, 0.0, 0.0])
+        );
     }
 
     #[test]

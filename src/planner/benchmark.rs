@@ -41,12 +41,14 @@ pub fn plan(
     let p = &mission.theta_pso;
     observer.on_event(Event::Stage("planning"));
     let mut last_cost = f64::NAN;
+    let starts = spso::seeding::particles(&model, &decoder, p.seeded_particles, seed);
     let run = spso::optimise(
         &model,
         &decoder,
         p.swarm_size,
         p.iterations,
         seed,
+        &starts,
         |iteration, best, nodes| {
             if best != last_cost {
                 last_cost = best;

@@ -6,6 +6,7 @@
 
 pub mod cost;
 pub mod encoding;
+pub mod seeding;
 
 pub use cost::{Model, Terms, Threat};
 
@@ -57,7 +58,8 @@ pub struct Run {
 }
 
 /// Minimises the benchmark cost with `encoding` and its published settings
-/// for `particles` × `iterations`. `on_iteration(iteration, best J, best
+/// for `particles` × `iterations`, particle i starting at `starts[i]` when
+/// given (`seeding::particles`). `on_iteration(iteration, best J, best
 /// nodes)` may stop the run (the best so far is kept).
 pub fn optimise(
     model: &Model,
@@ -65,6 +67,7 @@ pub fn optimise(
     particles: usize,
     iterations: usize,
     seed: u64,
+    starts: &[Vec<f64>],
     mut on_iteration: impl FnMut(usize, f64, &[f64]) -> ControlFlow<()>,
 ) -> Run {
     let space = decoder.space();
@@ -76,6 +79,7 @@ pub fn optimise(
         &space,
         &config,
         seed,
+        starts,
         |position, bound| {
             decoder.decode(position, &mut buffer);
             model.cost_below(&buffer, bound)
