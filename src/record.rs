@@ -554,6 +554,9 @@ fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamRes
                 rerun::Color::from_rgb(220, 60, 60),
             ]),
     )?;
+    if let (Some(terrain), Some(map)) = (&m.terrain, m.height_map()) {
+        log_terrain(stream, map, terrain.lookup)?;
+    }
     let iwps = find_iwps(m);
     if !iwps.is_empty() {
         let z = ((m.bounds.z[0] + m.bounds.z[1]) / 2.0) as f32;
@@ -588,6 +591,31 @@ fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamRes
         )),
     )?;
     Ok(())
+}
+
+/// The mission's height map as a mesh of at most 200 × 200 points, coloured
+/// by height as the designer's map shades it.
+fn log_terrain(
+    stream: &RecordingStream,
+    map: &crate::terrain::HeightMap,
+    lookup: crate::terrain::Lookup,
+) -> rerun::RecordingStreamResult<()> {
+    let grid = crate::terrain::Grid::of(map, lookup, 200);
+    let [low, high] = map.range;
+    let span = f64::from(high - low).max(1e-9);
+    stream.log_static(
+        "world/terrain",
+        &rerun::Mesh3D::new(
+            grid.points
+                .iter()
+                .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32]),
+        )
+        .with_triangle_indices(grid.triangles())
+        .with_vertex_colors(grid.points.iter().map(|p| {
+            let [r, g, b] = crate::terrain::height_colour((p[2] - f64::from(low)) / span);
+            rerun::Color::from_rgb(r, g, b)
+        })),
+    )
 }
 
 /// Vehicle `n`'s colour, the same as on the designer's map.

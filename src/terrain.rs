@@ -242,6 +242,71 @@ impl HeightMap {
     }
 }
 
+/// The colour of ground at `t` of a map's height range (0 lowest, 1
+/// highest): green low to brown high. The designer's map shades its cells
+/// with a dimmed copy, the Rerun recording colours the terrain mesh with it.
+pub fn height_colour(t: f64) -> [u8; 3] {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mix = |low: f64, high: f64| (low + t * (high - low)).round() as u8;
+    [mix(56.0, 176.0), mix(118.0, 132.0), mix(62.0, 84.0)]
+}
+
+/// A regular grid of ground points for drawing a map in 3-D: every
+/// `stride`-th pixel centre (and the last row and column), at most
+/// `max_side` points a side.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid {
+    pub columns: usize,
+    pub rows: usize,
+    /// ENU (x, y, ground) per point, row by row.
+    pub points: Vec<[f64; 3]>,
+}
+
+impl Grid {
+    /// The grid of `map` read with `lookup` (negative heights as stored).
+    pub fn of(map: &HeightMap, lookup: Lookup, max_side: usize) -> Self {
+        let pick = |count: usize| -> Vec<usize> {
+            let stride = count.saturating_sub(1).div_ceil(max_side.max(2) - 1).max(1);
+            let mut v: Vec<usize> = (0..count).step_by(stride).collect();
+            if v.last() != Some(&(count - 1)) {
+                v.push(count - 1);
+            }
+            v
+        };
+        let (cols, rows) = (pick(map.width), pick(map.height));
+        let mut points = Vec::with_capacity(cols.len() * rows.len());
+        for &r in &rows {
+            for &c in &cols {
+                let x = map.origin[0] + c as f64 * map.pixel[0];
+                let y = map.origin[1] + r as f64 * map.pixel[1];
+                points.push([x, y, map.ground_clamped(lookup, x, y)]);
+            }
+        }
+        Grid {
+            columns: cols.len(),
+            rows: rows.len(),
+            points,
+        }
+    }
+
+    /// Two triangles per grid square, as indices into `points`.
+    pub fn triangles(&self) -> Vec<[u32; 3]> {
+        let mut out = Vec::with_capacity(2 * self.columns * self.rows);
+        for r in 1..self.rows {
+            for c in 1..self.columns {
+                let at = |r: usize, c: usize| (r * self.columns + c) as u32;
+                out.push([at(r - 1, c - 1), at(r - 1, c), at(r, c)]);
+                out.push([at(r - 1, c - 1), at(r, c), at(r, c - 1)]);
+            }
+        }
+        out
+    }
+}
+
 /// A loaded map shared by every copy of the mission, or why it could not be
 /// loaded. Compares equal whatever it holds: the mission's `[terrain]` keys
 /// say which map it is.
@@ -356,5 +421,24 @@ mod tests {
         assert!(HeightMap::new(1, vec![f32::NAN], [0.0; 2], [1.0; 2]).is_err());
         assert!(HeightMap::new(1, vec![-3.4e38], [0.0; 2], [1.0; 2]).is_err());
         assert!(HeightMap::new(1, vec![1.0], [0.0; 2], [0.0, 1.0]).is_err());
+    }
+
+    #[test]
+    fn a_grid_keeps_the_corners_and_the_heights() {
+        let heights: Vec<f32> = (0..25).map(|k| k as f32).collect();
+        let map = HeightMap::new(5, heights, [10.0, 20.0], [2.0, 2.0]).expect("5 × 5");
+        let g = Grid::of(&map, Lookup::Nearest, 3);
+        assert_eq!((g.columns, g.rows), (3, 3));
+        assert_eq!(g.points[0], [10.0, 20.0, 0.0]);
+        assert_eq!(g.points[8], [18.0, 28.0, 24.0]);
+        assert_eq!(g.points[4], [14.0, 24.0, 12.0]);
+        assert_eq!(g.triangles().len(), 8);
+        assert!(
+            g.triangles()
+                .iter()
+                .flatten()
+                .all(|&i| (i as usize) < g.points.len())
+        );
+        assert!(height_colour(1.0)[0] > height_colour(0.0)[0]);
     }
 }

@@ -191,6 +191,47 @@ fn record_writes_the_mission_scene_alone() {
         values::<f32>(&chunks, "/world/obstacles", "Cylinders3D:radii"),
         vec![7.0, 8.0]
     );
+    assert!(
+        !paths.iter().any(|p| p == "/world/terrain"),
+        "no terrain here"
+    );
+}
+
+/// Issue 15: a mission's terrain is in the recording as a mesh in the same
+/// frame as the paths: the SPSO benchmark's 1045 × 879 map every 6th column
+/// and 5th row (at most 200 points a side) plus the last, at its heights.
+#[test]
+fn the_terrain_is_recorded_as_a_mesh() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let rrd = dir.path().join("terrain.rrd");
+    let out = skyform(&[
+        "record",
+        "missions/spso-benchmark.toml",
+        "--rrd",
+        &rrd.display().to_string(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let chunks = chunks(&rrd);
+    let vertices = values::<[f32; 3]>(&chunks, "/world/terrain", "Mesh3D:vertex_positions");
+    assert_eq!(vertices.len(), 175 * 177);
+    assert_eq!(&vertices[0][..2], &[1.0, 1.0]);
+    assert_eq!(&vertices[vertices.len() - 1][..2], &[1045.0, 879.0]);
+    let (low, high) = vertices
+        .iter()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), v| {
+            (l.min(v[2]), h.max(v[2]))
+        });
+    assert!(
+        low > 45.0 && high < 300.0 && high - low > 150.0,
+        "{low}..{high}"
+    );
+    let colours = values::<u32>(&chunks, "/world/terrain", "Mesh3D:vertex_colors");
+    assert_eq!(colours.len(), vertices.len());
 }
 
 #[test]

@@ -45,3 +45,58 @@ fn the_side_view_draws_the_ground_under_the_path() {
     assert!(side.contains("ground"), "{side}");
     insta::assert_snapshot!(side);
 }
+
+/// Issue 15: the map shades the terrain (colour by height under the braille
+/// layer): the cell over the highest ground is browner than the cell over
+/// the lowest, cells off the map are not shaded, and the title gives the
+/// range.
+#[test]
+fn the_map_shades_each_cell_by_the_ground_under_it() {
+    use ratatui::style::Color;
+    let app = benchmark_app();
+    let mut terminal = Terminal::new(TestBackend::new(140, 42)).expect("terminal");
+    let mut viewport = None;
+    terminal
+        .draw(|frame| {
+            view::draw(frame, &app, Instant::now());
+            viewport = view::layout(frame.area()).map(|a| view::map::Viewport::map(&app, a.left));
+        })
+        .expect("draw");
+    let Some(vp) = viewport else {
+        panic!("no map drawn");
+    };
+    let buffer = terminal.backend().buffer().clone();
+    let map = app.mission().height_map().expect("terrain");
+    let (mut lowest, mut highest) = ((f32::INFINITY, None), (f32::NEG_INFINITY, None));
+    let mut shaded = std::collections::BTreeSet::new();
+    for row in vp.inner.top()..vp.inner.bottom() {
+        for column in vp.inner.left()..vp.inner.right() {
+            let Some(p) = vp.to_world(column, row) else {
+                continue;
+            };
+            let bg = buffer[(column, row)].bg;
+            match map.nearest(p.x, p.y) {
+                Some(h) => {
+                    shaded.insert(format!("{bg:?}"));
+                    if h < lowest.0 {
+                        lowest = (h, Some(bg));
+                    }
+                    if h > highest.0 {
+                        highest = (h, Some(bg));
+                    }
+                }
+                None => assert_eq!(bg, Color::Reset, "off the map at ({column}, {row})"),
+            }
+        }
+    }
+    let red = |c: Option<Color>| match c {
+        Some(Color::Rgb(r, _, _)) => r,
+        other => panic!("not shaded: {other:?}"),
+    };
+    assert!(
+        red(highest.1) > red(lowest.1) + 40,
+        "{highest:?} vs {lowest:?}"
+    );
+    assert!(shaded.len() > 20, "only {} shades", shaded.len());
+    assert!(render(&app).contains("ground 49–296 m"));
+}

@@ -298,6 +298,9 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect) {
         }
         _ => {}
     }
+    if let Some(ground) = super::terrain::legend(m) {
+        title.push(ground);
+    }
     let block = pane_block(TextLine::from(title), app.focus == Focus::Map);
     let dot = scale / 2.0;
     let canvas = Canvas::default()
@@ -307,6 +310,7 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect) {
         .y_bounds(vp.y)
         .paint(|ctx| paint_map(ctx, app, m, dot, scale));
     frame.render_widget(canvas, area);
+    super::terrain::shade_map(frame.buffer_mut(), m, &vp);
     // The fleet replay's time slider, on the map's last row.
     if let (Some(t), Some(end)) = (app.replay_time(), app.replay_end())
         && area.height > 3
