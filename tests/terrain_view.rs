@@ -100,3 +100,81 @@ fn the_map_shades_each_cell_by_the_ground_under_it() {
     assert!(shaded.len() > 20, "only {} shades", shaded.len());
     assert!(render(&app).contains("ground 49–296 m"));
 }
+
+/// Types `text` into the selected item's field labelled `label` and applies it.
+fn type_into(app: &mut App, label: &str, text: &str) {
+    use skyform::tui::app::Focus;
+    let k = app
+        .fields()
+        .iter()
+        .position(|f| f.label == label)
+        .unwrap_or_else(|| panic!("no field {label}"));
+    app.update(Action::FocusOn(Focus::Inspector));
+    while app.field > k {
+        app.update(Action::FieldUp);
+    }
+    while app.field < k {
+        app.update(Action::FieldDown);
+    }
+    let mut chars = text.chars();
+    app.update(Action::EditStart(chars.next()));
+    for c in chars {
+        app.update(Action::EditInput(c));
+    }
+    app.update(Action::EditCommit);
+}
+
+/// Issue 15: `[terrain]` in the inspector. Its keys are fields; a new file
+/// is read at once, one that does not load is an error on `terrain.file`
+/// and undo brings the map back.
+#[test]
+fn the_inspector_edits_the_terrain_and_reloads_its_map() {
+    use skyform::terrain::Lookup;
+    use skyform::tui::fields::Item;
+    let mut app = benchmark_app();
+    app.update(Action::Select(Item::Terrain));
+    let labels: Vec<&str> = app.fields().iter().map(|f| f.label).collect();
+    assert_eq!(
+        labels,
+        [
+            "file",
+            "origin x (m)",
+            "origin y (m)",
+            "pixel x (m)",
+            "pixel y (m)",
+            "lookup"
+        ]
+    );
+    type_into(&mut app, "lookup", "bilinear");
+    assert_eq!(
+        app.mission().terrain.as_ref().map(|t| t.lookup),
+        Some(Lookup::Bilinear)
+    );
+    type_into(&mut app, "lookup", "cubic");
+    assert_eq!(
+        app.mission().terrain.as_ref().map(|t| t.lookup),
+        Some(Lookup::Bilinear)
+    );
+
+    type_into(&mut app, "file", "terrain/missing.tif");
+    assert!(app.mission().height_map().is_none());
+    let errors: Vec<String> = app
+        .doc
+        .diagnostics()
+        .iter()
+        .map(|d| format!("{} {}", d.path, d.message))
+        .collect();
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.starts_with("terrain.file") && e.contains("missing.tif")),
+        "{errors:?}"
+    );
+    assert!(render(&app).contains("missing.tif"));
+    app.update(Action::Undo);
+    assert!(
+        app.mission().height_map().is_some(),
+        "undo brings the map back"
+    );
+    assert_eq!(app.doc.error_count(), 0);
+}

@@ -130,6 +130,7 @@ impl Document {
     pub fn edit(&mut self, change: impl FnOnce(&mut Mission)) {
         let before = self.mission.clone();
         change(&mut self.mission);
+        self.reload_terrain_if_moved(&before);
         if self.mission != before {
             self.push_undo(before);
             self.changed();
@@ -215,6 +216,26 @@ impl Document {
         self.never_saved = false;
         self.path = Some(target.clone());
         Ok(target)
+    }
+
+    /// Reads the height map again when the edit changed which file it is or
+    /// where it lies (the loaded map compares equal whatever it holds), from
+    /// the mission's folder as loading does.
+    fn reload_terrain_if_moved(&mut self, before: &Mission) {
+        let key = |m: &Mission| {
+            m.terrain
+                .as_ref()
+                .map(|t| (t.file.clone(), t.origin, t.pixel_size))
+        };
+        if key(&self.mission) != key(before) {
+            let base = self
+                .path
+                .as_deref()
+                .and_then(Path::parent)
+                .map(Path::to_path_buf)
+                .unwrap_or_default();
+            self.mission.load_terrain(&base);
+        }
     }
 
     fn push_undo(&mut self, before: Mission) {

@@ -22,6 +22,8 @@ pub enum Item {
     Bounds,
     Start,
     Goal,
+    /// The `[terrain]` height map (listed when the mission has one).
+    Terrain,
     Obstacle(usize),
     Formation,
     Slot(usize),
@@ -43,6 +45,7 @@ impl Item {
             Item::Bounds => "Bounds".into(),
             Item::Start => "Start".into(),
             Item::Goal => "Goal".into(),
+            Item::Terrain => "Terrain".into(),
             Item::Obstacle(i) => match mission.obstacles.get(*i) {
                 Some(o) => format!("Obstacle {} '{}'", i + 1, o.name),
                 None => format!("Obstacle {}", i + 1),
@@ -63,6 +66,7 @@ impl Item {
             Item::Obstacle(i) => *i < mission.obstacles.len(),
             Item::Slot(i) => *i < mission.formation.slots.len(),
             Item::FleetTarget(i) => *i < mission.fleet.targets.len(),
+            Item::Terrain => mission.terrain.is_some(),
             Item::Waypoint([a, b]) => {
                 let named = |n: &String| mission.obstacles.iter().any(|o| &o.name == n);
                 (named(a) && named(b))
@@ -80,6 +84,9 @@ impl Item {
 /// The items the map's next/previous keys cycle through, in order.
 pub fn map_items(mission: &Mission) -> Vec<Item> {
     let mut items = vec![Item::Mission, Item::Bounds, Item::Start, Item::Goal];
+    if mission.terrain.is_some() {
+        items.push(Item::Terrain);
+    }
     items.extend((0..mission.obstacles.len()).map(Item::Obstacle));
     items.push(Item::ThetaPso);
     items.push(Item::Squadron);
@@ -290,6 +297,77 @@ fn find_choice<'m>(m: &'m Mission, between: &[String; 2]) -> Option<&'m Waypoint
         .waypoints
         .iter()
         .find(|w| same_pair(&w.between, &between[0], &between[1]))
+}
+
+/// The `[terrain]` keys; the map is read again when they change
+/// (`Document::edit`), and a file that does not load is an error on
+/// `terrain.file`.
+fn terrain_fields(m: &Mission) -> Vec<Field> {
+    let Some(t) = &m.terrain else {
+        return Vec::new();
+    };
+    fn terrain<'a>(m: &'a mut Mission) -> Result<&'a mut crate::mission::Terrain, String> {
+        m.terrain
+            .as_mut()
+            .ok_or_else(|| "the mission has no [terrain]".to_owned())
+    }
+    let lookup = match t.lookup {
+        crate::terrain::Lookup::Nearest => "nearest",
+        crate::terrain::Lookup::Bilinear => "bilinear",
+    };
+    vec![
+        field("file", "terrain.file", &t.file, |m, _, text| {
+            if text.trim().is_empty() {
+                return Err("the terrain needs a GeoTIFF file".into());
+            }
+            terrain(m)?.file = text.trim().to_owned();
+            Ok(())
+        }),
+        field(
+            "origin x (m)",
+            "terrain.origin",
+            fmt_num(t.origin[0]),
+            |m, _, text| {
+                terrain(m)?.origin[0] = number(text)?;
+                Ok(())
+            },
+        ),
+        field(
+            "origin y (m)",
+            "terrain.origin",
+            fmt_num(t.origin[1]),
+            |m, _, text| {
+                terrain(m)?.origin[1] = number(text)?;
+                Ok(())
+            },
+        ),
+        field(
+            "pixel x (m)",
+            "terrain.pixel_size",
+            fmt_num(t.pixel_size[0]),
+            |m, _, text| {
+                terrain(m)?.pixel_size[0] = number(text)?;
+                Ok(())
+            },
+        ),
+        field(
+            "pixel y (m)",
+            "terrain.pixel_size",
+            fmt_num(t.pixel_size[1]),
+            |m, _, text| {
+                terrain(m)?.pixel_size[1] = number(text)?;
+                Ok(())
+            },
+        ),
+        field("lookup", "terrain.lookup", lookup, |m, _, text| {
+            terrain(m)?.lookup = match text.trim() {
+                "nearest" => crate::terrain::Lookup::Nearest,
+                "bilinear" => crate::terrain::Lookup::Bilinear,
+                other => return Err(format!("'{other}' is not a lookup: nearest or bilinear")),
+            };
+            Ok(())
+        }),
+    ]
 }
 
 /// The inspector's fields for `item`, with the values they have in `mission`.
@@ -633,6 +711,7 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
         }
         Item::Squadron => squadron_fields(m),
         Item::Fleet => fleet_fields(m),
+        Item::Terrain => terrain_fields(m),
         Item::FleetTarget(i) => {
             let Some(t) = m.fleet.targets.get(*i) else {
                 return Vec::new();

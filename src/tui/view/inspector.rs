@@ -30,6 +30,7 @@ fn item_path(item: &Item) -> Option<String> {
         Item::Bounds => Some("bounds".into()),
         Item::Start => Some("route.start".into()),
         Item::Goal => Some("route.goal".into()),
+        Item::Terrain => Some("terrain".into()),
         Item::Formation => Some("formation".into()),
         Item::Slot(i) => Some(format!("formation.slots[{i}]")),
         Item::ThetaPso => Some("theta_pso".into()),
