@@ -317,35 +317,53 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                 body,
             );
         }
-        Overlay::Open { entries, cursor } => {
-            let height = (entries.len() as u16 + 3).min(area.height.saturating_sub(4));
-            let first = cursor.saturating_sub(height.saturating_sub(4) as usize);
-            let mut lines: Vec<Line> = entries
-                .iter()
-                .enumerate()
-                .skip(first)
-                .take(height.saturating_sub(3) as usize)
-                .map(|(k, e)| {
-                    let label = match e {
-                        super::app::Entry::File(p) => {
-                            p.strip_prefix(&app.cwd).unwrap_or(p).display().to_string()
+        Overlay::Open {
+            input,
+            matches,
+            cursor,
+            ..
+        } => {
+            // Prompt line, list, hints: the list takes what the screen leaves.
+            let inner = (matches.len() as u16 + 2).min(area.height.saturating_sub(6));
+            let room = inner.saturating_sub(2) as usize;
+            let first = (cursor + 1).saturating_sub(room.max(1));
+            let mut lines = vec![Line::from(vec![
+                Span::raw("Path or filter: "),
+                Span::styled(format!("{input}▏"), Style::default().white().on_blue()),
+            ])];
+            let typed_only = !input.trim().is_empty()
+                && matches.len() == 1
+                && matches!(&matches[0], super::app::Entry::File(p)
+                    if *p == super::app::typed_path(&app.cwd, input));
+            lines.extend(
+                matches
+                    .iter()
+                    .enumerate()
+                    .skip(first)
+                    .take(room)
+                    .map(|(k, e)| {
+                        let mut label = super::app::entry_label(e, &app.cwd);
+                        if typed_only {
+                            label = format!("{label}  (not listed: Enter opens this path)");
                         }
-                        other => other.label(),
-                    };
-                    if k == *cursor {
-                        Line::styled(format!("▶ {label}"), Style::default().black().on_yellow())
-                    } else {
-                        Line::raw(format!("  {label}"))
-                    }
-                })
-                .collect();
+                        if k == *cursor {
+                            Line::styled(format!("▶ {label}"), Style::default().black().on_yellow())
+                        } else {
+                            Line::raw(format!("  {label}"))
+                        }
+                    }),
+            );
             lines.push(hints(&[
+                ("type", " filter or path   "),
                 ("↑↓", " choose   "),
                 ("Enter", " open   "),
                 ("Esc", " cancel"),
             ]));
-            let title = ("Open a mission (missions/, ./, built-in)", Color::Cyan);
-            popup(frame, area, (72, height + 2), title, Paragraph::new(lines));
+            let title = (
+                "Open a mission (missions/, ./, built-in, a path)",
+                Color::Cyan,
+            );
+            popup(frame, area, (72, inner + 2), title, Paragraph::new(lines));
         }
         Overlay::Overwrite { path, .. } => {
             let lines = vec![
@@ -380,16 +398,16 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                     "Discard the unsaved changes and open {}?",
                     entry.label()
                 )),
-                hints(&[("y", " discard and open   "), ("Esc", " cancel")]),
+                hints(&[
+                    ("s", " save, then open   "),
+                    ("y", " discard and open   "),
+                    ("Esc", " cancel"),
+                ]),
             ];
+            let width = 80.min(area.width);
+            let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
             let body = Paragraph::new(lines).wrap(Wrap { trim: false });
-            popup(
-                frame,
-                area,
-                (80, 4),
-                ("Unsaved changes", Color::Yellow),
-                body,
-            );
+            popup(frame, area, size, ("Unsaved changes", Color::Yellow), body);
         }
     }
 }
