@@ -20,7 +20,11 @@ const WIDTH: u16 = 140;
 const HEIGHT: u16 = 42;
 
 fn render(app: &App, now: Instant) -> String {
-    let mut terminal = Terminal::new(TestBackend::new(WIDTH, HEIGHT)).unwrap();
+    render_at(app, now, (WIDTH, HEIGHT))
+}
+
+fn render_at(app: &App, now: Instant, (width, height): (u16, u16)) -> String {
+    let mut terminal = Terminal::new(TestBackend::new(width, height)).unwrap();
     terminal.draw(|frame| view::draw(frame, app, now)).unwrap();
     terminal.backend().to_string()
 }
@@ -178,4 +182,175 @@ fn the_readme_screenshot_is_the_finished_result_snapshot() {
         shown, screen,
         "refresh the README screenshot from the snapshot"
     );
+}
+
+/// The screen's rows, without the quotes the backend's text puts around them.
+fn rows_of(screen: &str) -> Vec<String> {
+    screen
+        .lines()
+        .map(|l| l.trim_start_matches('"').trim_end_matches('"').to_owned())
+        .collect()
+}
+
+/// At 80×24 the bridge's piers are a cell or two apart: each name drawn is
+/// whole, with a cell free on either side (none written over another).
+#[test]
+fn map_labels_do_not_cover_each_other_at_80_by_24() {
+    let app = default_app();
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    let map: Vec<String> = rows_of(&screen)
+        .iter()
+        .map(|r| r.chars().take(36).collect())
+        .collect();
+    let mut drawn = 0;
+    for o in &app.mission().obstacles {
+        for row in &map {
+            let Some(at) = row.find(&o.name) else {
+                continue;
+            };
+            drawn += 1;
+            let before = row[..at].chars().next_back();
+            let after = row[at + o.name.len()..].chars().next();
+            for c in [before, after].into_iter().flatten() {
+                assert!(
+                    !c.is_alphanumeric(),
+                    "'{}' runs into another label: {row}",
+                    o.name
+                );
+            }
+        }
+    }
+    assert!(drawn >= 8, "most names still fit: {drawn}\n{screen}");
+    insta::assert_snapshot!(screen);
+}
+
+/// The selected obstacle's name is drawn even where another would have been.
+#[test]
+fn the_selected_obstacles_label_wins() {
+    let mut app = default_app();
+    let i = app
+        .mission()
+        .obstacles
+        .iter()
+        .position(|o| o.name == "light pole 4")
+        .unwrap();
+    // The map's columns only (the inspector names the pole too).
+    let map = |app: &App| -> String {
+        rows_of(&render_at(app, Instant::now(), (80, 24)))
+            .iter()
+            .map(|r| r.chars().take(36).collect::<String>() + "\n")
+            .collect()
+    };
+    assert!(
+        !map(&app).contains("light pole 4"),
+        "hidden when not selected"
+    );
+    app.update(Action::Select(Item::Obstacle(i)));
+    let screen = map(&app);
+    assert!(screen.contains("light pole 4"), "{screen}");
+}
+
+#[test]
+fn the_iwp_table_stays_readable_at_80_by_24() {
+    let mut app = default_app();
+    app.update(Action::ShowFormation);
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    assert!(screen.contains("◆ light pole 4 ↔ pier 5"), "{screen}");
+    assert!(
+        screen.contains("gap 1.50 m · alignment (chosen)"),
+        "{screen}"
+    );
+    insta::assert_snapshot!(screen);
+}
+
+/// The row after the one holding `text` continues it: blank up to the
+/// column `text` starts at, then words (a hanging indent).
+fn assert_hangs(screen: &str, text: &str) {
+    let rows: Vec<Vec<char>> = rows_of(screen)
+        .iter()
+        .map(|r| r.chars().collect())
+        .collect();
+    let (k, column) = rows
+        .iter()
+        .enumerate()
+        .find_map(|(k, r)| {
+            let s: String = r.iter().collect();
+            s.find(text).map(|at| (k, s[..at].chars().count()))
+        })
+        .unwrap_or_else(|| panic!("'{text}' is not on screen:\n{screen}"));
+    let next = &rows[k + 1];
+    // Where this column of the overlay starts: after its border, or after
+    // the other column's text.
+    let start = rows[k][..column]
+        .iter()
+        .rposition(|c| *c == '║')
+        .map_or(0, |b| b + 1);
+    let start = start.max(column.saturating_sub(18));
+    assert!(
+        next[start..column].iter().all(|c| *c == ' '),
+        "the continuation starts left of the description:\n{}\n{}",
+        rows[k].iter().collect::<String>(),
+        next.iter().collect::<String>()
+    );
+    assert_ne!(next[column], ' ', "no continuation under '{text}'");
+}
+
+#[test]
+fn help_overlay_at_160_by_48_wraps_under_the_descriptions() {
+    let mut app = default_app();
+    app.update(Action::ToggleHelp);
+    let screen = render_at(&app, Instant::now(), (160, 48));
+    assert_hangs(&screen, "next / previous item");
+    assert_hangs(&screen, "run the distributed fleet");
+    insta::assert_snapshot!(screen);
+}
+
+#[test]
+fn help_overlay_at_80_by_24_wraps_under_the_descriptions() {
+    let mut app = default_app();
+    app.update(Action::ToggleHelp);
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    assert_hangs(&screen, "next / previous item");
+    insta::assert_snapshot!(screen);
+}
+
+#[test]
+fn the_open_dialog_filters_and_takes_a_typed_path_at_80_by_24() {
+    let mut app = default_app();
+    app.update(Action::AddObstacle(None));
+    app.update(Action::Open);
+    for c in "narrow".chars() {
+        app.update(Action::PromptInput(c));
+    }
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    assert!(screen.contains("Path or filter: narrow"), "{screen}");
+    assert!(
+        screen.contains("▶ (built-in) narrow-passage.toml"),
+        "{screen}"
+    );
+    assert!(
+        !screen.contains("║  (built-in) bridge"),
+        "filtered out: {screen}"
+    );
+    insta::assert_snapshot!(screen);
+
+    app.update(Action::PromptClear);
+    for c in "elsewhere/mine.toml".chars() {
+        app.update(Action::PromptInput(c));
+    }
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    assert!(
+        screen.contains("elsewhere/mine.toml  (not listed: Enter opens this path)"),
+        "{screen}"
+    );
+
+    app.update(Action::PromptClear);
+    for c in "narrow".chars() {
+        app.update(Action::PromptInput(c));
+    }
+    app.update(Action::Confirm);
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    assert!(screen.contains("s save, then open"), "{screen}");
+    assert!(screen.contains("y discard and open"), "{screen}");
+    assert!(screen.contains("Esc cancel"), "{screen}");
 }

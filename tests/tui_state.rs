@@ -930,3 +930,238 @@ fn an_iwp_choice_error_alone_keeps_the_iwps_on_the_map() {
     let app = App::new(Document::new(m, None), dir.path().to_path_buf());
     assert!(app.iwps.is_empty());
 }
+
+/// Types `text` into the prompt on screen (save as, open).
+fn type_prompt(app: &mut App, text: &str) {
+    app.update(Action::PromptClear);
+    for c in text.chars() {
+        app.update(Action::PromptInput(c));
+    }
+}
+
+/// A second mission (narrow passage) saved at `path`.
+fn other_mission_at(path: &std::path::Path) -> Mission {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let m = mission::load(&root.join("missions/narrow-passage.toml"))
+        .unwrap()
+        .mission;
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).unwrap();
+    }
+    mission::save(&m, path).unwrap();
+    m
+}
+
+#[test]
+fn open_takes_a_typed_path_relative_to_the_working_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    // Not listed: only missions/ and ./ are.
+    let other = other_mission_at(&dir.path().join("elsewhere/other.toml"));
+    app.update(Action::Open);
+    type_prompt(&mut app, "elsewhere/other.toml");
+    let Some(Overlay::Open { matches, .. }) = &app.overlay else {
+        panic!("no open dialog: {:?}", app.overlay);
+    };
+    assert_eq!(
+        matches.first(),
+        Some(&skyform::tui::app::Entry::File(
+            dir.path().join("elsewhere/other.toml")
+        )),
+        "the typed path comes first"
+    );
+    app.update(Action::Confirm);
+    assert!(app.overlay.is_none(), "{:?}", app.overlay);
+    assert_eq!(app.mission(), &other);
+    assert_eq!(
+        app.doc.path(),
+        Some(dir.path().join("elsewhere/other.toml").as_path())
+    );
+}
+
+#[test]
+fn open_filters_the_list_by_what_is_typed() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut app = App::new(Document::new(default_mission().mission, None), root);
+    app.update(Action::Open);
+    type_prompt(&mut app, "NARROW");
+    let Some(Overlay::Open { matches, .. }) = &app.overlay else {
+        panic!("no open dialog");
+    };
+    assert!(!matches.is_empty());
+    assert!(
+        matches.iter().all(|e| e.label().contains("narrow")),
+        "{matches:?}"
+    );
+    app.update(Action::Confirm);
+    assert!(app.doc.title().contains("narrow"), "{}", app.doc.title());
+}
+
+#[test]
+fn opening_a_missing_or_invalid_file_says_which_and_loses_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::AddObstacle(None));
+    let edited = app.mission().clone();
+
+    app.update(Action::Open);
+    type_prompt(&mut app, "nope/missing.toml");
+    app.update(Action::Confirm);
+    let status = app.status.clone().expect("a status");
+    assert!(status.error, "{status:?}");
+    assert!(
+        status.text.contains("missing.toml") && status.text.contains("no such file"),
+        "{}",
+        status.text
+    );
+    assert!(
+        matches!(app.overlay, Some(Overlay::Open { .. })),
+        "the dialog stays to fix the path"
+    );
+
+    std::fs::write(dir.path().join("notes.toml"), "this is = = not toml").unwrap();
+    type_prompt(&mut app, "notes.toml");
+    app.update(Action::Confirm);
+    let status = app.status.clone().expect("a status");
+    assert!(
+        status.error && status.text.contains("notes.toml"),
+        "{status:?}"
+    );
+    assert!(
+        matches!(app.overlay, Some(Overlay::Open { .. })),
+        "refused before asking to discard: {:?}",
+        app.overlay
+    );
+
+    std::fs::create_dir(dir.path().join("folder")).unwrap();
+    type_prompt(&mut app, "folder");
+    app.update(Action::Confirm);
+    let status = app.status.clone().expect("a status");
+    assert!(status.text.contains("folder"), "{status:?}");
+
+    app.update(Action::Dismiss);
+    assert_eq!(app.mission(), &edited, "nothing is lost");
+    assert!(app.doc.is_modified());
+}
+
+#[test]
+fn the_unsaved_changes_prompt_on_open_can_save_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::AddObstacle(None));
+    let edited = app.mission().clone();
+    let other = other_mission_at(&dir.path().join("other.toml"));
+    app.update(Action::Open);
+    type_prompt(&mut app, "other.toml");
+    app.update(Action::Confirm);
+    assert!(matches!(app.overlay, Some(Overlay::Discard(_))));
+    app.update(Action::Save);
+    assert_eq!(
+        mission::load(&dir.path().join("bridge.toml"))
+            .unwrap()
+            .mission,
+        edited,
+        "saved first"
+    );
+    assert_eq!(app.mission(), &other, "then opened");
+    assert!(!app.doc.is_modified());
+    let status = app.status.clone().unwrap();
+    assert!(
+        status.text.contains("saved") && status.text.contains("opened"),
+        "{status:?}"
+    );
+}
+
+#[test]
+fn save_first_goes_through_save_as_and_opens_only_once_saved() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = App::new(
+        Document::new(default_mission().mission, None),
+        dir.path().to_path_buf(),
+    );
+    app.update(Action::AddObstacle(None));
+    let edited = app.mission().clone();
+    let other = other_mission_at(&dir.path().join("other.toml"));
+    let open_other = |app: &mut App| {
+        app.update(Action::Open);
+        type_prompt(app, "other.toml");
+        app.update(Action::Confirm);
+        assert!(matches!(app.overlay, Some(Overlay::Discard(_))));
+        app.update(Action::Save);
+        assert!(
+            matches!(app.overlay, Some(Overlay::SaveAs { .. })),
+            "the built-in mission needs a name: {:?}",
+            app.overlay
+        );
+    };
+    open_other(&mut app);
+    app.update(Action::Dismiss);
+    assert_eq!(app.mission(), &edited, "cancelled: nothing opened");
+    assert!(app.doc.is_modified());
+
+    open_other(&mut app);
+    type_prompt(&mut app, "mine.toml");
+    app.update(Action::Confirm);
+    assert_eq!(
+        mission::load(&dir.path().join("mine.toml"))
+            .unwrap()
+            .mission,
+        edited
+    );
+    assert_eq!(app.mission(), &other);
+}
+
+#[test]
+fn save_first_of_an_invalid_mission_asks_and_a_refusal_does_not_open() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Select(Item::Obstacle(2)));
+    type_into(&mut app, "radius (m)", "-1");
+    let edited = app.mission().clone();
+    let other = other_mission_at(&dir.path().join("other.toml"));
+    let open_other = |app: &mut App| {
+        app.update(Action::Open);
+        type_prompt(app, "other.toml");
+        app.update(Action::Confirm);
+        app.update(Action::Save);
+        assert!(
+            matches!(app.overlay, Some(Overlay::SaveInvalid { .. })),
+            "{:?}",
+            app.overlay
+        );
+    };
+    open_other(&mut app);
+    app.update(Action::Dismiss);
+    assert_eq!(app.mission(), &edited, "not saved, not opened");
+    assert_eq!(
+        mission::load(&dir.path().join("bridge.toml"))
+            .unwrap()
+            .mission,
+        default_mission().mission
+    );
+
+    open_other(&mut app);
+    app.update(Action::Confirm);
+    let text = std::fs::read_to_string(dir.path().join("bridge.toml")).unwrap();
+    assert_eq!(
+        mission::check_str(&text, None).mission.unwrap().obstacles[2].radius,
+        -1.0
+    );
+    assert_eq!(app.mission(), &other);
+}
+
+#[test]
+fn the_open_dialog_types_letters_and_its_prompt_offers_save_first() {
+    use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    use skyform::tui::input::key_action;
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::Open);
+    let key = |c| KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE);
+    assert_eq!(key_action(&app, key('q')), Some(Action::PromptInput('q')));
+    app.overlay = Some(Overlay::Discard(skyform::tui::app::Entry::Builtin(
+        "bridge-inspection.toml",
+    )));
+    assert_eq!(key_action(&app, key('s')), Some(Action::Save));
+    assert_eq!(key_action(&app, key('y')), Some(Action::Confirm));
+}

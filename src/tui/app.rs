@@ -52,11 +52,13 @@ impl Entry {
     }
 }
 
-/// What to do once a save went through.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What to do once a save went through (nothing happens if it did not).
+#[derive(Debug, Clone, PartialEq)]
 pub enum AfterSave {
     Stay,
     Quit,
+    /// "Save first" in the open dialog's unsaved-changes prompt.
+    Open(Entry),
 }
 
 /// A window on top of the screen that takes the keys.
@@ -75,11 +77,17 @@ pub enum Overlay {
         errors: Vec<String>,
         then: AfterSave,
     },
+    /// The open dialog: the missions found, the text typed (a filter, or
+    /// a path to open that is not listed), what it leaves (`matches`) and
+    /// the cursor in those.
     Open {
         entries: Vec<Entry>,
+        input: String,
+        matches: Vec<Entry>,
         cursor: usize,
     },
-    /// Unsaved changes would be lost by opening `entry`.
+    /// Unsaved changes would be lost by opening `entry`: save first,
+    /// discard them, or stay.
     Discard(Entry),
     /// "Save as" onto a file that exists: replace it?
     Overwrite {
@@ -752,8 +760,12 @@ impl App {
                     self.set_error(format!("warning: {problem}"));
                 }
             }
-            Save => match self.overlay {
+            Save => match &self.overlay {
                 Some(Overlay::Quit) => self.save(None, AfterSave::Quit, false),
+                Some(Overlay::Discard(entry)) => {
+                    let then = AfterSave::Open(entry.clone());
+                    self.save(None, then, false);
+                }
                 _ => self.save(None, AfterSave::Stay, false),
             },
             SaveAs => {
@@ -770,27 +782,25 @@ impl App {
             }
             Open => {
                 let entries = open_entries(&self.cwd);
-                self.overlay = Some(Overlay::Open { entries, cursor: 0 });
+                self.overlay = Some(Overlay::Open {
+                    matches: entries.clone(),
+                    entries,
+                    input: String::new(),
+                    cursor: 0,
+                });
             }
             Confirm => self.confirm(),
-            PromptInput(c) => {
-                if let Some(Overlay::SaveAs { input, .. }) = &mut self.overlay {
-                    input.push(c);
-                }
-            }
-            PromptClear => {
-                if let Some(Overlay::SaveAs { input, .. }) = &mut self.overlay {
-                    input.clear();
-                }
-            }
-            PromptBackspace => {
-                if let Some(Overlay::SaveAs { input, .. }) = &mut self.overlay {
-                    input.pop();
-                }
-            }
+            PromptInput(c) => self.edit_prompt(|input| input.push(c)),
+            PromptClear => self.edit_prompt(String::clear),
+            PromptBackspace => self.edit_prompt(|input| {
+                input.pop();
+            }),
             PickerMove(d) => {
-                if let Some(Overlay::Open { entries, cursor }) = &mut self.overlay {
-                    let n = entries.len() as i32;
+                if let Some(Overlay::Open {
+                    matches, cursor, ..
+                }) = &mut self.overlay
+                {
+                    let n = matches.len() as i32;
                     if n > 0 {
                         *cursor = (*cursor as i32 + d).clamp(0, n - 1) as usize;
                     }
@@ -856,6 +866,25 @@ impl App {
             self.field = 0;
         }
         self.selected = item;
+    }
+
+    /// Changes the text of the prompt on screen (save as, open); the open
+    /// dialog filters its list by it.
+    fn edit_prompt(&mut self, change: impl FnOnce(&mut String)) {
+        match &mut self.overlay {
+            Some(Overlay::SaveAs { input, .. }) => change(input),
+            Some(Overlay::Open {
+                entries,
+                input,
+                matches,
+                cursor,
+            }) => {
+                change(input);
+                *matches = open_matches(entries, input, &self.cwd);
+                *cursor = 0;
+            }
+            _ => {}
+        }
     }
 
     fn quit(&mut self) {
@@ -1213,9 +1242,17 @@ impl App {
                     self.recovery = Some(fresh);
                 }
                 self.overlay = None;
-                self.set_status(format!("saved {}", p.display()));
-                if then == AfterSave::Quit {
-                    self.shutdown();
+                let saved = format!("saved {}", p.display());
+                self.set_status(saved.clone());
+                match then {
+                    AfterSave::Stay => {}
+                    AfterSave::Quit => self.shutdown(),
+                    AfterSave::Open(entry) => {
+                        self.open(entry);
+                        if let Some(s) = self.status.as_mut().filter(|s| !s.error) {
+                            s.text = format!("{saved} · {}", s.text);
+                        }
+                    }
                 }
             }
             Err(e) => {
@@ -1261,13 +1298,21 @@ impl App {
                 ));
             }
             Some(Overlay::SaveInvalid { path, then, .. }) => self.save(path, then, true),
-            Some(Overlay::Open { entries, cursor }) => {
-                if let Some(entry) = entries.get(cursor).cloned() {
-                    if self.doc.is_modified() {
+            Some(Overlay::Open {
+                matches, cursor, ..
+            }) => {
+                let Some(entry) = matches.get(cursor).cloned() else {
+                    self.set_error("nothing to open: type a path or pick a listed mission");
+                    return;
+                };
+                // A file that cannot be opened is refused here, before the
+                // unsaved-changes question; the dialog stays to fix the path.
+                match load(&entry) {
+                    Err(e) => self.set_error(e),
+                    Ok(_) if self.doc.is_modified() => {
                         self.overlay = Some(Overlay::Discard(entry));
-                    } else {
-                        self.open(entry);
                     }
+                    Ok(loaded) => self.install(entry, loaded),
                 }
             }
             Some(Overlay::Discard(entry)) => self.open(entry),
@@ -1276,64 +1321,106 @@ impl App {
     }
 
     /// Replaces the document with another mission. A file that cannot be
-    /// read as a mission at all is refused; one with validation errors opens
-    /// (the inspector shows them).
+    /// read as a mission at all is refused (the status says why, naming
+    /// it, and the document stays); one with validation errors opens (the
+    /// inspector shows them).
     pub fn open(&mut self, entry: Entry) {
         self.overlay = None;
-        let (text, name, path) = match &entry {
-            Entry::File(p) => match mission::read(p) {
+        match load(&entry) {
+            Ok(loaded) => self.install(entry, loaded),
+            Err(e) => self.set_error(e),
+        }
+    }
+
+    fn install(&mut self, entry: Entry, loaded: Loaded) {
+        self.overlay = None;
+        let Loaded {
+            mission: m,
+            text,
+            name,
+            path,
+            errors,
+        } = loaded;
+        self.doc = Document::new(m, path)
+            .with_source(text)
+            .with_label(entry.label());
+        // The jobs were of the other mission: not "stale", gone.
+        for job in self.jobs.iter().filter(|j| j.is_running()) {
+            job.cancel.cancel();
+        }
+        self.jobs.clear();
+        self.job_cursor = 0;
+        if let Some(r) = &mut self.recovery {
+            // Opening another mission drops this one's unsaved edits
+            // (the user was asked); its copy goes with them.
+            r.discard();
+            self.enable_recovery(match &entry {
+                Entry::File(p) => Origin::File(p.clone()),
+                Entry::Builtin(name) => Origin::Builtin((*name).to_owned()),
+            });
+        }
+        self.selected = Item::Mission;
+        self.field = 0;
+        self.editing = None;
+        self.zoom = 1.0;
+        self.center = None;
+        self.shown_job = None;
+        self.refresh();
+        if errors > 0 {
+            self.set_error(format!("opened {name}: {errors} error(s) to fix"));
+        } else {
+            self.set_status(format!("opened {name}"));
+        }
+    }
+}
+
+/// A mission read for opening, not yet in the designer.
+struct Loaded {
+    mission: Mission,
+    text: String,
+    name: String,
+    path: Option<PathBuf>,
+    errors: usize,
+}
+
+/// Reads and checks `entry`; the message names the file when it cannot be
+/// opened (missing, a folder, not a mission).
+fn load(entry: &Entry) -> Result<Loaded, String> {
+    let (text, name, path) = match entry {
+        Entry::File(p) => {
+            if p.is_dir() {
+                return Err(format!("cannot open {}: it is a folder", p.display()));
+            }
+            if !p.exists() {
+                return Err(format!("cannot open {}: no such file", p.display()));
+            }
+            match mission::read(p) {
                 Ok(text) => (text, p.display().to_string(), Some(p.clone())),
-                Err(e) => return self.set_error(e.to_string()),
-            },
-            Entry::Builtin(name) => match mission::BUILTIN.iter().find(|b| b.file_name == *name) {
-                Some(b) => (b.text.to_owned(), b.file_name.to_owned(), None),
-                None => return self.set_error(format!("no built-in mission {name}")),
-            },
-        };
-        let checked = crate::diagnose::check_text(&text, Some(&name));
-        match checked.mission {
-            Some(m) => {
-                self.doc = Document::new(m, path)
-                    .with_source(text)
-                    .with_label(entry.label());
-                // The jobs were of the other mission: not "stale", gone.
-                for job in self.jobs.iter().filter(|j| j.is_running()) {
-                    job.cancel.cancel();
-                }
-                self.jobs.clear();
-                self.job_cursor = 0;
-                if let Some(r) = &mut self.recovery {
-                    // Opening another mission drops this one's unsaved edits
-                    // (the user was asked); its copy goes with them.
-                    r.discard();
-                    self.enable_recovery(match &entry {
-                        Entry::File(p) => Origin::File(p.clone()),
-                        Entry::Builtin(name) => Origin::Builtin((*name).to_owned()),
-                    });
-                }
-                self.selected = Item::Mission;
-                self.field = 0;
-                self.editing = None;
-                self.zoom = 1.0;
-                self.center = None;
-                self.shown_job = None;
-                self.refresh();
-                let errors = checked.report.error_count();
-                if errors > 0 {
-                    self.set_error(format!("opened {name}: {errors} error(s) to fix"));
-                } else {
-                    self.set_status(format!("opened {name}"));
-                }
+                Err(e) => return Err(e.to_string()),
             }
-            None => {
-                let first = checked
-                    .report
-                    .errors()
-                    .next()
-                    .map(|d| d.to_string())
-                    .unwrap_or_default();
-                self.set_error(format!("cannot open {name}: {first}"));
-            }
+        }
+        Entry::Builtin(name) => match mission::BUILTIN.iter().find(|b| b.file_name == *name) {
+            Some(b) => (b.text.to_owned(), b.file_name.to_owned(), None),
+            None => return Err(format!("no built-in mission {name}")),
+        },
+    };
+    let checked = crate::diagnose::check_text(&text, Some(&name));
+    match checked.mission {
+        Some(mission) => Ok(Loaded {
+            mission,
+            errors: checked.report.error_count(),
+            text,
+            name,
+            path,
+        }),
+        None => {
+            let first = checked
+                .report
+                .errors()
+                .next()
+                .map(|d| d.to_string())
+                .unwrap_or_default();
+            Err(format!("cannot open {name}: {first}"))
         }
     }
 }
@@ -1445,6 +1532,68 @@ pub fn open_entries(cwd: &Path) -> Vec<Entry> {
         .collect();
     entries.extend(mission::BUILTIN.iter().map(|b| Entry::Builtin(b.file_name)));
     entries
+}
+
+/// A typed path, relative to `cwd` unless absolute (`~/` is the home folder).
+pub fn typed_path(cwd: &Path, input: &str) -> PathBuf {
+    let input = input.trim();
+    if let Some(rest) = input.strip_prefix("~/")
+        && let Some(home) = std::env::var_os("HOME")
+    {
+        return PathBuf::from(home).join(rest);
+    }
+    cwd.join(input)
+}
+
+/// What the open dialog lists for the text typed: the entries whose label
+/// holds it (exact, then starting with it, then the rest), after the typed
+/// path itself when it is a file not listed; just the typed path when
+/// nothing matches (Enter then opens it, or says why not).
+pub fn open_matches(entries: &[Entry], input: &str, cwd: &Path) -> Vec<Entry> {
+    let wanted = input.trim().to_lowercase();
+    if wanted.is_empty() {
+        return entries.to_vec();
+    }
+    let typed = typed_path(cwd, input);
+    let mut ranked: Vec<(u8, &Entry)> = entries
+        .iter()
+        .filter_map(|e| {
+            let label = entry_label(e, cwd).to_lowercase();
+            let file = match e {
+                Entry::File(p) => p.file_name().map(|n| n.to_string_lossy().to_lowercase()),
+                Entry::Builtin(n) => Some(n.to_lowercase()),
+            };
+            let rank = if label == wanted || matches!(e, Entry::File(p) if *p == typed) {
+                0
+            } else if label.starts_with(&wanted)
+                || file.as_ref().is_some_and(|f| f.starts_with(&wanted))
+            {
+                1
+            } else if label.contains(&wanted) {
+                2
+            } else {
+                return None;
+            };
+            Some((rank, e))
+        })
+        .collect();
+    ranked.sort_by_key(|(rank, _)| *rank);
+    let mut matches: Vec<Entry> = ranked.into_iter().map(|(_, e)| e.clone()).collect();
+    let listed = matches
+        .iter()
+        .any(|e| matches!(e, Entry::File(p) if *p == typed));
+    if matches.is_empty() || (!listed && typed.is_file()) {
+        matches.insert(0, Entry::File(typed));
+    }
+    matches
+}
+
+/// An entry as the open dialog shows it: files relative to `cwd`.
+pub fn entry_label(entry: &Entry, cwd: &Path) -> String {
+    match entry {
+        Entry::File(p) => p.strip_prefix(cwd).unwrap_or(p).display().to_string(),
+        other => other.label(),
+    }
 }
 
 /// The formation's radius (for drawing and hit-testing slots).

@@ -157,18 +157,28 @@ fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
             KeyCode::Char('n') => Some(Action::Dismiss),
             _ => None,
         },
-        Overlay::SaveInvalid { .. } | Overlay::Discard(_) | Overlay::Overwrite { .. } => {
-            match key.code {
-                KeyCode::Char('y') => Some(Action::Confirm),
-                KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
-                _ => None,
-            }
-        }
+        Overlay::Discard(_) => match key.code {
+            KeyCode::Char('s') => Some(Action::Save),
+            KeyCode::Char('y') | KeyCode::Char('d') => Some(Action::Confirm),
+            KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
+            _ => None,
+        },
+        Overlay::SaveInvalid { .. } | Overlay::Overwrite { .. } => match key.code {
+            KeyCode::Char('y') => Some(Action::Confirm),
+            KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
+            _ => None,
+        },
+        // Letters type (a filter or a path): only Esc cancels.
         Overlay::Open { .. } => match key.code {
             KeyCode::Up => Some(Action::PickerMove(-1)),
             KeyCode::Down => Some(Action::PickerMove(1)),
+            KeyCode::PageUp => Some(Action::PickerMove(-10)),
+            KeyCode::PageDown => Some(Action::PickerMove(10)),
             KeyCode::Enter => Some(Action::Confirm),
-            KeyCode::Esc | KeyCode::Char('q') => Some(Action::Dismiss),
+            KeyCode::Esc => Some(Action::Dismiss),
+            KeyCode::Backspace => Some(Action::PromptBackspace),
+            KeyCode::Char('u') if ctrl => Some(Action::PromptClear),
+            KeyCode::Char(c) if !ctrl => Some(Action::PromptInput(c)),
             _ => None,
         },
     }

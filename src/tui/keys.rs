@@ -26,7 +26,7 @@ pub const KEYS: &[(&str, &str, &str)] = &[
     (
         "General",
         "Ctrl-s",
-        "save (atomic, into your file); W save as (Ctrl-u clears the name); o open",
+        "save (atomic, into your file); W save as (Ctrl-u clears the name); o open (type to filter the list or give any path)",
     ),
     (
         "Select & move",

@@ -308,7 +308,10 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect) {
         .marker(Marker::Braille)
         .x_bounds(vp.x)
         .y_bounds(vp.y)
-        .paint(|ctx| paint_map(ctx, app, m, dot, scale));
+        .paint(|ctx| {
+            paint_map(ctx, app, m, dot);
+            paint_labels(ctx, app, m, &vp);
+        });
     frame.render_widget(canvas, area);
     super::terrain::shade_map(frame.buffer_mut(), m, &vp);
     // The fleet replay's time slider, on the map's last row.
@@ -336,7 +339,7 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect) {
     }
 }
 
-fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
+fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     let b = &m.bounds;
     ctx.draw(&Rectangle {
         x: b.x[0],
@@ -484,24 +487,122 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
         paint_fleet(ctx, app, o, stale, dot);
     }
 
-    // IWPs (eq. 9): enabled ones bright, disabled ones dim.
+    // At a FLATLO result's kilometre scale the formation is a dot.
+    if shown_outcome(app, Outcome::flatlo).is_none() {
+        draw_formation_at_start(ctx, app, m, dot);
+    }
+}
+
+/// Cells taken by the map's text, so a label is drawn only where it does
+/// not cover another (at 80×24 the bridge's piers are a few cells apart).
+struct Labels<'a> {
+    vp: &'a Viewport,
+    taken: Vec<Rect>,
+}
+
+impl Labels<'_> {
+    /// The cell the canvas prints a label at `(x, y)` in (its own rounding,
+    /// which is not [`Viewport::to_cell`]'s), or None outside the view.
+    fn cell(&self, x: f64, y: f64) -> Option<(u16, u16)> {
+        let (r, vp) = (self.vp.inner, self.vp);
+        let inside = (vp.x[0]..=vp.x[1]).contains(&x) && (vp.y[0]..=vp.y[1]).contains(&y);
+        if !inside || r.width == 0 || r.height == 0 {
+            return None;
+        }
+        let fx = (x - vp.x[0]) * f64::from(r.width - 1) / (vp.x[1] - vp.x[0]);
+        let fy = (vp.y[1] - y) * f64::from(r.height - 1) / (vp.y[1] - vp.y[0]);
+        Some((r.x + fx as u16, r.y + fy as u16))
+    }
+
+    /// The cells text of `width` printed at `(x, y)` covers, when all of it
+    /// is in view.
+    fn rect(&self, x: f64, y: f64, width: usize) -> Option<Rect> {
+        let (column, row) = self.cell(x, y)?;
+        let width = u16::try_from(width).ok()?;
+        let r = Rect::new(column, row, width, 1);
+        (r.right() <= self.vp.inner.right()).then_some(r)
+    }
+
+    fn free(&self, r: Rect) -> bool {
+        // One blank column between two labels, so they do not read as one.
+        let padded = Rect::new(r.x.saturating_sub(1), r.y, r.width + 2, 1);
+        !self.taken.iter().any(|t| t.intersects(padded))
+    }
+
+    /// Marks text printed regardless (markers) as taken.
+    fn reserve(&mut self, x: f64, y: f64, width: usize) {
+        if let Some((column, row)) = self.cell(x, y) {
+            let width = u16::try_from(width).unwrap_or(u16::MAX);
+            self.taken.push(Rect::new(column, row, width, 1));
+        }
+    }
+
+    /// Prints `label` at the first of `spots` where it is in view and free;
+    /// `force` prints it at the first spot even when none is (the selection's).
+    fn place(
+        &mut self,
+        ctx: &mut Context,
+        spots: &[(f64, f64)],
+        label: Span<'static>,
+        force: bool,
+    ) {
+        let width = label.width();
+        let spot = spots
+            .iter()
+            .find(|(x, y)| self.rect(*x, *y, width).is_some_and(|r| self.free(r)))
+            .or(if force { spots.first() } else { None });
+        if let Some(&(x, y)) = spot {
+            if let Some(r) = self.rect(x, y, width) {
+                self.taken.push(r);
+            }
+            ctx.print(x, y, label);
+        }
+    }
+}
+
+/// The map's text: IWP marks, obstacle names where they fit, start and goal.
+fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
     // A FLATLO result is drawn at kilometre scale: the θ-PSO route, IWPs and
     // obstacle names would be letters piled on a few cells.
     if shown_outcome(app, Outcome::flatlo).is_some() {
         return;
     }
+    let scale = vp.metres_per_column();
+    let mut labels = Labels {
+        vp,
+        taken: Vec::new(),
+    };
+    let (s, g) = (&m.route.start, &m.route.goal);
+    labels.reserve(s.x, s.y, 1);
+    labels.reserve(g.x, g.y, 1);
+    for t in &m.fleet.targets {
+        labels.reserve(t.position.x, t.position.y, 2);
+    }
+    // IWPs (eq. 9): enabled ones bright, disabled ones dim.
     for w in &app.iwps {
         let (glyph, style) = if w.enabled {
             ("◆", Style::default().fg(Color::LightCyan))
         } else {
             ("◇", Style::default().fg(Color::DarkGray))
         };
+        labels.reserve(w.position.x, w.position.y, 1);
         ctx.print(w.position.x, w.position.y, Span::styled(glyph, style));
     }
-    // Obstacle names, where they fit.
+    // Obstacle names, right of the obstacle or else left of it, where they
+    // cover no other text; the selected one's first.
     if m.obstacles.len() <= 40 {
-        for (i, o) in m.obstacles.iter().enumerate() {
-            let style = if app.selected == Item::Obstacle(i) {
+        let selected = match app.selected {
+            Item::Obstacle(i) => Some(i),
+            _ => None,
+        };
+        let order = selected
+            .into_iter()
+            .chain((0..m.obstacles.len()).filter(|i| Some(*i) != selected));
+        for i in order {
+            let Some(o) = m.obstacles.get(i) else {
+                continue;
+            };
+            let style = if selected == Some(i) {
                 Style::default().yellow().bold()
             } else if o.inspect {
                 Style::default().fg(Color::LightMagenta)
@@ -513,14 +614,14 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
             } else {
                 o.name.clone()
             };
-            ctx.print(
-                o.center.x + o.radius + scale,
-                o.center.y,
-                Span::styled(label, style),
-            );
+            let width = Span::raw(label.as_str()).width() as f64;
+            let spots = [
+                (o.center.x + o.radius + scale, o.center.y),
+                (o.center.x - o.radius - scale * (width + 1.0), o.center.y),
+            ];
+            labels.place(ctx, &spots, Span::styled(label, style), selected == Some(i));
         }
     }
-    draw_formation_at_start(ctx, app, m, dot);
     let marker = |item: Item, glyph: &'static str, color: Color| {
         let style = if app.selected == item {
             Style::default().black().bg(color).bold()
@@ -529,7 +630,6 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64, scale: f64) {
         };
         Span::styled(glyph, style)
     };
-    let (s, g) = (&m.route.start, &m.route.goal);
     ctx.print(s.x, s.y, marker(Item::Start, "S", Color::Green));
     ctx.print(g.x, g.y, marker(Item::Goal, "G", Color::Red));
 }
@@ -760,9 +860,25 @@ fn closest_along(points: &[Point3<f64>], along: &[f64], c: &Point2<f64>) -> Opti
     best
 }
 
+/// Narrower than this inside its border (an 80-column screen), the IWP
+/// table gives each IWP two lines instead of five columns squeezed to a few
+/// letters each.
+const IWP_TABLE_WIDE: u16 = 56;
+
+fn iwp_table_is_narrow(area: Rect) -> bool {
+    area.width.saturating_sub(2) < IWP_TABLE_WIDE
+}
+
 /// The formation editor's drawing (top) and IWP table (bottom).
 pub fn formation_split(app: &App, area: Rect) -> [Rect; 2] {
-    let list_height = (app.iwps.len() as u16 + 3).clamp(4, area.height / 2);
+    let n = app.iwps.len() as u16;
+    // Borders, plus a header row or a second line per IWP.
+    let wanted = if iwp_table_is_narrow(area) {
+        2 * n + 2
+    } else {
+        n + 3
+    };
+    let list_height = wanted.clamp(4, area.height / 2);
     ratatui::layout::Layout::vertical([
         ratatui::layout::Constraint::Min(6),
         ratatui::layout::Constraint::Length(list_height),
@@ -831,8 +947,7 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect) {
         });
     frame.render_widget(canvas, top);
 
-    let header = Row::new(["IWP between", "gap m", "on", "choice", "shape used"])
-        .style(Style::default().bold());
+    let narrow = iwp_table_is_narrow(bottom);
     let rows: Vec<Row> = app
         .iwps
         .iter()
@@ -845,13 +960,28 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect) {
             } else {
                 Style::default().fg(Color::DarkGray)
             };
+            let between = format!("{} ↔ {}", w.between[0], w.between[1]);
             let choice = if w.choice == ShapeChoice::Auto {
                 "auto".to_owned()
             } else {
                 shape_name(w.choice).to_owned()
             };
+            if narrow {
+                let mark = if w.enabled { "◆" } else { "◇" };
+                let off = if w.enabled { "" } else { " · off" };
+                let shape = if w.choice == ShapeChoice::Auto {
+                    format!("auto → {}", w.shape_name())
+                } else {
+                    format!("{} (chosen)", w.shape_name())
+                };
+                let text = ratatui::text::Text::from(vec![
+                    TextLine::raw(format!("{mark} {between}{off}")),
+                    TextLine::raw(format!("  gap {:.2} m · {shape}", w.gap)),
+                ]);
+                return Row::new([Cell::from(text)]).height(2).style(style);
+            }
             Row::new([
-                Cell::from(format!("{} ↔ {}", w.between[0], w.between[1])),
+                Cell::from(between),
                 Cell::from(format!("{:.2}", w.gap)),
                 Cell::from(if w.enabled { "yes" } else { "no" }),
                 Cell::from(choice),
@@ -861,23 +991,31 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect) {
         })
         .collect();
     let empty = app.iwps.is_empty();
-    let title = if empty {
-        " IWPs (eq. 9): none: no gap narrower than the formation ".to_owned()
-    } else {
-        " IWPs (eq. 9) · s cycle shape · space on/off ".to_owned()
+    let title = match (empty, narrow) {
+        (true, false) => " IWPs (eq. 9): none: no gap narrower than the formation ",
+        (true, true) => " IWPs (eq. 9): none ",
+        (false, false) => " IWPs (eq. 9) · s cycle shape · space on/off ",
+        (false, true) => " IWPs · s shape · Space on/off ",
     };
-    let table = Table::new(
-        rows,
-        [
-            ratatui::layout::Constraint::Min(20),
-            ratatui::layout::Constraint::Length(6),
-            ratatui::layout::Constraint::Length(3),
-            ratatui::layout::Constraint::Length(10),
-            ratatui::layout::Constraint::Length(10),
-        ],
-    )
-    .header(header)
-    .block(pane_block(TextLine::from(title), false));
+    let block = pane_block(TextLine::from(title), false);
+    let table = if narrow {
+        Table::new(rows, [ratatui::layout::Constraint::Fill(1)]).block(block)
+    } else {
+        let header = Row::new(["IWP between", "gap m", "on", "choice", "shape used"])
+            .style(Style::default().bold());
+        Table::new(
+            rows,
+            [
+                ratatui::layout::Constraint::Min(20),
+                ratatui::layout::Constraint::Length(6),
+                ratatui::layout::Constraint::Length(3),
+                ratatui::layout::Constraint::Length(10),
+                ratatui::layout::Constraint::Length(10),
+            ],
+        )
+        .header(header)
+        .block(block)
+    };
     frame.render_widget(table, bottom);
 }
 

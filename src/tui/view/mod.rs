@@ -181,36 +181,66 @@ fn key(k: &str) -> Span<'static> {
     Span::styled(k.to_owned(), Style::default().yellow().bold())
 }
 
+/// The keys column of the help overlay, in cells: descriptions start here.
+const KEYS_COLUMN: usize = 18;
+
+/// One key of the help overlay in a column `width` cells wide: the keys,
+/// then what they do, wrapped so that every continuation line starts under
+/// the description (a hanging indent), not at the left edge.
+fn key_lines(keys: &str, what: &str, width: u16) -> Vec<Line<'static>> {
+    let indent = KEYS_COLUMN.max(Line::raw(keys).width() + 4);
+    // A blank cell at the end keeps it apart from the next column.
+    let room = usize::from(width).saturating_sub(indent + 1).max(12);
+    let mut lines = Vec::new();
+    for (k, chunk) in wrap_words(what, room).into_iter().enumerate() {
+        let lead = if k == 0 {
+            key(&format!("  {keys:<w$}", w = indent - 2))
+        } else {
+            Span::raw(" ".repeat(indent))
+        };
+        lines.push(Line::from(vec![lead, Span::raw(chunk)]));
+    }
+    lines
+}
+
+/// `text` in lines of at most `room` cells, broken between words (a word
+/// longer than a line is cut).
+fn wrap_words(text: &str, room: usize) -> Vec<String> {
+    let width = |s: &str| Line::raw(s).width();
+    let mut lines: Vec<String> = Vec::new();
+    let mut current = String::new();
+    for word in text.split_whitespace() {
+        let needed = width(&current) + usize::from(!current.is_empty()) + width(word);
+        if needed <= room {
+            if !current.is_empty() {
+                current.push(' ');
+            }
+            current.push_str(word);
+            continue;
+        }
+        if !current.is_empty() {
+            lines.push(std::mem::take(&mut current));
+        }
+        // A word wider than a whole line: cut it where the line ends.
+        for c in word.chars() {
+            if width(&current) + width(c.encode_utf8(&mut [0; 4])) > room && !current.is_empty() {
+                lines.push(std::mem::take(&mut current));
+            }
+            current.push(c);
+        }
+    }
+    if !current.is_empty() || lines.is_empty() {
+        lines.push(current);
+    }
+    lines
+}
+
 fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
     match overlay {
         Overlay::Help => {
             // Two columns when there is room, else one (the README lists every key too).
             let groups = ["General", "Select & move", "Edit", "Formation", "Run"];
-            let column = |names: &[&str]| {
-                let mut lines = Vec::new();
-                for name in names {
-                    if !lines.is_empty() {
-                        lines.push(Line::raw(""));
-                    }
-                    lines.push(Line::styled(
-                        name.to_string(),
-                        Style::default().bold().underlined(),
-                    ));
-                    for (_, keys, what) in KEYS.iter().filter(|(g, _, _)| g == name) {
-                        lines.push(Line::from(vec![
-                            key(&format!("  {keys:<16}")),
-                            Span::raw(what.to_string()),
-                        ]));
-                    }
-                }
-                lines
-            };
             let wide = area.width >= 120;
-            let (left, right) = if wide {
-                (column(&groups[..2]), column(&groups[2..]))
-            } else {
-                (column(&groups), Vec::new())
-            };
             let width = if wide {
                 area.width.min(150)
             } else {
@@ -222,6 +252,30 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                 (l, inner_width - l)
             } else {
                 (inner_width, inner_width)
+            };
+            let column = |names: &[&str], width: u16| {
+                let mut lines = Vec::new();
+                for name in names {
+                    if !lines.is_empty() {
+                        lines.push(Line::raw(""));
+                    }
+                    lines.push(Line::styled(
+                        name.to_string(),
+                        Style::default().bold().underlined(),
+                    ));
+                    for (_, keys, what) in KEYS.iter().filter(|(g, _, _)| g == name) {
+                        lines.extend(key_lines(keys, what, width));
+                    }
+                }
+                lines
+            };
+            let (left, right) = if wide {
+                (
+                    column(&groups[..2], left_width),
+                    column(&groups[2..], right_width),
+                )
+            } else {
+                (column(&groups, left_width), Vec::new())
             };
             let content = rows(&left, left_width).max(rows(&right, right_width));
             let height = content + 2;
@@ -248,9 +302,17 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                     .scroll((scroll, 0))
             };
             if wide {
-                let [a, b] =
-                    Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)])
-                        .areas(inner);
+                // The widths the lines were wrapped to (a layout of the
+                // real rectangle may round its split a cell differently).
+                let a = Rect {
+                    width: left_width.min(inner.width),
+                    ..inner
+                };
+                let b = Rect {
+                    x: a.right(),
+                    width: inner.width - a.width,
+                    ..inner
+                };
                 frame.render_widget(text(left), a);
                 frame.render_widget(text(right), b);
             } else {
@@ -317,35 +379,53 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                 body,
             );
         }
-        Overlay::Open { entries, cursor } => {
-            let height = (entries.len() as u16 + 3).min(area.height.saturating_sub(4));
-            let first = cursor.saturating_sub(height.saturating_sub(4) as usize);
-            let mut lines: Vec<Line> = entries
-                .iter()
-                .enumerate()
-                .skip(first)
-                .take(height.saturating_sub(3) as usize)
-                .map(|(k, e)| {
-                    let label = match e {
-                        super::app::Entry::File(p) => {
-                            p.strip_prefix(&app.cwd).unwrap_or(p).display().to_string()
+        Overlay::Open {
+            input,
+            matches,
+            cursor,
+            ..
+        } => {
+            // Prompt line, list, hints: the list takes what the screen leaves.
+            let inner = (matches.len() as u16 + 2).min(area.height.saturating_sub(6));
+            let room = inner.saturating_sub(2) as usize;
+            let first = (cursor + 1).saturating_sub(room.max(1));
+            let mut lines = vec![Line::from(vec![
+                Span::raw("Path or filter: "),
+                Span::styled(format!("{input}▏"), Style::default().white().on_blue()),
+            ])];
+            let typed_only = !input.trim().is_empty()
+                && matches.len() == 1
+                && matches!(&matches[0], super::app::Entry::File(p)
+                    if *p == super::app::typed_path(&app.cwd, input));
+            lines.extend(
+                matches
+                    .iter()
+                    .enumerate()
+                    .skip(first)
+                    .take(room)
+                    .map(|(k, e)| {
+                        let mut label = super::app::entry_label(e, &app.cwd);
+                        if typed_only {
+                            label = format!("{label}  (not listed: Enter opens this path)");
                         }
-                        other => other.label(),
-                    };
-                    if k == *cursor {
-                        Line::styled(format!("▶ {label}"), Style::default().black().on_yellow())
-                    } else {
-                        Line::raw(format!("  {label}"))
-                    }
-                })
-                .collect();
+                        if k == *cursor {
+                            Line::styled(format!("▶ {label}"), Style::default().black().on_yellow())
+                        } else {
+                            Line::raw(format!("  {label}"))
+                        }
+                    }),
+            );
             lines.push(hints(&[
+                ("type", " filter or path   "),
                 ("↑↓", " choose   "),
                 ("Enter", " open   "),
                 ("Esc", " cancel"),
             ]));
-            let title = ("Open a mission (missions/, ./, built-in)", Color::Cyan);
-            popup(frame, area, (72, height + 2), title, Paragraph::new(lines));
+            let title = (
+                "Open a mission (missions/, ./, built-in, a path)",
+                Color::Cyan,
+            );
+            popup(frame, area, (72, inner + 2), title, Paragraph::new(lines));
         }
         Overlay::Overwrite { path, .. } => {
             let lines = vec![
@@ -380,16 +460,37 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                     "Discard the unsaved changes and open {}?",
                     entry.label()
                 )),
-                hints(&[("y", " discard and open   "), ("Esc", " cancel")]),
+                hints(&[
+                    ("s", " save, then open   "),
+                    ("y", " discard and open   "),
+                    ("Esc", " cancel"),
+                ]),
             ];
+            let width = 80.min(area.width);
+            let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
             let body = Paragraph::new(lines).wrap(Wrap { trim: false });
-            popup(
-                frame,
-                area,
-                (80, 4),
-                ("Unsaved changes", Color::Yellow),
-                body,
-            );
+            popup(frame, area, size, ("Unsaved changes", Color::Yellow), body);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn words_wrap_within_the_room_and_long_ones_are_cut() {
+        assert_eq!(wrap_words("one two three", 7), ["one two", "three"]);
+        assert_eq!(wrap_words("abcdefghij", 4), ["abcd", "efgh", "ij"]);
+        assert_eq!(wrap_words("", 4), [""]);
+    }
+
+    #[test]
+    fn a_wrapped_key_line_hangs_under_its_description() {
+        let lines = key_lines("n  p", "next / previous item of the map", 37);
+        let text: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+        assert_eq!(text[0], "  n  p            next / previous");
+        assert_eq!(text[1], "                  item of the map");
+        assert!(lines.iter().all(|l| l.width() < 37), "{text:?}");
     }
 }
