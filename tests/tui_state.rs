@@ -567,8 +567,8 @@ mod mouse {
 fn the_readme_lists_every_key_the_help_overlay_shows() {
     let readme =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
-    for (_, keys, what) in skyform::tui::keys::KEYS {
-        let row = format!("| `{keys}` | {what} |");
+    for key in skyform::tui::keys::KEYS {
+        let row = format!("| `{}` | {} |", key.keys, key.help);
         assert!(readme.contains(&row), "README.md lacks the key row {row}");
     }
 }
@@ -1164,4 +1164,111 @@ fn the_open_dialog_types_letters_and_its_prompt_offers_save_first() {
     )));
     assert_eq!(key_action(&app, key('s')), Some(Action::Save));
     assert_eq!(key_action(&app, key('y')), Some(Action::Confirm));
+}
+
+/// Issue 13: one key table. Every binding dispatches to its action in a
+/// state where its condition holds (and no earlier row shadows it), and
+/// every key that does something on the main screen, in every focus and
+/// pane, is a binding of the table, or a number typed over an inspector
+/// field (the Enter row says so).
+#[test]
+fn every_binding_dispatches_and_every_key_that_acts_is_in_the_table() {
+    use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    use skyform::tui::app::Pane;
+    use skyform::tui::input::key_action;
+    use skyform::tui::keys::{KEYS, Key, lookup};
+
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let event = |k: Key| match k {
+        Key::Char(c) if c.is_ascii_uppercase() => {
+            KeyEvent::new(KeyCode::Char(c), KeyModifiers::SHIFT)
+        }
+        Key::Char(c) => KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE),
+        Key::Ctrl(c) => KeyEvent::new(KeyCode::Char(c), KeyModifiers::CONTROL),
+        Key::Code(KeyCode::BackTab) => KeyEvent::new(KeyCode::BackTab, KeyModifiers::SHIFT),
+        Key::Code(code) => KeyEvent::new(code, KeyModifiers::NONE),
+        Key::Shift(code) => KeyEvent::new(code, KeyModifiers::SHIFT),
+    };
+    let mut states = Vec::new();
+    for pane in [Pane::Map, Pane::Formation] {
+        for focus in [Focus::Map, Focus::Inspector, Focus::Jobs] {
+            states.push((focus, pane));
+        }
+    }
+    let enter = |app: &mut App, (focus, pane): (Focus, Pane)| {
+        app.update(match pane {
+            Pane::Map => Action::ShowMap,
+            Pane::Formation => Action::ShowFormation,
+        });
+        app.update(Action::FocusOn(focus));
+        assert_eq!((app.focus, app.pane), (focus, pane));
+    };
+    let mut bindings = 0;
+    for row in KEYS {
+        for b in row.bindings {
+            let Some(&state) = states
+                .iter()
+                .find(|(f, p)| b.when.holds(*f, *p) && lookup(b.key, *f, *p) == Some(b))
+            else {
+                panic!(
+                    "{b:?} ('{}') is shadowed by an earlier binding everywhere",
+                    row.keys
+                );
+            };
+            enter(&mut app, state);
+            assert_eq!(
+                key_action(&app, event(b.key)),
+                Some(b.action.clone()),
+                "{b:?} in {state:?}"
+            );
+            bindings += 1;
+        }
+    }
+    assert!(bindings > 50, "{bindings} bindings");
+
+    let mut presses: Vec<KeyEvent> = (' '..='~')
+        .map(|c| event(Key::Char(c)))
+        .chain(('a'..='z').map(|c| event(Key::Ctrl(c))))
+        .collect();
+    for code in [
+        KeyCode::Enter,
+        KeyCode::Esc,
+        KeyCode::Tab,
+        KeyCode::BackTab,
+        KeyCode::Delete,
+        KeyCode::Backspace,
+        KeyCode::Home,
+        KeyCode::End,
+        KeyCode::PageUp,
+        KeyCode::PageDown,
+        KeyCode::Insert,
+        KeyCode::F(1),
+        KeyCode::F(5),
+        KeyCode::Left,
+        KeyCode::Right,
+        KeyCode::Up,
+        KeyCode::Down,
+    ] {
+        presses.push(event(Key::Code(code)));
+        presses.push(event(Key::Shift(code)));
+    }
+    let in_table = |action: &Action| {
+        KEYS.iter()
+            .flat_map(|row| row.bindings)
+            .any(|b| &b.action == action)
+    };
+    for &state in &states {
+        enter(&mut app, state);
+        for press in &presses {
+            if let Some(action) = key_action(&app, *press) {
+                let typing =
+                    matches!(action, Action::EditStart(Some(_))) && state.0 == Focus::Inspector;
+                assert!(
+                    typing || in_table(&action),
+                    "{press:?} in {state:?} gives {action:?}, which no row of the key table lists"
+                );
+            }
+        }
+    }
 }

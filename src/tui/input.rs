@@ -1,5 +1,5 @@
-//! Keys and mouse events to actions. The keymap is also listed as data
-//! (`keys::KEYS`) for the help overlay and the README.
+//! Keys and mouse events to actions. The main screen's keys are looked up
+//! in the key table (`keys::KEYS`); windows and typing keep theirs here.
 
 use ratatui::crossterm::event::{
     KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind,
@@ -9,6 +9,7 @@ use ratatui::layout::{Position, Rect};
 use super::action::Action;
 use super::app::{App, Focus, Overlay, Pane, formation_extent};
 use super::fields::Item;
+use super::keys::{self, Key};
 use super::view::map::{Viewport, formation_split};
 use super::view::{Areas, layout};
 
@@ -36,94 +37,25 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
             _ => None,
         };
     }
-    if ctrl {
-        return match key.code {
-            KeyCode::Char('s') => Some(Action::Save),
-            KeyCode::Char('z') => Some(Action::Undo),
-            KeyCode::Char('r') | KeyCode::Char('y') => Some(Action::Redo),
-            _ => None,
-        };
+    let pressed = match key.code {
+        KeyCode::Char(c) if ctrl => Key::Ctrl(c),
+        KeyCode::Char(c) => Key::Char(c),
+        code @ (KeyCode::Left | KeyCode::Right | KeyCode::Up | KeyCode::Down) if shift => {
+            Key::Shift(code)
+        }
+        code => Key::Code(code),
+    };
+    if let Some(binding) = keys::lookup(pressed, app.focus, app.pane) {
+        return Some(binding.action.clone());
     }
-    let focus = app.focus;
-    let moves_things = focus == Focus::Map;
-    match key.code {
-        KeyCode::Char('?') => Some(Action::ToggleHelp),
-        KeyCode::Char('q') => Some(Action::Quit),
-        KeyCode::Esc => Some(Action::Dismiss),
-        KeyCode::Tab => Some(Action::FocusNext),
-        KeyCode::BackTab => Some(Action::FocusPrevious),
-        KeyCode::Char('1') if focus != Focus::Inspector => Some(Action::ShowMap),
-        KeyCode::Char('2') if focus != Focus::Inspector => Some(Action::ShowFormation),
-        KeyCode::Char('v') => Some(Action::ToggleSideView),
-        KeyCode::Char('u') => Some(Action::Undo),
-        KeyCode::Char('W') => Some(Action::SaveAs),
-        KeyCode::Char('o') => Some(Action::Open),
-        KeyCode::Char('n') => Some(Action::SelectNext),
-        KeyCode::Char('p') => Some(Action::SelectPrevious),
-        KeyCode::Char('[') => Some(Action::ChangeStep(-1)),
-        KeyCode::Char(']') => Some(Action::ChangeStep(1)),
-        KeyCode::Char('+') | KeyCode::Char('=') => Some(Action::Zoom(1.25, None)),
-        KeyCode::Char('-') if focus != Focus::Inspector => Some(Action::Zoom(0.8, None)),
-        KeyCode::Char('0') if focus != Focus::Inspector => Some(Action::Fit),
-        KeyCode::Char('a') => Some(match app.pane {
-            Pane::Map => Action::AddObstacle(None),
-            Pane::Formation => Action::AddSlot,
-        }),
-        KeyCode::Char('A') => Some(Action::ToggleAddTool),
-        KeyCode::Char('d') => Some(Action::Duplicate),
-        KeyCode::Delete | KeyCode::Char('D') => Some(Action::Delete),
-        KeyCode::Char('P') => Some(Action::CyclePreset),
-        KeyCode::Char('s') => Some(Action::CycleShape),
-        KeyCode::Char(' ') => Some(Action::ToggleWaypoint),
-        KeyCode::Char('i') => Some(Action::ToggleInspect),
-        KeyCode::Char('r') => Some(Action::Run),
-        KeyCode::Char('N') => Some(Action::RunNewSeed),
-        KeyCode::Char('F') => Some(Action::RunFlatlo),
-        KeyCode::Char('T') => Some(Action::RunFleet),
-        KeyCode::Char(',') => Some(Action::Scrub(-1.0)),
-        KeyCode::Char('.') if focus != Focus::Inspector => Some(Action::Scrub(1.0)),
-        KeyCode::Char('>') => Some(Action::TogglePlay),
-        KeyCode::Char('x') => Some(Action::Cancel),
-        KeyCode::Char('e') => Some(Action::ToggleRecording),
-        KeyCode::Char('E') => Some(Action::CycleViewer),
-        KeyCode::Char('X') => Some(Action::Export),
-        KeyCode::Left | KeyCode::Right | KeyCode::Up | KeyCode::Down
-            if shift && app.pane == Pane::Map =>
-        {
-            let (x, y) = arrow(key.code);
-            Some(Action::Pan(x * 0.1, y * 0.1))
-        }
-        KeyCode::Left | KeyCode::Right | KeyCode::Up | KeyCode::Down if moves_things => {
-            let (x, y) = arrow(key.code);
-            Some(Action::Nudge(x, y))
-        }
-        KeyCode::Up => Some(match focus {
-            Focus::Jobs => Action::JobUp,
-            _ => Action::FieldUp,
-        }),
-        KeyCode::Down => Some(match focus {
-            Focus::Jobs => Action::JobDown,
-            _ => Action::FieldDown,
-        }),
-        KeyCode::Enter => Some(match focus {
-            Focus::Jobs => Action::ShowJob,
-            _ => Action::EditStart(None),
-        }),
-        KeyCode::Char(c)
-            if focus == Focus::Inspector && (c.is_ascii_digit() || c == '-' || c == '.') =>
+    // In the inspector a number typed over a field replaces it.
+    match pressed {
+        Key::Char(c)
+            if app.focus == Focus::Inspector && (c.is_ascii_digit() || c == '-' || c == '.') =>
         {
             Some(Action::EditStart(Some(c)))
         }
         _ => None,
-    }
-}
-
-fn arrow(code: KeyCode) -> (f64, f64) {
-    match code {
-        KeyCode::Left => (-1.0, 0.0),
-        KeyCode::Right => (1.0, 0.0),
-        KeyCode::Up => (0.0, 1.0),
-        _ => (0.0, -1.0),
     }
 }
 

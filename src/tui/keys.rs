@@ -1,123 +1,431 @@
-//! The key table the help overlay, the hints and the README show. Its own
-//! module so the views read it without importing the input handling (which
-//! imports the views for hit-testing).
+//! The key table: every key of the main screen, when it applies and what
+//! it does, as data. Dispatch (`input::key_action`), the help overlay, the
+//! empty jobs panel and the README's table all read it, so a key cannot do
+//! one thing and be documented as another; a test dispatches every binding
+//! and checks that every key that does something is in the table.
+//! Windows (prompts, the help itself) keep their few keys in `input.rs` and
+//! show them in their own hint lines.
 
-/// Every key, grouped as the help overlay shows them: (group, keys, what).
-pub const KEYS: &[(&str, &str, &str)] = &[
-    (
-        "General",
-        "?",
-        "this help (↑ ↓ PgUp PgDn scroll it on a small screen)",
-    ),
-    (
-        "General",
-        "q  Ctrl-c",
-        "quit (asks when there are unsaved changes)",
-    ),
-    ("General", "Tab  Shift-Tab", "focus map → inspector → jobs"),
-    ("General", "1  2", "map / formation editor"),
-    (
-        "General",
-        "v",
-        "side view: distance along the path vs altitude",
-    ),
-    ("General", "u  Ctrl-z", "undo"),
-    ("General", "Ctrl-r  Ctrl-y", "redo"),
-    (
-        "General",
-        "Ctrl-s",
-        "save (atomic, into your file); W save as (Ctrl-u clears the name); o open (type to filter the list or give any path)",
-    ),
-    (
-        "Select & move",
-        "n  p",
-        "next / previous item (map: mission, bounds, start, goal, obstacles, θ-PSO; formation: slots, IWPs)",
-    ),
-    (
-        "Select & move",
-        "← → ↑ ↓",
-        "nudge the selection one step (map & formation focus)",
-    ),
-    ("Select & move", "[  ]", "smaller / larger nudge step"),
-    ("Select & move", "+  -  0", "zoom in / out / fit"),
-    ("Select & move", "Shift-arrows", "pan the map"),
-    (
-        "Select & move",
-        "mouse",
-        "click selects, drag moves, wheel zooms",
-    ),
-    (
-        "Edit",
-        "a",
-        "add an obstacle at the view's centre (formation: add a slot)",
-    ),
-    (
-        "Edit",
-        "A",
-        "add tool: click an empty spot to place an obstacle",
-    ),
-    ("Edit", "d", "duplicate the selected obstacle"),
-    (
-        "Edit",
-        "i",
-        "inspect the selected obstacle (eq. 8) or stop inspecting it",
-    ),
-    (
-        "Edit",
-        "Del  D",
-        "delete the selected obstacle / slot / IWP choice",
-    ),
-    (
-        "Edit",
-        "Enter",
-        "edit the field (inspector); type a number to replace it; Enter applies",
-    ),
-    (
-        "Edit",
-        "Esc",
-        "cancel typing, close a window, leave the add tool",
-    ),
-    (
-        "Formation",
-        "P",
-        "apply the next preset: triangle, line abreast, column, V, diamond",
-    ),
-    (
-        "Formation",
-        "s  Space",
-        "cycle the IWP's shape / enable or disable it",
-    ),
-    ("Run", "r", "run θ-PSO with the mission's seed"),
-    (
-        "Run",
-        "F",
-        "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
-    ),
-    (
-        "Run",
-        "T",
-        "run the distributed fleet (select Fleet and its targets with n/p to edit them; d adds a target)",
-    ),
-    (
-        "Run",
-        ",  .  >",
-        "fleet replay: back / forward one second, play or pause",
-    ),
-    ("Run", "N", "re-run the last pipeline with a new seed"),
-    ("Run", "x", "cancel the selected (or latest) running job"),
-    (
-        "Run",
-        "Enter",
-        "jobs focus: show that job's result on the map",
-    ),
-    (
-        "Run",
-        "e  E",
-        "record runs to .rrd beside the mission / Rerun viewer: off, connect, spawn",
-    ),
-    (
-        "Run",
-        "X",
-        "export the shown result per vehicle (.plan, .waypoints, CSV) to <mission>-export/",
-    ),
+use ratatui::crossterm::event::KeyCode;
+
+use super::action::{Action, Focus, Pane};
+
+/// A key press as the table states it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Key {
+    /// A printable character (Shift is part of the character).
+    Char(char),
+    /// Ctrl and a character.
+    Ctrl(char),
+    /// Any other key, unmodified (Shift-Tab arrives as `BackTab`).
+    Code(KeyCode),
+    /// An arrow with Shift.
+    Shift(KeyCode),
+}
+
+/// When a binding applies; besides, no window is open and no field is
+/// being typed into.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum When {
+    Always,
+    Focus(Focus),
+    NotFocus(Focus),
+    Pane(Pane),
+}
+
+impl When {
+    pub fn holds(self, focus: Focus, pane: Pane) -> bool {
+        match self {
+            When::Always => true,
+            When::Focus(f) => focus == f,
+            When::NotFocus(f) => focus != f,
+            When::Pane(p) => pane == p,
+        }
+    }
+}
+
+/// One key and the action it sends when its condition holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Binding {
+    pub key: Key,
+    pub when: When,
+    pub action: Action,
+}
+
+const fn bind(key: Key, when: When, action: Action) -> Binding {
+    Binding { key, when, action }
+}
+
+/// One row of the help overlay and the README: its keys as shown, what they
+/// do, and the bindings behind them (none for the mouse).
+#[derive(Debug)]
+pub struct KeyRow {
+    pub group: &'static str,
+    pub keys: &'static str,
+    pub help: &'static str,
+    pub bindings: &'static [Binding],
+}
+
+/// The first binding for `key` that holds with this focus and pane; a
+/// Shift-arrow nothing binds acts as the plain arrow.
+pub fn lookup(key: Key, focus: Focus, pane: Pane) -> Option<&'static Binding> {
+    let find = |key: Key| {
+        KEYS.iter()
+            .flat_map(|row| row.bindings)
+            .find(|b| b.key == key && b.when.holds(focus, pane))
+    };
+    find(key).or_else(|| match key {
+        Key::Shift(code) => find(Key::Code(code)),
+        _ => None,
+    })
+}
+
+/// Every key, grouped as the help overlay shows them. Earlier bindings win.
+pub static KEYS: &[KeyRow] = &[
+    KeyRow {
+        group: "General",
+        keys: "?",
+        help: "this help (↑ ↓ PgUp PgDn scroll it on a small screen)",
+        bindings: &[bind(Key::Char('?'), When::Always, Action::ToggleHelp)],
+    },
+    KeyRow {
+        group: "General",
+        keys: "q  Ctrl-c",
+        help: "quit (asks when there are unsaved changes)",
+        bindings: &[
+            bind(Key::Char('q'), When::Always, Action::Quit),
+            bind(Key::Ctrl('c'), When::Always, Action::Quit),
+        ],
+    },
+    KeyRow {
+        group: "General",
+        keys: "Tab  Shift-Tab",
+        help: "focus map → inspector → jobs",
+        bindings: &[
+            bind(Key::Code(KeyCode::Tab), When::Always, Action::FocusNext),
+            bind(
+                Key::Code(KeyCode::BackTab),
+                When::Always,
+                Action::FocusPrevious,
+            ),
+        ],
+    },
+    KeyRow {
+        group: "General",
+        keys: "1  2",
+        help: "map / formation editor",
+        bindings: &[
+            bind(
+                Key::Char('1'),
+                When::NotFocus(Focus::Inspector),
+                Action::ShowMap,
+            ),
+            bind(
+                Key::Char('2'),
+                When::NotFocus(Focus::Inspector),
+                Action::ShowFormation,
+            ),
+        ],
+    },
+    KeyRow {
+        group: "General",
+        keys: "v",
+        help: "side view: distance along the path vs altitude",
+        bindings: &[bind(Key::Char('v'), When::Always, Action::ToggleSideView)],
+    },
+    KeyRow {
+        group: "General",
+        keys: "u  Ctrl-z",
+        help: "undo",
+        bindings: &[
+            bind(Key::Char('u'), When::Always, Action::Undo),
+            bind(Key::Ctrl('z'), When::Always, Action::Undo),
+        ],
+    },
+    KeyRow {
+        group: "General",
+        keys: "Ctrl-r  Ctrl-y",
+        help: "redo",
+        bindings: &[
+            bind(Key::Ctrl('r'), When::Always, Action::Redo),
+            bind(Key::Ctrl('y'), When::Always, Action::Redo),
+        ],
+    },
+    KeyRow {
+        group: "General",
+        keys: "Ctrl-s",
+        help: "save (atomic, into your file)",
+        bindings: &[bind(Key::Ctrl('s'), When::Always, Action::Save)],
+    },
+    KeyRow {
+        group: "General",
+        keys: "W",
+        help: "save as (Ctrl-u clears the name)",
+        bindings: &[bind(Key::Char('W'), When::Always, Action::SaveAs)],
+    },
+    KeyRow {
+        group: "General",
+        keys: "o",
+        help: "open (type to filter the list or give any path)",
+        bindings: &[bind(Key::Char('o'), When::Always, Action::Open)],
+    },
+    KeyRow {
+        group: "Select & move",
+        keys: "n  p",
+        help: "next / previous item (map: mission, bounds, start, goal, obstacles, θ-PSO; formation: slots, IWPs)",
+        bindings: &[
+            bind(Key::Char('n'), When::Always, Action::SelectNext),
+            bind(Key::Char('p'), When::Always, Action::SelectPrevious),
+        ],
+    },
+    KeyRow {
+        group: "Select & move",
+        keys: "← → ↑ ↓",
+        help: "nudge the selection one step (map & formation focus)",
+        bindings: &[
+            bind(
+                Key::Code(KeyCode::Left),
+                When::Focus(Focus::Map),
+                Action::Nudge(-1.0, 0.0),
+            ),
+            bind(
+                Key::Code(KeyCode::Right),
+                When::Focus(Focus::Map),
+                Action::Nudge(1.0, 0.0),
+            ),
+            bind(
+                Key::Code(KeyCode::Up),
+                When::Focus(Focus::Map),
+                Action::Nudge(0.0, 1.0),
+            ),
+            bind(
+                Key::Code(KeyCode::Down),
+                When::Focus(Focus::Map),
+                Action::Nudge(0.0, -1.0),
+            ),
+        ],
+    },
+    KeyRow {
+        group: "Select & move",
+        keys: "↑  ↓",
+        help: "inspector: previous / next field; jobs: previous / next job",
+        bindings: &[
+            bind(
+                Key::Code(KeyCode::Up),
+                When::Focus(Focus::Jobs),
+                Action::JobUp,
+            ),
+            bind(
+                Key::Code(KeyCode::Down),
+                When::Focus(Focus::Jobs),
+                Action::JobDown,
+            ),
+            bind(Key::Code(KeyCode::Up), When::Always, Action::FieldUp),
+            bind(Key::Code(KeyCode::Down), When::Always, Action::FieldDown),
+        ],
+    },
+    KeyRow {
+        group: "Select & move",
+        keys: "[  ]",
+        help: "smaller / larger nudge step",
+        bindings: &[
+            bind(Key::Char('['), When::Always, Action::ChangeStep(-1)),
+            bind(Key::Char(']'), When::Always, Action::ChangeStep(1)),
+        ],
+    },
+    KeyRow {
+        group: "Select & move",
+        keys: "+  -  0",
+        help: "zoom in / out / fit",
+        bindings: &[
+            bind(Key::Char('+'), When::Always, Action::Zoom(1.25, None)),
+            bind(Key::Char('='), When::Always, Action::Zoom(1.25, None)),
+            bind(
+                Key::Char('-'),
+                When::NotFocus(Focus::Inspector),
+                Action::Zoom(0.8, None),
+            ),
+            bind(
+                Key::Char('0'),
+                When::NotFocus(Focus::Inspector),
+                Action::Fit,
+            ),
+        ],
+    },
+    KeyRow {
+        group: "Select & move",
+        keys: "Shift-arrows",
+        help: "pan the map",
+        bindings: &[
+            bind(
+                Key::Shift(KeyCode::Left),
+                When::Pane(Pane::Map),
+                Action::Pan(-0.1, 0.0),
+            ),
+            bind(
+                Key::Shift(KeyCode::Right),
+                When::Pane(Pane::Map),
+                Action::Pan(0.1, 0.0),
+            ),
+            bind(
+                Key::Shift(KeyCode::Up),
+                When::Pane(Pane::Map),
+                Action::Pan(0.0, 0.1),
+            ),
+            bind(
+                Key::Shift(KeyCode::Down),
+                When::Pane(Pane::Map),
+                Action::Pan(0.0, -0.1),
+            ),
+        ],
+    },
+    KeyRow {
+        group: "Select & move",
+        keys: "mouse",
+        help: "click selects, drag moves, wheel zooms",
+        bindings: &[],
+    },
+    KeyRow {
+        group: "Edit",
+        keys: "a",
+        help: "add an obstacle at the view's centre (formation: add a slot)",
+        bindings: &[
+            bind(
+                Key::Char('a'),
+                When::Pane(Pane::Map),
+                Action::AddObstacle(None),
+            ),
+            bind(Key::Char('a'), When::Pane(Pane::Formation), Action::AddSlot),
+        ],
+    },
+    KeyRow {
+        group: "Edit",
+        keys: "A",
+        help: "add tool: click an empty spot to place an obstacle",
+        bindings: &[bind(Key::Char('A'), When::Always, Action::ToggleAddTool)],
+    },
+    KeyRow {
+        group: "Edit",
+        keys: "d",
+        help: "duplicate the selected obstacle",
+        bindings: &[bind(Key::Char('d'), When::Always, Action::Duplicate)],
+    },
+    KeyRow {
+        group: "Edit",
+        keys: "i",
+        help: "inspect the selected obstacle (eq. 8) or stop inspecting it",
+        bindings: &[bind(Key::Char('i'), When::Always, Action::ToggleInspect)],
+    },
+    KeyRow {
+        group: "Edit",
+        keys: "Del  D",
+        help: "delete the selected obstacle / slot / IWP choice",
+        bindings: &[
+            bind(Key::Code(KeyCode::Delete), When::Always, Action::Delete),
+            bind(Key::Char('D'), When::Always, Action::Delete),
+        ],
+    },
+    KeyRow {
+        group: "Edit",
+        keys: "Enter",
+        help: "edit the field (inspector); type a number to replace it; Enter applies",
+        bindings: &[bind(
+            Key::Code(KeyCode::Enter),
+            When::NotFocus(Focus::Jobs),
+            Action::EditStart(None),
+        )],
+    },
+    KeyRow {
+        group: "Edit",
+        keys: "Esc",
+        help: "cancel typing, close a window, leave the add tool",
+        bindings: &[bind(Key::Code(KeyCode::Esc), When::Always, Action::Dismiss)],
+    },
+    KeyRow {
+        group: "Formation",
+        keys: "P",
+        help: "apply the next preset: triangle, line abreast, column, V, diamond",
+        bindings: &[bind(Key::Char('P'), When::Always, Action::CyclePreset)],
+    },
+    KeyRow {
+        group: "Formation",
+        keys: "s  Space",
+        help: "cycle the IWP's shape / enable or disable it",
+        bindings: &[
+            bind(Key::Char('s'), When::Always, Action::CycleShape),
+            bind(Key::Char(' '), When::Always, Action::ToggleWaypoint),
+        ],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "r",
+        help: "run θ-PSO with the mission's seed",
+        bindings: &[bind(Key::Char('r'), When::Always, Action::Run)],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "F",
+        help: "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
+        bindings: &[bind(Key::Char('F'), When::Always, Action::RunFlatlo)],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "T",
+        help: "run the distributed fleet (select Fleet and its targets with n/p to edit them; d adds a target)",
+        bindings: &[bind(Key::Char('T'), When::Always, Action::RunFleet)],
+    },
+    KeyRow {
+        group: "Run",
+        keys: ",  .  >",
+        help: "fleet replay: back / forward one second, play or pause",
+        bindings: &[
+            bind(Key::Char(','), When::Always, Action::Scrub(-1.0)),
+            bind(
+                Key::Char('.'),
+                When::NotFocus(Focus::Inspector),
+                Action::Scrub(1.0),
+            ),
+            bind(Key::Char('>'), When::Always, Action::TogglePlay),
+        ],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "N",
+        help: "re-run the last pipeline with a new seed",
+        bindings: &[bind(Key::Char('N'), When::Always, Action::RunNewSeed)],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "x",
+        help: "cancel the selected (or latest) running job",
+        bindings: &[bind(Key::Char('x'), When::Always, Action::Cancel)],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "Enter",
+        help: "jobs focus: show that job's result on the map",
+        bindings: &[bind(
+            Key::Code(KeyCode::Enter),
+            When::Focus(Focus::Jobs),
+            Action::ShowJob,
+        )],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "e",
+        help: "record runs to .rrd beside the mission (on / off)",
+        bindings: &[bind(Key::Char('e'), When::Always, Action::ToggleRecording)],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "E",
+        help: "Rerun viewer: off, connect, spawn",
+        bindings: &[bind(Key::Char('E'), When::Always, Action::CycleViewer)],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "X",
+        help: "export the shown result per vehicle (.plan, .waypoints, CSV) to <mission>-export/",
+        bindings: &[bind(Key::Char('X'), When::Always, Action::Export)],
+    },
 ];

@@ -10,8 +10,10 @@ use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, BorderType, Borders, Chart, Dataset, GraphType, Paragraph};
 
+use crate::tui::action::Action;
 use crate::tui::app::{App, Focus};
 use crate::tui::jobs::{Job, JobState};
+use crate::tui::keys::KEYS;
 
 /// `██████░░░░ 60%` in `width` cells.
 fn bar(progress: f64, width: usize) -> String {
@@ -73,31 +75,28 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
     let inner = block.inner(area);
     frame.render_widget(block, area);
     if app.jobs.is_empty() {
-        let text = vec![
-            Line::raw("No runs yet."),
-            Line::from(vec![
-                Span::styled("r", Style::default().yellow().bold()),
-                Span::raw(" run θ-PSO with the mission's seed"),
-            ]),
-            Line::from(vec![
-                Span::styled("F", Style::default().yellow().bold()),
-                Span::raw(" run FLATLO (the squadron transition)"),
-            ]),
-            Line::from(vec![
-                Span::styled("T", Style::default().yellow().bold()),
-                Span::raw(" run the distributed fleet"),
-            ]),
-            Line::from(vec![
-                Span::styled("N", Style::default().yellow().bold()),
-                Span::raw(" re-run with a new seed"),
-            ]),
-            Line::from(vec![
-                Span::styled("e", Style::default().yellow().bold()),
-                Span::raw(" record runs to .rrd · "),
-                Span::styled("E", Style::default().yellow().bold()),
-                Span::raw(" Rerun viewer"),
-            ]),
-        ];
+        // The Run keys of the key table, each with its help up to any
+        // parenthesis.
+        let mut text = vec![Line::raw("No runs yet.")];
+        for row in KEYS.iter().filter(|row| {
+            row.bindings.iter().any(|b| {
+                matches!(
+                    b.action,
+                    Action::Run
+                        | Action::RunFlatlo
+                        | Action::RunFleet
+                        | Action::RunNewSeed
+                        | Action::ToggleRecording
+                        | Action::CycleViewer
+                )
+            })
+        }) {
+            let help = row.help.split(" (").next().unwrap_or(row.help);
+            text.push(Line::from(vec![
+                Span::styled(row.keys.to_owned(), Style::default().yellow().bold()),
+                Span::raw(format!(" {help}")),
+            ]));
+        }
         frame.render_widget(Paragraph::new(text), inner);
         return;
     }

@@ -263,8 +263,8 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                         name.to_string(),
                         Style::default().bold().underlined(),
                     ));
-                    for (_, keys, what) in KEYS.iter().filter(|(g, _, _)| g == name) {
-                        lines.extend(key_lines(keys, what, width));
+                    for row in KEYS.iter().filter(|row| row.group == *name) {
+                        lines.extend(key_lines(row.keys, row.help, width));
                     }
                 }
                 lines
