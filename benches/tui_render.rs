@@ -20,7 +20,9 @@ fn full_frame(c: &mut Criterion) {
     c.bench_function("tui/frame_200_obstacles_200x60", |b| {
         b.iter(|| {
             terminal
-                .draw(|frame| view::draw(frame, &app, now))
+                .draw(|frame| {
+                    view::draw(frame, &app, now);
+                })
                 .map(|_| ())
         })
     });

@@ -29,7 +29,9 @@ fn benchmark_app() -> App {
 fn render(app: &App) -> String {
     let mut terminal = Terminal::new(TestBackend::new(140, 42)).expect("terminal");
     terminal
-        .draw(|frame| view::draw(frame, app, Instant::now()))
+        .draw(|frame| {
+            view::draw(frame, app, Instant::now());
+        })
         .expect("draw");
     terminal.backend().to_string()
 }
@@ -58,8 +60,7 @@ fn the_map_shades_each_cell_by_the_ground_under_it() {
     let mut viewport = None;
     terminal
         .draw(|frame| {
-            view::draw(frame, &app, Instant::now());
-            viewport = view::layout(frame.area()).map(|a| view::map::Viewport::map(&app, a.left));
+            viewport = view::draw(frame, &app, Instant::now()).map(|d| d.canvas);
         })
         .expect("draw");
     let Some(vp) = viewport else {

@@ -25,7 +25,11 @@ fn render(app: &App, now: Instant) -> String {
 
 fn render_at(app: &App, now: Instant, (width, height): (u16, u16)) -> String {
     let mut terminal = Terminal::new(TestBackend::new(width, height)).unwrap();
-    terminal.draw(|frame| view::draw(frame, app, now)).unwrap();
+    terminal
+        .draw(|frame| {
+            view::draw(frame, app, now);
+        })
+        .unwrap();
     terminal.backend().to_string()
 }
 
@@ -120,7 +124,9 @@ fn a_stale_result_is_marked_on_the_map() {
 fn a_terminal_too_small_gets_a_message() {
     let mut terminal = Terminal::new(TestBackend::new(60, 20)).unwrap();
     terminal
-        .draw(|frame| view::draw(frame, &default_app(), Instant::now()))
+        .draw(|frame| {
+            view::draw(frame, &default_app(), Instant::now());
+        })
         .unwrap();
     let screen = terminal.backend().to_string();
     assert!(screen.contains("Terminal too small"));

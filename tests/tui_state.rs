@@ -438,8 +438,8 @@ mod mouse {
     use ratatui::crossterm::event::{KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
     use ratatui::layout::Rect;
     use skyform::tui::input::mouse_action;
-    use skyform::tui::view::layout;
     use skyform::tui::view::map::Viewport;
+    use skyform::tui::view::{Drawn, layout};
 
     const SCREEN: Rect = Rect::new(0, 0, 140, 42);
 
@@ -450,6 +450,35 @@ mod mouse {
             row,
             modifiers: KeyModifiers::NONE,
         }
+    }
+
+    /// What a frame of `app` on `SCREEN` shows where.
+    fn drawn(app: &App) -> Drawn {
+        Drawn::of(app, SCREEN).expect("the screen is large enough")
+    }
+
+    /// Issue 13: a click is read against the frame the user clicked on. The
+    /// view zooms (a wheel turn, say) before the next frame is drawn; a
+    /// click on the obstacle as it was drawn still picks it.
+    #[test]
+    fn a_click_is_read_against_the_frame_that_was_drawn() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut app = app_in(dir.path());
+        let shown = drawn(&app);
+        let target = app.mission().obstacles[0].center;
+        let cell = shown.canvas.to_cell(target).expect("on the map");
+        app.update(Action::Zoom(4.0, None));
+        let now = drawn(&app);
+        assert_ne!(now.canvas, shown.canvas, "the view changed");
+        let click = mouse_action(
+            &app,
+            event(MouseEventKind::Down(MouseButton::Left), cell),
+            &shown,
+        );
+        assert!(
+            matches!(click, Some(Action::DragStart(Item::Obstacle(0), _))),
+            "{click:?}"
+        );
     }
 
     fn cell_of(app: &App, p: Point2<f64>) -> (u16, u16) {
@@ -474,7 +503,7 @@ mod mouse {
         let down = mouse_action(
             &app,
             event(MouseEventKind::Down(MouseButton::Left), cell),
-            SCREEN,
+            &drawn(&app),
         );
         assert!(
             matches!(down, Some(Action::DragStart(Item::Obstacle(i), _)) if i == tree),
@@ -485,7 +514,7 @@ mod mouse {
         let drag = mouse_action(
             &app,
             event(MouseEventKind::Drag(MouseButton::Left), to),
-            SCREEN,
+            &drawn(&app),
         )
         .unwrap();
         app.update(drag);
@@ -493,7 +522,7 @@ mod mouse {
             mouse_action(
                 &app,
                 event(MouseEventKind::Up(MouseButton::Left), to),
-                SCREEN,
+                &drawn(&app),
             )
             .unwrap(),
         );
@@ -522,7 +551,7 @@ mod mouse {
         let plain = mouse_action(
             &app,
             event(MouseEventKind::Down(MouseButton::Left), cell),
-            SCREEN,
+            &drawn(&app),
         );
         assert_eq!(
             plain,
@@ -533,7 +562,7 @@ mod mouse {
         let add = mouse_action(
             &app,
             event(MouseEventKind::Down(MouseButton::Left), cell),
-            SCREEN,
+            &drawn(&app),
         )
         .unwrap();
         app.update(add);
@@ -551,7 +580,9 @@ mod mouse {
         let under = Viewport::map(&app, areas.left)
             .to_world(cell.0, cell.1)
             .unwrap();
-        app.update(mouse_action(&app, event(MouseEventKind::ScrollUp, cell), SCREEN).unwrap());
+        app.update(
+            mouse_action(&app, event(MouseEventKind::ScrollUp, cell), &drawn(&app)).unwrap(),
+        );
         assert!((app.zoom - 1.25).abs() < 1e-12);
         let after = Viewport::map(&app, areas.left)
             .to_world(cell.0, cell.1)
@@ -638,7 +669,9 @@ fn a_release_over_a_window_still_ends_the_drag() {
         row: 10,
         modifiers: KeyModifiers::NONE,
     };
-    let action = mouse_action(&app, up, ratatui::layout::Rect::new(0, 0, 140, 42));
+    let drawn = skyform::tui::view::Drawn::of(&app, ratatui::layout::Rect::new(0, 0, 140, 42))
+        .expect("large enough");
+    let action = mouse_action(&app, up, &drawn);
     assert_eq!(action, Some(Action::DragEnd));
     app.update(Action::DragEnd);
     app.update(Action::Dismiss);

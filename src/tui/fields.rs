@@ -306,7 +306,7 @@ fn terrain_fields(m: &Mission) -> Vec<Field> {
     let Some(t) = &m.terrain else {
         return Vec::new();
     };
-    fn terrain<'a>(m: &'a mut Mission) -> Result<&'a mut crate::mission::Terrain, String> {
+    fn terrain(m: &mut Mission) -> Result<&mut crate::mission::Terrain, String> {
         m.terrain
             .as_mut()
             .ok_or_else(|| "the mission has no [terrain]".to_owned())

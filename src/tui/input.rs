@@ -4,14 +4,14 @@
 use ratatui::crossterm::event::{
     KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind,
 };
-use ratatui::layout::{Position, Rect};
+use ratatui::layout::Position;
 
 use super::action::Action;
 use super::app::{App, Focus, Overlay, Pane, formation_extent};
 use super::fields::Item;
 use super::keys::{self, Key};
-use super::view::map::{Viewport, formation_split};
-use super::view::{Areas, layout};
+use super::view::Drawn;
+use super::view::map::Viewport;
 
 /// The action for a key press, given what is on screen.
 pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
@@ -116,8 +116,8 @@ fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
     }
 }
 
-/// The action for a mouse event on a screen of size `screen`.
-pub fn mouse_action(app: &App, mouse: MouseEvent, screen: Rect) -> Option<Action> {
+/// The action for a mouse event on the screen last drawn (`drawn`).
+pub fn mouse_action(app: &App, mouse: MouseEvent, drawn: &Drawn) -> Option<Action> {
     // A release always ends a drag, even over a window opened meanwhile.
     if mouse.kind == MouseEventKind::Up(MouseButton::Left) {
         return Some(Action::DragEnd);
@@ -125,12 +125,12 @@ pub fn mouse_action(app: &App, mouse: MouseEvent, screen: Rect) -> Option<Action
     if app.overlay.is_some() {
         return None;
     }
-    let areas = layout(screen)?;
+    let areas = drawn.areas;
     let at = Position::new(mouse.column, mouse.row);
     match mouse.kind {
         MouseEventKind::Down(MouseButton::Left) => {
             if areas.left.contains(at) {
-                let (item, point) = hit(app, &areas, mouse.column, mouse.row)?;
+                let (item, point) = hit(app, &drawn.canvas, mouse.column, mouse.row)?;
                 return match item {
                     Some(item) => Some(Action::DragStart(item, point)),
                     None if app.add_tool && app.pane == Pane::Map => {
@@ -148,8 +148,7 @@ pub fn mouse_action(app: &App, mouse: MouseEvent, screen: Rect) -> Option<Action
             None
         }
         MouseEventKind::Drag(MouseButton::Left) => {
-            let vp = pane_viewport(app, &areas);
-            let p = clamp_to(&vp, mouse.column, mouse.row);
+            let p = clamp_to(&drawn.canvas, mouse.column, mouse.row);
             Some(Action::DragTo(to_pane(app, p)))
         }
         MouseEventKind::Up(MouseButton::Left) => Some(Action::DragEnd),
@@ -159,22 +158,14 @@ pub fn mouse_action(app: &App, mouse: MouseEvent, screen: Rect) -> Option<Action
             } else {
                 0.8
             };
-            let vp = pane_viewport(app, &areas);
             let about = if app.pane == Pane::Map && !app.side_view {
-                vp.to_world(mouse.column, mouse.row)
+                drawn.canvas.to_world(mouse.column, mouse.row)
             } else {
                 None
             };
             Some(Action::Zoom(factor, about))
         }
         _ => None,
-    }
-}
-
-fn pane_viewport(app: &App, areas: &Areas) -> Viewport {
-    match app.pane {
-        Pane::Map => Viewport::map(app, areas.left),
-        Pane::Formation => Viewport::formation(app, formation_split(app, areas.left)[0]),
     }
 }
 
@@ -198,14 +189,13 @@ fn clamp_to(vp: &Viewport, column: u16, row: u16) -> nalgebra::Point2<f64> {
 /// What is under a click in the left pane, and the point in the pane's plane.
 fn hit(
     app: &App,
-    areas: &Areas,
+    vp: &Viewport,
     column: u16,
     row: u16,
 ) -> Option<(Option<Item>, nalgebra::Point2<f64>)> {
     if app.side_view && app.pane == Pane::Map {
         return None;
     }
-    let vp = pane_viewport(app, areas);
     let canvas_point = vp.to_world(column, row)?;
     let p = to_pane(app, canvas_point);
     // About one cell around the click.

@@ -211,9 +211,11 @@ fn event_loop(
     let job_messages = app.job_messages().clone();
     let mut redraw = true;
     let mut code = 0u8;
+    // What the last frame showed where: clicks are read against it.
+    let mut drawn = None;
     loop {
         if redraw {
-            terminal.draw(|frame| view::draw(frame, app, Instant::now()))?;
+            terminal.draw(|frame| drawn = view::draw(frame, app, Instant::now()))?;
         }
         if app.should_quit {
             return Ok(code);
@@ -226,7 +228,7 @@ fn event_loop(
         redraw = false;
         select! {
             recv(input) -> event => match event {
-                Ok(event) => redraw |= handle(terminal, app, event?)?,
+                Ok(event) => redraw |= handle(terminal, app, drawn.as_ref(), event?)?,
                 Err(_) => return Err(io::Error::other("the terminal input closed")),
             },
             recv(job_messages) -> msg => {
@@ -250,13 +252,18 @@ fn event_loop(
         // Take what else is waiting before drawing once.
         redraw |= app.drain_job_messages();
         while let Ok(event) = input.try_recv() {
-            redraw |= handle(terminal, app, event?)?;
+            redraw |= handle(terminal, app, drawn.as_ref(), event?)?;
         }
     }
 }
 
 /// Applies one terminal event; returns whether the screen must be redrawn.
-fn handle(terminal: &DefaultTerminal, app: &mut App, event: Event) -> io::Result<bool> {
+fn handle(
+    terminal: &DefaultTerminal,
+    app: &mut App,
+    drawn: Option<&view::Drawn>,
+    event: Event,
+) -> io::Result<bool> {
     let size = terminal.size()?;
     let too_small = view::layout(Rect::new(0, 0, size.width, size.height)).is_none();
     let action = match event {
@@ -266,10 +273,7 @@ fn handle(terminal: &DefaultTerminal, app: &mut App, event: Event) -> io::Result
         }
         Event::Mouse(_) if too_small => None,
         Event::Key(key) => input::key_action(app, key),
-        Event::Mouse(mouse) => {
-            let size = terminal.size()?;
-            input::mouse_action(app, mouse, Rect::new(0, 0, size.width, size.height))
-        }
+        Event::Mouse(mouse) => drawn.and_then(|d| input::mouse_action(app, mouse, d)),
         Event::Resize(..) => return Ok(true),
         _ => None,
     };

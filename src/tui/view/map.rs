@@ -8,7 +8,7 @@
 
 use nalgebra::{Point2, Point3};
 use ratatui::Frame;
-use ratatui::layout::{Margin, Rect};
+use ratatui::layout::Rect;
 use ratatui::style::{Color, Style};
 use ratatui::symbols::Marker;
 use ratatui::text::{Line as TextLine, Span};
@@ -20,87 +20,16 @@ use crate::fleet::FleetOutcome;
 use crate::geometry::segment_projection;
 use crate::mission::{Mission, Preset, ShapeChoice};
 use crate::planner::ThetaPsoOutcome;
-use crate::tui::app::{App, Focus, formation_extent};
+use crate::tui::app::{App, Focus};
 use crate::tui::fields::{Item, shape_name};
 use crate::tui::jobs::Outcome;
+
+pub use super::viewport::Viewport;
 
 /// UAV `i`'s colour (0-based), the same as in the Rerun recording.
 pub fn uav_color(i: usize) -> Color {
     let [r, g, b] = crate::tracks::vehicle_color(i);
     Color::Rgb(r, g, b)
-}
-
-/// A rectangle of the screen and the piece of the plane it shows.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Viewport {
-    /// The cells drawn into (inside the pane's border).
-    pub inner: Rect,
-    pub x: [f64; 2],
-    pub y: [f64; 2],
-}
-
-impl Viewport {
-    /// A view of `inner` centred on `center`, `metres_per_column` wide per cell.
-    fn centred(inner: Rect, center: Point2<f64>, metres_per_column: f64) -> Self {
-        let half_w = inner.width.max(1) as f64 * metres_per_column / 2.0;
-        let half_h = inner.height.max(1) as f64 * 2.0 * metres_per_column / 2.0;
-        Viewport {
-            inner,
-            x: [center.x - half_w, center.x + half_w],
-            y: [center.y - half_h, center.y + half_h],
-        }
-    }
-
-    /// The top-down map of `app` drawn in the pane `area` (border included).
-    pub fn map(app: &App, area: Rect) -> Self {
-        let inner = area.inner(Margin::new(1, 1));
-        let (bx, by) = app.map_extent();
-        let (w, h) = (
-            (bx[1] - bx[0]).abs().max(1.0),
-            (by[1] - by[0]).abs().max(1.0),
-        );
-        let fit =
-            (w / inner.width.max(1) as f64).max(h / (2.0 * inner.height.max(1) as f64)) * 1.08;
-        Viewport::centred(inner, app.map_center(), fit / app.zoom)
-    }
-
-    /// The formation editor: canvas x is to the right of travel (−y of the
-    /// formation frame), canvas y is forward (x).
-    pub fn formation(app: &App, area: Rect) -> Self {
-        let inner = area.inner(Margin::new(1, 1));
-        let r = formation_extent(app.mission()) + app.mission().formation.uav_radius + 1.0;
-        let fit = (2.0 * r / inner.width.max(1) as f64)
-            .max(2.0 * r / (2.0 * inner.height.max(1) as f64))
-            * 1.15;
-        Viewport::centred(inner, Point2::origin(), fit / app.formation_zoom)
-    }
-
-    pub fn metres_per_column(&self) -> f64 {
-        (self.x[1] - self.x[0]) / self.inner.width.max(1) as f64
-    }
-
-    /// The cell a point falls in, or None outside the view.
-    pub fn to_cell(&self, p: Point2<f64>) -> Option<(u16, u16)> {
-        let r = self.inner;
-        let fx = (p.x - self.x[0]) / (self.x[1] - self.x[0]) * r.width as f64;
-        let fy = (self.y[1] - p.y) / (self.y[1] - self.y[0]) * r.height as f64;
-        let inside = (0.0..r.width as f64).contains(&fx) && (0.0..r.height as f64).contains(&fy);
-        inside.then(|| (r.x + fx as u16, r.y + fy as u16))
-    }
-
-    /// The point under a cell, or None outside the view.
-    pub fn to_world(&self, column: u16, row: u16) -> Option<Point2<f64>> {
-        let r = self.inner;
-        if column < r.x || row < r.y || column >= r.x + r.width || row >= r.y + r.height {
-            return None;
-        }
-        let fx = (column - r.x) as f64 + 0.5;
-        let fy = (row - r.y) as f64 + 0.5;
-        Some(Point2::new(
-            self.x[0] + fx * (self.x[1] - self.x[0]) / r.width as f64,
-            self.y[1] - fy * (self.y[1] - self.y[0]) / r.height as f64,
-        ))
-    }
 }
 
 /// A circle drawn with as many points as it has braille dots around it, so
@@ -240,12 +169,13 @@ fn paint_fleet(ctx: &mut Context, app: &App, o: &FleetOutcome, stale: bool, dot:
 }
 
 /// The top-down map (or the side view when toggled).
-pub fn draw_map(frame: &mut Frame, app: &App, area: Rect) {
+/// The map in `area`, drawn through `vp` (the viewport `Drawn` reports).
+pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     if app.side_view {
         return draw_side(frame, app, area);
     }
     let m = app.mission();
-    let vp = Viewport::map(app, area);
+    let vp = *vp;
     let scale = vp.metres_per_column();
     let mut title = vec![
         Span::styled(" Map ", Style::default().bold()),
@@ -886,11 +816,12 @@ pub fn formation_split(app: &App, area: Rect) -> [Rect; 2] {
     .areas(area)
 }
 
-/// The formation editor: slots in the formation frame, and the IWPs' shapes.
-pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect) {
+/// The formation editor: slots in the formation frame (drawn through `vp`,
+/// the viewport `Drawn` reports), and the IWPs' shapes.
+pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     let m = app.mission();
     let [top, bottom] = formation_split(app, area);
-    let vp = Viewport::formation(app, top);
+    let vp = *vp;
     let title = TextLine::from(vec![
         Span::styled(" Formation ", Style::default().bold()),
         Span::raw(format!(

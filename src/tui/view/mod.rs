@@ -5,6 +5,7 @@ pub mod inspector;
 pub mod jobs;
 pub mod map;
 pub mod terrain;
+pub mod viewport;
 
 use std::time::Instant;
 
@@ -50,10 +51,37 @@ pub fn layout(area: Rect) -> Option<Areas> {
     })
 }
 
-/// Draws the whole screen.
-pub fn draw(frame: &mut Frame, app: &App, now: Instant) {
+/// What a frame showed where: its panels and the left pane's canvas. The
+/// event loop keeps the last one and reads clicks against it (the picture
+/// the user clicked on, not one recomputed from a state that may have
+/// changed since).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Drawn {
+    pub areas: Areas,
+    /// The map's or the formation editor's canvas.
+    pub canvas: map::Viewport,
+}
+
+impl Drawn {
+    /// What `draw` shows of `app` on a screen of `screen`; None when the
+    /// screen is too small for the designer.
+    pub fn of(app: &App, screen: Rect) -> Option<Drawn> {
+        let areas = layout(screen)?;
+        let canvas = match app.pane {
+            Pane::Map => map::Viewport::map(app, areas.left),
+            Pane::Formation => {
+                map::Viewport::formation(app, map::formation_split(app, areas.left)[0])
+            }
+        };
+        Some(Drawn { areas, canvas })
+    }
+}
+
+/// Draws the whole screen; returns what it drew where (None on the "too
+/// small" screen).
+pub fn draw(frame: &mut Frame, app: &App, now: Instant) -> Option<Drawn> {
     let area = frame.area();
-    let Some(areas) = layout(area) else {
+    let Some(drawn) = Drawn::of(app, area) else {
         let text = vec![
             Line::styled("Terminal too small", Style::default().bold()),
             Line::raw(format!(
@@ -66,11 +94,12 @@ pub fn draw(frame: &mut Frame, app: &App, now: Instant) {
             Paragraph::new(text).wrap(Wrap { trim: true }).centered(),
             area,
         );
-        return;
+        return None;
     };
+    let areas = drawn.areas;
     match app.pane {
-        Pane::Map => map::draw_map(frame, app, areas.left),
-        Pane::Formation => map::draw_formation(frame, app, areas.left),
+        Pane::Map => map::draw_map(frame, app, areas.left, &drawn.canvas),
+        Pane::Formation => map::draw_formation(frame, app, areas.left, &drawn.canvas),
     }
     inspector::draw(frame, app, areas.inspector);
     jobs::draw(frame, app, areas.jobs, now);
@@ -78,6 +107,7 @@ pub fn draw(frame: &mut Frame, app: &App, now: Instant) {
     if let Some(overlay) = &app.overlay {
         draw_overlay(frame, app, overlay, area);
     }
+    Some(drawn)
 }
 
 fn draw_status(frame: &mut Frame, app: &App, area: Rect) {

@@ -6,7 +6,7 @@ use ratatui::buffer::Buffer;
 use ratatui::style::{Color, Style};
 use ratatui::text::Span;
 
-use super::map::Viewport;
+use super::viewport::Viewport;
 use crate::mission::Mission;
 
 /// The shade of a cell whose ground is at `t` of the map's height range
