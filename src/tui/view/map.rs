@@ -955,23 +955,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_row_spans_twice_the_metres_of_a_column() {
-        let vp = Viewport::centred(Rect::new(1, 1, 100, 40), Point2::new(0.0, 0.0), 0.5);
-        assert!((vp.x[1] - vp.x[0] - 50.0).abs() < 1e-12);
-        assert!((vp.y[1] - vp.y[0] - 40.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn a_cell_maps_back_to_the_metres_under_it() {
-        let vp = Viewport::centred(Rect::new(1, 1, 100, 40), Point2::new(10.0, 20.0), 0.5);
-        // The cell right of the centre line, below it.
-        let p = vp.to_world(51, 21).unwrap();
-        assert!((p.x - 10.25).abs() < 1e-9, "{p}");
-        assert!((p.y - 19.5).abs() < 1e-9, "{p}");
-        assert_eq!(vp.to_world(0, 5), None, "the border is not the map");
-    }
-
-    #[test]
     fn decimation_keeps_the_ends() {
         let pts: Vec<(f64, f64)> = (0..=100).map(|i| (i as f64 * 0.01, 0.0)).collect();
         let d = decimate(pts.into_iter(), 0.25);
