@@ -583,7 +583,7 @@ mod mouse {
         app.update(
             mouse_action(&app, event(MouseEventKind::ScrollUp, cell), &drawn(&app)).unwrap(),
         );
-        assert!((app.zoom - 1.25).abs() < 1e-12);
+        assert!((app.camera().zoom() - 1.25).abs() < 1e-12);
         let after = Viewport::map(&app, areas.left)
             .to_world(cell.0, cell.1)
             .unwrap();

@@ -17,6 +17,7 @@ use nalgebra::{Point2, Vector3};
 
 use super::action::Action;
 pub use super::action::{Focus, Pane};
+use super::camera::Camera;
 use super::document::Document;
 use super::fields::{self, Field, Item};
 use super::jobs::{self, Job, JobId, JobMsg, Kind, RecordSettings, Viewer};
@@ -112,9 +113,6 @@ struct Drag {
     grab: nalgebra::Vector2<f64>,
 }
 
-/// Nudge steps offered, metres.
-pub const STEPS: [f64; 10] = [0.01, 0.1, 0.5, 1.0, 5.0, 10.0, 50.0, 100.0, 500.0, 1000.0];
-
 /// The whole TUI state.
 pub struct App {
     pub doc: Document,
@@ -128,12 +126,8 @@ pub struct App {
     pub focus: Focus,
     pub pane: Pane,
     pub side_view: bool,
-    /// Map zoom (1 = bounds fit the view) and centre (None = the bounds' centre).
-    pub zoom: f64,
-    pub center: Option<Point2<f64>>,
-    pub formation_zoom: f64,
-    /// Index into [`STEPS`].
-    pub step: usize,
+    /// Zoom, pan and nudge step (its own component).
+    camera: Camera,
     /// Clicking an empty spot of the map places an obstacle.
     pub add_tool: bool,
     pub preset: Preset,
@@ -174,10 +168,7 @@ impl App {
             focus: Focus::Map,
             pane: Pane::Map,
             side_view: false,
-            zoom: 1.0,
-            center: None,
-            formation_zoom: 1.0,
-            step: 3,
+            camera: Camera::default(),
             add_tool: false,
             preset: Preset::Triangle,
             jobs: Vec::new(),
@@ -211,7 +202,12 @@ impl App {
     }
 
     pub fn step_size(&self) -> f64 {
-        STEPS[self.step.min(STEPS.len() - 1)]
+        self.camera.step_size()
+    }
+
+    /// How the map and the formation editor are looked at.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
     }
 
     pub fn any_running(&self) -> bool {
@@ -246,9 +242,7 @@ impl App {
 
     /// Where the map looks: the panned centre, or the middle of the extent.
     pub fn map_center(&self) -> Point2<f64> {
-        let (x, y) = self.map_extent();
-        self.center
-            .unwrap_or(Point2::new((x[0] + x[1]) / 2.0, (y[0] + y[1]) / 2.0))
+        self.camera.map_center(self.map_extent())
     }
 
     /// Duration of the shown fleet result, if one is shown (the replay's range).
@@ -484,7 +478,7 @@ impl App {
             Select(item) => self.select(item),
             Nudge(dx, dy) => self.nudge(dx, dy),
             ChangeStep(d) => {
-                self.step = (self.step as i32 + d).clamp(0, STEPS.len() as i32 - 1) as usize;
+                self.camera.change_step(d);
                 self.set_status(format!(
                     "nudge step {} m",
                     fields::fmt_num(self.step_size())
@@ -492,24 +486,16 @@ impl App {
             }
             Zoom(factor, at) => self.zoom_by(factor, at),
             Pan(fx, fy) => {
-                let (x, y) = self.map_extent();
-                let (w, h) = (x[1] - x[0], y[1] - y[0]);
-                let c = self.map_center();
-                self.center = Some(Point2::new(
-                    c.x + fx * w / self.zoom,
-                    c.y + fy * h / self.zoom,
-                ));
+                let extent = self.map_extent();
+                self.camera.pan(fx, fy, extent);
             }
             Fit => match self.pane {
-                Pane::Map => {
-                    self.zoom = 1.0;
-                    self.center = None;
-                }
-                Pane::Formation => self.formation_zoom = 1.0,
+                Pane::Map => self.camera.fit_map(),
+                Pane::Formation => self.camera.fit_formation(),
             },
             AddObstacle(at) => {
                 let p = at
-                    .or(self.center)
+                    .or(self.camera.panned_center())
                     .unwrap_or(self.mission().bounds.center_xy());
                 let obstacle = fields::new_obstacle(self.mission(), p);
                 let name = obstacle.name.clone();
@@ -934,17 +920,10 @@ impl App {
     fn zoom_by(&mut self, factor: f64, at: Option<Point2<f64>>) {
         match self.pane {
             Pane::Map => {
-                let zoom = (self.zoom * factor).clamp(0.1, 10_000.0);
-                let applied = zoom / self.zoom;
-                if let Some(p) = at {
-                    let c = self.map_center();
-                    self.center = Some(p + (c - p) / applied);
-                }
-                self.zoom = zoom;
+                let extent = self.map_extent();
+                self.camera.zoom_map(factor, at, extent);
             }
-            Pane::Formation => {
-                self.formation_zoom = (self.formation_zoom * factor).clamp(0.1, 100.0)
-            }
+            Pane::Formation => self.camera.zoom_formation(factor),
         }
     }
 
@@ -1362,8 +1341,7 @@ impl App {
         self.selected = Item::Mission;
         self.field = 0;
         self.editing = None;
-        self.zoom = 1.0;
-        self.center = None;
+        self.camera.fit_map();
         self.shown_job = None;
         self.refresh();
         if errors > 0 {

@@ -9,6 +9,7 @@
 
 pub mod action;
 pub mod app;
+pub mod camera;
 pub mod document;
 pub mod export;
 pub mod fields;

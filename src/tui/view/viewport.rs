@@ -41,7 +41,7 @@ impl Viewport {
         );
         let fit =
             (w / inner.width.max(1) as f64).max(h / (2.0 * inner.height.max(1) as f64)) * 1.08;
-        Viewport::centred(inner, app.map_center(), fit / app.zoom)
+        Viewport::centred(inner, app.map_center(), fit / app.camera().zoom())
     }
 
     /// The formation editor: canvas x is to the right of travel (−y of the
@@ -52,7 +52,7 @@ impl Viewport {
         let fit = (2.0 * r / inner.width.max(1) as f64)
             .max(2.0 * r / (2.0 * inner.height.max(1) as f64))
             * 1.15;
-        Viewport::centred(inner, Point2::origin(), fit / app.formation_zoom)
+        Viewport::centred(inner, Point2::origin(), fit / app.camera().formation_zoom())
     }
 
     pub fn metres_per_column(&self) -> f64 {
