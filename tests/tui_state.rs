@@ -618,12 +618,12 @@ fn a_fleet_run_replays_on_the_map() {
     app.update(Action::Scrub(-2.5));
     assert_eq!(app.replay_time(), Some(3.5));
     app.update(Action::TogglePlay);
-    assert!(app.playing && app.wants_tick());
+    assert!(app.is_playing() && app.wants_tick());
     app.tick(Duration::from_secs(1));
     assert!((app.replay_time().unwrap() - 4.5).abs() < 1e-9);
     app.tick(Duration::from_secs(10));
     assert_eq!(app.replay_time(), Some(6.0));
-    assert!(!app.playing, "stops at the end");
+    assert!(!app.is_playing(), "stops at the end");
     // Fleet targets are items: select, move, add, delete.
     app.update(Action::Select(Item::FleetTarget(0)));
     app.update(Action::FocusOn(Focus::Map));

@@ -22,6 +22,7 @@ use super::document::Document;
 use super::fields::{self, Field, Item};
 use super::jobs::{self, Job, JobId, JobMsg, Kind, RecordSettings, Viewer};
 use super::recovery::{self, Origin, Recovery};
+use super::replay::Replay;
 use crate::geometry::farthest_offset;
 use crate::mission::{self, Mission, Preset, Severity};
 use crate::pipeline::Level;
@@ -140,10 +141,8 @@ pub struct App {
     /// Record runs to an `.rrd` beside the mission.
     pub record_rrd: bool,
     pub viewer: Viewer,
-    /// Fleet replay: the instant shown on the map (None = the end) and
-    /// whether it advances by itself.
-    pub replay: Option<f64>,
-    pub playing: bool,
+    /// The fleet replay (its own component).
+    replay: Replay,
     pub should_quit: bool,
     /// Where relative paths (save as, open) start.
     pub cwd: PathBuf,
@@ -178,8 +177,7 @@ impl App {
             status: None,
             record_rrd: false,
             viewer: Viewer::Off,
-            replay: None,
-            playing: false,
+            replay: Replay::default(),
             should_quit: false,
             cwd,
             drag: None,
@@ -208,6 +206,11 @@ impl App {
     /// How the map and the formation editor are looked at.
     pub fn camera(&self) -> &Camera {
         &self.camera
+    }
+
+    /// Whether the fleet replay is playing.
+    pub fn is_playing(&self) -> bool {
+        self.replay.is_playing()
     }
 
     pub fn any_running(&self) -> bool {
@@ -253,13 +256,12 @@ impl App {
 
     /// The fleet replay instant on the map: the replay cursor, or the end.
     pub fn replay_time(&self) -> Option<f64> {
-        self.replay_end()
-            .map(|end| self.replay.unwrap_or(end).min(end))
+        self.replay_end().map(|end| self.replay.time(end))
     }
 
     /// The loop needs to wake up by itself (running jobs, a playing replay).
     pub fn wants_tick(&self) -> bool {
-        self.any_running() || self.playing || self.recovery_pending()
+        self.any_running() || self.replay.is_playing() || self.recovery_pending()
     }
 
     /// Keeps a recovery copy of unsaved edits (`recovery.rs`) for the
@@ -325,14 +327,8 @@ impl App {
     /// recovery write goes out.
     pub fn tick(&mut self, elapsed: Duration) {
         self.keep_recovery(Instant::now(), false);
-        if self.playing
-            && let Some(end) = self.replay_end()
-        {
-            let t = self.replay.unwrap_or(0.0) + elapsed.as_secs_f64();
-            self.replay = Some(t.min(end));
-            if t >= end {
-                self.playing = false;
-            }
+        if let Some(end) = self.replay_end() {
+            self.replay.advance(elapsed, end);
         }
     }
 
@@ -672,17 +668,12 @@ impl App {
             RunFleet => self.run(Kind::Fleet, self.mission().seed),
             Scrub(seconds) => {
                 if let Some(end) = self.replay_end() {
-                    let t = self.replay.unwrap_or(end) + seconds;
-                    self.replay = Some(t.clamp(0.0, end));
-                    self.playing = false;
+                    self.replay.scrub(seconds, end);
                 }
             }
             TogglePlay => {
                 if let Some(end) = self.replay_end() {
-                    if !self.playing && self.replay.is_none_or(|t| t >= end) {
-                        self.replay = Some(0.0);
-                    }
-                    self.playing = !self.playing;
+                    self.replay.toggle(end);
                 }
             }
             RunNewSeed => {
@@ -1141,8 +1132,7 @@ impl App {
                     None => format!("job {id} {verb}"),
                 };
                 self.shown_job = Some(id);
-                self.replay = None;
-                self.playing = false;
+                self.replay.reset();
                 self.set_status(text);
             }
         }

@@ -19,6 +19,7 @@ pub mod input;
 pub mod jobs;
 pub mod keys;
 pub mod recovery;
+pub mod replay;
 pub mod view;
 
 use std::io::{self, IsTerminal};

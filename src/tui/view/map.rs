@@ -189,7 +189,7 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
         title.push(Span::styled(
             format!(
                 " t = {t:.1} / {end:.1} s {} ",
-                if app.playing { "▶" } else { "‖" }
+                if app.is_playing() { "▶" } else { "‖" }
             ),
             Style::default().black().on_cyan(),
         ));
