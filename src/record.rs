@@ -328,6 +328,8 @@ fn spawn_viewer() -> Result<String, String> {
 /// θ-PSO iterations that arrive together into one `send_columns` per series.
 fn run_worker(stream: RecordingStream, inbox: Receiver<Message>) {
     let mut pending: Vec<(usize, CostTerms, Vec<[f32; 3]>)> = Vec::new();
+    // The mission of the scene, for what an outcome is measured against.
+    let mut scene: Option<Box<Mission>> = None;
     while let Ok(first) = inbox.recv() {
         let mut batch = vec![first];
         batch.extend(inbox.try_iter());
@@ -340,7 +342,10 @@ fn run_worker(stream: RecordingStream, inbox: Receiver<Message>) {
                 } => pending.push((iteration, cost, path)),
                 other => {
                     flush_iterations(&stream, &mut pending);
-                    log_message(&stream, other);
+                    if let Message::Scene(m) = &other {
+                        scene = Some(m.clone());
+                    }
+                    log_message(&stream, other, scene.as_deref());
                 }
             }
         }
@@ -350,11 +355,11 @@ fn run_worker(stream: RecordingStream, inbox: Receiver<Message>) {
     drop(stream);
 }
 
-fn log_message(stream: &RecordingStream, message: Message) {
+fn log_message(stream: &RecordingStream, message: Message, scene: Option<&Mission>) {
     let result = match message {
         Message::Scene(mission) => log_scene(stream, &mission),
         Message::Outcome(outcome) => match *outcome {
-            Outcome::ThetaPso(o) => log_theta_pso(stream, &o),
+            Outcome::ThetaPso(o) => log_theta_pso(stream, &o, scene),
             Outcome::Flatlo(o) => {
                 let _ = layout(Layout::Flatlo)
                     .send(stream, rerun::blueprint::BlueprintActivation::default());
@@ -431,31 +436,47 @@ enum Layout {
 /// sends its own, which the viewer then shows.
 fn layout(kind: Layout) -> rerun::blueprint::Blueprint {
     use rerun::blueprint::{
-        Blueprint, Horizontal, Spatial3DView, TextDocumentView, TextLogView, TimePanel,
-        TimeSeriesView, Vertical,
+        Blueprint, BlueprintPanel, ContainerLike, Horizontal, SelectionPanel, Spatial3DView, Tabs,
+        TextDocumentView, TextLogView, TimePanel, TimeSeriesView, Vertical,
     };
-    let (series, events) = match kind {
+    let (series, events): (Vec<ContainerLike>, &str) = match kind {
+        // The clearance plays with the flight on `sim_time`, the timeline
+        // the viewer opens on; the cost is on `iteration`, in the tab behind.
         Layout::ThetaPso => (
-            vec![TimeSeriesView::new("θ-PSO cost (iteration)").with_origin("/theta_pso/cost")],
+            vec![
+                Tabs::new([
+                    TimeSeriesView::new("clearance to obstacles, m")
+                        .with_origin("/theta_pso/clearance")
+                        .into(),
+                    TimeSeriesView::new("θ-PSO cost (timeline: iteration)")
+                        .with_origin("/theta_pso/cost")
+                        .into(),
+                ])
+                .into(),
+            ],
             "/theta_pso",
         ),
         Layout::Flatlo => (
             vec![
-                TimeSeriesView::new("airspeed, m/s").with_origin("/flatlo/airspeed"),
-                TimeSeriesView::new("load factor").with_origin("/flatlo/load_factor"),
+                TimeSeriesView::new("airspeed, m/s")
+                    .with_origin("/flatlo/airspeed")
+                    .into(),
+                TimeSeriesView::new("load factor")
+                    .with_origin("/flatlo/load_factor")
+                    .into(),
             ],
             "/flatlo",
         ),
         Layout::Fleet => (
             vec![
                 TimeSeriesView::new("inter-agent distances, m (Fig. 13)")
-                    .with_origin("/fleet/distances"),
+                    .with_origin("/fleet/distances")
+                    .into(),
             ],
             "/fleet",
         ),
     };
-    let mut column: Vec<rerun::blueprint::ContainerLike> =
-        series.into_iter().map(Into::into).collect();
+    let mut column = series;
     column.push(TextLogView::new("events").with_origin(events).into());
     column.push(
         TextDocumentView::new("mission")
@@ -468,6 +489,14 @@ fn layout(kind: Layout) -> rerun::blueprint::Blueprint {
             Vertical::new(column).into(),
         ])
         .with_column_shares([2.0, 1.0]),
+    )
+    // The scene gets the room: the blueprint tree and the selection panel
+    // start folded away (the viewer's menu brings them back).
+    .with_blueprint_panel(
+        BlueprintPanel::new().with_state(rerun::blueprint::components::PanelState::Collapsed),
+    )
+    .with_selection_panel(
+        SelectionPanel::new().with_state(rerun::blueprint::components::PanelState::Collapsed),
     )
     .with_time_panel(TimePanel::new().with_timeline("sim_time"))
 }
@@ -618,6 +647,43 @@ fn log_terrain(
     )
 }
 
+/// Each UAV's clearance over `sim_time`: the distance from its sphere of
+/// radius r_Q to the nearest obstacle (terrain-raised), 0 = touching. The
+/// plot beside the scene on the timeline the flight plays on.
+fn log_clearances(
+    stream: &RecordingStream,
+    o: &ThetaPsoOutcome,
+    m: &Mission,
+) -> rerun::RecordingStreamResult<()> {
+    let cylinders: Vec<_> = m.obstacles.iter().map(|ob| m.cylinder(ob)).collect();
+    if cylinders.is_empty() {
+        return Ok(());
+    }
+    for t in &o.trajectories {
+        let entity = format!("theta_pso/clearance/uav_{}", t.uav + 1);
+        stream.log_static(
+            entity.as_str(),
+            &rerun::SeriesLines::new()
+                .with_colors([uav_color(t.uav)])
+                .with_names([format!("UAV {}", t.uav + 1)]),
+        )?;
+        let times = rerun::TimeColumn::new_duration_secs("sim_time", t.samples.iter().map(|s| s.t));
+        let values = t
+            .samples
+            .iter()
+            .map(|s| {
+                cylinders
+                    .iter()
+                    .map(|c| c.clearance(&s.position))
+                    .fold(f64::INFINITY, f64::min)
+                    - m.formation.uav_radius
+            })
+            .collect();
+        log_series(stream, &entity, &times, values)?;
+    }
+    Ok(())
+}
+
 /// Vehicle `n`'s colour, the same as on the designer's map.
 fn uav_color(n: usize) -> rerun::Color {
     let [r, g, b] = crate::tracks::vehicle_color(n);
@@ -663,7 +729,11 @@ fn log_series(
 fn log_theta_pso(
     stream: &RecordingStream,
     o: &ThetaPsoOutcome,
+    scene: Option<&Mission>,
 ) -> rerun::RecordingStreamResult<()> {
+    if let Some(m) = scene {
+        log_clearances(stream, o, m)?;
+    }
     stream.send_property(
         "theta_pso",
         &rerun::TextDocument::from_markdown(format!(
@@ -977,12 +1047,21 @@ fn log_fleet(stream: &RecordingStream, o: &FleetOutcome) -> rerun::RecordingStre
         let reference = format!("fleet/references/{name}");
         log_moving_point(stream, &reference, &times, style, references)?;
     }
+    // Named from 1, as the agents are everywhere a person reads.
     for d in &o.distances {
-        let entity = format!("fleet/distances/{}_{}", d.a, d.b);
+        let entity = format!("fleet/distances/{}_{}", d.a + 1, d.b + 1);
+        stream.log_static(
+            entity.as_str(),
+            &rerun::SeriesLines::new().with_names([format!("agents {}–{}", d.a + 1, d.b + 1)]),
+        )?;
         log_series(stream, &entity, &times, d.values.clone())?;
     }
     if !o.distances.is_empty() {
         let c = vec![o.safety_distance; o.times.len()];
+        stream.log_static(
+            "fleet/distances/safety_c",
+            &rerun::SeriesLines::new().with_names(["c (safety distance)"]),
+        )?;
         log_series(stream, "fleet/distances/safety_c", &times, c)?;
     }
     let z = o

@@ -162,6 +162,35 @@ fn a_theta_pso_recording_holds_the_scene_the_plan_and_the_timelines() {
     for (a, b) in totals.iter().zip(&history) {
         assert!((a - b).abs() <= 1e-12 * a.abs(), "{a} vs {b}");
     }
+
+    // Issue 16: the plot beside the scene has data on `sim_time`, the
+    // timeline the viewer opens on: each UAV's clearance (beyond r_Q) over
+    // the flight, whose smallest value is the verification's worst obstacle
+    // clearance less its limit.
+    let checks = outcome["verification"]["checks"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let Some(check) = checks.iter().find(|c| c["name"] == "obstacle clearance") else {
+        panic!("no obstacle clearance check in {checks:?}");
+    };
+    let expected =
+        check["worst"].as_f64().unwrap_or(f64::NAN) - check["limit"].as_f64().unwrap_or(f64::NAN);
+    let mut lowest = f64::INFINITY;
+    for uav in 1..=3 {
+        let entity = format!("/theta_pso/clearance/uav_{uav}");
+        let series = values::<f64>(&chunks, &entity, "Scalars:scalars");
+        assert!(!series.is_empty(), "no {entity}");
+        assert!(
+            last_time(&chunks, &entity, "sim_time").is_some(),
+            "{entity} not on sim_time"
+        );
+        lowest = series.iter().copied().fold(lowest, f64::min);
+    }
+    assert!(
+        (lowest - expected).abs() < 1e-6,
+        "lowest clearance {lowest} vs {expected}"
+    );
 }
 
 #[test]
@@ -362,7 +391,7 @@ fn a_fleet_recording_holds_agents_references_and_the_distance_series() {
     for (a, b) in [(0, 1), (0, 2), (1, 2)] {
         let series: Vec<f64> = values(
             &chunks,
-            &format!("/fleet/distances/{a}_{b}"),
+            &format!("/fleet/distances/{}_{}", a + 1, b + 1),
             "Scalars:scalars",
         );
         let expected: Vec<f64> = outcome["distances"]
