@@ -4,10 +4,10 @@
 //! function of this state, and input (`input.rs`) only produces actions, so
 //! the whole app can be driven and checked in tests without a terminal.
 //!
-//! Over 700 lines because `App` still holds every part of the designer's
-//! state (document, inspector, camera, jobs, replay, overlays) with one
-//! `update`: splitting it into components that own their state is the open
-//! part of issue 13.
+//! Over 700 lines because `App` still holds most of the designer's state
+//! (document, inspector, jobs, overlays) with one `update`; the camera
+//! (`camera.rs`) and the replay (`replay.rs`) are components that own
+//! theirs. Splitting out the rest the same way is the open part of issue 13.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
