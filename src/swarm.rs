@@ -119,31 +119,11 @@ where
 {
     let dims = space.dims();
     let n = config.particles.max(1);
-    let mut rngs: Vec<ChaCha8Rng> = (0..n)
-        .map(|i| {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            // 2^32 streams per run: restarts never share a stream with a first run.
-            rng.set_stream((config.streams << 32) | i as u64);
-            rng
-        })
-        .collect();
-
+    let mut rngs = particle_streams(seed, config.streams, n);
     let mut positions: Vec<Vec<f64>> = rngs
         .iter_mut()
         .enumerate()
-        .map(|(i, rng)| {
-            // Draw the random start even for a seeded particle, so seeding
-            // one particle does not shift any other particle's stream.
-            let random: Vec<f64> = (0..dims)
-                .map(|d| sample(rng, space.lower[d], space.upper[d]))
-                .collect();
-            match starts.get(i) {
-                Some(start) if start.len() == dims => (0..dims)
-                    .map(|d| start[d].clamp(space.lower[d], space.upper[d]))
-                    .collect(),
-                _ => random,
-            }
-        })
+        .map(|(i, rng)| start_position(rng, space, starts.get(i)))
         .collect();
     let mut velocities = vec![vec![0.0; dims]; n];
 
@@ -160,18 +140,8 @@ where
         .collect();
     let mut global = best_of(&personal);
 
-    let report = IterationReport {
-        iteration: 0,
-        best: &global,
-        improved: true,
-    };
-    if on_iteration(&report).is_break() {
-        return SwarmResult {
-            best: global,
-            iterations: 0,
-            evaluations,
-            stopped: true,
-        };
+    if let Some(stopped) = report_or_stop(&mut on_iteration, &global, 0, true, evaluations) {
+        return stopped;
     }
 
     for iteration in 1..=config.iterations {
@@ -203,18 +173,10 @@ where
         if improved {
             global = candidate;
         }
-        let report = IterationReport {
-            iteration,
-            best: &global,
-            improved,
-        };
-        if on_iteration(&report).is_break() {
-            return SwarmResult {
-                best: global,
-                iterations: iteration,
-                evaluations,
-                stopped: true,
-            };
+        if let Some(stopped) =
+            report_or_stop(&mut on_iteration, &global, iteration, improved, evaluations)
+        {
+            return stopped;
         }
     }
     SwarmResult {
@@ -276,13 +238,7 @@ where
 {
     let dims = space.dims();
     let n = config.particles.max(1);
-    let mut rngs: Vec<ChaCha8Rng> = (0..n)
-        .map(|i| {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            rng.set_stream((config.streams << 32) | i as u64);
-            rng
-        })
-        .collect();
+    let mut rngs = particle_streams(seed, config.streams, n);
     let mut guarded = |x: &[f64], bound: f64| {
         let c = cost(x, bound);
         if c.is_nan() { f64::INFINITY } else { c }
@@ -298,19 +254,8 @@ where
     for pass in 0..config.init_passes.max(1) {
         personal.clear();
         for (i, rng) in rngs.iter_mut().enumerate() {
-            for (d, x) in positions[i].iter_mut().enumerate() {
-                *x = sample(rng, space.lower[d], space.upper[d]);
-            }
-            // A given start replaces the draw in the first pass only (drawn
-            // anyway, so no other particle's stream shifts).
-            match starts.get(i) {
-                Some(start) if pass == 0 && start.len() == dims => {
-                    for (d, x) in positions[i].iter_mut().enumerate() {
-                        *x = start[d].clamp(space.lower[d], space.upper[d]);
-                    }
-                }
-                _ => {}
-            }
+            // A given start stands in the first pass only.
+            positions[i] = start_position(rng, space, starts.get(i).filter(|_| pass == 0));
             let c = guarded(&positions[i], f64::INFINITY);
             evaluations += 1;
             personal.push(Best {
@@ -329,18 +274,8 @@ where
         // No finite cost anywhere: the first particle stands for the swarm.
         global = personal[0].clone();
     }
-    let report = IterationReport {
-        iteration: 0,
-        best: &global,
-        improved: true,
-    };
-    if on_iteration(&report).is_break() {
-        return SwarmResult {
-            best: global,
-            iterations: 0,
-            evaluations,
-            stopped: true,
-        };
+    if let Some(stopped) = report_or_stop(&mut on_iteration, &global, 0, true, evaluations) {
+        return stopped;
     }
     let mut w = config.inertia;
     for iteration in 1..=config.iterations {
@@ -373,18 +308,10 @@ where
             }
         }
         w *= config.damping;
-        let report = IterationReport {
-            iteration,
-            best: &global,
-            improved,
-        };
-        if on_iteration(&report).is_break() {
-            return SwarmResult {
-                best: global,
-                iterations: iteration,
-                evaluations,
-                stopped: true,
-            };
+        if let Some(stopped) =
+            report_or_stop(&mut on_iteration, &global, iteration, improved, evaluations)
+        {
+            return stopped;
         }
     }
     SwarmResult {
@@ -393,6 +320,59 @@ where
         evaluations,
         stopped: false,
     }
+}
+
+/// One seeded stream per particle; 2^32 streams per run, so restarts
+/// (`streams` = 1, 2, …) never share a stream with a first run.
+fn particle_streams(seed: u64, streams: u64, n: usize) -> Vec<ChaCha8Rng> {
+    (0..n)
+        .map(|i| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            rng.set_stream((streams << 32) | i as u64);
+            rng
+        })
+        .collect()
+}
+
+/// A particle's first position: uniform in the box, or `start` clamped into
+/// it when given. The random draw is made either way, so seeding one
+/// particle does not shift any other particle's stream.
+fn start_position(rng: &mut ChaCha8Rng, space: &SearchSpace, start: Option<&Vec<f64>>) -> Vec<f64> {
+    let dims = space.dims();
+    let random: Vec<f64> = (0..dims)
+        .map(|d| sample(rng, space.lower[d], space.upper[d]))
+        .collect();
+    match start {
+        Some(start) if start.len() == dims => (0..dims)
+            .map(|d| start[d].clamp(space.lower[d], space.upper[d]))
+            .collect(),
+        _ => random,
+    }
+}
+
+/// Reports an iteration; the result to return when `on_iteration` stops the
+/// run there (the best so far kept).
+fn report_or_stop<C>(
+    on_iteration: &mut C,
+    global: &Best,
+    iteration: usize,
+    improved: bool,
+    evaluations: usize,
+) -> Option<SwarmResult>
+where
+    C: FnMut(&IterationReport<'_>) -> ControlFlow<()>,
+{
+    let report = IterationReport {
+        iteration,
+        best: global,
+        improved,
+    };
+    on_iteration(&report).is_break().then(|| SwarmResult {
+        best: global.clone(),
+        iterations: iteration,
+        evaluations,
+        stopped: true,
+    })
 }
 
 fn sample(rng: &mut ChaCha8Rng, lower: f64, upper: f64) -> f64 {
