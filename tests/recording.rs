@@ -193,23 +193,23 @@ fn a_theta_pso_recording_holds_the_scene_the_plan_and_the_timelines() {
     );
 }
 
-#[test]
-fn record_writes_the_mission_scene_alone() {
+/// `skyform record MISSION --rrd …`, which must succeed, read back.
+fn record_scene(mission: &str) -> Vec<Chunk> {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
     let rrd = dir.path().join("scene.rrd");
-    let out = skyform(&[
-        "record",
-        "missions/narrow-passage.toml",
-        "--rrd",
-        &rrd.display().to_string(),
-    ]);
+    let out = skyform(&["record", mission, "--rrd", &rrd.display().to_string()]);
     assert_eq!(
         out.status.code(),
         Some(0),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let chunks = chunks(&rrd);
+    chunks(&rrd)
+}
+
+#[test]
+fn record_writes_the_mission_scene_alone() {
+    let chunks = record_scene("missions/narrow-passage.toml");
     let paths = entity_paths(&chunks);
     assert!(paths.iter().any(|p| p == "/world/obstacles"));
     assert!(
@@ -231,21 +231,7 @@ fn record_writes_the_mission_scene_alone() {
 /// and 5th row (at most 200 points a side) plus the last, at its heights.
 #[test]
 fn the_terrain_is_recorded_as_a_mesh() {
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let rrd = dir.path().join("terrain.rrd");
-    let out = skyform(&[
-        "record",
-        "missions/spso-benchmark.toml",
-        "--rrd",
-        &rrd.display().to_string(),
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let chunks = chunks(&rrd);
+    let chunks = record_scene("missions/spso-benchmark.toml");
     let vertices = values::<[f32; 3]>(&chunks, "/world/terrain", "Mesh3D:vertex_positions");
     assert_eq!(vertices.len(), 175 * 177);
     assert_eq!(&vertices[0][..2], &[1.0, 1.0]);

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
+use skyform::tui::fixtures::type_into;
 use skyform::tui::{Action, App, Document, view};
 
 fn benchmark_app() -> App {
@@ -100,29 +101,6 @@ fn the_map_shades_each_cell_by_the_ground_under_it() {
     );
     assert!(shaded.len() > 20, "only {} shades", shaded.len());
     assert!(render(&app).contains("ground 49–296 m"));
-}
-
-/// Types `text` into the selected item's field labelled `label` and applies it.
-fn type_into(app: &mut App, label: &str, text: &str) {
-    use skyform::tui::app::Focus;
-    let k = app
-        .fields()
-        .iter()
-        .position(|f| f.label == label)
-        .unwrap_or_else(|| panic!("no field {label}"));
-    app.update(Action::FocusOn(Focus::Inspector));
-    while app.field > k {
-        app.update(Action::FieldUp);
-    }
-    while app.field < k {
-        app.update(Action::FieldDown);
-    }
-    let mut chars = text.chars();
-    app.update(Action::EditStart(chars.next()));
-    for c in chars {
-        app.update(Action::EditInput(c));
-    }
-    app.update(Action::EditCommit);
 }
 
 /// Issue 15: `[terrain]` in the inspector. Its keys are fields; a new file

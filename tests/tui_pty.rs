@@ -148,6 +148,18 @@ fn bridge_copy(dir: &std::path::Path) -> std::path::PathBuf {
     file
 }
 
+/// The bridge with 20,000 iterations: a run long enough to be interrupted.
+fn long_bridge_copy(dir: &std::path::Path) -> std::path::PathBuf {
+    let file = bridge_copy(dir);
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &file,
+        text.replace("iterations = 150", "iterations = 20000"),
+    )
+    .unwrap();
+    file
+}
+
 #[test]
 fn edit_run_save_quit_in_a_real_terminal() {
     let dir = tempfile::tempdir().unwrap();
@@ -254,14 +266,7 @@ fn a_killed_designer_offers_its_unsaved_edits_back() {
 fn sigterm_during_a_run_restores_the_terminal_and_closes_the_recording() {
     let dir = tempfile::tempdir().unwrap();
     let state = tempfile::tempdir().unwrap();
-    let file = bridge_copy(dir.path());
-    // A run long enough to be interrupted.
-    let text = std::fs::read_to_string(&file).unwrap();
-    std::fs::write(
-        &file,
-        text.replace("iterations = 150", "iterations = 20000"),
-    )
-    .unwrap();
+    let file = long_bridge_copy(dir.path());
 
     let mut s = launch(&file, state.path());
     s.wait_for("Inspector", Duration::from_secs(30));
@@ -299,13 +304,7 @@ fn sigterm_during_a_run_restores_the_terminal_and_closes_the_recording() {
 fn at_80_by_24_help_scrolls_to_the_run_keys_and_a_cancel_shows_its_share() {
     let dir = tempfile::tempdir().unwrap();
     let state = tempfile::tempdir().unwrap();
-    let file = bridge_copy(dir.path());
-    let text = std::fs::read_to_string(&file).unwrap();
-    std::fs::write(
-        &file,
-        text.replace("iterations = 150", "iterations = 20000"),
-    )
-    .unwrap();
+    let file = long_bridge_copy(dir.path());
     let mut s = launch_sized(&file, state.path(), 24, 80);
     s.wait_for("Inspector", Duration::from_secs(30));
 

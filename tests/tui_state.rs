@@ -8,7 +8,7 @@ use nalgebra::Point2;
 use skyform::mission::{self, Mission, Severity, default_mission};
 use skyform::tui::app::{Focus, Overlay};
 use skyform::tui::fields::Item;
-use skyform::tui::fixtures::app_with_result;
+use skyform::tui::fixtures::{app_with_result, type_into};
 use skyform::tui::jobs::JobState;
 use skyform::tui::{Action, App, Document};
 
@@ -17,28 +17,6 @@ fn app_in(dir: &std::path::Path) -> App {
     let m = default_mission().mission;
     mission::save(&m, &path).unwrap();
     App::new(Document::new(m, Some(path)), dir.to_path_buf())
-}
-
-/// Types `text` into the selected item's field labelled `label` and applies it.
-fn type_into(app: &mut App, label: &str, text: &str) {
-    let k = app
-        .fields()
-        .iter()
-        .position(|f| f.label == label)
-        .unwrap_or_else(|| panic!("no field {label}"));
-    app.update(Action::FocusOn(Focus::Inspector));
-    while app.field > k {
-        app.update(Action::FieldUp);
-    }
-    while app.field < k {
-        app.update(Action::FieldDown);
-    }
-    let mut chars = text.chars();
-    app.update(Action::EditStart(chars.next()));
-    for c in chars {
-        app.update(Action::EditInput(c));
-    }
-    app.update(Action::EditCommit);
 }
 
 #[test]

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use nalgebra::{Point2, Point3};
 
+use super::action::{Action, Focus};
 use super::app::App;
 use super::document::Document;
 use super::jobs::{Job, JobError, JobMsg, Kind, Outcome};
@@ -86,4 +87,25 @@ pub fn app_with_flatlo_result(mission: Mission, seed: u64) -> App {
         .map_err(JobError::from);
     app.on_job_msg(JobMsg::Done(1, result), started);
     app
+}
+
+/// Types `text` into the selected item's field labelled `label` and applies
+/// it, by actions as a user would (focus, arrows, typing, Enter).
+pub fn type_into(app: &mut App, label: &str, text: &str) {
+    let Some(k) = app.fields().iter().position(|f| f.label == label) else {
+        panic!("no field {label}");
+    };
+    app.update(Action::FocusOn(Focus::Inspector));
+    while app.field > k {
+        app.update(Action::FieldUp);
+    }
+    while app.field < k {
+        app.update(Action::FieldDown);
+    }
+    let mut chars = text.chars();
+    app.update(Action::EditStart(chars.next()));
+    for c in chars {
+        app.update(Action::EditInput(c));
+    }
+    app.update(Action::EditCommit);
 }
