@@ -623,7 +623,7 @@ fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamRes
 }
 
 /// The mission's height map as a mesh of at most 200 × 200 points, coloured
-/// by height as the designer's map shades it.
+/// by height (`terrain::height_colour`: the hues of the designer's map, brighter).
 fn log_terrain(
     stream: &RecordingStream,
     map: &crate::terrain::HeightMap,

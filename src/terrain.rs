@@ -243,16 +243,26 @@ impl HeightMap {
 }
 
 /// The colour of ground at `t` of a map's height range (0 lowest, 1
-/// highest): green low to brown high. The designer's map shades its cells
-/// with a dimmed copy, the Rerun recording colours the terrain mesh with it.
-pub fn height_colour(t: f64) -> [u8; 3] {
+/// highest) on a ramp from `low` to `high` (RGB); `t` outside [0, 1] is
+/// clamped, NaN counts as the lowest.
+pub fn height_ramp(t: f64, low: [u8; 3], high: [u8; 3]) -> [u8; 3] {
     let t = if t.is_finite() {
         t.clamp(0.0, 1.0)
     } else {
         0.0
     };
-    let mix = |low: f64, high: f64| (low + t * (high - low)).round() as u8;
-    [mix(56.0, 176.0), mix(118.0, 132.0), mix(62.0, 84.0)]
+    let mix = |a: u8, b: u8| (f64::from(a) + t * (f64::from(b) - f64::from(a))).round() as u8;
+    [
+        mix(low[0], high[0]),
+        mix(low[1], high[1]),
+        mix(low[2], high[2]),
+    ]
+}
+
+/// The Rerun recording's terrain colour: green low to brown high (the
+/// designer's map uses a darker ramp of the same hues under its glyphs).
+pub fn height_colour(t: f64) -> [u8; 3] {
+    height_ramp(t, [56, 118, 62], [176, 132, 84])
 }
 
 /// A regular grid of ground points for drawing a map in 3-D: every

@@ -13,13 +13,8 @@ use crate::mission::Mission;
 /// (0 lowest, 1 highest): dark green low to brown high, dim enough for the
 /// braille layer and the labels drawn over it to stay readable.
 pub fn ground_shade(t: f64) -> Color {
-    let t = if t.is_finite() {
-        t.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let mix = |low: f64, high: f64| (low + t * (high - low)).round() as u8;
-    Color::Rgb(mix(18.0, 96.0), mix(44.0, 66.0), mix(22.0, 30.0))
+    let [r, g, b] = crate::terrain::height_ramp(t, [18, 44, 22], [96, 66, 30]);
+    Color::Rgb(r, g, b)
 }
 
 /// Sets the background of every map cell over the terrain to the shade of
