@@ -700,7 +700,7 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
     let mut app = App::new(Document::new(m, Some(path.clone())), dir.path().to_owned());
 
     app.update(Action::Export);
-    let status = app.status.clone().unwrap_or_else(|| panic!("no status"));
+    let status = app.status().cloned().unwrap_or_else(|| panic!("no status"));
     assert!(
         status.error && status.text.contains("no result"),
         "{}",
@@ -711,7 +711,7 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
     assert!(app.wait_for_jobs(std::time::Duration::from_secs(120)));
     app.update(Action::ShowJob);
     app.update(Action::Export);
-    let status = app.status.clone().unwrap_or_else(|| panic!("no status"));
+    let status = app.status().cloned().unwrap_or_else(|| panic!("no status"));
     assert!(!status.error, "{}", status.text);
     let folder = dir.path().join("bridge-export");
     assert!(

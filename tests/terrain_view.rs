@@ -138,7 +138,7 @@ fn the_inspector_edits_the_terrain_and_reloads_its_map() {
     type_into(&mut app, "file", "terrain/missing.tif");
     assert!(app.mission().height_map().is_none());
     let errors: Vec<String> = app
-        .doc
+        .doc()
         .diagnostics()
         .iter()
         .map(|d| format!("{} {}", d.path, d.message))
@@ -155,5 +155,5 @@ fn the_inspector_edits_the_terrain_and_reloads_its_map() {
         app.mission().height_map().is_some(),
         "undo brings the map back"
     );
-    assert_eq!(app.doc.error_count(), 0);
+    assert_eq!(app.doc().error_count(), 0);
 }

@@ -114,6 +114,14 @@ pub fn formation_items(mission: &Mission, iwps: &[Iwp]) -> Vec<Item> {
     items
 }
 
+/// Whether a diagnostic at `path` belongs to the field at `field`.
+pub fn concerns(path: &str, field: &str) -> bool {
+    path == field
+        || path
+            .strip_prefix(field)
+            .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('['))
+}
+
 /// An obstacle renamed from `old` to `new`: the IWP choices that named it
 /// follow, unless another obstacle still carries the old name.
 fn rename_references(m: &mut Mission, old: &str, new: &str) {

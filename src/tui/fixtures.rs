@@ -63,8 +63,7 @@ pub fn app_with_result(mut mission: Mission, seed: u64, iterations: usize) -> Ap
         PathBuf::from("."),
     );
     let started = Instant::now();
-    app.jobs
-        .push(Job::new(1, Kind::ThetaPso, seed, mission, started));
+    app.adopt_job(Job::new(1, Kind::ThetaPso, seed, mission, started));
     let result = outcome
         .map(|o| Outcome::ThetaPso(Box::new(o)))
         .map_err(JobError::from);
@@ -80,8 +79,7 @@ pub fn app_with_flatlo_result(mission: Mission, seed: u64) -> App {
         PathBuf::from("."),
     );
     let started = Instant::now();
-    app.jobs
-        .push(Job::new(1, Kind::Flatlo, seed, mission, started));
+    app.adopt_job(Job::new(1, Kind::Flatlo, seed, mission, started));
     let result = outcome
         .map(|o| Outcome::Flatlo(Box::new(o)))
         .map_err(JobError::from);
@@ -96,10 +94,10 @@ pub fn type_into(app: &mut App, label: &str, text: &str) {
         panic!("no field {label}");
     };
     app.update(Action::FocusOn(Focus::Inspector));
-    while app.field > k {
+    while app.editor().field() > k {
         app.update(Action::FieldUp);
     }
-    while app.field < k {
+    while app.editor().field() < k {
         app.update(Action::FieldDown);
     }
     let mut chars = text.chars();

@@ -8,8 +8,9 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, BorderType, Borders, Paragraph, Wrap};
 
 use crate::mission::Severity;
-use crate::tui::app::{App, Focus, concerns};
+use crate::tui::app::{App, Focus};
 use crate::tui::fields::Item;
+use crate::tui::fields::concerns;
 
 fn severity_span(severity: Severity, text: String) -> Span<'static> {
     match severity {
@@ -42,10 +43,10 @@ fn item_path(item: &Item) -> Option<String> {
 }
 
 pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
-    let focused = app.focus == Focus::Inspector;
+    let focused = app.focus() == Focus::Inspector;
     let m = app.mission();
     let fields = app.fields();
-    let diagnostics = app.doc.diagnostics();
+    let diagnostics = app.doc().diagnostics();
     let label_width = fields
         .iter()
         .map(|f| f.label.chars().count())
@@ -54,8 +55,8 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
     let mut lines: Vec<Line> = Vec::new();
     let mut cursor_line = 0;
     for (k, f) in fields.iter().enumerate() {
-        let cursor = k == app.field;
-        let editing = cursor && app.editing.is_some();
+        let cursor = k == app.editor().field();
+        let editing = cursor && app.editor().editing().is_some();
         let label = format!("{:<label_width$}  ", f.label);
         let label_style = if cursor && focused {
             Style::default().black().on_yellow()
@@ -64,7 +65,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         } else {
             Style::default().fg(Color::Gray)
         };
-        let value = match (&app.editing, editing) {
+        let value = match (app.editor().editing(), editing) {
             (Some(e), true) => {
                 Span::styled(format!("{}▏", e.buffer), Style::default().white().on_blue())
             }
@@ -75,7 +76,8 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         }
         lines.push(Line::from(vec![Span::styled(label, label_style), value]));
         if editing {
-            if let Some(Some((severity, text))) = app.editing.as_ref().map(|e| e.problem.clone()) {
+            if let Some(Some((severity, text))) = app.editor().editing().map(|e| e.problem.clone())
+            {
                 lines.push(Line::from(severity_span(severity, text)));
             }
         } else {
@@ -92,7 +94,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         }
     }
     // Messages about the item that no field shows (e.g. an obstacle outside the bounds).
-    if let Some(prefix) = item_path(&app.selected) {
+    if let Some(prefix) = item_path(app.selected()) {
         for d in diagnostics.iter().filter(|d| {
             let p = d.path.to_string();
             concerns(&p, &prefix) && !fields.iter().any(|f| concerns(&p, &f.path))
@@ -103,8 +105,8 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
             )));
         }
     }
-    if app.selected == Item::Mission {
-        let errors = app.doc.error_count();
+    if *app.selected() == Item::Mission {
+        let errors = app.doc().error_count();
         let warnings = diagnostics.len() - errors;
         lines.push(Line::raw(""));
         lines.push(Line::from(vec![
@@ -132,7 +134,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         }
     }
     lines.push(Line::raw(""));
-    let hint = if app.editing.is_some() {
+    let hint = if app.editor().editing().is_some() {
         "Enter apply · Esc cancel"
     } else {
         "↑↓ field · Enter/type to edit · n/p next/prev item"
@@ -150,7 +152,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         .border_style(Style::default().fg(border))
         .title(Line::from(vec![
             Span::styled(" Inspector ", Style::default().bold()),
-            Span::raw(format!("· {} ", app.selected.title(m))),
+            Span::raw(format!("· {} ", app.selected().title(m))),
         ]));
     // Keep the cursor visible in a long list.
     let inner_height = area.height.saturating_sub(2) as usize;
