@@ -112,7 +112,8 @@ fn the_inspector_edits_the_terrain_and_reloads_its_map() {
     use skyform::tui::fields::Item;
     let mut app = benchmark_app();
     app.update(Action::Select(Item::Terrain));
-    let labels: Vec<&str> = app.fields().iter().map(|f| f.label).collect();
+    let fields = app.fields();
+    let labels: Vec<&str> = fields.iter().map(|f| f.label()).collect();
     assert_eq!(
         labels,
         [

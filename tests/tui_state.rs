@@ -112,7 +112,7 @@ fn validation_follows_the_typing() {
     for _ in 0..4 {
         app.update(Action::FieldDown);
     }
-    assert_eq!(app.fields()[app.editor().field()].label, "radius (m)");
+    assert_eq!(app.fields()[app.editor().field()].label(), "radius (m)");
     app.update(Action::EditStart(Some('-')));
     let problem = app.editor().editing().unwrap().problem.clone();
     assert_eq!(

@@ -563,7 +563,7 @@ impl Editor {
         };
         let buffer = match first {
             Some(c) => c.to_string(),
-            None => f.value.clone(),
+            None => f.value().to_owned(),
         };
         self.editing = Some(Editing {
             buffer,
@@ -587,7 +587,7 @@ impl Editor {
             Err(e) => Some((Severity::Error, e)),
             Ok(()) => crate::diagnose::diagnose(&trial)
                 .into_iter()
-                .filter(|d| fields::concerns(&d.path.to_string(), &field.path))
+                .filter(|d| d.path.starts_with(field.path()))
                 .min_by_key(|d| d.severity)
                 .map(|d| (d.severity, d.message)),
         };
@@ -606,7 +606,7 @@ impl Editor {
         };
         // Enter applies and stays on the field: ↓ goes to the next one (a
         // move on Enter as well made the next ↓ skip a field).
-        if editing.buffer.trim() == field.value {
+        if editing.buffer.trim() == field.value() {
             // Nothing typed: no change, no undo step (and no rounding).
             return;
         }
@@ -614,11 +614,11 @@ impl Editor {
         match field.set(&mut trial, &self.selected, &editing.buffer) {
             Ok(()) => {
                 self.edit(status, |m| *m = trial);
-                status.say(format!("{} = {}", field.label, editing.buffer.trim()));
+                status.say(format!("{} = {}", field.label(), editing.buffer.trim()));
             }
             Err(e) => {
                 // Keep the text so it can be corrected.
-                status.error(format!("{}: {e}", field.label));
+                status.error(format!("{}: {e}", field.label()));
                 self.editing = Some(Editing {
                     problem: Some((Severity::Error, e)),
                     ..editing

@@ -90,7 +90,7 @@ pub fn app_with_flatlo_result(mission: Mission, seed: u64) -> App {
 /// Types `text` into the selected item's field labelled `label` and applies
 /// it, by actions as a user would (focus, arrows, typing, Enter).
 pub fn type_into(app: &mut App, label: &str, text: &str) {
-    let Some(k) = app.fields().iter().position(|f| f.label == label) else {
+    let Some(k) = app.fields().iter().position(|f| f.label() == label) else {
         panic!("no field {label}");
     };
     app.update(Action::FocusOn(Focus::Inspector));

@@ -10,7 +10,6 @@ use ratatui::widgets::{Block, BorderType, Borders, Paragraph, Wrap};
 use crate::mission::Severity;
 use crate::tui::app::{App, Focus};
 use crate::tui::fields::Item;
-use crate::tui::fields::concerns;
 
 fn severity_span(severity: Severity, text: String) -> Span<'static> {
     match severity {
@@ -23,25 +22,6 @@ fn severity_span(severity: Severity, text: String) -> Span<'static> {
     }
 }
 
-/// The mission path prefix of an item: diagnostics under it that no field
-/// claims are listed at the bottom.
-fn item_path(item: &Item) -> Option<String> {
-    match item {
-        Item::Obstacle(i) => Some(format!("obstacles[{i}]")),
-        Item::Bounds => Some("bounds".into()),
-        Item::Start => Some("route.start".into()),
-        Item::Goal => Some("route.goal".into()),
-        Item::Terrain => Some("terrain".into()),
-        Item::Formation => Some("formation".into()),
-        Item::Slot(i) => Some(format!("formation.slots[{i}]")),
-        Item::ThetaPso => Some("theta_pso".into()),
-        Item::Squadron => Some("flatlo".into()),
-        Item::Fleet => Some("fleet".into()),
-        Item::FleetTarget(i) => Some(format!("fleet.targets[{i}]")),
-        Item::Mission | Item::Waypoint(_) => None,
-    }
-}
-
 pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
     let focused = app.focus() == Focus::Inspector;
     let m = app.mission();
@@ -49,7 +29,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
     let diagnostics = app.doc().diagnostics();
     let label_width = fields
         .iter()
-        .map(|f| f.label.chars().count())
+        .map(|f| f.label().chars().count())
         .max()
         .unwrap_or(0);
     let mut lines: Vec<Line> = Vec::new();
@@ -57,7 +37,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
     for (k, f) in fields.iter().enumerate() {
         let cursor = k == app.editor().field();
         let editing = cursor && app.editor().editing().is_some();
-        let label = format!("{:<label_width$}  ", f.label);
+        let label = format!("{:<label_width$}  ", f.label());
         let label_style = if cursor && focused {
             Style::default().black().on_yellow()
         } else if cursor {
@@ -69,7 +49,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
             (Some(e), true) => {
                 Span::styled(format!("{}▏", e.buffer), Style::default().white().on_blue())
             }
-            _ => Span::raw(f.value.clone()),
+            _ => Span::raw(f.value().to_owned()),
         };
         if cursor {
             cursor_line = lines.len();
@@ -82,22 +62,18 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
             }
         } else {
             // Show each message once, under the first field it concerns.
-            let first_with_path = fields.iter().position(|g| g.path == f.path) == Some(k);
+            let first_with_path = fields.iter().position(|g| g.path() == f.path()) == Some(k);
             if first_with_path {
-                for d in diagnostics
-                    .iter()
-                    .filter(|d| concerns(&d.path.to_string(), &f.path))
-                {
+                for d in diagnostics.iter().filter(|d| d.path.starts_with(f.path())) {
                     lines.push(Line::from(severity_span(d.severity, d.message.clone())));
                 }
             }
         }
     }
     // Messages about the item that no field shows (e.g. an obstacle outside the bounds).
-    if let Some(prefix) = item_path(app.selected()) {
+    if let Some(prefix) = app.selected().path() {
         for d in diagnostics.iter().filter(|d| {
-            let p = d.path.to_string();
-            concerns(&p, &prefix) && !fields.iter().any(|f| concerns(&p, &f.path))
+            d.path.starts_with(&prefix) && !fields.iter().any(|f| d.path.starts_with(f.path()))
         }) {
             lines.push(Line::from(severity_span(
                 d.severity,
