@@ -183,10 +183,6 @@ impl App {
         self.replay.is_playing()
     }
 
-    pub fn any_running(&self) -> bool {
-        self.board.any_running()
-    }
-
     /// Lists a job that runs elsewhere (a run planned synchronously for a
     /// test or the benchmark); its messages come through `on_job_msg`.
     pub fn adopt_job(&mut self, job: Job) {
@@ -242,7 +238,7 @@ impl App {
 
     /// The loop needs to wake up by itself (running jobs, a playing replay).
     pub fn wants_tick(&self) -> bool {
-        self.any_running() || self.replay.is_playing() || self.recovery_pending()
+        self.board.any_running() || self.replay.is_playing() || self.recovery_pending()
     }
 
     /// Keeps a recovery copy of unsaved edits (`recovery.rs`) for the
@@ -331,7 +327,13 @@ impl App {
                     self.pane = Pane::Map;
                 }
             }
-            Export => self.export_shown(),
+            Export => {
+                let path = self.editor.doc().path();
+                match super::export::export_shown(self.board.shown(), path, &self.cwd) {
+                    Ok(text) => self.status.say(text),
+                    Err(text) => self.status.error(text),
+                }
+            }
             SelectNext | SelectPrevious | Select(_) | Nudge(..) | AddObstacle(_)
             | ToggleAddTool | Duplicate | Delete | AddSlot | CyclePreset | CycleShape
             | ToggleWaypoint | ToggleInspect | FieldUp | FieldDown | EditStart(_)
@@ -478,26 +480,6 @@ impl App {
         }
     }
 
-    /// Exports the shown job's result beside the mission; the status line
-    /// says where, or why not.
-    fn export_shown(&mut self) {
-        let Some(job) = self.board.shown() else {
-            self.status
-                .error("no result on the map to export: run a pipeline, or Enter on a job");
-            return;
-        };
-        let path = self.editor.doc().path();
-        let stem = path
-            .and_then(Path::file_stem)
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| slug(&job.mission.name));
-        let dir = super::export::folder(path, &self.cwd, &stem);
-        match super::export::export_job(job, &dir, &stem) {
-            Ok(text) => self.status.say(text),
-            Err(text) => self.status.error(text),
-        }
-    }
-
     /// Quits without asking (a signal: the terminal is closing or the
     /// process is told to stop). Unsaved edits stay in the recovery copy.
     pub fn quit_now(&mut self) {
@@ -532,7 +514,7 @@ impl App {
     /// Blocks until no job runs (tests, headless use). False on timeout.
     pub fn wait_for_jobs(&mut self, timeout: Duration) -> bool {
         let deadline = Instant::now() + timeout;
-        while self.any_running() {
+        while self.board.any_running() {
             let left = deadline.saturating_duration_since(Instant::now());
             match self.board.messages().recv_timeout(left) {
                 Ok(msg) => self.on_job_msg(msg, Instant::now()),
