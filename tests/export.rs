@@ -700,7 +700,7 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
     let mut app = App::new(Document::new(m, Some(path.clone())), dir.path().to_owned());
 
     app.update(Action::Export);
-    let status = app.status.clone().unwrap_or_else(|| panic!("no status"));
+    let status = app.status().cloned().unwrap_or_else(|| panic!("no status"));
     assert!(
         status.error && status.text.contains("no result"),
         "{}",
@@ -711,7 +711,7 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
     assert!(app.wait_for_jobs(std::time::Duration::from_secs(120)));
     app.update(Action::ShowJob);
     app.update(Action::Export);
-    let status = app.status.clone().unwrap_or_else(|| panic!("no status"));
+    let status = app.status().cloned().unwrap_or_else(|| panic!("no status"));
     assert!(!status.error, "{}", status.text);
     let folder = dir.path().join("bridge-export");
     assert!(
@@ -725,15 +725,15 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
 
     // The inspector edits [origin] (Mission item): its three fields.
     let fields = skyform::tui::fields::fields(&Item::Mission, app.mission());
-    let labels: Vec<&str> = fields.iter().map(|f| f.label).collect();
+    let labels: Vec<&str> = fields.iter().map(|f| f.label()).collect();
     for label in ["origin lat (°)", "origin lon (°)", "origin alt (m)"] {
         assert!(labels.contains(&label), "{labels:?}");
     }
     let lat = fields
         .iter()
-        .find(|f| f.label == "origin lat (°)")
+        .find(|f| f.label() == "origin lat (°)")
         .unwrap_or_else(|| panic!("no field"));
-    assert_eq!(lat.value, "-33.87601");
+    assert_eq!(lat.value(), "-33.87601");
     let mut edited = app.mission().clone();
     lat.set(&mut edited, &Item::Mission, "-34.5")
         .unwrap_or_else(|e| panic!("{e}"));

@@ -112,7 +112,8 @@ fn the_inspector_edits_the_terrain_and_reloads_its_map() {
     use skyform::tui::fields::Item;
     let mut app = benchmark_app();
     app.update(Action::Select(Item::Terrain));
-    let labels: Vec<&str> = app.fields().iter().map(|f| f.label).collect();
+    let fields = app.fields();
+    let labels: Vec<&str> = fields.iter().map(|f| f.label()).collect();
     assert_eq!(
         labels,
         [
@@ -138,7 +139,7 @@ fn the_inspector_edits_the_terrain_and_reloads_its_map() {
     type_into(&mut app, "file", "terrain/missing.tif");
     assert!(app.mission().height_map().is_none());
     let errors: Vec<String> = app
-        .doc
+        .doc()
         .diagnostics()
         .iter()
         .map(|d| format!("{} {}", d.path, d.message))
@@ -155,5 +156,5 @@ fn the_inspector_edits_the_terrain_and_reloads_its_map() {
         app.mission().height_map().is_some(),
         "undo brings the map back"
     );
-    assert_eq!(app.doc.error_count(), 0);
+    assert_eq!(app.doc().error_count(), 0);
 }

@@ -78,9 +78,8 @@ fn jobs_panel_mid_run() {
     let mut app = default_app();
     let started = Instant::now();
     let m = app.mission().clone();
-    app.jobs
-        .push(Job::new(1, Kind::ThetaPso, 7, m.clone(), started));
-    app.shown_job = Some(1);
+    app.adopt_job(Job::new(1, Kind::ThetaPso, 7, m.clone(), started));
+    app.update(Action::ShowJob);
     app.update(Action::FocusOn(Focus::Jobs));
     let path = vec![m.route.start, Point3::new(60.0, 45.0, 8.0), m.route.goal];
     app.on_job_msg(JobMsg::Stage(1, "planning".into()), started);
@@ -103,7 +102,7 @@ fn jobs_panel_mid_run() {
 fn jobs_panel_with_a_finished_result() {
     let mut app = app_with_result(default_mission().mission, 7, 150);
     app.update(Action::FocusOn(Focus::Jobs));
-    let started = app.jobs[0].started;
+    let started = app.jobs()[0].started;
     let screen = render(&app, started);
     assert!(screen.contains("feasible"), "{screen}");
     assert!(screen.contains("all checks pass"), "{screen}");
@@ -116,7 +115,7 @@ fn a_stale_result_is_marked_on_the_map() {
     app.update(Action::Select(Item::Goal));
     app.update(Action::FocusOn(Focus::Map));
     app.update(Action::Nudge(-1.0, 0.0));
-    let screen = render(&app, app.jobs[0].started);
+    let screen = render(&app, app.jobs()[0].started);
     assert!(screen.contains("STALE"), "{screen}");
 }
 
@@ -151,7 +150,7 @@ fn a_flatlo_result_on_the_kilometre_map_with_its_verification_table() {
         .mission;
     let mut app = app_with_flatlo_result(m, 3);
     app.update(Action::FocusOn(Focus::Jobs));
-    let screen = render(&app, app.jobs[0].started);
+    let screen = render(&app, app.jobs()[0].started);
     assert!(screen.contains("✓ separation kept"), "{screen}");
     assert!(
         screen.contains("1-3"),

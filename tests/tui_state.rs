@@ -27,7 +27,7 @@ fn add_move_edit_then_undo_three_times_and_redo() {
     let n = original.obstacles.len();
 
     app.update(Action::AddObstacle(Some(Point2::new(30.0, 40.0))));
-    assert_eq!(app.selected, Item::Obstacle(n));
+    assert_eq!(app.selected(), &Item::Obstacle(n));
     app.update(Action::FocusOn(Focus::Map));
     app.update(Action::Nudge(1.0, 0.0)); // one 1 m step east
     type_into(&mut app, "radius (m)", "3.5");
@@ -35,7 +35,7 @@ fn add_move_edit_then_undo_three_times_and_redo() {
     let added = &app.mission().obstacles[n];
     assert_eq!(added.center, Point2::new(31.0, 40.0));
     assert_eq!(added.radius, 3.5);
-    assert!(app.doc.is_modified());
+    assert!(app.doc().is_modified());
 
     for _ in 0..3 {
         app.update(Action::Undo);
@@ -46,7 +46,7 @@ fn add_move_edit_then_undo_three_times_and_redo() {
         "three undos take back add, move and edit"
     );
     assert!(
-        !app.doc.is_modified(),
+        !app.doc().is_modified(),
         "back at the saved mission: not modified"
     );
 
@@ -62,7 +62,7 @@ fn add_move_edit_then_undo_three_times_and_redo() {
         "redo brings the obstacle back where it was added"
     );
     assert_eq!(app.mission().obstacles[n].radius, 1.0);
-    assert!(app.doc.is_modified());
+    assert!(app.doc().is_modified());
 }
 
 #[test]
@@ -86,7 +86,7 @@ fn a_drag_is_one_undo_step() {
     assert_eq!(app.mission(), &before);
     app.update(Action::Undo);
     assert_eq!(
-        app.status.as_ref().map(|s| s.text.as_str()),
+        app.status().map(|s| s.text.as_str()),
         Some("nothing to undo")
     );
 }
@@ -98,9 +98,9 @@ fn a_click_without_moving_records_no_undo_step() {
     let at = app.mission().route.goal.xy();
     app.update(Action::DragStart(Item::Goal, at));
     app.update(Action::DragEnd);
-    assert_eq!(app.selected, Item::Goal);
-    assert!(!app.doc.can_undo());
-    assert!(!app.doc.is_modified());
+    assert_eq!(app.selected(), &Item::Goal);
+    assert!(!app.doc().can_undo());
+    assert!(!app.doc().is_modified());
 }
 
 #[test]
@@ -112,26 +112,26 @@ fn validation_follows_the_typing() {
     for _ in 0..4 {
         app.update(Action::FieldDown);
     }
-    assert_eq!(app.fields()[app.field].label, "radius (m)");
+    assert_eq!(app.fields()[app.editor().field()].label(), "radius (m)");
     app.update(Action::EditStart(Some('-')));
-    let problem = app.editing.as_ref().unwrap().problem.clone();
+    let problem = app.editor().editing().unwrap().problem.clone();
     assert_eq!(
         problem,
         Some((Severity::Error, "'-' is not a number".into()))
     );
     app.update(Action::EditInput('2'));
-    let (severity, message) = app.editing.as_ref().unwrap().problem.clone().unwrap();
+    let (severity, message) = app.editor().editing().unwrap().problem.clone().unwrap();
     assert_eq!(severity, Severity::Error);
     assert!(message.contains("must be positive"), "{message}");
     app.update(Action::EditBackspace);
     app.update(Action::EditBackspace);
     app.update(Action::EditInput('2'));
-    assert_eq!(app.editing.as_ref().unwrap().problem, None, "2 m is fine");
+    assert_eq!(app.editor().editing().unwrap().problem, None, "2 m is fine");
     // Nothing was applied while typing.
     assert_eq!(app.mission(), &default_mission().mission);
     app.update(Action::EditCancel);
-    assert!(app.editing.is_none());
-    assert!(!app.doc.is_modified());
+    assert!(app.editor().editing().is_none());
+    assert!(!app.doc().is_modified());
 }
 
 #[test]
@@ -152,9 +152,9 @@ fn a_run_in_the_background_gives_the_same_result_as_the_pipeline() {
     let dir = tempfile::tempdir().unwrap();
     let mut app = app_in(dir.path());
     app.update(Action::Run);
-    assert_eq!(app.jobs.len(), 1);
+    assert_eq!(app.jobs().len(), 1);
     assert!(app.wait_for_jobs(Duration::from_secs(60)));
-    let job = &app.jobs[0];
+    let job = &app.jobs()[0];
     assert_eq!(job.state, JobState::Done { passed: true });
     let direct = skyform::planner::plan(
         app.mission(),
@@ -167,11 +167,11 @@ fn a_run_in_the_background_gives_the_same_result_as_the_pipeline() {
     let outcome = job.outcome.as_ref().and_then(|o| o.theta_pso()).unwrap();
     assert_eq!(outcome.cost, direct.cost);
     assert_eq!(job.convergence, direct.convergence);
-    assert_eq!(app.shown_job, Some(job.id));
+    assert_eq!(app.board().shown_id(), Some(job.id));
 
     app.update(Action::RunNewSeed);
     assert!(app.wait_for_jobs(Duration::from_secs(60)));
-    assert_eq!(app.jobs[1].seed, app.mission().seed + 1);
+    assert_eq!(app.jobs()[1].seed, app.mission().seed + 1);
 }
 
 #[test]
@@ -184,7 +184,7 @@ fn cancel_keeps_the_best_so_far() {
     type_into(&mut app, "iterations", "40000");
     app.update(Action::Run);
     // Let it get going, then cancel.
-    while app.jobs[0].convergence.len() < 3 {
+    while app.jobs()[0].convergence.len() < 3 {
         let msg = app
             .job_messages()
             .recv_timeout(Duration::from_secs(30))
@@ -193,7 +193,7 @@ fn cancel_keeps_the_best_so_far() {
     }
     app.update(Action::Cancel);
     assert!(app.wait_for_jobs(Duration::from_secs(30)));
-    let job = &app.jobs[0];
+    let job = &app.jobs()[0];
     assert_eq!(job.state, JobState::Cancelled);
     let outcome = job.outcome.as_ref().and_then(|o| o.theta_pso()).unwrap();
     assert!(outcome.iterations < 40_000);
@@ -207,8 +207,8 @@ fn an_invalid_mission_is_not_run() {
     app.update(Action::Select(Item::Obstacle(0)));
     type_into(&mut app, "radius (m)", "0");
     app.update(Action::Run);
-    assert!(app.jobs.is_empty());
-    let status = app.status.clone().unwrap();
+    assert!(app.jobs().is_empty());
+    let status = app.status().cloned().unwrap();
     assert!(status.error);
     assert!(
         status.text.contains("obstacles[0].radius"),
@@ -226,8 +226,8 @@ fn a_run_over_its_budget_is_not_started() {
     app.update(Action::Select(Item::Formation));
     type_into(&mut app, "ground speed (m/s)", "0.000001");
     app.update(Action::Run);
-    assert!(app.jobs.is_empty());
-    let status = app.status.clone().unwrap();
+    assert!(app.jobs().is_empty());
+    let status = app.status().cloned().unwrap();
     assert!(status.error);
     assert!(
         status.text.contains("formation.ground_speed")
@@ -240,8 +240,8 @@ fn a_run_over_its_budget_is_not_started() {
     app.update(Action::Select(Item::ThetaPso));
     type_into(&mut app, "swarm size", "100000000");
     app.update(Action::Run);
-    assert!(app.jobs.is_empty());
-    let status = app.status.clone().unwrap();
+    assert!(app.jobs().is_empty());
+    let status = app.status().cloned().unwrap();
     assert!(
         status.text.contains("theta_pso.swarm_size"),
         "{}",
@@ -254,9 +254,9 @@ fn save_writes_the_file_and_clears_the_modified_flag() {
     let dir = tempfile::tempdir().unwrap();
     let mut app = app_in(dir.path());
     app.update(Action::AddObstacle(Some(Point2::new(12.0, 34.0))));
-    assert!(app.doc.is_modified());
+    assert!(app.doc().is_modified());
     app.update(Action::Save);
-    assert!(!app.doc.is_modified());
+    assert!(!app.doc().is_modified());
     let saved = mission::load(&dir.path().join("bridge.toml"))
         .unwrap()
         .mission;
@@ -280,7 +280,7 @@ fn an_invalid_mission_is_saved_only_after_a_confirmation_naming_the_errors() {
     app.update(Action::Select(Item::Obstacle(2)));
     type_into(&mut app, "radius (m)", "-1");
     app.update(Action::Save);
-    match &app.overlay {
+    match app.overlay() {
         Some(Overlay::SaveInvalid { errors, .. }) => {
             assert!(
                 errors
@@ -298,8 +298,8 @@ fn an_invalid_mission_is_saved_only_after_a_confirmation_naming_the_errors() {
         "not saved yet"
     );
     app.update(Action::Confirm);
-    assert!(app.overlay.is_none());
-    assert!(!app.doc.is_modified());
+    assert!(app.overlay().is_none());
+    assert!(!app.doc().is_modified());
     let text = std::fs::read_to_string(&path).unwrap();
     let checked = mission::check_str(&text, None);
     assert_eq!(checked.mission.unwrap().obstacles[2].radius, -1.0);
@@ -313,7 +313,7 @@ fn the_built_in_mission_is_saved_through_save_as() {
         dir.path().to_path_buf(),
     );
     app.update(Action::Save);
-    assert!(matches!(app.overlay, Some(Overlay::SaveAs { .. })));
+    assert!(matches!(app.overlay(), Some(Overlay::SaveAs { .. })));
     for _ in 0..60 {
         app.update(Action::PromptBackspace);
     }
@@ -321,7 +321,10 @@ fn the_built_in_mission_is_saved_through_save_as() {
         app.update(Action::PromptInput(c));
     }
     app.update(Action::Confirm);
-    assert_eq!(app.doc.path(), Some(dir.path().join("mine.toml").as_path()));
+    assert_eq!(
+        app.doc().path(),
+        Some(dir.path().join("mine.toml").as_path())
+    );
     assert_eq!(
         mission::load(&dir.path().join("mine.toml"))
             .unwrap()
@@ -335,19 +338,19 @@ fn quitting_with_unsaved_changes_asks_first() {
     let dir = tempfile::tempdir().unwrap();
     let mut app = app_in(dir.path());
     app.update(Action::Quit);
-    assert!(app.should_quit, "nothing to lose: quits at once");
+    assert!(app.should_quit(), "nothing to lose: quits at once");
 
     let mut app = app_in(dir.path());
     app.update(Action::AddObstacle(None));
     app.update(Action::Quit);
-    assert!(!app.should_quit);
-    assert_eq!(app.overlay, Some(Overlay::Quit));
+    assert!(!app.should_quit());
+    assert_eq!(app.overlay(), Some(&Overlay::Quit));
     app.update(Action::Dismiss);
-    assert!(app.overlay.is_none() && !app.should_quit);
+    assert!(app.overlay().is_none() && !app.should_quit());
     // Save and quit.
     app.update(Action::Quit);
     app.update(Action::Save);
-    assert!(app.should_quit);
+    assert!(app.should_quit());
     assert_eq!(
         mission::load(&dir.path().join("bridge.toml"))
             .unwrap()
@@ -362,7 +365,7 @@ fn open_lists_the_missions_and_refuses_to_drop_changes_silently() {
     let mut app = App::new(Document::new(default_mission().mission, None), root.clone());
     app.update(Action::AddObstacle(None));
     app.update(Action::Open);
-    let Some(Overlay::Open { entries, .. }) = app.overlay.clone() else {
+    let Some(Overlay::Open { entries, .. }) = app.overlay().cloned() else {
         panic!("no picker");
     };
     let narrow = entries
@@ -372,7 +375,7 @@ fn open_lists_the_missions_and_refuses_to_drop_changes_silently() {
     app.update(Action::PickerMove(narrow as i32));
     app.update(Action::Confirm);
     assert!(
-        matches!(app.overlay, Some(Overlay::Discard(_))),
+        matches!(app.overlay(), Some(Overlay::Discard(_))),
         "asks before dropping the edit"
     );
     app.update(Action::Confirm);
@@ -380,7 +383,7 @@ fn open_lists_the_missions_and_refuses_to_drop_changes_silently() {
         .unwrap()
         .mission;
     assert_eq!(app.mission(), &expected);
-    assert!(!app.doc.is_modified());
+    assert!(!app.doc().is_modified());
 }
 
 #[test]
@@ -388,14 +391,14 @@ fn presets_and_slot_edits_change_the_formation() {
     let dir = tempfile::tempdir().unwrap();
     let mut app = app_in(dir.path());
     app.update(Action::ShowFormation);
-    assert_eq!(app.selected, Item::Formation);
+    assert_eq!(app.selected(), &Item::Formation);
     app.update(Action::CyclePreset); // triangle → line abreast
     let slots = &app.mission().formation.slots;
     assert_eq!(slots.len(), 3);
     assert!(slots.iter().all(|s| s.x == 0.0), "line abreast: {slots:?}");
     app.update(Action::AddSlot);
     assert_eq!(app.mission().formation.slots.len(), 4);
-    assert_eq!(app.selected, Item::Slot(3));
+    assert_eq!(app.selected(), &Item::Slot(3));
     app.update(Action::Delete);
     assert_eq!(app.mission().formation.slots.len(), 3);
 
@@ -404,11 +407,11 @@ fn presets_and_slot_edits_change_the_formation() {
         "light pole 4".into(),
         "pier 5".into(),
     ])));
-    let before = app.iwps[0].choice;
+    let before = app.iwps()[0].choice;
     app.update(Action::CycleShape);
-    assert_ne!(app.iwps[0].choice, before);
+    assert_ne!(app.iwps()[0].choice, before);
     app.update(Action::ToggleWaypoint);
-    assert!(!app.iwps[0].enabled);
+    assert!(!app.iwps()[0].enabled);
 }
 
 mod mouse {
@@ -590,7 +593,7 @@ fn a_fleet_run_replays_on_the_map() {
     let mut app = App::new(Document::new(m, None), std::env::temp_dir());
     app.update(Action::RunFleet);
     assert!(app.wait_for_jobs(Duration::from_secs(60)));
-    assert_eq!(app.jobs[0].pipeline, skyform::pipeline::Kind::Fleet);
+    assert_eq!(app.jobs()[0].pipeline, skyform::pipeline::Kind::Fleet);
     assert_eq!(app.replay_end(), Some(6.0));
     assert_eq!(app.replay_time(), Some(6.0), "the end until scrubbed");
     app.update(Action::Scrub(-2.5));
@@ -627,8 +630,8 @@ fn applying_a_field_unchanged_changes_nothing() {
         app.update(Action::EditStart(None));
         app.update(Action::EditCommit);
     }
-    assert!(!app.doc.can_undo(), "no undo step for an unchanged value");
-    assert!(!app.doc.is_modified());
+    assert!(!app.doc().can_undo(), "no undo step for an unchanged value");
+    assert!(!app.doc().is_modified());
 }
 
 #[test]
@@ -681,9 +684,9 @@ fn save_as_onto_an_existing_file_asks_before_replacing_it() {
     }
     app.update(Action::Confirm);
     assert!(
-        matches!(&app.overlay, Some(Overlay::Overwrite { path, .. }) if path == &other),
+        matches!(app.overlay(), Some(Overlay::Overwrite { path, .. }) if path == &other),
         "{:?}",
-        app.overlay
+        app.overlay()
     );
     assert_eq!(
         std::fs::read_to_string(&other).unwrap(),
@@ -691,9 +694,9 @@ fn save_as_onto_an_existing_file_asks_before_replacing_it() {
     );
     // Esc keeps the file; asking again and answering y replaces it.
     app.update(Action::Dismiss);
-    assert!(app.overlay.is_none());
+    assert!(app.overlay().is_none());
     assert_eq!(
-        app.doc.path(),
+        app.doc().path(),
         Some(dir.path().join("bridge.toml").as_path())
     );
     app.update(Action::SaveAs);
@@ -705,7 +708,7 @@ fn save_as_onto_an_existing_file_asks_before_replacing_it() {
     }
     app.update(Action::Confirm);
     app.update(Action::Confirm);
-    assert_eq!(app.doc.path(), Some(other.as_path()));
+    assert_eq!(app.doc().path(), Some(other.as_path()));
     assert_eq!(mission::load(&other).unwrap().mission, *app.mission());
 }
 
@@ -725,7 +728,7 @@ fn renaming_an_obstacle_carries_its_iwp_choices_along() {
     let after = &app.mission().reconfiguration.waypoints[0];
     assert_eq!(after.between[0], "renamed pier");
     assert_eq!(after.between[1], choice.between[1]);
-    assert_eq!(app.doc.error_count(), 0, "{:?}", app.doc.error_lines());
+    assert_eq!(app.doc().error_count(), 0, "{:?}", app.doc().error_lines());
 }
 
 #[test]
@@ -737,14 +740,14 @@ fn a_dangling_iwp_choice_can_be_selected_and_deleted() {
     let pair = m.reconfiguration.waypoints[0].between.clone();
     mission::save(&m, &path).unwrap();
     let mut app = App::new(Document::new(m, Some(path)), dir.path().to_path_buf());
-    assert!(app.doc.error_count() > 0);
-    let items = skyform::tui::fields::formation_items(app.mission(), &app.iwps);
+    assert!(app.doc().error_count() > 0);
+    let items = skyform::tui::fields::formation_items(app.mission(), app.iwps());
     let item = Item::Waypoint(pair.clone());
     assert!(items.contains(&item), "{items:?}");
     app.update(Action::Select(item));
-    assert_eq!(app.selected, Item::Waypoint(pair));
+    assert_eq!(app.selected(), &Item::Waypoint(pair));
     app.update(Action::Delete);
-    assert_eq!(app.doc.error_count(), 0, "{:?}", app.doc.error_lines());
+    assert_eq!(app.doc().error_count(), 0, "{:?}", app.doc().error_lines());
 }
 
 #[test]
@@ -776,7 +779,7 @@ fn unsaved_edits_are_kept_in_a_recovery_copy_and_offered_back() {
 
     let mut app = app_in(dir.path());
     app.use_recovery(recovery());
-    match &app.overlay {
+    match app.overlay() {
         Some(Overlay::Recover(copy)) => {
             assert_eq!(copy.mission, moved);
             assert_eq!(copy.changes, 2);
@@ -785,7 +788,7 @@ fn unsaved_edits_are_kept_in_a_recovery_copy_and_offered_back() {
     }
     app.update(Action::Confirm);
     assert_eq!(app.mission(), &moved);
-    assert!(app.doc.is_modified());
+    assert!(app.doc().is_modified());
     app.update(Action::Save);
     app.keep_recovery(std::time::Instant::now(), false);
     assert_eq!(copies(), 0, "saved: the copy is gone");
@@ -799,10 +802,10 @@ fn unsaved_edits_are_kept_in_a_recovery_copy_and_offered_back() {
     assert_eq!(copies(), 1);
     let mut app = app_in(dir.path());
     app.use_recovery(recovery());
-    assert!(matches!(app.overlay, Some(Overlay::Recover(_))));
+    assert!(matches!(app.overlay(), Some(Overlay::Recover(_))));
     app.update(Action::Dismiss);
     assert_eq!(copies(), 0);
-    assert!(!app.doc.is_modified());
+    assert!(!app.doc().is_modified());
 }
 
 /// Issue 16: the friction fixes that a state can hold.
@@ -812,16 +815,20 @@ fn enter_applies_and_stays_and_a_good_edit_clears_an_old_error() {
     let mut app = app_in(dir.path());
     app.update(Action::Select(Item::Bounds));
     type_into(&mut app, "x min (m)", "abc");
-    assert!(app.status.as_ref().is_some_and(|s| s.error));
+    assert!(app.status().is_some_and(|s| s.error));
     app.update(Action::Dismiss);
-    let field = app.field;
+    let field = app.editor().field();
     type_into(&mut app, "x min (m)", "-5");
-    assert_eq!(app.field, field, "Enter stays on the field");
+    assert_eq!(app.editor().field(), field, "Enter stays on the field");
     assert_eq!(app.mission().bounds.x[0], -5.0);
-    let status = app.status.clone().unwrap();
+    let status = app.status().cloned().unwrap();
     assert!(!status.error, "the old error is gone: {}", status.text);
     app.update(Action::FieldDown);
-    assert_eq!(app.field, field + 1, "↓ goes to the very next field");
+    assert_eq!(
+        app.editor().field(),
+        field + 1,
+        "↓ goes to the very next field"
+    );
 }
 
 #[test]
@@ -831,7 +838,7 @@ fn s_outside_an_iwp_row_says_what_it_needs() {
     let before = app.mission().clone();
     app.update(Action::CycleShape);
     assert_eq!(app.mission(), &before);
-    let status = app.status.clone().unwrap();
+    let status = app.status().cloned().unwrap();
     assert!(status.text.contains("select one of the"), "{}", status.text);
 }
 
@@ -853,14 +860,14 @@ fn the_formation_title_follows_undo_back_to_the_original_shape() {
 #[test]
 fn opening_another_mission_drops_the_jobs_of_the_first() {
     let mut app = app_with_result(default_mission().mission, 7, 5);
-    assert_eq!(app.jobs.len(), 1);
+    assert_eq!(app.jobs().len(), 1);
     let b = mission::BUILTIN
         .iter()
         .find(|b| b.file_name == "narrow-passage.toml")
         .unwrap();
     app.open(skyform::tui::app::Entry::Builtin(b.file_name));
-    assert!(app.jobs.is_empty());
-    assert_eq!(app.doc.title(), "(built-in) narrow-passage.toml");
+    assert!(app.jobs().is_empty());
+    assert_eq!(app.doc().title(), "(built-in) narrow-passage.toml");
 }
 
 #[test]
@@ -894,7 +901,7 @@ fn a_duplicate_obstacle_name_is_flagged_on_the_renamed_one_while_typing() {
     app.update(Action::Select(Item::Obstacle(1)));
     type_into(&mut app, "name", &other);
     let at = |i: usize| format!("obstacles[{i}].name");
-    let lines = app.doc.error_lines();
+    let lines = app.doc().error_lines();
     assert!(lines.iter().any(|l| l.starts_with(&at(1))), "{lines:?}");
     assert!(lines.iter().any(|l| l.starts_with(&at(4))), "{lines:?}");
 }
@@ -912,12 +919,12 @@ fn quitting_without_saving_leaves_no_recovery_copy() {
     app.keep_recovery(std::time::Instant::now(), true);
     assert_eq!(std::fs::read_dir(state.path()).unwrap().count(), 1);
     app.update(Action::Quit);
-    assert!(matches!(app.overlay, Some(Overlay::Quit)));
+    assert!(matches!(app.overlay(), Some(Overlay::Quit)));
     app.update(Action::Confirm); // quit without saving
     // What the loop does after every action and on the way out:
     app.keep_recovery(std::time::Instant::now(), false);
     app.keep_recovery(std::time::Instant::now(), true);
-    assert!(app.should_quit);
+    assert!(app.should_quit());
     assert_eq!(std::fs::read_dir(state.path()).unwrap().count(), 0);
 }
 
@@ -933,13 +940,13 @@ fn an_iwp_choice_error_alone_keeps_the_iwps_on_the_map() {
         Document::new(m, Some(dir.path().join("m.toml"))),
         dir.path().to_path_buf(),
     );
-    assert!(app.doc.error_count() > 0);
-    assert_eq!(app.iwps.len(), n);
+    assert!(app.doc().error_count() > 0);
+    assert_eq!(app.iwps().len(), n);
     // Any other error: no IWPs (the geometry may be wrong).
     let mut m = default_mission().mission;
     m.obstacles[0].radius = -1.0;
     let app = App::new(Document::new(m, None), dir.path().to_path_buf());
-    assert!(app.iwps.is_empty());
+    assert!(app.iwps().is_empty());
 }
 
 /// Types `text` into the prompt on screen (save as, open).
@@ -971,8 +978,8 @@ fn open_takes_a_typed_path_relative_to_the_working_directory() {
     let other = other_mission_at(&dir.path().join("elsewhere/other.toml"));
     app.update(Action::Open);
     type_prompt(&mut app, "elsewhere/other.toml");
-    let Some(Overlay::Open { matches, .. }) = &app.overlay else {
-        panic!("no open dialog: {:?}", app.overlay);
+    let Some(Overlay::Open { matches, .. }) = app.overlay() else {
+        panic!("no open dialog: {:?}", app.overlay());
     };
     assert_eq!(
         matches.first(),
@@ -982,10 +989,10 @@ fn open_takes_a_typed_path_relative_to_the_working_directory() {
         "the typed path comes first"
     );
     app.update(Action::Confirm);
-    assert!(app.overlay.is_none(), "{:?}", app.overlay);
+    assert!(app.overlay().is_none(), "{:?}", app.overlay());
     assert_eq!(app.mission(), &other);
     assert_eq!(
-        app.doc.path(),
+        app.doc().path(),
         Some(dir.path().join("elsewhere/other.toml").as_path())
     );
 }
@@ -996,7 +1003,7 @@ fn open_filters_the_list_by_what_is_typed() {
     let mut app = App::new(Document::new(default_mission().mission, None), root);
     app.update(Action::Open);
     type_prompt(&mut app, "NARROW");
-    let Some(Overlay::Open { matches, .. }) = &app.overlay else {
+    let Some(Overlay::Open { matches, .. }) = app.overlay() else {
         panic!("no open dialog");
     };
     assert!(!matches.is_empty());
@@ -1005,7 +1012,11 @@ fn open_filters_the_list_by_what_is_typed() {
         "{matches:?}"
     );
     app.update(Action::Confirm);
-    assert!(app.doc.title().contains("narrow"), "{}", app.doc.title());
+    assert!(
+        app.doc().title().contains("narrow"),
+        "{}",
+        app.doc().title()
+    );
 }
 
 #[test]
@@ -1018,7 +1029,7 @@ fn opening_a_missing_or_invalid_file_says_which_and_loses_nothing() {
     app.update(Action::Open);
     type_prompt(&mut app, "nope/missing.toml");
     app.update(Action::Confirm);
-    let status = app.status.clone().expect("a status");
+    let status = app.status().cloned().expect("a status");
     assert!(status.error, "{status:?}");
     assert!(
         status.text.contains("missing.toml") && status.text.contains("no such file"),
@@ -1026,33 +1037,33 @@ fn opening_a_missing_or_invalid_file_says_which_and_loses_nothing() {
         status.text
     );
     assert!(
-        matches!(app.overlay, Some(Overlay::Open { .. })),
+        matches!(app.overlay(), Some(Overlay::Open { .. })),
         "the dialog stays to fix the path"
     );
 
     std::fs::write(dir.path().join("notes.toml"), "this is = = not toml").unwrap();
     type_prompt(&mut app, "notes.toml");
     app.update(Action::Confirm);
-    let status = app.status.clone().expect("a status");
+    let status = app.status().cloned().expect("a status");
     assert!(
         status.error && status.text.contains("notes.toml"),
         "{status:?}"
     );
     assert!(
-        matches!(app.overlay, Some(Overlay::Open { .. })),
+        matches!(app.overlay(), Some(Overlay::Open { .. })),
         "refused before asking to discard: {:?}",
-        app.overlay
+        app.overlay()
     );
 
     std::fs::create_dir(dir.path().join("folder")).unwrap();
     type_prompt(&mut app, "folder");
     app.update(Action::Confirm);
-    let status = app.status.clone().expect("a status");
+    let status = app.status().cloned().expect("a status");
     assert!(status.text.contains("folder"), "{status:?}");
 
     app.update(Action::Dismiss);
     assert_eq!(app.mission(), &edited, "nothing is lost");
-    assert!(app.doc.is_modified());
+    assert!(app.doc().is_modified());
 }
 
 #[test]
@@ -1065,7 +1076,7 @@ fn the_unsaved_changes_prompt_on_open_can_save_first() {
     app.update(Action::Open);
     type_prompt(&mut app, "other.toml");
     app.update(Action::Confirm);
-    assert!(matches!(app.overlay, Some(Overlay::Discard(_))));
+    assert!(matches!(app.overlay(), Some(Overlay::Discard(_))));
     app.update(Action::Save);
     assert_eq!(
         mission::load(&dir.path().join("bridge.toml"))
@@ -1075,8 +1086,8 @@ fn the_unsaved_changes_prompt_on_open_can_save_first() {
         "saved first"
     );
     assert_eq!(app.mission(), &other, "then opened");
-    assert!(!app.doc.is_modified());
-    let status = app.status.clone().unwrap();
+    assert!(!app.doc().is_modified());
+    let status = app.status().cloned().unwrap();
     assert!(
         status.text.contains("saved") && status.text.contains("opened"),
         "{status:?}"
@@ -1097,18 +1108,18 @@ fn save_first_goes_through_save_as_and_opens_only_once_saved() {
         app.update(Action::Open);
         type_prompt(app, "other.toml");
         app.update(Action::Confirm);
-        assert!(matches!(app.overlay, Some(Overlay::Discard(_))));
+        assert!(matches!(app.overlay(), Some(Overlay::Discard(_))));
         app.update(Action::Save);
         assert!(
-            matches!(app.overlay, Some(Overlay::SaveAs { .. })),
+            matches!(app.overlay(), Some(Overlay::SaveAs { .. })),
             "the built-in mission needs a name: {:?}",
-            app.overlay
+            app.overlay()
         );
     };
     open_other(&mut app);
     app.update(Action::Dismiss);
     assert_eq!(app.mission(), &edited, "cancelled: nothing opened");
-    assert!(app.doc.is_modified());
+    assert!(app.doc().is_modified());
 
     open_other(&mut app);
     type_prompt(&mut app, "mine.toml");
@@ -1136,9 +1147,9 @@ fn save_first_of_an_invalid_mission_asks_and_a_refusal_does_not_open() {
         app.update(Action::Confirm);
         app.update(Action::Save);
         assert!(
-            matches!(app.overlay, Some(Overlay::SaveInvalid { .. })),
+            matches!(app.overlay(), Some(Overlay::SaveInvalid { .. })),
             "{:?}",
-            app.overlay
+            app.overlay()
         );
     };
     open_other(&mut app);
@@ -1167,12 +1178,13 @@ fn the_open_dialog_types_letters_and_its_prompt_offers_save_first() {
     use skyform::tui::input::key_action;
     let dir = tempfile::tempdir().unwrap();
     let mut app = app_in(dir.path());
+    app.update(Action::AddObstacle(None)); // unsaved: opening asks first
     app.update(Action::Open);
     let key = |c| KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE);
     assert_eq!(key_action(&app, key('q')), Some(Action::PromptInput('q')));
-    app.overlay = Some(Overlay::Discard(skyform::tui::app::Entry::Builtin(
-        "bridge-inspection.toml",
-    )));
+    type_prompt(&mut app, "bridge.toml");
+    app.update(Action::Confirm);
+    assert!(matches!(app.overlay(), Some(Overlay::Discard(_))));
     assert_eq!(key_action(&app, key('s')), Some(Action::Save));
     assert_eq!(key_action(&app, key('y')), Some(Action::Confirm));
 }
@@ -1213,7 +1225,7 @@ fn every_binding_dispatches_and_every_key_that_acts_is_in_the_table() {
             Pane::Formation => Action::ShowFormation,
         });
         app.update(Action::FocusOn(focus));
-        assert_eq!((app.focus, app.pane), (focus, pane));
+        assert_eq!((app.focus(), app.pane()), (focus, pane));
     };
     let mut bindings = 0;
     for row in KEYS {

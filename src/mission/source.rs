@@ -45,6 +45,13 @@ impl FieldPath {
     pub fn is_root(&self) -> bool {
         self.0.is_empty()
     }
+
+    /// Whether this path is `ancestor` or lies below it: `obstacles[3].radius`
+    /// starts with `obstacles[3]` and with itself, not with `obstacles[3].r`
+    /// or `obstacles[30]` (it compares segments, not text).
+    pub fn starts_with(&self, ancestor: &FieldPath) -> bool {
+        self.0.starts_with(&ancestor.0)
+    }
 }
 
 impl fmt::Display for FieldPath {
@@ -196,6 +203,17 @@ mod tests {
     fn field_paths_print_like_toml_accessors() {
         let path = FieldPath::root().key("obstacles").index(3).key("radius");
         assert_eq!(path.to_string(), "obstacles[3].radius");
+    }
+
+    #[test]
+    fn a_path_starts_with_itself_and_its_parents_only() {
+        let o = |i| FieldPath::root().key("obstacles").index(i);
+        let radius = o(3).key("radius");
+        assert!(radius.starts_with(&radius) && radius.starts_with(&o(3)));
+        assert!(radius.starts_with(&FieldPath::root()));
+        assert!(!radius.starts_with(&o(30)) && !o(30).starts_with(&o(3)));
+        assert!(!radius.starts_with(&o(3).key("r")));
+        assert!(!o(3).starts_with(&radius));
     }
 
     #[test]

@@ -251,3 +251,19 @@ impl Document {
         self.diagnostics = crate::diagnose::diagnose(&self.mission);
     }
 }
+
+/// A file-name-friendly version of a mission name.
+pub fn slug(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
+        .collect();
+    let s = s.trim_matches('-').to_owned();
+    if s.is_empty() { "mission".into() } else { s }
+}

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::document::slug;
 use super::jobs::{Job, Outcome};
 use crate::export::{self, ExportError, Format, Options, Planned};
 use crate::mission::Mission;
@@ -20,6 +21,24 @@ pub fn folder(mission_path: Option<&Path>, cwd: &Path, stem: &str) -> PathBuf {
         .map(Path::to_path_buf)
         .unwrap_or_else(|| cwd.to_path_buf());
     dir.join(format!("{stem}-export"))
+}
+
+/// Exports the result on the map (`shown`) beside the mission file at
+/// `mission_path` (in `cwd` without one): the status line on success, the
+/// reason on refusal or failure.
+pub fn export_shown(
+    shown: Option<&Job>,
+    mission_path: Option<&Path>,
+    cwd: &Path,
+) -> Result<String, String> {
+    let Some(job) = shown else {
+        return Err("no result on the map to export: run a pipeline, or Enter on a job".into());
+    };
+    let stem = mission_path
+        .and_then(Path::file_stem)
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| slug(&job.mission.name));
+    export_job(job, &folder(mission_path, cwd, &stem), &stem)
 }
 
 /// Exports `job`'s result (not forced): the status line on success, the

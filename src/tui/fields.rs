@@ -1,18 +1,21 @@
-//! What can be selected and the inspector's editable fields for each.
+//! What can be selected, and the inspector's editable fields for each,
+//! declared once as data.
 //!
-//! A field is read and written as text, so typing a value, pasting one and a
-//! test all go through the same `set`. Each field names the mission path its
-//! diagnostics are reported on (`obstacles[3].radius`), which is how a
-//! validation message finds its way next to the field it concerns.
-//!
-//! Long (one closure per field of every item): declaring the fields as data
-//! with typed paths is the open part of issue 13.
+//! Each kind of item has a table of fields: a name and a unit, where the
+//! field is in the mission (keys below the table's base path: a typed
+//! [`FieldPath`], the one the validator reports its diagnostics on), and
+//! how it is read and written as text. Typing a value, pasting one and a
+//! test all go through the same `set`; a validation message finds the
+//! field it concerns by comparing paths ([`FieldPath::starts_with`]).
+//! The tables themselves are in `fields/table.rs`.
 
-use nalgebra::{Point2, Vector3};
+use nalgebra::Point2;
 
-use crate::mission::{Mission, Obstacle, ShapeChoice, WaypointChoice};
+use crate::mission::{FieldPath, Mission, Obstacle, ShapeChoice, WaypointChoice};
 use crate::planner::Iwp;
 use crate::planner::iwp::same_pair;
+
+mod table;
 
 /// Something the operator can select on the map, in the formation editor or
 /// in the item list.
@@ -79,6 +82,41 @@ impl Item {
             _ => true,
         }
     }
+
+    /// Where the item is in the mission: the messages under it that no
+    /// field shows are listed below its fields. None for the mission (its
+    /// fields span the file) and IWPs.
+    pub fn path(&self) -> Option<FieldPath> {
+        let root = FieldPath::root();
+        Some(match self {
+            Item::Obstacle(i) => root.key("obstacles").index(*i),
+            Item::Bounds => root.key("bounds"),
+            Item::Start => root.key("route").key("start"),
+            Item::Goal => root.key("route").key("goal"),
+            Item::Terrain => root.key("terrain"),
+            Item::Formation => root.key("formation"),
+            Item::Slot(i) => root.key("formation").key("slots").index(*i),
+            Item::ThetaPso => root.key("theta_pso"),
+            Item::Squadron => root.key("flatlo"),
+            Item::Fleet => root.key("fleet"),
+            Item::FleetTarget(i) => root.key("fleet").key("targets").index(*i),
+            Item::Mission | Item::Waypoint(_) => return None,
+        })
+    }
+
+    /// The item's index in its list of the mission (an IWP's: its entry in
+    /// `reconfiguration.waypoints`, if it has one yet).
+    fn index(&self, m: &Mission) -> Option<usize> {
+        match self {
+            Item::Obstacle(i) | Item::Slot(i) | Item::FleetTarget(i) => Some(*i),
+            Item::Waypoint([a, b]) => m
+                .reconfiguration
+                .waypoints
+                .iter()
+                .position(|w| same_pair(&w.between, a, b)),
+            _ => None,
+        }
+    }
 }
 
 /// The items the map's next/previous keys cycle through, in order.
@@ -114,32 +152,60 @@ pub fn formation_items(mission: &Mission, iwps: &[Iwp]) -> Vec<Item> {
     items
 }
 
-/// An obstacle renamed from `old` to `new`: the IWP choices that named it
-/// follow, unless another obstacle still carries the old name.
-fn rename_references(m: &mut Mission, old: &str, new: &str) {
-    if old == new || m.obstacles.iter().any(|o| o.name == old) {
-        return;
-    }
-    for choice in &mut m.reconfiguration.waypoints {
-        for name in &mut choice.between {
-            if name == old {
-                *name = new.to_owned();
-            }
+/// A step of a table's base path: a key, or the selected item's index in
+/// its list.
+#[derive(Debug, Clone, Copy)]
+enum Step {
+    Key(&'static str),
+    Index,
+}
+
+/// One field of the inspector, declared once.
+struct Spec {
+    name: &'static str,
+    /// Shown after the name, in parentheses; empty for none.
+    unit: &'static str,
+    /// Keys below the table's base: where the field is in the mission.
+    keys: &'static [&'static str],
+    /// The value as it would be typed; None when the item is not in the
+    /// mission (any more).
+    get: fn(&Mission, &Item) -> Option<String>,
+    /// Parses the (trimmed) text and writes it; the error says what is expected.
+    set: fn(&mut Mission, &Item, &str) -> Result<(), String>,
+}
+
+/// The fields of one kind of item, below one base path.
+struct Table {
+    base: &'static [Step],
+    fields: &'static [Spec],
+}
+
+impl Table {
+    /// Where `spec` is in `m` for `item`. An IWP without an entry yet has
+    /// none of its own: its fields stand for the list it will be added to.
+    fn path(&self, spec: &Spec, item: &Item, m: &Mission) -> FieldPath {
+        let mut path = FieldPath::root();
+        for step in self.base {
+            path = match step {
+                Step::Key(key) => path.key(key),
+                Step::Index => match item.index(m) {
+                    Some(i) => path.index(i),
+                    None => return path,
+                },
+            };
         }
+        spec.keys.iter().fold(path, |p, key| p.key(key))
     }
 }
 
-type Setter = fn(&mut Mission, &Item, &str) -> Result<(), String>;
-
-/// One editable line of the inspector.
+/// One editable line of the inspector: a field of the table, with the path
+/// and value it has for the selected item.
 #[derive(Clone)]
 pub struct Field {
-    pub label: &'static str,
-    /// Mission path whose diagnostics belong to this field.
-    pub path: String,
-    /// Current value, as it would be typed.
-    pub value: String,
-    set: Setter,
+    spec: &'static Spec,
+    label: String,
+    path: FieldPath,
+    value: String,
 }
 
 impl std::fmt::Debug for Field {
@@ -149,19 +215,55 @@ impl std::fmt::Debug for Field {
 }
 
 impl Field {
+    /// The name with its unit, as the inspector shows it: `radius (m)`.
+    pub fn label(&self) -> &str {
+        &self.label
+    }
+
+    /// The unit alone (`m`, `m/s`, `°`); empty for none.
+    pub fn unit(&self) -> &'static str {
+        self.spec.unit
+    }
+
+    /// Where the field is in the mission: the diagnostics at or below this
+    /// path are the field's.
+    pub fn path(&self) -> &FieldPath {
+        &self.path
+    }
+
+    /// Current value, as it would be typed.
+    pub fn value(&self) -> &str {
+        &self.value
+    }
+
     /// Parses `text` and writes it into `mission`; the error says what is expected.
     pub fn set(&self, mission: &mut Mission, item: &Item, text: &str) -> Result<(), String> {
-        (self.set)(mission, item, text.trim())
+        (self.spec.set)(mission, item, text.trim())
     }
 }
 
-fn field(label: &'static str, path: impl Into<String>, value: impl ToString, set: Setter) -> Field {
-    Field {
-        label,
-        path: path.into(),
-        value: value.to_string(),
-        set,
-    }
+/// The inspector's fields for `item`, with the values they have in
+/// `mission` (none for an item that is not in it).
+pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
+    let table = table::of(item);
+    table
+        .fields
+        .iter()
+        .filter_map(|spec| {
+            let value = (spec.get)(mission, item)?;
+            let label = if spec.unit.is_empty() {
+                spec.name.to_owned()
+            } else {
+                format!("{} ({})", spec.name, spec.unit)
+            };
+            Some(Field {
+                spec,
+                label,
+                path: table.path(spec, item, mission),
+                value,
+            })
+        })
+        .collect()
 }
 
 /// Metres, degrees, gains: any finite number.
@@ -169,23 +271,6 @@ pub fn number(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
         _ => Err(format!("'{text}' is not a number")),
-    }
-}
-
-fn count(text: &str) -> Result<usize, String> {
-    text.parse::<usize>()
-        .map_err(|_| format!("'{text}' is not a whole number ≥ 0"))
-}
-
-fn shape(text: &str) -> Result<ShapeChoice, String> {
-    match text.to_ascii_lowercase().as_str() {
-        "auto" | "automatic" => Ok(ShapeChoice::Auto),
-        "alignment" | "align" => Ok(ShapeChoice::Alignment),
-        "rotation" | "rotate" => Ok(ShapeChoice::Rotation),
-        "shrink" => Ok(ShapeChoice::Shrink),
-        _ => Err(format!(
-            "'{text}' is not a shape: auto, alignment, rotation or shrink"
-        )),
     }
 }
 
@@ -205,14 +290,6 @@ pub fn next_shape(choice: ShapeChoice) -> ShapeChoice {
         ShapeChoice::Alignment => ShapeChoice::Rotation,
         ShapeChoice::Rotation => ShapeChoice::Shrink,
         ShapeChoice::Shrink => ShapeChoice::Auto,
-    }
-}
-
-fn yes_no(text: &str) -> Result<bool, String> {
-    match text.to_ascii_lowercase().as_str() {
-        "yes" | "y" | "true" | "on" | "1" => Ok(true),
-        "no" | "n" | "false" | "off" | "0" => Ok(false),
-        _ => Err(format!("'{text}' is not yes or no")),
     }
 }
 
@@ -237,35 +314,6 @@ pub fn fmt_num(v: f64) -> String {
     if s == "-0" { "0".into() } else { s }
 }
 
-fn obstacle<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut Obstacle, String> {
-    match item {
-        Item::Obstacle(i) => m.obstacles.get_mut(*i).ok_or("no such obstacle".into()),
-        _ => Err("not an obstacle".into()),
-    }
-}
-
-/// One end of an obstacle's stand-off band; an empty entry goes back to the
-/// formation's `surface_distance` for both ends.
-fn set_stand_off(m: &mut Mission, item: &Item, end: usize, t: &str) -> Result<(), String> {
-    let default = m.formation.surface_distance;
-    let o = obstacle(m, item)?;
-    if t.trim().is_empty() {
-        o.stand_off = None;
-        return Ok(());
-    }
-    let mut band = o.stand_off.unwrap_or(default);
-    band[end] = number(t)?;
-    o.stand_off = Some(band);
-    Ok(())
-}
-
-fn slot<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut Vector3<f64>, String> {
-    match item {
-        Item::Slot(i) => m.formation.slots.get_mut(*i).ok_or("no such slot".into()),
-        _ => Err("not a slot".into()),
-    }
-}
-
 /// The reconfiguration entry for an IWP, created with the defaults when the
 /// file has none yet.
 pub fn waypoint_choice<'m>(
@@ -275,9 +323,11 @@ pub fn waypoint_choice<'m>(
     let Item::Waypoint(between) = item else {
         return Err("not an IWP".into());
     };
-    let same = |w: &WaypointChoice| same_pair(&w.between, &between[0], &between[1]);
     let list = &mut m.reconfiguration.waypoints;
-    let index = match list.iter().position(same) {
+    let index = match list
+        .iter()
+        .position(|w| same_pair(&w.between, &between[0], &between[1]))
+    {
         Some(i) => i,
         None => {
             list.push(WaypointChoice {
@@ -290,785 +340,6 @@ pub fn waypoint_choice<'m>(
         }
     };
     Ok(&mut list[index])
-}
-
-fn find_choice<'m>(m: &'m Mission, between: &[String; 2]) -> Option<&'m WaypointChoice> {
-    m.reconfiguration
-        .waypoints
-        .iter()
-        .find(|w| same_pair(&w.between, &between[0], &between[1]))
-}
-
-/// The `[terrain]` keys; the map is read again when they change
-/// (`Document::edit`), and a file that does not load is an error on
-/// `terrain.file`.
-fn terrain_fields(m: &Mission) -> Vec<Field> {
-    let Some(t) = &m.terrain else {
-        return Vec::new();
-    };
-    fn terrain(m: &mut Mission) -> Result<&mut crate::mission::Terrain, String> {
-        m.terrain
-            .as_mut()
-            .ok_or_else(|| "the mission has no [terrain]".to_owned())
-    }
-    let lookup = match t.lookup {
-        crate::terrain::Lookup::Nearest => "nearest",
-        crate::terrain::Lookup::Bilinear => "bilinear",
-    };
-    vec![
-        field("file", "terrain.file", &t.file, |m, _, text| {
-            if text.trim().is_empty() {
-                return Err("the terrain needs a GeoTIFF file".into());
-            }
-            terrain(m)?.file = text.trim().to_owned();
-            Ok(())
-        }),
-        field(
-            "origin x (m)",
-            "terrain.origin",
-            fmt_num(t.origin[0]),
-            |m, _, text| {
-                terrain(m)?.origin[0] = number(text)?;
-                Ok(())
-            },
-        ),
-        field(
-            "origin y (m)",
-            "terrain.origin",
-            fmt_num(t.origin[1]),
-            |m, _, text| {
-                terrain(m)?.origin[1] = number(text)?;
-                Ok(())
-            },
-        ),
-        field(
-            "pixel x (m)",
-            "terrain.pixel_size",
-            fmt_num(t.pixel_size[0]),
-            |m, _, text| {
-                terrain(m)?.pixel_size[0] = number(text)?;
-                Ok(())
-            },
-        ),
-        field(
-            "pixel y (m)",
-            "terrain.pixel_size",
-            fmt_num(t.pixel_size[1]),
-            |m, _, text| {
-                terrain(m)?.pixel_size[1] = number(text)?;
-                Ok(())
-            },
-        ),
-        field("lookup", "terrain.lookup", lookup, |m, _, text| {
-            terrain(m)?.lookup = match text.trim() {
-                "nearest" => crate::terrain::Lookup::Nearest,
-                "bilinear" => crate::terrain::Lookup::Bilinear,
-                other => return Err(format!("'{other}' is not a lookup: nearest or bilinear")),
-            };
-            Ok(())
-        }),
-    ]
-}
-
-/// The inspector's fields for `item`, with the values they have in `mission`.
-pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
-    let m = mission;
-    match item {
-        Item::Mission => vec![
-            field("name", "name", &m.name, |m, _, t| {
-                m.name = t.to_owned();
-                Ok(())
-            }),
-            field("description", "description", &m.description, |m, _, t| {
-                m.description = t.to_owned();
-                Ok(())
-            }),
-            field("seed", "seed", m.seed, |m, _, t| {
-                m.seed = t
-                    .parse()
-                    .map_err(|_| format!("'{t}' is not a seed (0 … 2⁶⁴-1)"))?;
-                Ok(())
-            }),
-            field(
-                "origin lat (°)",
-                "origin.latitude",
-                origin_value(m, |o| o.latitude),
-                |m, _, t| set_origin(m, t, |o, v| o.latitude = v),
-            ),
-            field(
-                "origin lon (°)",
-                "origin.longitude",
-                origin_value(m, |o| o.longitude),
-                |m, _, t| set_origin(m, t, |o, v| o.longitude = v),
-            ),
-            field(
-                "origin alt (m)",
-                "origin.altitude",
-                origin_value(m, |o| o.altitude),
-                |m, _, t| set_origin(m, t, |o, v| o.altitude = v),
-            ),
-        ],
-        Item::Bounds => {
-            let b = &m.bounds;
-            vec![
-                field("x min (m)", "bounds.x", fmt_num(b.x[0]), |m, _, t| {
-                    m.bounds.x[0] = number(t)?;
-                    Ok(())
-                }),
-                field("x max (m)", "bounds.x", fmt_num(b.x[1]), |m, _, t| {
-                    m.bounds.x[1] = number(t)?;
-                    Ok(())
-                }),
-                field("y min (m)", "bounds.y", fmt_num(b.y[0]), |m, _, t| {
-                    m.bounds.y[0] = number(t)?;
-                    Ok(())
-                }),
-                field("y max (m)", "bounds.y", fmt_num(b.y[1]), |m, _, t| {
-                    m.bounds.y[1] = number(t)?;
-                    Ok(())
-                }),
-                field("z min (m)", "bounds.z", fmt_num(b.z[0]), |m, _, t| {
-                    m.bounds.z[0] = number(t)?;
-                    Ok(())
-                }),
-                field("z max (m)", "bounds.z", fmt_num(b.z[1]), |m, _, t| {
-                    m.bounds.z[1] = number(t)?;
-                    Ok(())
-                }),
-            ]
-        }
-        Item::Start => {
-            let p = &m.route.start;
-            vec![
-                field("x (m)", "route.start", fmt_num(p.x), |m, _, t| {
-                    m.route.start.x = number(t)?;
-                    Ok(())
-                }),
-                field("y (m)", "route.start", fmt_num(p.y), |m, _, t| {
-                    m.route.start.y = number(t)?;
-                    Ok(())
-                }),
-                field("z (m)", "route.start", fmt_num(p.z), |m, _, t| {
-                    m.route.start.z = number(t)?;
-                    Ok(())
-                }),
-            ]
-        }
-        Item::Goal => {
-            let p = &m.route.goal;
-            vec![
-                field("x (m)", "route.goal", fmt_num(p.x), |m, _, t| {
-                    m.route.goal.x = number(t)?;
-                    Ok(())
-                }),
-                field("y (m)", "route.goal", fmt_num(p.y), |m, _, t| {
-                    m.route.goal.y = number(t)?;
-                    Ok(())
-                }),
-                field("z (m)", "route.goal", fmt_num(p.z), |m, _, t| {
-                    m.route.goal.z = number(t)?;
-                    Ok(())
-                }),
-            ]
-        }
-        Item::Obstacle(i) => {
-            let Some(o) = m.obstacles.get(*i) else {
-                return Vec::new();
-            };
-            let at = |key: &str| format!("obstacles[{i}].{key}");
-            vec![
-                field("name", at("name"), &o.name, |m, item, t| {
-                    let old = std::mem::replace(&mut obstacle(m, item)?.name, t.to_owned());
-                    rename_references(m, &old, t);
-                    Ok(())
-                }),
-                field(
-                    "kind",
-                    at("kind"),
-                    o.kind.as_deref().unwrap_or(""),
-                    |m, item, t| {
-                        obstacle(m, item)?.kind = (!t.is_empty()).then(|| t.to_owned());
-                        Ok(())
-                    },
-                ),
-                field(
-                    "centre x (m)",
-                    at("center"),
-                    fmt_num(o.center.x),
-                    |m, item, t| {
-                        obstacle(m, item)?.center.x = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "centre y (m)",
-                    at("center"),
-                    fmt_num(o.center.y),
-                    |m, item, t| {
-                        obstacle(m, item)?.center.y = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "radius (m)",
-                    at("radius"),
-                    fmt_num(o.radius),
-                    |m, item, t| {
-                        obstacle(m, item)?.radius = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "height (m)",
-                    at("height"),
-                    fmt_num(o.height),
-                    |m, item, t| {
-                        obstacle(m, item)?.height = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "inspect (eq. 8)",
-                    at("inspect"),
-                    if o.inspect { "yes" } else { "no" },
-                    |m, item, t| {
-                        obstacle(m, item)?.inspect = yes_no(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "stand-off min (m)",
-                    at("stand_off"),
-                    fmt_num(o.stand_off_band(&m.formation)[0]),
-                    |m, item, t| set_stand_off(m, item, 0, t),
-                ),
-                field(
-                    "stand-off max (m)",
-                    at("stand_off"),
-                    fmt_num(o.stand_off_band(&m.formation)[1]),
-                    |m, item, t| set_stand_off(m, item, 1, t),
-                ),
-            ]
-        }
-        Item::Formation => {
-            let f = &m.formation;
-            let r = &m.reconfiguration;
-            vec![
-                field(
-                    "UAV radius r_Q (m)",
-                    "formation.uav_radius",
-                    fmt_num(f.uav_radius),
-                    |m, _, t| {
-                        m.formation.uav_radius = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "ground speed (m/s)",
-                    "formation.ground_speed",
-                    fmt_num(f.ground_speed),
-                    |m, _, t| {
-                        m.formation.ground_speed = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "comm range (m)",
-                    "formation.comm_range",
-                    fmt_num(f.comm_range),
-                    |m, _, t| {
-                        m.formation.comm_range = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "surface d min (m)",
-                    "formation.surface_distance",
-                    fmt_num(f.surface_distance[0]),
-                    |m, _, t| {
-                        m.formation.surface_distance[0] = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "surface d max (m)",
-                    "formation.surface_distance",
-                    fmt_num(f.surface_distance[1]),
-                    |m, _, t| {
-                        m.formation.surface_distance[1] = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "inspection pass (m)",
-                    "formation.inspection_pass",
-                    fmt_num(f.inspection_pass),
-                    |m, _, t| {
-                        m.formation.inspection_pass = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "default shape",
-                    "reconfiguration.default_shape",
-                    shape_name(r.default_shape),
-                    |m, _, t| {
-                        m.reconfiguration.default_shape = shape(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "shrink scale",
-                    "reconfiguration.shrink_scale",
-                    fmt_num(r.shrink_scale),
-                    |m, _, t| {
-                        m.reconfiguration.shrink_scale = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "transition (m)",
-                    "reconfiguration.transition_distance",
-                    fmt_num(r.transition_distance),
-                    |m, _, t| {
-                        m.reconfiguration.transition_distance = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "hold (m)",
-                    "reconfiguration.hold_distance",
-                    fmt_num(r.hold_distance),
-                    |m, _, t| {
-                        m.reconfiguration.hold_distance = number(t)?;
-                        Ok(())
-                    },
-                ),
-            ]
-        }
-        Item::Slot(i) => {
-            let Some(s) = m.formation.slots.get(*i) else {
-                return Vec::new();
-            };
-            let at = format!("formation.slots[{i}]");
-            vec![
-                field("forward x (m)", at.clone(), fmt_num(s.x), |m, item, t| {
-                    slot(m, item)?.x = number(t)?;
-                    Ok(())
-                }),
-                field("left y (m)", at.clone(), fmt_num(s.y), |m, item, t| {
-                    slot(m, item)?.y = number(t)?;
-                    Ok(())
-                }),
-                field("up z (m)", at, fmt_num(s.z), |m, item, t| {
-                    slot(m, item)?.z = number(t)?;
-                    Ok(())
-                }),
-            ]
-        }
-        Item::Waypoint(between) => {
-            let choice = find_choice(m, between);
-            let index = m
-                .reconfiguration
-                .waypoints
-                .iter()
-                .position(|w| Some(w) == choice);
-            let at = |key: &str| match index {
-                Some(i) => format!("reconfiguration.waypoints[{i}].{key}"),
-                None => "reconfiguration.waypoints".into(),
-            };
-            let enabled = choice.is_none_or(|c| c.enabled);
-            let chosen = choice.map_or(ShapeChoice::Auto, |c| c.shape);
-            let scale = choice
-                .and_then(|c| c.scale)
-                .map(fmt_num)
-                .unwrap_or_default();
-            vec![
-                field(
-                    "enabled",
-                    at("enabled"),
-                    if enabled { "yes" } else { "no" },
-                    |m, item, t| {
-                        waypoint_choice(m, item)?.enabled = yes_no(t)?;
-                        Ok(())
-                    },
-                ),
-                field("shape", at("shape"), shape_name(chosen), |m, item, t| {
-                    waypoint_choice(m, item)?.shape = shape(t)?;
-                    Ok(())
-                }),
-                field(
-                    "scale (blank: default)",
-                    at("scale"),
-                    scale,
-                    |m, item, t| {
-                        waypoint_choice(m, item)?.scale =
-                            if t.is_empty() { None } else { Some(number(t)?) };
-                        Ok(())
-                    },
-                ),
-            ]
-        }
-        Item::Squadron => squadron_fields(m),
-        Item::Fleet => fleet_fields(m),
-        Item::Terrain => terrain_fields(m),
-        Item::FleetTarget(i) => {
-            let Some(t) = m.fleet.targets.get(*i) else {
-                return Vec::new();
-            };
-            let at = |key: &str| format!("fleet.targets[{i}].{key}");
-            vec![
-                field("time (s)", at("time"), fmt_num(t.time), |m, item, t| {
-                    target(m, item)?.time = number(t)?;
-                    Ok(())
-                }),
-                field(
-                    "x (m)",
-                    at("position"),
-                    fmt_num(t.position.x),
-                    |m, item, t| {
-                        target(m, item)?.position.x = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "y (m)",
-                    at("position"),
-                    fmt_num(t.position.y),
-                    |m, item, t| {
-                        target(m, item)?.position.y = number(t)?;
-                        Ok(())
-                    },
-                ),
-            ]
-        }
-        Item::ThetaPso => {
-            let p = &m.theta_pso;
-            vec![
-                field(
-                    "swarm size",
-                    "theta_pso.swarm_size",
-                    p.swarm_size,
-                    |m, _, t| {
-                        m.theta_pso.swarm_size = count(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "waypoints",
-                    "theta_pso.waypoints",
-                    p.waypoints,
-                    |m, _, t| {
-                        m.theta_pso.waypoints = count(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "iterations",
-                    "theta_pso.iterations",
-                    p.iterations,
-                    |m, _, t| {
-                        m.theta_pso.iterations = count(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "inertia w",
-                    "theta_pso.inertia",
-                    fmt_num(p.inertia),
-                    |m, _, t| {
-                        m.theta_pso.inertia = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "cognitive c1",
-                    "theta_pso.cognitive",
-                    fmt_num(p.cognitive),
-                    |m, _, t| {
-                        m.theta_pso.cognitive = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "social c2",
-                    "theta_pso.social",
-                    fmt_num(p.social),
-                    |m, _, t| {
-                        m.theta_pso.social = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field("segments L", "theta_pso.segments", p.segments, |m, _, t| {
-                    m.theta_pso.segments = count(t)?;
-                    Ok(())
-                }),
-                field(
-                    "β1 length",
-                    "theta_pso.weight_length",
-                    fmt_num(p.weight_length),
-                    |m, _, t| {
-                        m.theta_pso.weight_length = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "β2 obstacle",
-                    "theta_pso.weight_obstacle",
-                    fmt_num(p.weight_obstacle),
-                    |m, _, t| {
-                        m.theta_pso.weight_obstacle = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "β3 altitude",
-                    "theta_pso.weight_altitude",
-                    fmt_num(p.weight_altitude),
-                    |m, _, t| {
-                        m.theta_pso.weight_altitude = number(t)?;
-                        Ok(())
-                    },
-                ),
-                field(
-                    "βR waypoints",
-                    "theta_pso.weight_waypoints",
-                    fmt_num(p.weight_waypoints),
-                    |m, _, t| {
-                        m.theta_pso.weight_waypoints = number(t)?;
-                        Ok(())
-                    },
-                ),
-            ]
-        }
-    }
-}
-
-fn target<'m>(
-    m: &'m mut Mission,
-    item: &Item,
-) -> Result<&'m mut crate::mission::FleetTarget, String> {
-    match item {
-        Item::FleetTarget(i) => m.fleet.targets.get_mut(*i).ok_or("no such target".into()),
-        _ => Err("not a fleet target".into()),
-    }
-}
-
-/// The fleet's parameters (Table 1 and the scenario); gains and the
-/// airframe stay in the file.
-fn fleet_fields(m: &Mission) -> Vec<Field> {
-    let p = &m.fleet;
-    vec![
-        field("agents n", "fleet.agents", p.agents, |m, _, t| {
-            m.fleet.agents = count(t)?;
-            Ok(())
-        }),
-        field(
-            "ρ target weight",
-            "fleet.rho",
-            fmt_num(p.rho),
-            |m, _, t| {
-                m.fleet.rho = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "σ steepness",
-            "fleet.sigma",
-            fmt_num(p.sigma),
-            |m, _, t| {
-                m.fleet.sigma = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "c safety (m)",
-            "fleet.safety_distance",
-            fmt_num(p.safety_distance),
-            |m, _, t| {
-                m.fleet.safety_distance = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "l neighbourhood (m)",
-            "fleet.neighbourhood",
-            fmt_num(p.neighbourhood),
-            |m, _, t| {
-                m.fleet.neighbourhood = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "d_obs detection (m)",
-            "fleet.detection_range",
-            fmt_num(p.detection_range),
-            |m, _, t| {
-                m.fleet.detection_range = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "h_max step (m)",
-            "fleet.step_max",
-            fmt_num(p.step_max),
-            |m, _, t| {
-                m.fleet.step_max = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "τ replan (s)",
-            "fleet.replan_period",
-            fmt_num(p.replan_period),
-            |m, _, t| {
-                m.fleet.replan_period = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "d_ip to target (m)",
-            "fleet.target_distance",
-            fmt_num(p.target_distance),
-            |m, _, t| {
-                m.fleet.target_distance = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "altitude (m)",
-            "fleet.altitude",
-            fmt_num(p.altitude),
-            |m, _, t| {
-                m.fleet.altitude = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "duration (s)",
-            "fleet.duration",
-            fmt_num(p.duration),
-            |m, _, t| {
-                m.fleet.duration = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "tolerance",
-            "fleet.tolerance",
-            fmt_num(p.tolerance),
-            |m, _, t| {
-                m.fleet.tolerance = number(t)?;
-                Ok(())
-            },
-        ),
-    ]
-}
-
-/// FLATLO's squadron: what the operator sets per mission; the airframe
-/// constants stay in the file.
-fn squadron_fields(m: &Mission) -> Vec<Field> {
-    let p = &m.flatlo;
-    vec![
-        field("aircraft N", "flatlo.aircraft", p.aircraft, |m, _, t| {
-            m.flatlo.aircraft = count(t)?;
-            Ok(())
-        }),
-        field(
-            "spacing Δd (m)",
-            "flatlo.spacing",
-            fmt_num(p.spacing),
-            |m, _, t| {
-                m.flatlo.spacing = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "airspeed (m/s)",
-            "flatlo.airspeed",
-            fmt_num(p.airspeed),
-            |m, _, t| {
-                m.flatlo.airspeed = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "turn radius r (m)",
-            "flatlo.turn_radius",
-            fmt_num(p.turn_radius),
-            |m, _, t| {
-                m.flatlo.turn_radius = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "heading φ (°)",
-            "flatlo.heading_deg",
-            fmt_num(p.heading_deg),
-            |m, _, t| {
-                m.flatlo.heading_deg = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "climb β (°)",
-            "flatlo.climb_deg",
-            fmt_num(p.climb_deg),
-            |m, _, t| {
-                m.flatlo.climb_deg = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "altitude (m)",
-            "flatlo.altitude",
-            fmt_num(p.altitude),
-            |m, _, t| {
-                m.flatlo.altitude = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "start x (m)",
-            "flatlo.start",
-            fmt_num(p.start.x),
-            |m, _, t| {
-                m.flatlo.start.x = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "start y (m)",
-            "flatlo.start",
-            fmt_num(p.start.y),
-            |m, _, t| {
-                m.flatlo.start.y = number(t)?;
-                Ok(())
-            },
-        ),
-        field(
-            "final leg K2 (m)",
-            "flatlo.final_leg",
-            fmt_num(p.final_leg),
-            |m, _, t| {
-                m.flatlo.final_leg = number(t)?;
-                Ok(())
-            },
-        ),
-        field("noise σ", "flatlo.noise", fmt_num(p.noise), |m, _, t| {
-            m.flatlo.noise = number(t)?;
-            Ok(())
-        }),
-        field(
-            "min separation (m)",
-            "flatlo.min_separation",
-            fmt_num(p.min_separation),
-            |m, _, t| {
-                m.flatlo.min_separation = number(t)?;
-                Ok(())
-            },
-        ),
-    ]
 }
 
 /// A new obstacle at `center` with a name not yet used.
@@ -1106,34 +377,6 @@ pub fn duplicate_obstacle(mission: &Mission, original: &Obstacle) -> Obstacle {
     copy
 }
 
-/// An `[origin]` value for the inspector: empty when the mission has none.
-fn origin_value(m: &Mission, get: fn(&crate::mission::GeoOrigin) -> f64) -> String {
-    m.origin
-        .as_ref()
-        .map_or_else(String::new, |o| fmt_num(get(o)))
-}
-
-/// Sets one `[origin]` value (creating the section at 0°, 0°, 0 m); an empty
-/// text removes the section (exports then offer CSV in ENU only).
-fn set_origin(
-    m: &mut Mission,
-    text: &str,
-    set: fn(&mut crate::mission::GeoOrigin, f64),
-) -> Result<(), String> {
-    if text.trim().is_empty() {
-        m.origin = None;
-        return Ok(());
-    }
-    let v = number(text)?;
-    let origin = m.origin.get_or_insert(crate::mission::GeoOrigin {
-        latitude: 0.0,
-        longitude: 0.0,
-        altitude: 0.0,
-    });
-    set(origin, v);
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1152,15 +395,20 @@ mod tests {
         ];
         for item in items {
             for (k, f) in fields(&item, &m).into_iter().enumerate() {
-                let value = if f.label.contains("shape") {
+                let value = if f.label().contains("shape") {
                     "shrink".to_string()
-                } else if f.value == "yes" || f.value == "no" {
+                } else if f.value() == "yes" || f.value() == "no" {
                     "yes".to_string()
                 } else {
                     "7".to_string()
                 };
                 f.set(&mut m, &item, &value).unwrap();
-                assert_eq!(fields(&item, &m)[k].value, value, "{item:?} {}", f.label);
+                assert_eq!(
+                    fields(&item, &m)[k].value(),
+                    value,
+                    "{item:?} {}",
+                    f.label()
+                );
             }
         }
     }
@@ -1169,7 +417,7 @@ mod tests {
     fn bad_text_is_refused_with_what_was_expected() {
         let mut m = default_mission().mission;
         let radius = &fields(&Item::Obstacle(0), &m)[4];
-        assert_eq!(radius.label, "radius (m)");
+        assert_eq!(radius.label(), "radius (m)");
         let before = m.clone();
         let err = radius.set(&mut m, &Item::Obstacle(0), "wide").unwrap_err();
         assert_eq!(err, "'wide' is not a number");
@@ -1183,6 +431,11 @@ mod tests {
         m.reconfiguration.waypoints.clear();
         let item = Item::Waypoint(["pier 5".into(), "light pole 4".into()]);
         let shape = &fields(&item, &m)[1];
+        assert!(shape.set(&mut m, &item, "round").is_err());
+        assert!(
+            m.reconfiguration.waypoints.is_empty(),
+            "not on a refused text"
+        );
         shape.set(&mut m, &item, "rotation").unwrap();
         assert_eq!(m.reconfiguration.waypoints.len(), 1);
         assert_eq!(m.reconfiguration.waypoints[0].shape, ShapeChoice::Rotation);
@@ -1191,6 +444,64 @@ mod tests {
         fields(&item, &m)[0].set(&mut m, &item, "no").unwrap();
         assert_eq!(m.reconfiguration.waypoints.len(), 1);
         assert!(!m.reconfiguration.waypoints[0].enabled);
+    }
+
+    /// Issue 13: a field's path is the typed path the validator reports on.
+    #[test]
+    fn each_field_is_at_the_typed_path_its_diagnostics_name() {
+        let mut m = default_mission().mission;
+        let at = |item: &Item, m: &Mission, label: &str| {
+            let f = fields(item, m).into_iter().find(|f| f.label() == label);
+            f.map(|f| f.path().to_string())
+        };
+        let obstacle = Item::Obstacle(3);
+        assert_eq!(
+            at(&obstacle, &m, "radius (m)").as_deref(),
+            Some("obstacles[3].radius")
+        );
+        assert_eq!(
+            at(&obstacle, &m, "stand-off max (m)").as_deref(),
+            Some("obstacles[3].stand_off")
+        );
+        assert_eq!(
+            at(&Item::Start, &m, "z (m)").as_deref(),
+            Some("route.start")
+        );
+        assert_eq!(
+            at(&Item::Formation, &m, "default shape").as_deref(),
+            Some("reconfiguration.default_shape")
+        );
+        assert_eq!(
+            at(&Item::Slot(2), &m, "up z (m)").as_deref(),
+            Some("formation.slots[2]")
+        );
+        // An IWP without an entry yet: the list it will be added to.
+        m.reconfiguration.waypoints.clear();
+        let iwp = Item::Waypoint(["pier 5".into(), "light pole 4".into()]);
+        assert_eq!(
+            at(&iwp, &m, "shape").as_deref(),
+            Some("reconfiguration.waypoints")
+        );
+        fields(&iwp, &m)[1].set(&mut m, &iwp, "shrink").unwrap();
+        assert_eq!(
+            at(&iwp, &m, "shape").as_deref(),
+            Some("reconfiguration.waypoints[0].shape")
+        );
+
+        // The validator's message on the radius is the radius field's.
+        m.obstacles[3].radius = -1.0;
+        let radius = &fields(&obstacle, &m)[4];
+        let found: Vec<_> = crate::diagnose::diagnose(&m)
+            .into_iter()
+            .filter(|d| d.path.starts_with(radius.path()))
+            .collect();
+        assert!(
+            found.iter().any(|d| d.message.contains("must be positive")),
+            "{found:?}"
+        );
+        assert_eq!(radius.unit(), "m");
+        // A missing item has no fields.
+        assert!(fields(&Item::Obstacle(99), &m).is_empty());
     }
 
     #[test]

@@ -63,8 +63,7 @@ pub fn app_with_result(mut mission: Mission, seed: u64, iterations: usize) -> Ap
         PathBuf::from("."),
     );
     let started = Instant::now();
-    app.jobs
-        .push(Job::new(1, Kind::ThetaPso, seed, mission, started));
+    app.adopt_job(Job::new(1, Kind::ThetaPso, seed, mission, started));
     let result = outcome
         .map(|o| Outcome::ThetaPso(Box::new(o)))
         .map_err(JobError::from);
@@ -80,8 +79,7 @@ pub fn app_with_flatlo_result(mission: Mission, seed: u64) -> App {
         PathBuf::from("."),
     );
     let started = Instant::now();
-    app.jobs
-        .push(Job::new(1, Kind::Flatlo, seed, mission, started));
+    app.adopt_job(Job::new(1, Kind::Flatlo, seed, mission, started));
     let result = outcome
         .map(|o| Outcome::Flatlo(Box::new(o)))
         .map_err(JobError::from);
@@ -92,14 +90,14 @@ pub fn app_with_flatlo_result(mission: Mission, seed: u64) -> App {
 /// Types `text` into the selected item's field labelled `label` and applies
 /// it, by actions as a user would (focus, arrows, typing, Enter).
 pub fn type_into(app: &mut App, label: &str, text: &str) {
-    let Some(k) = app.fields().iter().position(|f| f.label == label) else {
+    let Some(k) = app.fields().iter().position(|f| f.label() == label) else {
         panic!("no field {label}");
     };
     app.update(Action::FocusOn(Focus::Inspector));
-    while app.field > k {
+    while app.editor().field() > k {
         app.update(Action::FieldUp);
     }
-    while app.field < k {
+    while app.editor().field() < k {
         app.update(Action::FieldDown);
     }
     let mut chars = text.chars();

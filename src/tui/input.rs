@@ -7,11 +7,12 @@ use ratatui::crossterm::event::{
 use ratatui::layout::Position;
 
 use super::action::Action;
-use super::app::{App, Focus, Overlay, Pane, formation_extent};
+use super::app::{App, Focus, Overlay, Pane};
 use super::fields::Item;
 use super::keys::{self, Key};
 use super::view::Drawn;
 use super::view::map::Viewport;
+use super::view::viewport::formation_extent;
 
 /// The action for a key press, given what is on screen.
 pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
@@ -23,10 +24,10 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
     if ctrl && key.code == KeyCode::Char('c') {
         return Some(Action::Quit);
     }
-    if let Some(overlay) = &app.overlay {
+    if let Some(overlay) = app.overlay() {
         return overlay_key(overlay, key, ctrl);
     }
-    if app.editing.is_some() {
+    if app.editor().editing().is_some() {
         return match key.code {
             KeyCode::Enter | KeyCode::Tab => Some(Action::EditCommit),
             KeyCode::Esc => Some(Action::EditCancel),
@@ -45,13 +46,13 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
         }
         code => Key::Code(code),
     };
-    if let Some(binding) = keys::lookup(pressed, app.focus, app.pane) {
+    if let Some(binding) = keys::lookup(pressed, app.focus(), app.pane()) {
         return Some(binding.action.clone());
     }
     // In the inspector a number typed over a field replaces it.
     match pressed {
         Key::Char(c)
-            if app.focus == Focus::Inspector && (c.is_ascii_digit() || c == '-' || c == '.') =>
+            if app.focus() == Focus::Inspector && (c.is_ascii_digit() || c == '-' || c == '.') =>
         {
             Some(Action::EditStart(Some(c)))
         }
@@ -122,7 +123,7 @@ pub fn mouse_action(app: &App, mouse: MouseEvent, drawn: &Drawn) -> Option<Actio
     if mouse.kind == MouseEventKind::Up(MouseButton::Left) {
         return Some(Action::DragEnd);
     }
-    if app.overlay.is_some() {
+    if app.overlay().is_some() {
         return None;
     }
     let areas = drawn.areas;
@@ -133,7 +134,7 @@ pub fn mouse_action(app: &App, mouse: MouseEvent, drawn: &Drawn) -> Option<Actio
                 let (item, point) = hit(app, &drawn.canvas, mouse.column, mouse.row)?;
                 return match item {
                     Some(item) => Some(Action::DragStart(item, point)),
-                    None if app.add_tool && app.pane == Pane::Map => {
+                    None if app.editor().add_tool() && app.pane() == Pane::Map => {
                         Some(Action::AddObstacle(Some(point)))
                     }
                     None => Some(Action::FocusOn(Focus::Map)),
@@ -158,7 +159,7 @@ pub fn mouse_action(app: &App, mouse: MouseEvent, drawn: &Drawn) -> Option<Actio
             } else {
                 0.8
             };
-            let about = if app.pane == Pane::Map && !app.side_view {
+            let about = if app.pane() == Pane::Map && !app.side_view() {
                 drawn.canvas.to_world(mouse.column, mouse.row)
             } else {
                 None
@@ -171,7 +172,7 @@ pub fn mouse_action(app: &App, mouse: MouseEvent, drawn: &Drawn) -> Option<Actio
 
 /// Canvas point → the pane's plane (formation canvas is (−y, x)).
 fn to_pane(app: &App, p: nalgebra::Point2<f64>) -> nalgebra::Point2<f64> {
-    match app.pane {
+    match app.pane() {
         Pane::Map => p,
         Pane::Formation => nalgebra::Point2::new(p.y, -p.x),
     }
@@ -193,7 +194,7 @@ fn hit(
     column: u16,
     row: u16,
 ) -> Option<(Option<Item>, nalgebra::Point2<f64>)> {
-    if app.side_view && app.pane == Pane::Map {
+    if app.side_view() && app.pane() == Pane::Map {
         return None;
     }
     let canvas_point = vp.to_world(column, row)?;
@@ -207,7 +208,7 @@ fn hit(
             best = Some((d, item));
         }
     };
-    match app.pane {
+    match app.pane() {
         Pane::Map => {
             for (item, q) in [
                 (Item::Start, m.route.start.xy()),

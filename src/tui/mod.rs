@@ -1,16 +1,21 @@
 //! The terminal mission designer.
 //!
 //! The state/update/view split of ratatui's component apps: `app.rs` holds
-//! the state and its one mutator, `action.rs` the vocabulary of changes,
-//! `input.rs` turns keys and mouse into actions, `view/` draws the state, and
-//! `jobs.rs` runs pipelines on worker threads that report through a channel.
+//! the state (components that own theirs: `editor.rs`, `board.rs`,
+//! `overlay.rs`, `camera.rs`, `replay.rs`) and its one mutator, which hands
+//! each action to the component that owns it; `action.rs` is the vocabulary
+//! of changes, `input.rs` turns keys and mouse into actions, `view/` draws
+//! the state, and `jobs.rs` runs pipelines on worker threads that report
+//! through a channel.
 //! The loop below waits on input *or* job messages, so it never spins while
 //! idle and never blocks while a job runs.
 
 pub mod action;
 pub mod app;
+pub mod board;
 pub mod camera;
 pub mod document;
+pub mod editor;
 pub mod export;
 pub mod fields;
 #[doc(hidden)]
@@ -18,8 +23,10 @@ pub mod fixtures;
 pub mod input;
 pub mod jobs;
 pub mod keys;
+pub mod overlay;
 pub mod recovery;
 pub mod replay;
+pub mod status;
 pub mod view;
 
 use std::io::{self, IsTerminal};
@@ -106,10 +113,7 @@ pub fn run(path: Option<PathBuf>) -> Result<u8, String> {
     let cwd = std::env::current_dir().unwrap_or_else(|_| PathBuf::from("."));
     let mut app = App::new(doc, cwd);
     if let Some(note) = note {
-        app.status = Some(app::Status {
-            text: note,
-            error: true,
-        });
+        app.show_error(note);
     }
     app.enable_recovery(match &path {
         Some(p) => recovery::Origin::File(p.clone()),
@@ -219,7 +223,7 @@ fn event_loop(
         if redraw {
             terminal.draw(|frame| drawn = view::draw(frame, app, Instant::now()))?;
         }
-        if app.should_quit {
+        if app.should_quit() {
             return Ok(code);
         }
         let tick = if app.wants_tick() {

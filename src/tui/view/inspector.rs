@@ -8,7 +8,7 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, BorderType, Borders, Paragraph, Wrap};
 
 use crate::mission::Severity;
-use crate::tui::app::{App, Focus, concerns};
+use crate::tui::app::{App, Focus};
 use crate::tui::fields::Item;
 
 fn severity_span(severity: Severity, text: String) -> Span<'static> {
@@ -22,41 +22,22 @@ fn severity_span(severity: Severity, text: String) -> Span<'static> {
     }
 }
 
-/// The mission path prefix of an item: diagnostics under it that no field
-/// claims are listed at the bottom.
-fn item_path(item: &Item) -> Option<String> {
-    match item {
-        Item::Obstacle(i) => Some(format!("obstacles[{i}]")),
-        Item::Bounds => Some("bounds".into()),
-        Item::Start => Some("route.start".into()),
-        Item::Goal => Some("route.goal".into()),
-        Item::Terrain => Some("terrain".into()),
-        Item::Formation => Some("formation".into()),
-        Item::Slot(i) => Some(format!("formation.slots[{i}]")),
-        Item::ThetaPso => Some("theta_pso".into()),
-        Item::Squadron => Some("flatlo".into()),
-        Item::Fleet => Some("fleet".into()),
-        Item::FleetTarget(i) => Some(format!("fleet.targets[{i}]")),
-        Item::Mission | Item::Waypoint(_) => None,
-    }
-}
-
 pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
-    let focused = app.focus == Focus::Inspector;
+    let focused = app.focus() == Focus::Inspector;
     let m = app.mission();
     let fields = app.fields();
-    let diagnostics = app.doc.diagnostics();
+    let diagnostics = app.doc().diagnostics();
     let label_width = fields
         .iter()
-        .map(|f| f.label.chars().count())
+        .map(|f| f.label().chars().count())
         .max()
         .unwrap_or(0);
     let mut lines: Vec<Line> = Vec::new();
     let mut cursor_line = 0;
     for (k, f) in fields.iter().enumerate() {
-        let cursor = k == app.field;
-        let editing = cursor && app.editing.is_some();
-        let label = format!("{:<label_width$}  ", f.label);
+        let cursor = k == app.editor().field();
+        let editing = cursor && app.editor().editing().is_some();
+        let label = format!("{:<label_width$}  ", f.label());
         let label_style = if cursor && focused {
             Style::default().black().on_yellow()
         } else if cursor {
@@ -64,38 +45,35 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         } else {
             Style::default().fg(Color::Gray)
         };
-        let value = match (&app.editing, editing) {
+        let value = match (app.editor().editing(), editing) {
             (Some(e), true) => {
                 Span::styled(format!("{}▏", e.buffer), Style::default().white().on_blue())
             }
-            _ => Span::raw(f.value.clone()),
+            _ => Span::raw(f.value().to_owned()),
         };
         if cursor {
             cursor_line = lines.len();
         }
         lines.push(Line::from(vec![Span::styled(label, label_style), value]));
         if editing {
-            if let Some(Some((severity, text))) = app.editing.as_ref().map(|e| e.problem.clone()) {
+            if let Some(Some((severity, text))) = app.editor().editing().map(|e| e.problem.clone())
+            {
                 lines.push(Line::from(severity_span(severity, text)));
             }
         } else {
             // Show each message once, under the first field it concerns.
-            let first_with_path = fields.iter().position(|g| g.path == f.path) == Some(k);
+            let first_with_path = fields.iter().position(|g| g.path() == f.path()) == Some(k);
             if first_with_path {
-                for d in diagnostics
-                    .iter()
-                    .filter(|d| concerns(&d.path.to_string(), &f.path))
-                {
+                for d in diagnostics.iter().filter(|d| d.path.starts_with(f.path())) {
                     lines.push(Line::from(severity_span(d.severity, d.message.clone())));
                 }
             }
         }
     }
     // Messages about the item that no field shows (e.g. an obstacle outside the bounds).
-    if let Some(prefix) = item_path(&app.selected) {
+    if let Some(prefix) = app.selected().path() {
         for d in diagnostics.iter().filter(|d| {
-            let p = d.path.to_string();
-            concerns(&p, &prefix) && !fields.iter().any(|f| concerns(&p, &f.path))
+            d.path.starts_with(&prefix) && !fields.iter().any(|f| d.path.starts_with(f.path()))
         }) {
             lines.push(Line::from(severity_span(
                 d.severity,
@@ -103,8 +81,8 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
             )));
         }
     }
-    if app.selected == Item::Mission {
-        let errors = app.doc.error_count();
+    if *app.selected() == Item::Mission {
+        let errors = app.doc().error_count();
         let warnings = diagnostics.len() - errors;
         lines.push(Line::raw(""));
         lines.push(Line::from(vec![
@@ -132,7 +110,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         }
     }
     lines.push(Line::raw(""));
-    let hint = if app.editing.is_some() {
+    let hint = if app.editor().editing().is_some() {
         "Enter apply · Esc cancel"
     } else {
         "↑↓ field · Enter/type to edit · n/p next/prev item"
@@ -150,7 +128,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         .border_style(Style::default().fg(border))
         .title(Line::from(vec![
             Span::styled(" Inspector ", Style::default().bold()),
-            Span::raw(format!("· {} ", app.selected.title(m))),
+            Span::raw(format!("· {} ", app.selected().title(m))),
         ]));
     // Keep the cursor visible in a long list.
     let inner_height = area.height.saturating_sub(2) as usize;

@@ -46,13 +46,13 @@ fn state_span(job: &Job) -> Span<'static> {
 }
 
 pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
-    let focused = app.focus == Focus::Jobs;
+    let focused = app.focus() == Focus::Jobs;
     let border = if focused {
         Color::Yellow
     } else {
         Color::DarkGray
     };
-    let rec = match (app.record_rrd, app.viewer) {
+    let rec = match (app.board().record_rrd(), app.board().viewer()) {
         (false, crate::tui::jobs::Viewer::Off) => String::new(),
         (rrd, viewer) => format!(
             "· rec{}{} ",
@@ -74,7 +74,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         ]));
     let inner = block.inner(area);
     frame.render_widget(block, area);
-    if app.jobs.is_empty() {
+    if app.jobs().is_empty() {
         // The Run keys of the key table, each with its help up to any
         // parenthesis.
         let mut text = vec![Line::raw("No runs yet.")];
@@ -100,22 +100,25 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         frame.render_widget(Paragraph::new(text), inner);
         return;
     }
-    let list_height = (app.jobs.len() as u16).min(inner.height / 3).max(1);
+    let list_height = (app.jobs().len() as u16).min(inner.height / 3).max(1);
     let [list, detail] =
         Layout::vertical([Constraint::Length(list_height), Constraint::Min(0)]).areas(inner);
 
     // The list, scrolled to keep the cursor in view.
-    let first = app.job_cursor.saturating_sub(list_height as usize - 1);
+    let first = app
+        .board()
+        .cursor()
+        .saturating_sub(list_height as usize - 1);
     let bar_width = (inner.width as usize).saturating_sub(50).clamp(4, 12);
     let lines: Vec<Line> = app
-        .jobs
+        .jobs()
         .iter()
         .enumerate()
         .skip(first)
         .take(list_height as usize)
         .map(|(k, job)| {
-            let cursor = k == app.job_cursor;
-            let shown = app.shown_job == Some(job.id);
+            let cursor = k == app.board().cursor();
+            let shown = app.board().shown_id() == Some(job.id);
             let head = format!(
                 "{}{}{:>2} {} s{:<3} ",
                 if cursor { "▶" } else { " " },
@@ -145,7 +148,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         .collect();
     frame.render_widget(Paragraph::new(lines), list);
 
-    let Some(job) = app.jobs.get(app.job_cursor) else {
+    let Some(job) = app.jobs().get(app.board().cursor()) else {
         return;
     };
     let mut facts: Vec<Line> = Vec::new();

@@ -171,7 +171,7 @@ fn paint_fleet(ctx: &mut Context, app: &App, o: &FleetOutcome, stale: bool, dot:
 /// The top-down map (or the side view when toggled).
 /// The map in `area`, drawn through `vp` (the viewport `Drawn` reports).
 pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
-    if app.side_view {
+    if app.side_view() {
         return draw_side(frame, app, area);
     }
     let m = app.mission();
@@ -194,7 +194,7 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
             Style::default().black().on_cyan(),
         ));
     }
-    if app.add_tool {
+    if app.editor().add_tool() {
         title.push(Span::styled(
             " ADD: click to place ",
             Style::default().black().on_green(),
@@ -231,7 +231,7 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     if let Some(ground) = super::terrain::legend(m) {
         title.push(ground);
     }
-    let block = pane_block(TextLine::from(title), app.focus == Focus::Map);
+    let block = pane_block(TextLine::from(title), app.focus() == Focus::Map);
     let dot = scale / 2.0;
     let canvas = Canvas::default()
         .block(block)
@@ -302,7 +302,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
         }
     }
     for (i, o) in m.obstacles.iter().enumerate() {
-        let selected = app.selected == Item::Obstacle(i);
+        let selected = *app.selected() == Item::Obstacle(i);
         let color = if selected {
             Color::Yellow
         } else if o.inspect {
@@ -343,7 +343,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
             color: Color::Blue,
         });
     } else if let Some(job) = app
-        .jobs
+        .jobs()
         .iter()
         .rev()
         .find(|j| j.is_running() && !j.live_path.is_empty())
@@ -402,7 +402,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
         paint_squadron(ctx, o, stale, dot);
     }
     for (k, t) in m.fleet.targets.iter().enumerate() {
-        let style = if app.selected == Item::FleetTarget(k) {
+        let style = if *app.selected() == Item::FleetTarget(k) {
             Style::default().black().on_yellow().bold()
         } else {
             Style::default().fg(Color::Yellow).bold()
@@ -509,7 +509,7 @@ fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
         labels.reserve(t.position.x, t.position.y, 2);
     }
     // IWPs (eq. 9): enabled ones bright, disabled ones dim.
-    for w in &app.iwps {
+    for w in app.iwps() {
         let (glyph, style) = if w.enabled {
             ("◆", Style::default().fg(Color::LightCyan))
         } else {
@@ -521,7 +521,7 @@ fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
     // Obstacle names, right of the obstacle or else left of it, where they
     // cover no other text; the selected one's first.
     if m.obstacles.len() <= 40 {
-        let selected = match app.selected {
+        let selected = match *app.selected() {
             Item::Obstacle(i) => Some(i),
             _ => None,
         };
@@ -553,7 +553,7 @@ fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
         }
     }
     let marker = |item: Item, glyph: &'static str, color: Color| {
-        let style = if app.selected == item {
+        let style = if *app.selected() == item {
             Style::default().black().bg(color).bold()
         } else {
             Style::default().fg(color).bold()
@@ -678,7 +678,7 @@ fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
     ]);
     let stale = result.as_ref().is_some_and(|(_, s)| *s);
     let canvas = Canvas::default()
-        .block(pane_block(title, app.focus == Focus::Map))
+        .block(pane_block(title, app.focus() == Focus::Map))
         .marker(Marker::Braille)
         .x_bounds([-0.02 * length, 1.02 * length])
         .y_bounds([0.0, top])
@@ -801,7 +801,7 @@ fn iwp_table_is_narrow(area: Rect) -> bool {
 
 /// The formation editor's drawing (top) and IWP table (bottom).
 pub fn formation_split(app: &App, area: Rect) -> [Rect; 2] {
-    let n = app.iwps.len() as u16;
+    let n = app.iwps().len() as u16;
     // Borders, plus a header row or a second line per IWP.
     let wanted = if iwp_table_is_narrow(area) {
         2 * n + 2
@@ -833,7 +833,7 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     ]);
     let dot = vp.metres_per_column() / 2.0;
     let canvas = Canvas::default()
-        .block(pane_block(title, app.focus == Focus::Map))
+        .block(pane_block(title, app.focus() == Focus::Map))
         .marker(Marker::Braille)
         .x_bounds(vp.x)
         .y_bounds(vp.y)
@@ -850,7 +850,7 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
             });
             ctx.layer();
             for (i, s) in m.formation.slots.iter().enumerate() {
-                let selected = app.selected == Item::Slot(i);
+                let selected = *app.selected() == Item::Slot(i);
                 let color = if selected {
                     Color::Yellow
                 } else {
@@ -880,10 +880,10 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
 
     let narrow = iwp_table_is_narrow(bottom);
     let rows: Vec<Row> = app
-        .iwps
+        .iwps()
         .iter()
         .map(|w| {
-            let selected = app.selected == Item::Waypoint(w.between.clone());
+            let selected = *app.selected() == Item::Waypoint(w.between.clone());
             let style = if selected {
                 Style::default().black().on_yellow()
             } else if w.enabled {
@@ -921,7 +921,7 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
             .style(style)
         })
         .collect();
-    let empty = app.iwps.is_empty();
+    let empty = app.iwps().is_empty();
     let title = match (empty, narrow) {
         (true, false) => " IWPs (eq. 9): none: no gap narrower than the formation ",
         (true, true) => " IWPs (eq. 9): none ",

@@ -67,7 +67,7 @@ impl Drawn {
     /// screen is too small for the designer.
     pub fn of(app: &App, screen: Rect) -> Option<Drawn> {
         let areas = layout(screen)?;
-        let canvas = match app.pane {
+        let canvas = match app.pane() {
             Pane::Map => map::Viewport::map(app, areas.left),
             Pane::Formation => {
                 map::Viewport::formation(app, map::formation_split(app, areas.left)[0])
@@ -97,24 +97,24 @@ pub fn draw(frame: &mut Frame, app: &App, now: Instant) -> Option<Drawn> {
         return None;
     };
     let areas = drawn.areas;
-    match app.pane {
+    match app.pane() {
         Pane::Map => map::draw_map(frame, app, areas.left, &drawn.canvas),
         Pane::Formation => map::draw_formation(frame, app, areas.left, &drawn.canvas),
     }
     inspector::draw(frame, app, areas.inspector);
     jobs::draw(frame, app, areas.jobs, now);
     draw_status(frame, app, areas.status);
-    if let Some(overlay) = &app.overlay {
+    if let Some(overlay) = app.overlay() {
         draw_overlay(frame, app, overlay, area);
     }
     Some(drawn)
 }
 
 fn draw_status(frame: &mut Frame, app: &App, area: Rect) {
-    let modified = app.doc.is_modified();
+    let modified = app.doc().is_modified();
     let mut spans = vec![
         Span::styled(
-            format!(" {} ", app.doc.title()),
+            format!(" {} ", app.doc().title()),
             Style::default().black().on_gray(),
         ),
         if modified {
@@ -123,7 +123,7 @@ fn draw_status(frame: &mut Frame, app: &App, area: Rect) {
             Span::raw(" ")
         },
     ];
-    let errors = app.doc.error_count();
+    let errors = app.doc().error_count();
     if errors > 0 {
         spans.push(Span::styled(
             format!(" {errors} error(s) "),
@@ -131,7 +131,7 @@ fn draw_status(frame: &mut Frame, app: &App, area: Rect) {
         ));
     }
     spans.push(Span::raw(" "));
-    if let Some(status) = &app.status {
+    if let Some(status) = app.status() {
         let style = if status.error {
             Style::default().light_red().bold()
         } else {
@@ -139,8 +139,8 @@ fn draw_status(frame: &mut Frame, app: &App, area: Rect) {
         };
         spans.push(Span::styled(status.text.clone(), style));
     }
-    let hints = match (app.focus, app.pane) {
-        _ if app.editing.is_some() => "Enter apply · Esc cancel",
+    let hints = match (app.focus(), app.pane()) {
+        _ if app.editor().editing().is_some() => "Enter apply · Esc cancel",
         (Focus::Map, Pane::Map) => "n/p select · arrows move · a add · r run · ? help",
         (Focus::Map, Pane::Formation) => "n/p select · arrows move · P preset · s shape · ? help",
         (Focus::Inspector, _) => "↑↓ field · Enter edit · Tab focus · ? help",
@@ -314,7 +314,7 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
             // Taller than the screen: it scrolls (↑ ↓ PgUp PgDn), and says so.
             let fits = height <= r.height;
             let max_scroll = content.saturating_sub(r.height.saturating_sub(2));
-            let scroll = app.help_scroll.min(max_scroll);
+            let scroll = app.help_scroll().min(max_scroll);
             let title = if fits {
                 "Keys · any key closes".to_owned()
             } else {
@@ -351,7 +351,7 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
         }
         Overlay::Quit => {
             let lines = vec![
-                Line::raw(format!("{} has unsaved changes.", app.doc.title())),
+                Line::raw(format!("{} has unsaved changes.", app.doc().title())),
                 Line::raw(""),
                 hints(&[
                     ("s", " save and quit   "),
@@ -364,7 +364,7 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
         }
         Overlay::SaveAs { input, .. } => {
             let lines = vec![
-                Line::raw(format!("File (relative to {}):", app.cwd.display())),
+                Line::raw(format!("File (relative to {}):", app.cwd().display())),
                 Line::from(Span::styled(
                     format!("{input}▏"),
                     Style::default().white().on_blue(),
@@ -425,8 +425,8 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
             ])];
             let typed_only = !input.trim().is_empty()
                 && matches.len() == 1
-                && matches!(&matches[0], super::app::Entry::File(p)
-                    if *p == super::app::typed_path(&app.cwd, input));
+                && matches!(&matches[0], super::overlay::Entry::File(p)
+                    if *p == super::overlay::typed_path(app.cwd(), input));
             lines.extend(
                 matches
                     .iter()
@@ -434,7 +434,7 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                     .skip(first)
                     .take(room)
                     .map(|(k, e)| {
-                        let mut label = super::app::entry_label(e, &app.cwd);
+                        let mut label = super::overlay::entry_label(e, app.cwd());
                         if typed_only {
                             label = format!("{label}  (not listed: Enter opens this path)");
                         }

@@ -8,7 +8,9 @@
 use nalgebra::Point2;
 use ratatui::layout::{Margin, Rect};
 
-use crate::tui::app::{App, formation_extent};
+use crate::geometry::farthest_offset;
+use crate::mission::Mission;
+use crate::tui::app::App;
 
 /// A rectangle of the screen and the piece of the plane it shows.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,6 +83,11 @@ impl Viewport {
             self.y[1] - fy * (self.y[1] - self.y[0]) / r.height as f64,
         ))
     }
+}
+
+/// The formation's radius (for drawing and hit-testing slots).
+pub fn formation_extent(m: &Mission) -> f64 {
+    farthest_offset(&m.formation.slots).max(1.0)
 }
 
 #[cfg(test)]

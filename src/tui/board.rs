@@ -1,0 +1,283 @@
+//! The job board: the runs of this session (`jobs.rs` runs each on its own
+//! thread), the cursor in their list, the one whose result the map shows,
+//! and how runs are recorded (an `.rrd` beside the mission, a Rerun viewer).
+//!
+//! It owns the channel the workers report through; the main loop waits on
+//! [`JobBoard::messages`] and hands each message back to [`JobBoard::on_msg`].
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crossbeam_channel::{Receiver, Sender, unbounded};
+
+use super::action::Action;
+use super::document::{Document, slug};
+use super::jobs::{self, Job, JobId, JobMsg, Kind, RecordSettings, Viewer};
+use super::status::StatusLine;
+use crate::pipeline::Level;
+
+pub struct JobBoard {
+    jobs: Vec<Job>,
+    /// The selected row of the jobs panel.
+    cursor: usize,
+    /// The job whose result the map shows.
+    shown: Option<JobId>,
+    /// Record runs to an `.rrd` beside the mission.
+    record_rrd: bool,
+    viewer: Viewer,
+    tx: Sender<JobMsg>,
+    rx: Receiver<JobMsg>,
+}
+
+impl Default for JobBoard {
+    fn default() -> Self {
+        let (tx, rx) = unbounded();
+        JobBoard {
+            jobs: Vec::new(),
+            cursor: 0,
+            shown: None,
+            record_rrd: false,
+            viewer: Viewer::Off,
+            tx,
+            rx,
+        }
+    }
+}
+
+impl JobBoard {
+    pub fn jobs(&self) -> &[Job] {
+        &self.jobs
+    }
+
+    /// The selected row: an index into [`JobBoard::jobs`].
+    pub fn cursor(&self) -> usize {
+        self.cursor
+    }
+
+    /// The id of the job whose result the map shows.
+    pub fn shown_id(&self) -> Option<JobId> {
+        self.shown
+    }
+
+    /// The job whose result is on the map.
+    pub fn shown(&self) -> Option<&Job> {
+        let id = self.shown?;
+        self.jobs.iter().find(|j| j.id == id)
+    }
+
+    pub fn record_rrd(&self) -> bool {
+        self.record_rrd
+    }
+
+    pub fn viewer(&self) -> Viewer {
+        self.viewer
+    }
+
+    /// The channel the workers report through.
+    pub fn messages(&self) -> &Receiver<JobMsg> {
+        &self.rx
+    }
+
+    pub fn any_running(&self) -> bool {
+        self.jobs.iter().any(Job::is_running)
+    }
+
+    /// Lists a job that runs elsewhere (a run planned synchronously for a
+    /// test or the benchmark), selected as a started run is; its messages
+    /// come through [`JobBoard::on_msg`].
+    pub fn adopt(&mut self, job: Job) {
+        self.jobs.push(job);
+        self.cursor = self.jobs.len() - 1;
+    }
+
+    /// Shows the selected job's result; false when there is no job.
+    pub fn show_selected(&mut self) -> bool {
+        match self.jobs.get(self.cursor) {
+            Some(job) => {
+                self.shown = Some(job.id);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Cancels the running jobs (they return their best at once).
+    pub fn cancel_all(&self) {
+        for job in self.jobs.iter().filter(|j| j.is_running()) {
+            job.cancel.cancel();
+        }
+    }
+
+    /// Another mission is open: its jobs are not "stale" but gone.
+    pub fn clear(&mut self) {
+        self.cancel_all();
+        self.jobs.clear();
+        self.cursor = 0;
+        self.shown = None;
+    }
+
+    /// Starts, cancels, selects or configures runs for one action (the
+    /// others are not the board's). `doc` is what a run plans; `cwd` where
+    /// the recording of a mission without a file goes.
+    pub fn update(&mut self, action: Action, doc: &Document, cwd: &Path, status: &mut StatusLine) {
+        use Action::*;
+        let seed = doc.mission().seed;
+        match action {
+            Run => self.run(Kind::ThetaPso, seed, doc, cwd, status),
+            RunFlatlo => self.run(Kind::Flatlo, seed, doc, cwd, status),
+            RunFleet => self.run(Kind::Fleet, seed, doc, cwd, status),
+            RunNewSeed => {
+                let seed = self
+                    .jobs
+                    .iter()
+                    .map(|j| j.seed)
+                    .max()
+                    .map_or(seed.wrapping_add(1), |s| s.wrapping_add(1));
+                let pipeline = self.jobs.last().map_or(Kind::ThetaPso, |j| j.pipeline);
+                self.run(pipeline, seed, doc, cwd, status);
+            }
+            Cancel => self.cancel(status),
+            JobUp => self.cursor = self.cursor.saturating_sub(1),
+            JobDown => self.cursor = (self.cursor + 1).min(self.jobs.len().saturating_sub(1)),
+            ToggleRecording => {
+                self.record_rrd = !self.record_rrd;
+                status.say(if self.record_rrd {
+                    "runs are recorded to an .rrd beside the mission"
+                } else {
+                    "runs are not recorded"
+                });
+            }
+            CycleViewer => self.cycle_viewer(status),
+            _ => {}
+        }
+    }
+
+    fn cancel(&self, status: &mut StatusLine) {
+        let target = self
+            .jobs
+            .get(self.cursor)
+            .filter(|j| j.is_running())
+            .or_else(|| self.jobs.iter().rev().find(|j| j.is_running()));
+        match target {
+            Some(job) => {
+                job.cancel.cancel();
+                status.say(format!("cancelling job {}…", job.id));
+            }
+            None => status.say("no job is running"),
+        }
+    }
+
+    fn cycle_viewer(&mut self, status: &mut StatusLine) {
+        self.viewer = self.viewer.next();
+        status.say(match self.viewer {
+            Viewer::Off => "no Rerun viewer",
+            Viewer::Connect => "runs stream to a running Rerun viewer (rerun --port 9876)",
+            Viewer::Spawn => "runs start a Rerun viewer (`rerun` on PATH)",
+        });
+        // Say now when the viewer cannot be reached, not at the run.
+        #[cfg(feature = "rerun")]
+        if self.viewer != Viewer::Off
+            && let Some(problem) = crate::record::viewer_problem(self.viewer == Viewer::Spawn)
+        {
+            status.error(format!("warning: {problem}"));
+        }
+    }
+
+    fn run(
+        &mut self,
+        pipeline: Kind,
+        seed: u64,
+        doc: &Document,
+        cwd: &Path,
+        status: &mut StatusLine,
+    ) {
+        let errors = doc.error_lines();
+        if let Some(first) = errors.first() {
+            status.error(format!(
+                "cannot run: {} error(s) in the mission; first: {first}",
+                errors.len()
+            ));
+            return;
+        }
+        let id = self.jobs.last().map_or(1, |j| j.id + 1);
+        let job = Job::new(id, pipeline, seed, doc.mission().clone(), Instant::now());
+        let record = RecordSettings {
+            rrd: self
+                .record_rrd
+                .then(|| rrd_path(doc, cwd, pipeline.slug(), seed)),
+            viewer: self.viewer,
+        };
+        jobs::spawn_pipeline(
+            id,
+            pipeline,
+            job.mission.clone(),
+            seed,
+            job.cancel.clone(),
+            record,
+            self.tx.clone(),
+        );
+        self.jobs.push(job);
+        self.cursor = self.jobs.len() - 1;
+        status.say(format!(
+            "job {id}: {} started with seed {seed} (x cancels)",
+            pipeline.name()
+        ));
+    }
+
+    /// Applies a worker's message (`now` stamps job ends). True when a run
+    /// finished and its result is now the one shown.
+    pub fn on_msg(&mut self, msg: JobMsg, now: Instant, status: &mut StatusLine) -> bool {
+        let id = msg.job();
+        let note = match &msg {
+            JobMsg::Log(_, Level::Warn, text) => Some((true, format!("job {id}: {text}"))),
+            JobMsg::Recorded { path, bytes, .. } => Some((
+                false,
+                format!(
+                    "job {id}: recorded {} ({:.1} MB)",
+                    path.display(),
+                    *bytes as f64 / 1e6
+                ),
+            )),
+            JobMsg::Done(_, Err(e)) => Some((true, format!("job {id} failed: {e}"))),
+            _ => None,
+        };
+        let done = matches!(msg, JobMsg::Done(_, Ok(_)));
+        let mut shown = false;
+        if let Some(job) = self.jobs.iter_mut().find(|j| j.id == id) {
+            job.apply(msg, now);
+            if done {
+                let verb = if job.state == jobs::JobState::Cancelled {
+                    "cancelled"
+                } else {
+                    "done"
+                };
+                let text = match &job.outcome {
+                    Some(o) => format!("job {id} {verb}: {}", o.headline()),
+                    None => format!("job {id} {verb}"),
+                };
+                self.shown = Some(id);
+                shown = true;
+                status.say(text);
+            }
+        }
+        if let Some((error, text)) = note {
+            status.set(text, error);
+        }
+        shown
+    }
+}
+
+/// `<mission file stem>-<pipeline>-seed<N>.rrd` beside the mission file
+/// (in `cwd` for a mission without one).
+pub fn rrd_path(doc: &Document, cwd: &Path, pipeline: &str, seed: u64) -> PathBuf {
+    let (dir, stem) = match doc.path() {
+        Some(p) => (
+            p.parent().map(Path::to_path_buf).unwrap_or_default(),
+            p.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| slug(&doc.mission().name)),
+        ),
+        None => (cwd.to_path_buf(), slug(&doc.mission().name)),
+    };
+    dir.join(format!("{stem}-{pipeline}-seed{seed}.rrd"))
+}

@@ -1,0 +1,687 @@
+//! The document and the inspector as one component: the mission being
+//! edited (with its undo history), the IWPs found in it, what is selected,
+//! the inspector's field cursor and the line being typed, the add tool, the
+//! formation preset and a drag in progress.
+//!
+//! One component because every edit goes through the selection (a nudge
+//! moves the selected item, the inspector edits its fields) and every edit
+//! must leave the selection valid and the IWPs current ([`Editor::refresh`]).
+//! The rest of the screen reaches it through [`Editor::update`] and reads it
+//! through its accessors.
+
+use std::path::PathBuf;
+
+use nalgebra::{Point2, Vector2, Vector3};
+
+use super::action::{Action, Pane};
+use super::document::Document;
+use super::fields::{self, Field, Item};
+use super::status::StatusLine;
+use crate::mission::{self, FleetTarget, Mission, MissionError, PathSegment, Preset, Severity};
+use crate::planner::iwp::{self, min_pair_distance};
+use crate::planner::{Iwp, find_iwps};
+
+/// A line of text being typed into an inspector field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Editing {
+    pub buffer: String,
+    /// Why the text cannot be used, or the validation message it would cause
+    /// (updated on every key).
+    pub problem: Option<(Severity, String)>,
+}
+
+/// A drag in progress: the item and where it was grabbed relative to its position.
+#[derive(Debug, Clone, PartialEq)]
+struct Drag {
+    item: Item,
+    grab: Vector2<f64>,
+}
+
+/// What the editor needs to know of the screen around it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Surroundings {
+    /// The left pane on screen (which items n/p cycle through).
+    pub pane: Pane,
+    /// The nudge step, metres (nudges and drags snap to it).
+    pub step: f64,
+    /// Where the map looks, when it was panned (a new obstacle goes there).
+    pub panned_center: Option<Point2<f64>>,
+}
+
+/// What an action of the editor asks of the screen around it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Request {
+    /// Show the map (an obstacle was added).
+    ShowMap,
+    /// Focus the inspector (typing into a field began).
+    FocusInspector,
+}
+
+pub struct Editor {
+    doc: Document,
+    /// The IWPs of the current mission (eq. 9), refreshed on every change;
+    /// empty while the mission has errors.
+    iwps: Vec<Iwp>,
+    selected: Item,
+    /// Inspector cursor.
+    field: usize,
+    editing: Option<Editing>,
+    /// Clicking an empty spot of the map places an obstacle.
+    add_tool: bool,
+    preset: Preset,
+    drag: Option<Drag>,
+}
+
+impl Editor {
+    pub fn new(doc: Document) -> Self {
+        let mut editor = Editor {
+            doc,
+            iwps: Vec::new(),
+            selected: Item::Mission,
+            field: 0,
+            editing: None,
+            add_tool: false,
+            preset: Preset::Triangle,
+            drag: None,
+        };
+        editor.refresh();
+        editor
+    }
+
+    pub fn doc(&self) -> &Document {
+        &self.doc
+    }
+
+    pub fn mission(&self) -> &Mission {
+        self.doc.mission()
+    }
+
+    pub fn iwps(&self) -> &[Iwp] {
+        &self.iwps
+    }
+
+    pub fn selected(&self) -> &Item {
+        &self.selected
+    }
+
+    /// The inspector's cursor: an index into [`Editor::fields`].
+    pub fn field(&self) -> usize {
+        self.field
+    }
+
+    pub fn editing(&self) -> Option<&Editing> {
+        self.editing.as_ref()
+    }
+
+    pub fn add_tool(&self) -> bool {
+        self.add_tool
+    }
+
+    /// The inspector's fields for the selection.
+    pub fn fields(&self) -> Vec<Field> {
+        fields::fields(&self.selected, self.mission())
+    }
+
+    /// Another document (a mission opened): the selection goes back to the
+    /// mission item.
+    pub fn replace(&mut self, doc: Document) {
+        self.doc = doc;
+        self.selected = Item::Mission;
+        self.field = 0;
+        self.editing = None;
+        self.refresh();
+    }
+
+    /// Puts `mission` in place of the document's as one undo step (the
+    /// recovery copy, restored).
+    pub fn restore(&mut self, mission: Mission) {
+        self.doc.edit(|m| *m = mission);
+        self.refresh();
+    }
+
+    /// Saves the document to `path` (which becomes its file).
+    pub fn save(&mut self, path: PathBuf) -> Result<PathBuf, MissionError> {
+        self.doc.save(Some(path))
+    }
+
+    /// Stops typing into a field; false if nothing was being typed.
+    pub fn cancel_edit(&mut self) -> bool {
+        self.editing.take().is_some()
+    }
+
+    pub fn stop_add_tool(&mut self) {
+        self.add_tool = false;
+    }
+
+    /// Keeps the selection among the items `pane` shows (the map's when it
+    /// is not one of them, the formation's likewise).
+    pub fn keep_selection_in(&mut self, pane: Pane) {
+        let (items, fallback) = match pane {
+            Pane::Map => (fields::map_items(self.mission()), Item::Bounds),
+            Pane::Formation => (
+                fields::formation_items(self.mission(), &self.iwps),
+                Item::Formation,
+            ),
+        };
+        if !items.contains(&self.selected) {
+            self.select(fallback);
+        }
+    }
+
+    /// Changes the document, the selection or the inspector for one action
+    /// (the others are not the editor's and change nothing here).
+    pub fn update(
+        &mut self,
+        action: Action,
+        around: &Surroundings,
+        status: &mut StatusLine,
+    ) -> Option<Request> {
+        use Action::*;
+        match action {
+            SelectNext => self.select_step(around.pane, true),
+            SelectPrevious => self.select_step(around.pane, false),
+            Select(item) => self.select(item),
+            Nudge(dx, dy) => self.nudge(dx, dy, around.step, status),
+            AddObstacle(at) => {
+                let p = at
+                    .or(around.panned_center)
+                    .unwrap_or(self.mission().bounds.center_xy());
+                self.add_obstacle(p, status);
+                return Some(Request::ShowMap);
+            }
+            ToggleAddTool => {
+                self.add_tool = !self.add_tool;
+                status.say(if self.add_tool {
+                    "add tool: click an empty spot of the map to place an obstacle (Esc to stop)"
+                } else {
+                    "add tool off"
+                });
+            }
+            Duplicate => self.duplicate(status),
+            ToggleInspect => self.toggle_inspect(status),
+            Delete => self.delete(status),
+            AddSlot => self.add_slot(status),
+            CyclePreset => self.cycle_preset(status),
+            CycleShape => self.cycle_shape(status),
+            ToggleWaypoint => {
+                if let Item::Waypoint(_) = &self.selected {
+                    let item = self.selected.clone();
+                    self.edit(status, |m| {
+                        if let Ok(choice) = fields::waypoint_choice(m, &item) {
+                            choice.enabled = !choice.enabled;
+                        }
+                    });
+                }
+            }
+            FieldUp => {
+                self.editing = None;
+                self.field = self.field.saturating_sub(1);
+            }
+            FieldDown => {
+                self.editing = None;
+                let n = self.fields().len();
+                self.field = (self.field + 1).min(n.saturating_sub(1));
+            }
+            EditStart(first) => {
+                return self.start_editing(first).then_some(Request::FocusInspector);
+            }
+            EditInput(c) => {
+                if let Some(e) = &mut self.editing {
+                    e.buffer.push(c);
+                    self.check_editing();
+                }
+            }
+            EditBackspace => {
+                if let Some(e) = &mut self.editing {
+                    e.buffer.pop();
+                    self.check_editing();
+                }
+            }
+            EditCommit => self.commit_edit(status),
+            EditCancel => self.editing = None,
+            Undo => self.step_history(true, status),
+            Redo => self.step_history(false, status),
+            DragStart(item, at) => self.drag_start(item, at),
+            DragTo(at) => self.drag_to(at, around.step),
+            DragEnd => self.drag_end(),
+            _ => {}
+        }
+        None
+    }
+
+    /// After any change to the mission: keep the selection valid, recompute IWPs.
+    fn refresh(&mut self) {
+        let m = self.doc.mission();
+        self.iwps = iwps_despite_choices(m, self.doc.diagnostics());
+        if !self.selected.exists(m) {
+            self.selected = match self.selected {
+                Item::Obstacle(_) if !m.obstacles.is_empty() => {
+                    Item::Obstacle(m.obstacles.len() - 1)
+                }
+                Item::Slot(_) | Item::Waypoint(_) => Item::Formation,
+                _ => Item::Bounds,
+            };
+        }
+        let n = fields::fields(&self.selected, m).len();
+        self.field = self.field.min(n.saturating_sub(1));
+    }
+
+    /// One undo step; the status line moves on from an old error.
+    fn edit(&mut self, status: &mut StatusLine, change: impl FnOnce(&mut Mission)) {
+        self.doc.edit(change);
+        status.clear_error();
+        self.refresh();
+    }
+
+    fn select(&mut self, item: Item) {
+        if item != self.selected {
+            self.editing = None;
+            self.field = 0;
+        }
+        self.selected = item;
+    }
+
+    /// The next (or previous) item of those `pane` shows.
+    fn select_step(&mut self, pane: Pane, forward: bool) {
+        let items = match pane {
+            Pane::Map => fields::map_items(self.mission()),
+            Pane::Formation => fields::formation_items(self.mission(), &self.iwps),
+        };
+        if items.is_empty() {
+            return;
+        }
+        let i = items.iter().position(|it| *it == self.selected);
+        let n = items.len();
+        let next = match (i, forward) {
+            (Some(i), true) => (i + 1) % n,
+            (Some(i), false) => (i + n - 1) % n,
+            (None, _) => 0,
+        };
+        self.select(items[next].clone());
+    }
+
+    fn add_obstacle(&mut self, p: Point2<f64>, status: &mut StatusLine) {
+        let obstacle = fields::new_obstacle(self.mission(), p);
+        let name = obstacle.name.clone();
+        self.edit(status, |m| m.obstacles.push(obstacle));
+        let i = self.mission().obstacles.len() - 1;
+        self.select(Item::Obstacle(i));
+        status.say(format!("added '{name}' at ({:.1}, {:.1})", p.x, p.y));
+    }
+
+    /// A copy of the selected obstacle beside it, or a new fleet target
+    /// after the last.
+    fn duplicate(&mut self, status: &mut StatusLine) {
+        match self.selected {
+            Item::Fleet | Item::FleetTarget(_) => {
+                // A new target 10 s after the last, 1 m east of it.
+                let next = match self.mission().fleet.targets.last() {
+                    Some(t) => FleetTarget {
+                        time: t.time + 10.0,
+                        position: t.position + Vector2::new(1.0, 0.0),
+                    },
+                    None => FleetTarget {
+                        time: 0.0,
+                        position: crate::fleet::default_target(self.mission()),
+                    },
+                };
+                self.edit(status, |m| m.fleet.targets.push(next));
+                self.select(Item::FleetTarget(self.mission().fleet.targets.len() - 1));
+            }
+            Item::Obstacle(i) => {
+                if let Some(o) = self.mission().obstacles.get(i) {
+                    let copy = fields::duplicate_obstacle(self.mission(), o);
+                    self.edit(status, |m| m.obstacles.push(copy));
+                    self.select(Item::Obstacle(self.mission().obstacles.len() - 1));
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn toggle_inspect(&mut self, status: &mut StatusLine) {
+        if let Item::Obstacle(i) = self.selected
+            && let Some(o) = self.mission().obstacles.get(i)
+        {
+            let inspect = !o.inspect;
+            let name = o.name.clone();
+            self.edit(status, |m| m.obstacles[i].inspect = inspect);
+            status.say(if inspect {
+                format!("inspecting '{name}': the plan flies a pass along it (eq. 8)")
+            } else {
+                format!("'{name}' is no longer inspected")
+            });
+        } else {
+            status.say("select an obstacle (n/p or click) to inspect it");
+        }
+    }
+
+    fn add_slot(&mut self, status: &mut StatusLine) {
+        let slots = &self.mission().formation.slots;
+        let back = slots.iter().map(|s| s.x).fold(0.0, f64::min);
+        let spacing = self.preset_spacing();
+        self.edit(status, |m| {
+            m.formation
+                .slots
+                .push(Vector3::new(back - spacing, 0.0, 0.0))
+        });
+        self.select(Item::Slot(self.mission().formation.slots.len() - 1));
+    }
+
+    fn cycle_preset(&mut self, status: &mut StatusLine) {
+        self.preset = self.preset.next();
+        let n = self.mission().formation.slots.len().max(1);
+        let spacing = self.preset_spacing();
+        let slots = self.preset.slots(n, spacing);
+        self.edit(status, |m| m.formation.slots = slots);
+        status.say(format!(
+            "formation: {} of {n}, {} m apart",
+            self.preset.name(),
+            fields::fmt_num(spacing)
+        ));
+    }
+
+    fn cycle_shape(&mut self, status: &mut StatusLine) {
+        if let Item::Waypoint(_) = &self.selected {
+            let item = self.selected.clone();
+            self.edit(status, |m| {
+                if let Ok(choice) = fields::waypoint_choice(m, &item) {
+                    choice.shape = fields::next_shape(choice.shape);
+                }
+            });
+        } else {
+            // Say what `s` needs rather than do nothing.
+            let iwps = self.iwps.len();
+            status.error(if iwps == 0 {
+                "s changes an IWP's shape: this mission has no IWP".to_owned()
+            } else {
+                format!(
+                    "s changes an IWP's shape: select one of the {iwps} IWP row(s) \
+                     first (2 formation editor, then n)"
+                )
+            });
+        }
+    }
+
+    /// Undo (`back`) or redo.
+    fn step_history(&mut self, back: bool, status: &mut StatusLine) {
+        self.editing = None;
+        self.drag = None;
+        let (done, said) = if back {
+            (self.doc.undo(), ["undone", "nothing to undo"])
+        } else {
+            (self.doc.redo(), ["redone", "nothing to redo"])
+        };
+        if done {
+            self.refresh();
+            status.say(said[0]);
+        } else {
+            status.say(said[1]);
+        }
+    }
+
+    fn drag_start(&mut self, item: Item, at: Point2<f64>) {
+        // A drag whose release was never seen ends here.
+        if self.drag.take().is_some() {
+            self.doc.end_gesture();
+        }
+        self.select(item.clone());
+        if let Some(position) = self.position_of(&item) {
+            self.doc.begin_gesture();
+            self.drag = Some(Drag {
+                item,
+                grab: position - at,
+            });
+        }
+    }
+
+    fn drag_to(&mut self, at: Point2<f64>, step: f64) {
+        if let Some(drag) = self.drag.clone() {
+            // Dragged positions snap to the nudge step, as the keys move.
+            let snap = |v: f64| (v / step).round() * step;
+            let p = at + drag.grab;
+            let p = Point2::new(snap(p.x), snap(p.y));
+            self.doc.gesture_edit(|m| set_position(m, &drag.item, p));
+        }
+    }
+
+    fn drag_end(&mut self) {
+        if self.drag.take().is_some() {
+            self.doc.end_gesture();
+            self.refresh();
+        }
+    }
+
+    /// The preset the slots are now (after any undo), if they are one.
+    pub fn current_preset(&self) -> Option<Preset> {
+        let slots = &self.mission().formation.slots;
+        let spacing = self.preset_spacing();
+        Preset::ALL.into_iter().find(|p| {
+            let made = p.slots(slots.len().max(1), spacing);
+            made.len() == slots.len() && made.iter().zip(slots).all(|(a, b)| (a - b).norm() < 1e-9)
+        })
+    }
+
+    fn preset_spacing(&self) -> f64 {
+        let f = &self.mission().formation;
+        let d = min_pair_distance(&f.slots);
+        let floor = 2.0 * f.uav_radius + 1.0;
+        if d.is_finite() {
+            d.max(floor)
+        } else {
+            floor.max(2.0)
+        }
+    }
+
+    fn nudge(&mut self, dx: f64, dy: f64, s: f64, status: &mut StatusLine) {
+        let item = self.selected.clone();
+        match &item {
+            Item::Obstacle(_) | Item::Start | Item::Goal | Item::FleetTarget(_) => {
+                if let Some(p) = self.position_of(&item) {
+                    let to = p + Vector2::new(dx * s, dy * s);
+                    self.edit(status, |m| set_position(m, &item, to));
+                }
+            }
+            Item::Slot(i) => {
+                let i = *i;
+                // Formation frame on screen: forward is up, left is left.
+                self.edit(status, |m| {
+                    if let Some(slot) = m.formation.slots.get_mut(i) {
+                        slot.x += dy * s;
+                        slot.y -= dx * s;
+                    }
+                });
+            }
+            _ => status.say("select an obstacle, the start, the goal or a slot to move it"),
+        }
+    }
+
+    /// Where a movable item is, in its pane's plane (map: x, y ENU; formation:
+    /// forward, left).
+    pub fn position_of(&self, item: &Item) -> Option<Point2<f64>> {
+        let m = self.mission();
+        match item {
+            Item::Obstacle(i) => m.obstacles.get(*i).map(|o| o.center),
+            Item::Start => Some(m.route.start.xy()),
+            Item::Goal => Some(m.route.goal.xy()),
+            Item::Slot(i) => m.formation.slots.get(*i).map(|s| Point2::new(s.x, s.y)),
+            Item::FleetTarget(i) => m.fleet.targets.get(*i).map(|t| t.position),
+            _ => None,
+        }
+    }
+
+    fn delete(&mut self, status: &mut StatusLine) {
+        match self.selected.clone() {
+            Item::Obstacle(i) => {
+                let name = self.mission().obstacles.get(i).map(|o| o.name.clone());
+                self.edit(status, |m| {
+                    if i < m.obstacles.len() {
+                        m.obstacles.remove(i);
+                    }
+                });
+                if let Some(name) = name {
+                    status.say(format!("deleted '{name}' (u to undo)"));
+                }
+            }
+            Item::Slot(i) => {
+                if self.mission().formation.slots.len() <= 1 {
+                    status.error("a formation needs at least one slot");
+                    return;
+                }
+                self.edit(status, |m| {
+                    if i < m.formation.slots.len() {
+                        m.formation.slots.remove(i);
+                    }
+                });
+            }
+            Item::FleetTarget(i) => {
+                self.edit(status, |m| {
+                    if i < m.fleet.targets.len() {
+                        m.fleet.targets.remove(i);
+                    }
+                });
+                status.say("fleet target deleted (u to undo)");
+            }
+            Item::Waypoint(between) => {
+                self.edit(status, |m| {
+                    m.reconfiguration
+                        .waypoints
+                        .retain(|w| !iwp::same_pair(&w.between, &between[0], &between[1]))
+                });
+                status.say("IWP back to the mission's default shape");
+            }
+            _ => status.say("only obstacles, slots and IWP choices can be deleted"),
+        }
+    }
+
+    /// Starts typing into the field under the cursor (with its value, or
+    /// `first` alone); false when there is no field.
+    fn start_editing(&mut self, first: Option<char>) -> bool {
+        let fields = self.fields();
+        let Some(f) = fields.get(self.field) else {
+            return false;
+        };
+        let buffer = match first {
+            Some(c) => c.to_string(),
+            None => f.value().to_owned(),
+        };
+        self.editing = Some(Editing {
+            buffer,
+            problem: None,
+        });
+        self.check_editing();
+        true
+    }
+
+    /// Re-checks the text being typed: parse it, apply it to a copy, validate.
+    fn check_editing(&mut self) {
+        let fields = self.fields();
+        let Some(field) = fields.get(self.field) else {
+            return;
+        };
+        let Some(editing) = &self.editing else {
+            return;
+        };
+        let mut trial = self.mission().clone();
+        let problem = match field.set(&mut trial, &self.selected, &editing.buffer) {
+            Err(e) => Some((Severity::Error, e)),
+            Ok(()) => crate::diagnose::diagnose(&trial)
+                .into_iter()
+                .filter(|d| d.path.starts_with(field.path()))
+                .min_by_key(|d| d.severity)
+                .map(|d| (d.severity, d.message)),
+        };
+        if let Some(e) = &mut self.editing {
+            e.problem = problem;
+        }
+    }
+
+    fn commit_edit(&mut self, status: &mut StatusLine) {
+        let Some(editing) = self.editing.take() else {
+            return;
+        };
+        let fields = self.fields();
+        let Some(field) = fields.get(self.field) else {
+            return;
+        };
+        // Enter applies and stays on the field: ↓ goes to the next one (a
+        // move on Enter as well made the next ↓ skip a field).
+        if editing.buffer.trim() == field.value() {
+            // Nothing typed: no change, no undo step (and no rounding).
+            return;
+        }
+        let mut trial = self.mission().clone();
+        match field.set(&mut trial, &self.selected, &editing.buffer) {
+            Ok(()) => {
+                self.edit(status, |m| *m = trial);
+                status.say(format!("{} = {}", field.label(), editing.buffer.trim()));
+            }
+            Err(e) => {
+                // Keep the text so it can be corrected.
+                status.error(format!("{}: {e}", field.label()));
+                self.editing = Some(Editing {
+                    problem: Some((Severity::Error, e)),
+                    ..editing
+                });
+            }
+        }
+    }
+}
+
+/// The IWPs (eq. 9) of a mission whose only errors, if any, are in IWP
+/// choices: those choices are left out, so the map still marks every IWP
+/// while the user fixes the choice. Any other error: none.
+fn iwps_despite_choices(m: &Mission, diagnostics: &[mission::Diagnostic]) -> Vec<Iwp> {
+    let mut bad = Vec::new();
+    for d in diagnostics.iter().filter(|d| d.is_error()) {
+        match d.path.0.as_slice() {
+            [
+                PathSegment::Key(r),
+                PathSegment::Key(w),
+                PathSegment::Index(i),
+                ..,
+            ] if r == "reconfiguration" && w == "waypoints" => bad.push(*i),
+            _ => return Vec::new(),
+        }
+    }
+    if bad.is_empty() {
+        return find_iwps(m);
+    }
+    let mut clean = m.clone();
+    let mut k = 0;
+    clean.reconfiguration.waypoints.retain(|_| {
+        k += 1;
+        !bad.contains(&(k - 1))
+    });
+    find_iwps(&clean)
+}
+
+fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
+    match item {
+        Item::Obstacle(i) => {
+            if let Some(o) = m.obstacles.get_mut(*i) {
+                o.center = p;
+            }
+        }
+        Item::Start => {
+            m.route.start.x = p.x;
+            m.route.start.y = p.y;
+        }
+        Item::Goal => {
+            m.route.goal.x = p.x;
+            m.route.goal.y = p.y;
+        }
+        Item::Slot(i) => {
+            if let Some(s) = m.formation.slots.get_mut(*i) {
+                s.x = p.x;
+                s.y = p.y;
+            }
+        }
+        Item::FleetTarget(i) => {
+            if let Some(t) = m.fleet.targets.get_mut(*i) {
+                t.position = p;
+            }
+        }
+        _ => {}
+    }
+}

@@ -1,0 +1,401 @@
+//! The inspector's fields of every kind of item, declared as tables (see
+//! `fields.rs` for what a field is), and the reading and writing of their
+//! values as text. The tables keep one field a line (`rustfmt::skip`) so
+//! they read as tables: name, unit, keys, read, write.
+
+use nalgebra::Vector3;
+
+use super::Step::{Index, Key};
+use super::{Item, Spec, Table, fmt_num, number, shape_name, waypoint_choice};
+use crate::mission::{
+    FleetTarget, GeoOrigin, Mission, Obstacle, ShapeChoice, Terrain, WaypointChoice,
+};
+use crate::planner::iwp::same_pair;
+use crate::terrain::Lookup;
+
+/// The table of `item`'s kind.
+pub(super) fn of(item: &Item) -> &'static Table {
+    match item {
+        Item::Mission => &MISSION,
+        Item::Bounds => &BOUNDS,
+        Item::Start => &START,
+        Item::Goal => &GOAL,
+        Item::Terrain => &TERRAIN,
+        Item::Obstacle(_) => &OBSTACLE,
+        Item::Formation => &FORMATION,
+        Item::Slot(_) => &SLOT,
+        Item::Waypoint(_) => &WAYPOINT,
+        Item::ThetaPso => &THETA_PSO,
+        Item::Squadron => &SQUADRON,
+        Item::Fleet => &FLEET,
+        Item::FleetTarget(_) => &FLEET_TARGET,
+    }
+}
+
+#[rustfmt::skip]
+static MISSION: Table = Table { base: &[], fields: &[
+    Spec { name: "name", unit: "", keys: &["name"], get: |m, _| text(&m.name), set: |m, _, t| put(&mut m.name, Ok(t.to_owned())) },
+    Spec { name: "description", unit: "", keys: &["description"], get: |m, _| text(&m.description), set: |m, _, t| put(&mut m.description, Ok(t.to_owned())) },
+    Spec { name: "seed", unit: "", keys: &["seed"], get: |m, _| text(m.seed), set: |m, _, t| put(&mut m.seed, seed(t)) },
+    Spec { name: "origin lat", unit: "°", keys: &["origin", "latitude"], get: |m, _| origin(m, |o| o.latitude), set: |m, _, t| set_origin(m, t, |o, v| o.latitude = v) },
+    Spec { name: "origin lon", unit: "°", keys: &["origin", "longitude"], get: |m, _| origin(m, |o| o.longitude), set: |m, _, t| set_origin(m, t, |o, v| o.longitude = v) },
+    Spec { name: "origin alt", unit: "m", keys: &["origin", "altitude"], get: |m, _| origin(m, |o| o.altitude), set: |m, _, t| set_origin(m, t, |o, v| o.altitude = v) },
+]};
+
+#[rustfmt::skip]
+static BOUNDS: Table = Table { base: &[Key("bounds")], fields: &[
+    Spec { name: "x min", unit: "m", keys: &["x"], get: |m, _| num(m.bounds.x[0]), set: |m, _, t| put(&mut m.bounds.x[0], number(t)) },
+    Spec { name: "x max", unit: "m", keys: &["x"], get: |m, _| num(m.bounds.x[1]), set: |m, _, t| put(&mut m.bounds.x[1], number(t)) },
+    Spec { name: "y min", unit: "m", keys: &["y"], get: |m, _| num(m.bounds.y[0]), set: |m, _, t| put(&mut m.bounds.y[0], number(t)) },
+    Spec { name: "y max", unit: "m", keys: &["y"], get: |m, _| num(m.bounds.y[1]), set: |m, _, t| put(&mut m.bounds.y[1], number(t)) },
+    Spec { name: "z min", unit: "m", keys: &["z"], get: |m, _| num(m.bounds.z[0]), set: |m, _, t| put(&mut m.bounds.z[0], number(t)) },
+    Spec { name: "z max", unit: "m", keys: &["z"], get: |m, _| num(m.bounds.z[1]), set: |m, _, t| put(&mut m.bounds.z[1], number(t)) },
+]};
+
+#[rustfmt::skip]
+static START: Table = Table { base: &[Key("route"), Key("start")], fields: &[
+    Spec { name: "x", unit: "m", keys: &[], get: |m, _| num(m.route.start.x), set: |m, _, t| put(&mut m.route.start.x, number(t)) },
+    Spec { name: "y", unit: "m", keys: &[], get: |m, _| num(m.route.start.y), set: |m, _, t| put(&mut m.route.start.y, number(t)) },
+    Spec { name: "z", unit: "m", keys: &[], get: |m, _| num(m.route.start.z), set: |m, _, t| put(&mut m.route.start.z, number(t)) },
+]};
+
+#[rustfmt::skip]
+static GOAL: Table = Table { base: &[Key("route"), Key("goal")], fields: &[
+    Spec { name: "x", unit: "m", keys: &[], get: |m, _| num(m.route.goal.x), set: |m, _, t| put(&mut m.route.goal.x, number(t)) },
+    Spec { name: "y", unit: "m", keys: &[], get: |m, _| num(m.route.goal.y), set: |m, _, t| put(&mut m.route.goal.y, number(t)) },
+    Spec { name: "z", unit: "m", keys: &[], get: |m, _| num(m.route.goal.z), set: |m, _, t| put(&mut m.route.goal.z, number(t)) },
+]};
+
+/// The `[terrain]` keys; the map is read again when they change
+/// (`Document::edit`), and a file that does not load is an error on
+/// `terrain.file`.
+#[rustfmt::skip]
+static TERRAIN: Table = Table { base: &[Key("terrain")], fields: &[
+    Spec { name: "file", unit: "", keys: &["file"], get: |m, _| text(&m.terrain.as_ref()?.file), set: |m, _, t| put(&mut terrain(m)?.file, geotiff(t)) },
+    Spec { name: "origin x", unit: "m", keys: &["origin"], get: |m, _| num(m.terrain.as_ref()?.origin[0]), set: |m, _, t| put(&mut terrain(m)?.origin[0], number(t)) },
+    Spec { name: "origin y", unit: "m", keys: &["origin"], get: |m, _| num(m.terrain.as_ref()?.origin[1]), set: |m, _, t| put(&mut terrain(m)?.origin[1], number(t)) },
+    Spec { name: "pixel x", unit: "m", keys: &["pixel_size"], get: |m, _| num(m.terrain.as_ref()?.pixel_size[0]), set: |m, _, t| put(&mut terrain(m)?.pixel_size[0], number(t)) },
+    Spec { name: "pixel y", unit: "m", keys: &["pixel_size"], get: |m, _| num(m.terrain.as_ref()?.pixel_size[1]), set: |m, _, t| put(&mut terrain(m)?.pixel_size[1], number(t)) },
+    Spec { name: "lookup", unit: "", keys: &["lookup"], get: |m, _| text(lookup_name(m.terrain.as_ref()?.lookup)), set: |m, _, t| put(&mut terrain(m)?.lookup, lookup(t)) },
+]};
+
+#[rustfmt::skip]
+static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], fields: &[
+    Spec { name: "name", unit: "", keys: &["name"], get: |m, i| text(&obstacle_at(m, i)?.name), set: rename_obstacle },
+    Spec { name: "kind", unit: "", keys: &["kind"], get: |m, i| text(obstacle_at(m, i)?.kind.as_deref().unwrap_or("")), set: |m, i, t| put(&mut obstacle(m, i)?.kind, Ok((!t.is_empty()).then(|| t.to_owned()))) },
+    Spec { name: "centre x", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.x), set: |m, i, t| put(&mut obstacle(m, i)?.center.x, number(t)) },
+    Spec { name: "centre y", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.y), set: |m, i, t| put(&mut obstacle(m, i)?.center.y, number(t)) },
+    Spec { name: "radius", unit: "m", keys: &["radius"], get: |m, i| num(obstacle_at(m, i)?.radius), set: |m, i, t| put(&mut obstacle(m, i)?.radius, number(t)) },
+    Spec { name: "height", unit: "m", keys: &["height"], get: |m, i| num(obstacle_at(m, i)?.height), set: |m, i, t| put(&mut obstacle(m, i)?.height, number(t)) },
+    Spec { name: "inspect (eq. 8)", unit: "", keys: &["inspect"], get: |m, i| yes(obstacle_at(m, i)?.inspect), set: |m, i, t| put(&mut obstacle(m, i)?.inspect, yes_no(t)) },
+    Spec { name: "stand-off min", unit: "m", keys: &["stand_off"], get: |m, i| num(obstacle_at(m, i)?.stand_off_band(&m.formation)[0]), set: |m, i, t| set_stand_off(m, i, 0, t) },
+    Spec { name: "stand-off max", unit: "m", keys: &["stand_off"], get: |m, i| num(obstacle_at(m, i)?.stand_off_band(&m.formation)[1]), set: |m, i, t| set_stand_off(m, i, 1, t) },
+]};
+
+#[rustfmt::skip]
+static FORMATION: Table = Table { base: &[], fields: &[
+    Spec { name: "UAV radius r_Q", unit: "m", keys: &["formation", "uav_radius"], get: |m, _| num(m.formation.uav_radius), set: |m, _, t| put(&mut m.formation.uav_radius, number(t)) },
+    Spec { name: "ground speed", unit: "m/s", keys: &["formation", "ground_speed"], get: |m, _| num(m.formation.ground_speed), set: |m, _, t| put(&mut m.formation.ground_speed, number(t)) },
+    Spec { name: "comm range", unit: "m", keys: &["formation", "comm_range"], get: |m, _| num(m.formation.comm_range), set: |m, _, t| put(&mut m.formation.comm_range, number(t)) },
+    Spec { name: "surface d min", unit: "m", keys: &["formation", "surface_distance"], get: |m, _| num(m.formation.surface_distance[0]), set: |m, _, t| put(&mut m.formation.surface_distance[0], number(t)) },
+    Spec { name: "surface d max", unit: "m", keys: &["formation", "surface_distance"], get: |m, _| num(m.formation.surface_distance[1]), set: |m, _, t| put(&mut m.formation.surface_distance[1], number(t)) },
+    Spec { name: "inspection pass", unit: "m", keys: &["formation", "inspection_pass"], get: |m, _| num(m.formation.inspection_pass), set: |m, _, t| put(&mut m.formation.inspection_pass, number(t)) },
+    Spec { name: "default shape", unit: "", keys: &["reconfiguration", "default_shape"], get: |m, _| text(shape_name(m.reconfiguration.default_shape)), set: |m, _, t| put(&mut m.reconfiguration.default_shape, shape(t)) },
+    Spec { name: "shrink scale", unit: "", keys: &["reconfiguration", "shrink_scale"], get: |m, _| num(m.reconfiguration.shrink_scale), set: |m, _, t| put(&mut m.reconfiguration.shrink_scale, number(t)) },
+    Spec { name: "transition", unit: "m", keys: &["reconfiguration", "transition_distance"], get: |m, _| num(m.reconfiguration.transition_distance), set: |m, _, t| put(&mut m.reconfiguration.transition_distance, number(t)) },
+    Spec { name: "hold", unit: "m", keys: &["reconfiguration", "hold_distance"], get: |m, _| num(m.reconfiguration.hold_distance), set: |m, _, t| put(&mut m.reconfiguration.hold_distance, number(t)) },
+]};
+
+#[rustfmt::skip]
+static SLOT: Table = Table { base: &[Key("formation"), Key("slots"), Index], fields: &[
+    Spec { name: "forward x", unit: "m", keys: &[], get: |m, i| num(slot_at(m, i)?.x), set: |m, i, t| put(&mut slot(m, i)?.x, number(t)) },
+    Spec { name: "left y", unit: "m", keys: &[], get: |m, i| num(slot_at(m, i)?.y), set: |m, i, t| put(&mut slot(m, i)?.y, number(t)) },
+    Spec { name: "up z", unit: "m", keys: &[], get: |m, i| num(slot_at(m, i)?.z), set: |m, i, t| put(&mut slot(m, i)?.z, number(t)) },
+]};
+
+/// An IWP's reconfiguration choice: the defaults until the first edit
+/// creates its entry.
+#[rustfmt::skip]
+static WAYPOINT: Table = Table { base: &[Key("reconfiguration"), Key("waypoints"), Index], fields: &[
+    Spec { name: "enabled", unit: "", keys: &["enabled"], get: |m, i| yes(choice_at(m, i).is_none_or(|c| c.enabled)), set: |m, i, t| set_choice(m, i, yes_no(t), |c| &mut c.enabled) },
+    Spec { name: "shape", unit: "", keys: &["shape"], get: |m, i| text(shape_name(choice_at(m, i).map_or(ShapeChoice::Auto, |c| c.shape))), set: |m, i, t| set_choice(m, i, shape(t), |c| &mut c.shape) },
+    Spec { name: "scale (blank: default)", unit: "", keys: &["scale"], get: |m, i| text(choice_at(m, i).and_then(|c| c.scale).map(fmt_num).unwrap_or_default()), set: |m, i, t| set_choice(m, i, blank_or(number, t), |c| &mut c.scale) },
+]};
+
+#[rustfmt::skip]
+static THETA_PSO: Table = Table { base: &[Key("theta_pso")], fields: &[
+    Spec { name: "swarm size", unit: "", keys: &["swarm_size"], get: |m, _| text(m.theta_pso.swarm_size), set: |m, _, t| put(&mut m.theta_pso.swarm_size, count(t)) },
+    Spec { name: "waypoints", unit: "", keys: &["waypoints"], get: |m, _| text(m.theta_pso.waypoints), set: |m, _, t| put(&mut m.theta_pso.waypoints, count(t)) },
+    Spec { name: "iterations", unit: "", keys: &["iterations"], get: |m, _| text(m.theta_pso.iterations), set: |m, _, t| put(&mut m.theta_pso.iterations, count(t)) },
+    Spec { name: "inertia w", unit: "", keys: &["inertia"], get: |m, _| num(m.theta_pso.inertia), set: |m, _, t| put(&mut m.theta_pso.inertia, number(t)) },
+    Spec { name: "cognitive c1", unit: "", keys: &["cognitive"], get: |m, _| num(m.theta_pso.cognitive), set: |m, _, t| put(&mut m.theta_pso.cognitive, number(t)) },
+    Spec { name: "social c2", unit: "", keys: &["social"], get: |m, _| num(m.theta_pso.social), set: |m, _, t| put(&mut m.theta_pso.social, number(t)) },
+    Spec { name: "segments L", unit: "", keys: &["segments"], get: |m, _| text(m.theta_pso.segments), set: |m, _, t| put(&mut m.theta_pso.segments, count(t)) },
+    Spec { name: "β1 length", unit: "", keys: &["weight_length"], get: |m, _| num(m.theta_pso.weight_length), set: |m, _, t| put(&mut m.theta_pso.weight_length, number(t)) },
+    Spec { name: "β2 obstacle", unit: "", keys: &["weight_obstacle"], get: |m, _| num(m.theta_pso.weight_obstacle), set: |m, _, t| put(&mut m.theta_pso.weight_obstacle, number(t)) },
+    Spec { name: "β3 altitude", unit: "", keys: &["weight_altitude"], get: |m, _| num(m.theta_pso.weight_altitude), set: |m, _, t| put(&mut m.theta_pso.weight_altitude, number(t)) },
+    Spec { name: "βR waypoints", unit: "", keys: &["weight_waypoints"], get: |m, _| num(m.theta_pso.weight_waypoints), set: |m, _, t| put(&mut m.theta_pso.weight_waypoints, number(t)) },
+]};
+
+/// FLATLO's squadron: what the operator sets per mission; the airframe
+/// constants stay in the file.
+#[rustfmt::skip]
+static SQUADRON: Table = Table { base: &[Key("flatlo")], fields: &[
+    Spec { name: "aircraft N", unit: "", keys: &["aircraft"], get: |m, _| text(m.flatlo.aircraft), set: |m, _, t| put(&mut m.flatlo.aircraft, count(t)) },
+    Spec { name: "spacing Δd", unit: "m", keys: &["spacing"], get: |m, _| num(m.flatlo.spacing), set: |m, _, t| put(&mut m.flatlo.spacing, number(t)) },
+    Spec { name: "airspeed", unit: "m/s", keys: &["airspeed"], get: |m, _| num(m.flatlo.airspeed), set: |m, _, t| put(&mut m.flatlo.airspeed, number(t)) },
+    Spec { name: "turn radius r", unit: "m", keys: &["turn_radius"], get: |m, _| num(m.flatlo.turn_radius), set: |m, _, t| put(&mut m.flatlo.turn_radius, number(t)) },
+    Spec { name: "heading φ", unit: "°", keys: &["heading_deg"], get: |m, _| num(m.flatlo.heading_deg), set: |m, _, t| put(&mut m.flatlo.heading_deg, number(t)) },
+    Spec { name: "climb β", unit: "°", keys: &["climb_deg"], get: |m, _| num(m.flatlo.climb_deg), set: |m, _, t| put(&mut m.flatlo.climb_deg, number(t)) },
+    Spec { name: "altitude", unit: "m", keys: &["altitude"], get: |m, _| num(m.flatlo.altitude), set: |m, _, t| put(&mut m.flatlo.altitude, number(t)) },
+    Spec { name: "start x", unit: "m", keys: &["start"], get: |m, _| num(m.flatlo.start.x), set: |m, _, t| put(&mut m.flatlo.start.x, number(t)) },
+    Spec { name: "start y", unit: "m", keys: &["start"], get: |m, _| num(m.flatlo.start.y), set: |m, _, t| put(&mut m.flatlo.start.y, number(t)) },
+    Spec { name: "final leg K2", unit: "m", keys: &["final_leg"], get: |m, _| num(m.flatlo.final_leg), set: |m, _, t| put(&mut m.flatlo.final_leg, number(t)) },
+    Spec { name: "noise σ", unit: "", keys: &["noise"], get: |m, _| num(m.flatlo.noise), set: |m, _, t| put(&mut m.flatlo.noise, number(t)) },
+    Spec { name: "min separation", unit: "m", keys: &["min_separation"], get: |m, _| num(m.flatlo.min_separation), set: |m, _, t| put(&mut m.flatlo.min_separation, number(t)) },
+]};
+
+/// The fleet's parameters (Table 1 and the scenario); gains and the
+/// airframe stay in the file.
+#[rustfmt::skip]
+static FLEET: Table = Table { base: &[Key("fleet")], fields: &[
+    Spec { name: "agents n", unit: "", keys: &["agents"], get: |m, _| text(m.fleet.agents), set: |m, _, t| put(&mut m.fleet.agents, count(t)) },
+    Spec { name: "ρ target weight", unit: "", keys: &["rho"], get: |m, _| num(m.fleet.rho), set: |m, _, t| put(&mut m.fleet.rho, number(t)) },
+    Spec { name: "σ steepness", unit: "", keys: &["sigma"], get: |m, _| num(m.fleet.sigma), set: |m, _, t| put(&mut m.fleet.sigma, number(t)) },
+    Spec { name: "c safety", unit: "m", keys: &["safety_distance"], get: |m, _| num(m.fleet.safety_distance), set: |m, _, t| put(&mut m.fleet.safety_distance, number(t)) },
+    Spec { name: "l neighbourhood", unit: "m", keys: &["neighbourhood"], get: |m, _| num(m.fleet.neighbourhood), set: |m, _, t| put(&mut m.fleet.neighbourhood, number(t)) },
+    Spec { name: "d_obs detection", unit: "m", keys: &["detection_range"], get: |m, _| num(m.fleet.detection_range), set: |m, _, t| put(&mut m.fleet.detection_range, number(t)) },
+    Spec { name: "h_max step", unit: "m", keys: &["step_max"], get: |m, _| num(m.fleet.step_max), set: |m, _, t| put(&mut m.fleet.step_max, number(t)) },
+    Spec { name: "τ replan", unit: "s", keys: &["replan_period"], get: |m, _| num(m.fleet.replan_period), set: |m, _, t| put(&mut m.fleet.replan_period, number(t)) },
+    Spec { name: "d_ip to target", unit: "m", keys: &["target_distance"], get: |m, _| num(m.fleet.target_distance), set: |m, _, t| put(&mut m.fleet.target_distance, number(t)) },
+    Spec { name: "altitude", unit: "m", keys: &["altitude"], get: |m, _| num(m.fleet.altitude), set: |m, _, t| put(&mut m.fleet.altitude, number(t)) },
+    Spec { name: "duration", unit: "s", keys: &["duration"], get: |m, _| num(m.fleet.duration), set: |m, _, t| put(&mut m.fleet.duration, number(t)) },
+    Spec { name: "tolerance", unit: "", keys: &["tolerance"], get: |m, _| num(m.fleet.tolerance), set: |m, _, t| put(&mut m.fleet.tolerance, number(t)) },
+]};
+
+#[rustfmt::skip]
+static FLEET_TARGET: Table = Table { base: &[Key("fleet"), Key("targets"), Index], fields: &[
+    Spec { name: "time", unit: "s", keys: &["time"], get: |m, i| num(target_at(m, i)?.time), set: |m, i, t| put(&mut target(m, i)?.time, number(t)) },
+    Spec { name: "x", unit: "m", keys: &["position"], get: |m, i| num(target_at(m, i)?.position.x), set: |m, i, t| put(&mut target(m, i)?.position.x, number(t)) },
+    Spec { name: "y", unit: "m", keys: &["position"], get: |m, i| num(target_at(m, i)?.position.y), set: |m, i, t| put(&mut target(m, i)?.position.y, number(t)) },
+]};
+
+// Reading and writing the values as text.
+
+/// Writes a parsed value (or passes its error on).
+fn put<T>(place: &mut T, value: Result<T, String>) -> Result<(), String> {
+    *place = value?;
+    Ok(())
+}
+
+/// A value shown as it is printed.
+fn text(value: impl ToString) -> Option<String> {
+    Some(value.to_string())
+}
+
+/// A number shown as it would be typed ([`fmt_num`]).
+fn num(value: f64) -> Option<String> {
+    Some(fmt_num(value))
+}
+
+fn yes(value: bool) -> Option<String> {
+    text(if value { "yes" } else { "no" })
+}
+
+fn count(text: &str) -> Result<usize, String> {
+    text.parse::<usize>()
+        .map_err(|_| format!("'{text}' is not a whole number ≥ 0"))
+}
+
+fn shape(text: &str) -> Result<ShapeChoice, String> {
+    match text.to_ascii_lowercase().as_str() {
+        "auto" | "automatic" => Ok(ShapeChoice::Auto),
+        "alignment" | "align" => Ok(ShapeChoice::Alignment),
+        "rotation" | "rotate" => Ok(ShapeChoice::Rotation),
+        "shrink" => Ok(ShapeChoice::Shrink),
+        _ => Err(format!(
+            "'{text}' is not a shape: auto, alignment, rotation or shrink"
+        )),
+    }
+}
+
+fn yes_no(text: &str) -> Result<bool, String> {
+    match text.to_ascii_lowercase().as_str() {
+        "yes" | "y" | "true" | "on" | "1" => Ok(true),
+        "no" | "n" | "false" | "off" | "0" => Ok(false),
+        _ => Err(format!("'{text}' is not yes or no")),
+    }
+}
+
+fn seed(text: &str) -> Result<u64, String> {
+    text.parse()
+        .map_err(|_| format!("'{text}' is not a seed (0 … 2⁶⁴-1)"))
+}
+
+/// None for an empty text, else what `parse` makes of it.
+fn blank_or<T>(parse: fn(&str) -> Result<T, String>, text: &str) -> Result<Option<T>, String> {
+    if text.is_empty() {
+        Ok(None)
+    } else {
+        parse(text).map(Some)
+    }
+}
+
+fn geotiff(text: &str) -> Result<String, String> {
+    if text.trim().is_empty() {
+        return Err("the terrain needs a GeoTIFF file".into());
+    }
+    Ok(text.trim().to_owned())
+}
+
+fn lookup(text: &str) -> Result<Lookup, String> {
+    match text.trim() {
+        "nearest" => Ok(Lookup::Nearest),
+        "bilinear" => Ok(Lookup::Bilinear),
+        other => Err(format!("'{other}' is not a lookup: nearest or bilinear")),
+    }
+}
+
+fn lookup_name(lookup: Lookup) -> &'static str {
+    match lookup {
+        Lookup::Nearest => "nearest",
+        Lookup::Bilinear => "bilinear",
+    }
+}
+
+// The selected item in the mission, to read (`…_at`) and to write.
+
+fn obstacle_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m Obstacle> {
+    match item {
+        Item::Obstacle(i) => m.obstacles.get(*i),
+        _ => None,
+    }
+}
+
+fn obstacle<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut Obstacle, String> {
+    match item {
+        Item::Obstacle(i) => m.obstacles.get_mut(*i).ok_or("no such obstacle".into()),
+        _ => Err("not an obstacle".into()),
+    }
+}
+
+/// An obstacle renamed from `old` to `new`: the IWP choices that named it
+/// follow, unless another obstacle still carries the old name.
+fn rename_references(m: &mut Mission, old: &str, new: &str) {
+    if old == new || m.obstacles.iter().any(|o| o.name == old) {
+        return;
+    }
+    for choice in &mut m.reconfiguration.waypoints {
+        for name in &mut choice.between {
+            if name == old {
+                *name = new.to_owned();
+            }
+        }
+    }
+}
+
+/// A new name for an obstacle; the IWP choices that named it follow.
+fn rename_obstacle(m: &mut Mission, item: &Item, text: &str) -> Result<(), String> {
+    let old = std::mem::replace(&mut obstacle(m, item)?.name, text.to_owned());
+    rename_references(m, &old, text);
+    Ok(())
+}
+
+/// One end of an obstacle's stand-off band; an empty entry goes back to the
+/// formation's `surface_distance` for both ends.
+fn set_stand_off(m: &mut Mission, item: &Item, end: usize, t: &str) -> Result<(), String> {
+    let default = m.formation.surface_distance;
+    let o = obstacle(m, item)?;
+    if t.trim().is_empty() {
+        o.stand_off = None;
+        return Ok(());
+    }
+    let mut band = o.stand_off.unwrap_or(default);
+    band[end] = number(t)?;
+    o.stand_off = Some(band);
+    Ok(())
+}
+
+fn slot_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m Vector3<f64>> {
+    match item {
+        Item::Slot(i) => m.formation.slots.get(*i),
+        _ => None,
+    }
+}
+
+fn slot<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut Vector3<f64>, String> {
+    match item {
+        Item::Slot(i) => m.formation.slots.get_mut(*i).ok_or("no such slot".into()),
+        _ => Err("not a slot".into()),
+    }
+}
+
+fn target_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m FleetTarget> {
+    match item {
+        Item::FleetTarget(i) => m.fleet.targets.get(*i),
+        _ => None,
+    }
+}
+
+fn target<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut FleetTarget, String> {
+    match item {
+        Item::FleetTarget(i) => m.fleet.targets.get_mut(*i).ok_or("no such target".into()),
+        _ => Err("not a fleet target".into()),
+    }
+}
+
+fn terrain(m: &mut Mission) -> Result<&mut Terrain, String> {
+    m.terrain
+        .as_mut()
+        .ok_or_else(|| "the mission has no [terrain]".to_owned())
+}
+
+/// The reconfiguration entry of an IWP, if the file has one.
+fn choice_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m WaypointChoice> {
+    let Item::Waypoint([a, b]) = item else {
+        return None;
+    };
+    m.reconfiguration
+        .waypoints
+        .iter()
+        .find(|w| same_pair(&w.between, a, b))
+}
+
+/// Writes one value of an IWP's choice. The text is parsed before the entry
+/// is created, so a refused text leaves the mission as it was.
+fn set_choice<T>(
+    m: &mut Mission,
+    item: &Item,
+    value: Result<T, String>,
+    place: fn(&mut WaypointChoice) -> &mut T,
+) -> Result<(), String> {
+    let value = value?;
+    *place(waypoint_choice(m, item)?) = value;
+    Ok(())
+}
+
+/// An `[origin]` value for the inspector: empty when the mission has none.
+fn origin(m: &Mission, get: fn(&GeoOrigin) -> f64) -> Option<String> {
+    Some(
+        m.origin
+            .as_ref()
+            .map_or_else(String::new, |o| fmt_num(get(o))),
+    )
+}
+
+/// Sets one `[origin]` value (creating the section at 0°, 0°, 0 m); an empty
+/// text removes the section (exports then offer CSV in ENU only).
+fn set_origin(m: &mut Mission, text: &str, set: fn(&mut GeoOrigin, f64)) -> Result<(), String> {
+    if text.trim().is_empty() {
+        m.origin = None;
+        return Ok(());
+    }
+    let v = number(text)?;
+    let origin = m.origin.get_or_insert(GeoOrigin {
+        latitude: 0.0,
+        longitude: 0.0,
+        altitude: 0.0,
+    });
+    set(origin, v);
+    Ok(())
+}
