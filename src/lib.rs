@@ -6,6 +6,7 @@
 
 #[cfg(feature = "rerun")]
 pub mod cli;
+pub mod detour;
 pub mod diagnose;
 pub mod export;
 pub mod flatlo;

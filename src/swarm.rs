@@ -322,6 +322,23 @@ where
     }
 }
 
+/// Eq. 1 of the θ-PSO paper, third line (the angle encoding every θ-PSO
+/// objective decodes, here so the planner and the SPSO benchmark share it): x = ½ [(x_max − x_min) sin θ + x_max + x_min].
+pub fn decode_angle(theta: f64, min: f64, max: f64) -> f64 {
+    0.5 * ((max - min) * theta.sin() + max + min)
+}
+
+/// The inverse of eq. 1 on [min, max]: the angle that decodes to `x` (clamped).
+pub fn encode_angle(x: f64, min: f64, max: f64) -> f64 {
+    if max > min {
+        ((2.0 * x - max - min) / (max - min))
+            .clamp(-1.0, 1.0)
+            .asin()
+    } else {
+        0.0
+    }
+}
+
 /// One seeded stream per particle; 2^32 streams per run, so restarts
 /// (`streams` = 1, 2, …) never share a stream with a first run.
 fn particle_streams(seed: u64, streams: u64, n: usize) -> Vec<ChaCha8Rng> {

@@ -119,6 +119,10 @@ impl Mission {
     }
 }
 
+/// Most free nodes (`theta_pso.waypoints`) a path may have with
+/// `cost = "spso"`: that cost keeps a path's points in fixed-size arrays.
+pub const SPSO_MAX_NODES: usize = 30;
+
 /// The cost a θ-PSO run minimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -521,7 +521,7 @@ impl Checker {
                     "\"spso\" needs a [terrain] height map (its J3 and J4 read the ground)",
                 );
             }
-            let most = crate::spso::cost::MAX_POINTS - 2;
+            let most = super::SPSO_MAX_NODES;
             if p.waypoints > most {
                 self.error(
                     at.key("waypoints"),

@@ -22,22 +22,7 @@ use nalgebra::{Point2, Point3, Vector2, Vector3};
 use super::inspection::PassGeometry;
 use super::iwp::{Iwp, Shape, vertical_half_height};
 use crate::mission::Mission;
-
-/// Eq. 1, third line: x = ½ [(x_max − x_min) sin θ + x_max + x_min].
-pub fn decode_angle(theta: f64, min: f64, max: f64) -> f64 {
-    0.5 * ((max - min) * theta.sin() + max + min)
-}
-
-/// The inverse of eq. 1 on [min, max]: the angle that decodes to `x` (clamped).
-pub fn encode_angle(x: f64, min: f64, max: f64) -> f64 {
-    if max > min {
-        ((2.0 * x - max - min) / (max - min))
-            .clamp(-1.0, 1.0)
-            .asin()
-    } else {
-        0.0
-    }
-}
+pub use crate::swarm::{decode_angle, encode_angle};
 
 /// Where along the path the formation changes shape for one IWP.
 ///

@@ -18,8 +18,9 @@ use crate::terrain::HeightMap;
 /// (180/π)·atan2(y, x): Octave 7.3's `atan2d`, the product 180/π first.
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
-/// Most points (start, free nodes, goal) a path may have.
-pub const MAX_POINTS: usize = 32;
+/// Most points (start, free nodes, goal) a path may have: the free nodes
+/// validation allows, and start and goal.
+pub const MAX_POINTS: usize = crate::mission::SPSO_MAX_NODES + 2;
 
 /// A vertical cylinder threat: centre (x, y) and radius; only the x-y
 /// distance counts.

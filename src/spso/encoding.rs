@@ -151,8 +151,7 @@ impl Decoder {
             Encoding::Angle => {
                 for (c, b) in self.bounds.iter().enumerate() {
                     for i in 0..n {
-                        out[c * n + i] =
-                            crate::planner::path::encode_angle(nodes[c * n + i], b[0], b[1]);
+                        out[c * n + i] = crate::swarm::encode_angle(nodes[c * n + i], b[0], b[1]);
                     }
                 }
             }

@@ -22,7 +22,7 @@ use rand::rngs::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
 use super::{Decoder, Model};
-use crate::planner::reference::{self, Disc};
+use crate::detour::{self, Disc};
 
 /// `count` starting particles for `decoder`'s encoding, or none when no
 /// route reaches the goal.
@@ -71,7 +71,7 @@ fn route_nodes(model: &Model, decoder: &Decoder) -> Option<Vec<f64>> {
     let [bx, by, bz] = decoder.bounds;
     let start = Point2::new(model.start[0], model.start[1]);
     let goal = Point2::new(model.goal[0], model.goal[1]);
-    let route = reference::shortest_route(start, goal, &discs, &[], Some([bx, by]))?;
+    let route = detour::shortest_route(start, goal, &discs, &[], Some([bx, by]))?;
     let n = model.nodes;
     let z = 0.5 * (bz[0] + bz[1]);
     let mut out = vec![0.0; 3 * n];
