@@ -319,6 +319,31 @@ impl Default for Reconfiguration {
     }
 }
 
+impl Reconfiguration {
+    /// Where the choice for the IWP between obstacles `a` and `b` is in
+    /// `waypoints` (the pair is unordered).
+    pub fn position(&self, a: &str, b: &str) -> Option<usize> {
+        self.waypoints.iter().position(|w| w.is_between(a, b))
+    }
+
+    /// The choice for the IWP between obstacles `a` and `b`, if any.
+    pub fn choice(&self, a: &str, b: &str) -> Option<&WaypointChoice> {
+        self.position(a, b).map(|i| &self.waypoints[i])
+    }
+}
+
+impl WaypointChoice {
+    /// The choice names obstacles `a` and `b`, in either order.
+    pub fn is_between(&self, a: &str, b: &str) -> bool {
+        same_pair(&self.between, a, b)
+    }
+}
+
+/// The unordered pair `between` names obstacles `a` and `b`.
+pub fn same_pair(between: &[String; 2], a: &str, b: &str) -> bool {
+    (between[0] == a && between[1] == b) || (between[0] == b && between[1] == a)
+}
+
 /// The operator's choice for the IWP between two named obstacles.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

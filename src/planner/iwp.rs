@@ -380,11 +380,7 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
             if blocked {
                 continue;
             }
-            let choice = mission
-                .reconfiguration
-                .waypoints
-                .iter()
-                .find(|w| same_pair(&w.between, &a.name, &b.name));
+            let choice = mission.reconfiguration.choice(&a.name, &b.name);
             let (enabled, shape_choice, scale) = match choice {
                 Some(w) => (
                     w.enabled,
@@ -422,9 +418,4 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
         }
     }
     found
-}
-
-/// The unordered pair `between` names obstacles `a` and `b`.
-pub fn same_pair(between: &[String; 2], a: &str, b: &str) -> bool {
-    (between[0] == a && between[1] == b) || (between[0] == b && between[1] == a)
 }

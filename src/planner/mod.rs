@@ -156,9 +156,7 @@ pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
         if let (true, Some(reason)) = (iwp.enabled, &iwp.unusable) {
             let at = mission
                 .reconfiguration
-                .waypoints
-                .iter()
-                .position(|w| iwp::same_pair(&w.between, &iwp.between[0], &iwp.between[1]))
+                .position(&iwp.between[0], &iwp.between[1])
                 .map_or_else(
                     || {
                         FieldPath::root()

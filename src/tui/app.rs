@@ -9,8 +9,9 @@
 //! (`board.rs`), the overlays (`overlay.rs`), the camera (`camera.rs`) and
 //! the fleet replay (`replay.rs`). It keeps what the screen as a whole is
 //! in (focus, left pane, status line, quitting, working directory) and the
-//! flows that cross components: saving, opening and the recovery copy.
-//! `update` hands each action to the component that owns it.
+//! flows that cross components: saving, opening, showing and exporting a
+//! result, the recovery copy. `update` hands every other action to the
+//! component that owns it.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};

@@ -11,7 +11,7 @@ use std::time::Instant;
 use crossbeam_channel::{Receiver, Sender, unbounded};
 
 use super::action::Action;
-use super::document::{Document, slug};
+use super::document::{Document, stem};
 use super::jobs::{self, Job, JobId, JobMsg, Kind, RecordSettings, Viewer};
 use super::status::StatusLine;
 use crate::pipeline::Level;
@@ -270,14 +270,10 @@ impl JobBoard {
 /// `<mission file stem>-<pipeline>-seed<N>.rrd` beside the mission file
 /// (in `cwd` for a mission without one).
 pub fn rrd_path(doc: &Document, cwd: &Path, pipeline: &str, seed: u64) -> PathBuf {
-    let (dir, stem) = match doc.path() {
-        Some(p) => (
-            p.parent().map(Path::to_path_buf).unwrap_or_default(),
-            p.file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| slug(&doc.mission().name)),
-        ),
-        None => (cwd.to_path_buf(), slug(&doc.mission().name)),
+    let dir = match doc.path() {
+        Some(p) => p.parent().map(Path::to_path_buf).unwrap_or_default(),
+        None => cwd.to_path_buf(),
     };
+    let stem = stem(doc.path(), &doc.mission().name);
     dir.join(format!("{stem}-{pipeline}-seed{seed}.rrd"))
 }

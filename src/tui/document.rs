@@ -267,3 +267,11 @@ pub fn slug(name: &str) -> String {
     let s = s.trim_matches('-').to_owned();
     if s.is_empty() { "mission".into() } else { s }
 }
+
+/// What files made from a mission are named after: its file's stem, or the
+/// slug of its name when it has no file yet (recordings, exports).
+pub fn stem(path: Option<&Path>, name: &str) -> String {
+    path.and_then(Path::file_stem)
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| slug(name))
+}

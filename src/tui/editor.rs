@@ -18,7 +18,7 @@ use super::document::Document;
 use super::fields::{self, Field, Item};
 use super::status::StatusLine;
 use crate::mission::{self, FleetTarget, Mission, MissionError, PathSegment, Preset, Severity};
-use crate::planner::iwp::{self, min_pair_distance};
+use crate::planner::iwp::min_pair_distance;
 use crate::planner::{Iwp, find_iwps};
 
 /// A line of text being typed into an inspector field.
@@ -546,7 +546,7 @@ impl Editor {
                 self.edit(status, |m| {
                     m.reconfiguration
                         .waypoints
-                        .retain(|w| !iwp::same_pair(&w.between, &between[0], &between[1]))
+                        .retain(|w| !w.is_between(&between[0], &between[1]))
                 });
                 status.say("IWP back to the mission's default shape");
             }
@@ -587,7 +587,7 @@ impl Editor {
             Err(e) => Some((Severity::Error, e)),
             Ok(()) => crate::diagnose::diagnose(&trial)
                 .into_iter()
-                .filter(|d| d.path.starts_with(field.path()))
+                .filter(|d| fields::owner(&fields, &d.path) == Some(self.field))
                 .min_by_key(|d| d.severity)
                 .map(|d| (d.severity, d.message)),
         };

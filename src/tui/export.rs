@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::document::slug;
+use super::document::stem;
 use super::jobs::{Job, Outcome};
 use crate::export::{self, ExportError, Format, Options, Planned};
 use crate::mission::Mission;
@@ -34,10 +34,7 @@ pub fn export_shown(
     let Some(job) = shown else {
         return Err("no result on the map to export: run a pipeline, or Enter on a job".into());
     };
-    let stem = mission_path
-        .and_then(Path::file_stem)
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| slug(&job.mission.name));
+    let stem = stem(mission_path, &job.mission.name);
     export_job(job, &folder(mission_path, cwd, &stem), &stem)
 }
 

@@ -6,14 +6,15 @@
 //! [`FieldPath`], the one the validator reports its diagnostics on), and
 //! how it is read and written as text. Typing a value, pasting one and a
 //! test all go through the same `set`; a validation message finds the
-//! field it concerns by comparing paths ([`FieldPath::starts_with`]).
+//! field it names by comparing typed paths ([`owner`]: the field the
+//! message is on or inside, else the first element of the array it is
+//! about).
 //! The tables themselves are in `fields/table.rs`.
 
 use nalgebra::Point2;
 
-use crate::mission::{FieldPath, Mission, Obstacle, ShapeChoice, WaypointChoice};
+use crate::mission::{FieldPath, Mission, Obstacle, PathSegment, ShapeChoice, WaypointChoice};
 use crate::planner::Iwp;
-use crate::planner::iwp::same_pair;
 
 mod table;
 
@@ -72,23 +73,22 @@ impl Item {
             Item::Terrain => mission.terrain.is_some(),
             Item::Waypoint([a, b]) => {
                 let named = |n: &String| mission.obstacles.iter().any(|o| &o.name == n);
-                (named(a) && named(b))
-                    || mission
-                        .reconfiguration
-                        .waypoints
-                        .iter()
-                        .any(|w| same_pair(&w.between, a, b))
+                (named(a) && named(b)) || mission.reconfiguration.position(a, b).is_some()
             }
             _ => true,
         }
     }
 
-    /// Where the item is in the mission: the messages under it that no
-    /// field shows are listed below its fields. None for the mission (its
-    /// fields span the file) and IWPs.
-    pub fn path(&self) -> Option<FieldPath> {
+    /// Where the item is in `m`: the messages under it that no field shows
+    /// are listed below its fields. None for the mission (its fields span
+    /// the file) and for an IWP without an entry yet.
+    pub fn path(&self, m: &Mission) -> Option<FieldPath> {
         let root = FieldPath::root();
         Some(match self {
+            Item::Waypoint(_) => root
+                .key("reconfiguration")
+                .key("waypoints")
+                .index(self.index(m)?),
             Item::Obstacle(i) => root.key("obstacles").index(*i),
             Item::Bounds => root.key("bounds"),
             Item::Start => root.key("route").key("start"),
@@ -100,7 +100,7 @@ impl Item {
             Item::Squadron => root.key("flatlo"),
             Item::Fleet => root.key("fleet"),
             Item::FleetTarget(i) => root.key("fleet").key("targets").index(*i),
-            Item::Mission | Item::Waypoint(_) => return None,
+            Item::Mission => return None,
         })
     }
 
@@ -109,11 +109,7 @@ impl Item {
     fn index(&self, m: &Mission) -> Option<usize> {
         match self {
             Item::Obstacle(i) | Item::Slot(i) | Item::FleetTarget(i) => Some(*i),
-            Item::Waypoint([a, b]) => m
-                .reconfiguration
-                .waypoints
-                .iter()
-                .position(|w| same_pair(&w.between, a, b)),
+            Item::Waypoint([a, b]) => m.reconfiguration.position(a, b),
             _ => None,
         }
     }
@@ -144,7 +140,7 @@ pub fn formation_items(mission: &Mission, iwps: &[Iwp]) -> Vec<Item> {
     for choice in &mission.reconfiguration.waypoints {
         let listed = iwps
             .iter()
-            .any(|w| same_pair(&w.between, &choice.between[0], &choice.between[1]));
+            .any(|w| choice.is_between(&w.between[0], &w.between[1]));
         if !listed {
             items.push(Item::Waypoint(choice.between.clone()));
         }
@@ -170,7 +166,8 @@ struct Spec {
     /// The value as it would be typed; None when the item is not in the
     /// mission (any more).
     get: fn(&Mission, &Item) -> Option<String>,
-    /// Parses the (trimmed) text and writes it; the error says what is expected.
+    /// Writes the (trimmed) text into the item, parsed; the error says what
+    /// is expected, or that the item is gone.
     set: fn(&mut Mission, &Item, &str) -> Result<(), String>,
 }
 
@@ -181,20 +178,28 @@ struct Table {
 }
 
 impl Table {
-    /// Where `spec` is in `m` for `item`. An IWP without an entry yet has
-    /// none of its own: its fields stand for the list it will be added to.
+    /// Where `spec` is in `m` for `item`. An IWP without an entry yet is
+    /// where its entry will go (the end of the list), so it claims no other
+    /// entry's messages. Fields of one table that share their keys are the
+    /// elements of that array, in order (x min, x max; x, y, z), as the
+    /// validator indexes them (`bounds.x[1]`).
     fn path(&self, spec: &Spec, item: &Item, m: &Mission) -> FieldPath {
         let mut path = FieldPath::root();
         for step in self.base {
             path = match step {
                 Step::Key(key) => path.key(key),
-                Step::Index => match item.index(m) {
-                    Some(i) => path.index(i),
-                    None => return path,
-                },
+                Step::Index => {
+                    path.index(item.index(m).unwrap_or(m.reconfiguration.waypoints.len()))
+                }
             };
         }
-        spec.keys.iter().fold(path, |p, key| p.key(key))
+        let path = spec.keys.iter().fold(path, |p, key| p.key(key));
+        let mut siblings = self.fields.iter().filter(|s| s.keys == spec.keys);
+        let element = siblings.clone().position(|s| std::ptr::eq(s, spec));
+        match (siblings.nth(1), element) {
+            (Some(_), Some(i)) => path.index(i),
+            _ => path,
+        }
     }
 }
 
@@ -225,8 +230,8 @@ impl Field {
         self.spec.unit
     }
 
-    /// Where the field is in the mission: the diagnostics at or below this
-    /// path are the field's.
+    /// Where the field is in the mission; [`owner`] says which
+    /// diagnostics are shown under it.
     pub fn path(&self) -> &FieldPath {
         &self.path
     }
@@ -264,6 +269,27 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
             })
         })
         .collect()
+}
+
+/// Which of `fields` a message at `path` belongs under: the field whose path
+/// is the longest start of it (the field itself or something inside it),
+/// else the first element of the array the message is about (`bounds.x`:
+/// x min). None when no field shows it (it is listed below the fields).
+pub fn owner(fields: &[Field], path: &FieldPath) -> Option<usize> {
+    let inside = fields
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| path.starts_with(f.path()))
+        .max_by_key(|(k, f)| (f.path().0.len(), std::cmp::Reverse(*k)));
+    if let Some((k, _)) = inside {
+        return Some(k);
+    }
+    fields.iter().position(|f| {
+        let element = &f.path().0;
+        element.len() == path.0.len() + 1
+            && f.path().starts_with(path)
+            && matches!(element.last(), Some(PathSegment::Index(_)))
+    })
 }
 
 /// Metres, degrees, gains: any finite number.
@@ -323,11 +349,9 @@ pub fn waypoint_choice<'m>(
     let Item::Waypoint(between) = item else {
         return Err("not an IWP".into());
     };
+    let index = m.reconfiguration.position(&between[0], &between[1]);
     let list = &mut m.reconfiguration.waypoints;
-    let index = match list
-        .iter()
-        .position(|w| same_pair(&w.between, &between[0], &between[1]))
-    {
+    let index = match index {
         Some(i) => i,
         None => {
             list.push(WaypointChoice {
@@ -446,6 +470,70 @@ mod tests {
         assert!(!m.reconfiguration.waypoints[0].enabled);
     }
 
+    /// The message a field's owner would show, by the field's label.
+    fn shown_under(item: &Item, m: &Mission, message: &str) -> Option<String> {
+        let fields = fields(item, m);
+        let d = crate::diagnose::diagnose(m)
+            .into_iter()
+            .find(|d| d.message.contains(message))?;
+        owner(&fields, &d.path).map(|k| fields[k].label().to_owned())
+    }
+
+    /// A message on one element of an array is under that element's field;
+    /// one on the whole array under its first element; an IWP's own entry's
+    /// messages are under the IWP, and an IWP without an entry claims none.
+    #[test]
+    fn each_message_is_under_the_field_it_names() {
+        let mut m = default_mission().mission;
+        m.obstacles[3].stand_off = Some([1.0, f64::NAN]);
+        assert_eq!(
+            shown_under(&Item::Obstacle(3), &m, "finite").as_deref(),
+            Some("stand-off max (m)")
+        );
+        m.obstacles[3].stand_off = Some([1.0, 5.0]);
+        m.route.start.z = f64::INFINITY;
+        assert_eq!(
+            shown_under(&Item::Start, &m, "finite").as_deref(),
+            Some("z (m)")
+        );
+        m.route.start.z = 5.0;
+        m.bounds.x = [50.0, 10.0];
+        let d = crate::diagnose::diagnose(&m);
+        let whole = d
+            .iter()
+            .find(|d| d.path.to_string() == "bounds.x")
+            .expect("a message on bounds.x");
+        let bounds = fields(&Item::Bounds, &m);
+        assert_eq!(
+            owner(&bounds, &whole.path).map(|k| bounds[k].label()),
+            Some("x min (m)")
+        );
+        m.bounds.x = [0.0, 138.0];
+
+        // An IWP entry naming a missing obstacle: its message is listed
+        // with the IWP (no field holds `between`), and the IWP without an
+        // entry does not claim it.
+        let iwp = Item::Waypoint(["pier 5".into(), "light pole 4".into()]);
+        m.reconfiguration.waypoints.clear();
+        m.reconfiguration.waypoints.push(WaypointChoice {
+            between: ["pier 5".into(), "nowhere".into()],
+            enabled: true,
+            shape: ShapeChoice::Auto,
+            scale: None,
+        });
+        let broken = Item::Waypoint(["pier 5".into(), "nowhere".into()]);
+        let d = crate::diagnose::diagnose(&m);
+        let between = d
+            .iter()
+            .find(|d| d.path.to_string() == "reconfiguration.waypoints[0].between")
+            .expect("a message on the missing name");
+        assert!(owner(&fields(&iwp, &m), &between.path).is_none());
+        assert!(owner(&fields(&broken, &m), &between.path).is_none());
+        let listed = broken.path(&m).expect("the entry's path");
+        assert!(between.path.starts_with(&listed));
+        assert!(iwp.path(&m).is_none());
+    }
+
     /// Issue 13: a field's path is the typed path the validator reports on.
     #[test]
     fn each_field_is_at_the_typed_path_its_diagnostics_name() {
@@ -461,11 +549,11 @@ mod tests {
         );
         assert_eq!(
             at(&obstacle, &m, "stand-off max (m)").as_deref(),
-            Some("obstacles[3].stand_off")
+            Some("obstacles[3].stand_off[1]")
         );
         assert_eq!(
             at(&Item::Start, &m, "z (m)").as_deref(),
-            Some("route.start")
+            Some("route.start[2]")
         );
         assert_eq!(
             at(&Item::Formation, &m, "default shape").as_deref(),
@@ -473,14 +561,14 @@ mod tests {
         );
         assert_eq!(
             at(&Item::Slot(2), &m, "up z (m)").as_deref(),
-            Some("formation.slots[2]")
+            Some("formation.slots[2][2]")
         );
-        // An IWP without an entry yet: the list it will be added to.
+        // An IWP without an entry yet: where its entry will go.
         m.reconfiguration.waypoints.clear();
         let iwp = Item::Waypoint(["pier 5".into(), "light pole 4".into()]);
         assert_eq!(
             at(&iwp, &m, "shape").as_deref(),
-            Some("reconfiguration.waypoints")
+            Some("reconfiguration.waypoints[0].shape")
         );
         fields(&iwp, &m)[1].set(&mut m, &iwp, "shrink").unwrap();
         assert_eq!(

@@ -10,7 +10,6 @@ use super::{Item, Spec, Table, fmt_num, number, shape_name, waypoint_choice};
 use crate::mission::{
     FleetTarget, GeoOrigin, Mission, Obstacle, ShapeChoice, Terrain, WaypointChoice,
 };
-use crate::planner::iwp::same_pair;
 use crate::terrain::Lookup;
 
 /// The table of `item`'s kind.
@@ -355,10 +354,7 @@ fn choice_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m WaypointChoice> {
     let Item::Waypoint([a, b]) = item else {
         return None;
     };
-    m.reconfiguration
-        .waypoints
-        .iter()
-        .find(|w| same_pair(&w.between, a, b))
+    m.reconfiguration.choice(a, b)
 }
 
 /// Writes one value of an IWP's choice. The text is parsed before the entry

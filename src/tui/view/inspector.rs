@@ -9,7 +9,7 @@ use ratatui::widgets::{Block, BorderType, Borders, Paragraph, Wrap};
 
 use crate::mission::Severity;
 use crate::tui::app::{App, Focus};
-use crate::tui::fields::Item;
+use crate::tui::fields::{self, Item};
 
 fn severity_span(severity: Severity, text: String) -> Span<'static> {
     match severity {
@@ -61,20 +61,21 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
                 lines.push(Line::from(severity_span(severity, text)));
             }
         } else {
-            // Show each message once, under the first field it concerns.
-            let first_with_path = fields.iter().position(|g| g.path() == f.path()) == Some(k);
-            if first_with_path {
-                for d in diagnostics.iter().filter(|d| d.path.starts_with(f.path())) {
-                    lines.push(Line::from(severity_span(d.severity, d.message.clone())));
-                }
+            // Each message once, under the field it belongs to.
+            for d in diagnostics
+                .iter()
+                .filter(|d| fields::owner(&fields, &d.path) == Some(k))
+            {
+                lines.push(Line::from(severity_span(d.severity, d.message.clone())));
             }
         }
     }
     // Messages about the item that no field shows (e.g. an obstacle outside the bounds).
-    if let Some(prefix) = app.selected().path() {
-        for d in diagnostics.iter().filter(|d| {
-            d.path.starts_with(&prefix) && !fields.iter().any(|f| d.path.starts_with(f.path()))
-        }) {
+    if let Some(prefix) = app.selected().path(app.mission()) {
+        for d in diagnostics
+            .iter()
+            .filter(|d| d.path.starts_with(&prefix) && fields::owner(&fields, &d.path).is_none())
+        {
             lines.push(Line::from(severity_span(
                 d.severity,
                 format!("{}: {}", d.path, d.message),
