@@ -498,7 +498,7 @@ impl Editor {
 
     /// Where a movable item is, in its pane's plane (map: x, y ENU; formation:
     /// forward, left).
-    pub fn position_of(&self, item: &Item) -> Option<Point2<f64>> {
+    fn position_of(&self, item: &Item) -> Option<Point2<f64>> {
         let m = self.mission();
         match item {
             Item::Obstacle(i) => m.obstacles.get(*i).map(|o| o.center),

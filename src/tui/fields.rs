@@ -188,6 +188,7 @@ impl Table {
         for step in self.base {
             path = match step {
                 Step::Key(key) => path.key(key),
+                // Only an IWP can lack an index: its entry is not made yet.
                 Step::Index => {
                     path.index(item.index(m).unwrap_or(m.reconfiguration.waypoints.len()))
                 }
