@@ -27,6 +27,11 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
     let m = app.mission();
     let fields = app.fields();
     let diagnostics = app.doc().diagnostics();
+    // Which field shows each message, worked out once per frame.
+    let owners: Vec<Option<usize>> = diagnostics
+        .iter()
+        .map(|d| fields::owner(&fields, &d.path))
+        .collect();
     let label_width = fields
         .iter()
         .map(|f| f.label().chars().count())
@@ -62,9 +67,10 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
             }
         } else {
             // Each message once, under the field it belongs to.
-            for d in diagnostics
+            for (d, _) in diagnostics
                 .iter()
-                .filter(|d| fields::owner(&fields, &d.path) == Some(k))
+                .zip(&owners)
+                .filter(|(_, owner)| **owner == Some(k))
             {
                 lines.push(Line::from(severity_span(d.severity, d.message.clone())));
             }
@@ -72,9 +78,10 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
     }
     // Messages about the item that no field shows (e.g. an obstacle outside the bounds).
     if let Some(prefix) = app.selected().path(app.mission()) {
-        for d in diagnostics
+        for (d, _) in diagnostics
             .iter()
-            .filter(|d| d.path.starts_with(&prefix) && fields::owner(&fields, &d.path).is_none())
+            .zip(&owners)
+            .filter(|(d, owner)| owner.is_none() && d.path.starts_with(&prefix))
         {
             lines.push(Line::from(severity_span(
                 d.severity,
