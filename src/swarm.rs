@@ -17,7 +17,7 @@
 use std::ops::ControlFlow;
 
 use rand::rngs::ChaCha8Rng;
-use rand::{RngExt, SeedableRng};
+use rand::{Rng, RngExt, SeedableRng};
 use rayon::prelude::*;
 
 /// The swarm's hyper-parameters.
@@ -278,23 +278,31 @@ where
         return stopped;
     }
     let mut w = config.inertia;
+    let mut draws = vec![0u64; 2 * dims];
     for iteration in 1..=config.iterations {
         let mut improved = false;
         for (i, rng) in rngs.iter_mut().enumerate() {
             let (x, v) = (&mut positions[i], &mut velocities[i]);
-            for d in 0..dims {
-                let r1: f64 = rng.random();
-                let r2: f64 = rng.random();
-                let step = w * v[d]
-                    + config.cognitive * r1 * (personal[i].position[d] - x[d])
-                    + config.social * r2 * (global.position[d] - x[d]);
-                v[d] = step.clamp(-space.max_step[d], space.max_step[d]);
-                x[d] += v[d];
-                if x[d] < space.lower[d] || x[d] > space.upper[d] {
-                    v[d] = -v[d];
-                }
-                x[d] = x[d].clamp(space.lower[d], space.upper[d]);
+            // r1, r2 of each dimension in turn: the draws `rng.random::<f64>()`
+            // makes, taken first so the update below has no calls or
+            // branches and vectorises.
+            for u in draws.iter_mut() {
+                *u = rng.next_u64();
             }
+            let gains = Gains {
+                inertia: w,
+                cognitive: config.cognitive,
+                social: config.social,
+            };
+            move_particle(
+                space,
+                gains,
+                &draws,
+                &personal[i].position,
+                &global.position,
+                x,
+                v,
+            );
             let c = guarded(x, personal[i].cost);
             evaluations += 1;
             if c < personal[i].cost {
@@ -320,6 +328,54 @@ where
         evaluations,
         stopped: false,
     }
+}
+
+/// w, c1, c2 of one iteration.
+#[derive(Clone, Copy)]
+struct Gains {
+    inertia: f64,
+    cognitive: f64,
+    social: f64,
+}
+
+/// One particle's move in the reference loop (see [`minimize_sequential`]),
+/// dimension d with r1 = `draws[2d]`, r2 = `draws[2d + 1]` as uniform
+/// [0, 1) numbers. Written with selects in place of `clamp` and `if`, so it
+/// vectorises; the arithmetic and its order are the reference's.
+fn move_particle(
+    space: &SearchSpace,
+    gains: Gains,
+    draws: &[u64],
+    personal: &[f64],
+    global: &[f64],
+    x: &mut [f64],
+    v: &mut [f64],
+) {
+    let lanes = x
+        .iter_mut()
+        .zip(v.iter_mut())
+        .zip(draws.chunks_exact(2))
+        .zip(personal.iter().zip(global))
+        .zip(space.lower.iter().zip(&space.upper).zip(&space.max_step));
+    for ((((x, v), r), (&p, &g)), ((&lo, &hi), &limit)) in lanes {
+        let (r1, r2) = (unit_interval(r[0]), unit_interval(r[1]));
+        let step =
+            gains.inertia * *v + gains.cognitive * r1 * (p - *x) + gains.social * r2 * (g - *x);
+        let step = if step < -limit { -limit } else { step };
+        let step = if step > limit { limit } else { step };
+        let moved = *x + step;
+        let outside = moved < lo || moved > hi;
+        *v = if outside { -step } else { step };
+        let moved = if moved < lo { lo } else { moved };
+        *x = if moved > hi { hi } else { moved };
+    }
+}
+
+/// `rand`'s uniform f64 in [0, 1) from one 64-bit draw: the top 53 bits
+/// times 2⁻⁵³, what `rng.random::<f64>()` returns for the same draw.
+#[inline(always)]
+fn unit_interval(draw: u64) -> f64 {
+    (draw >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// Eq. 1 of the θ-PSO paper, third line (the angle encoding every θ-PSO
@@ -429,6 +485,84 @@ fn best_of(personal: &[Best]) -> Best {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_draw_becomes_the_number_rand_would_give() {
+        let (mut a, mut b) = (ChaCha8Rng::seed_from_u64(7), ChaCha8Rng::seed_from_u64(7));
+        for _ in 0..1000 {
+            let want: f64 = a.random();
+            assert_eq!(unit_interval(b.next_u64()).to_bits(), want.to_bits());
+        }
+    }
+
+    /// The reference's move, written plainly (`SPSO_MAIN.m`).
+    fn reference_move(
+        space: &SearchSpace,
+        g: Gains,
+        r: &[f64],
+        p: &[f64],
+        b: &[f64],
+        x: &mut [f64],
+        v: &mut [f64],
+    ) {
+        for d in 0..x.len() {
+            let step = g.inertia * v[d]
+                + g.cognitive * r[2 * d] * (p[d] - x[d])
+                + g.social * r[2 * d + 1] * (b[d] - x[d]);
+            v[d] = step.clamp(-space.max_step[d], space.max_step[d]);
+            x[d] += v[d];
+            if x[d] < space.lower[d] || x[d] > space.upper[d] {
+                v[d] = -v[d];
+            }
+            x[d] = x[d].clamp(space.lower[d], space.upper[d]);
+        }
+    }
+
+    #[test]
+    fn the_vectorised_move_is_the_reference_move_bit_for_bit() {
+        let space = SearchSpace {
+            lower: vec![-1.0, 0.0, 2.0, -5.0],
+            upper: vec![1.0, 10.0, 3.0, 5.0],
+            max_step: vec![1.0, 5.0, 0.5, 2.5],
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut hits = [0usize; 2];
+        for _ in 0..5000 {
+            let wide = |rng: &mut ChaCha8Rng, d: usize| {
+                let span = space.upper[d] - space.lower[d];
+                space.lower[d] + span * (3.0 * rng.random::<f64>() - 1.0)
+            };
+            let x0: Vec<f64> = (0..4)
+                .map(|d| wide(&mut rng, d).clamp(space.lower[d], space.upper[d]))
+                .collect();
+            let v0: Vec<f64> = (0..4)
+                .map(|d| space.max_step[d] * (2.0 * rng.random::<f64>() - 1.0))
+                .collect();
+            let p: Vec<f64> = (0..4).map(|d| wide(&mut rng, d)).collect();
+            let b: Vec<f64> = (0..4).map(|d| wide(&mut rng, d)).collect();
+            let draws: Vec<u64> = (0..8).map(|_| rng.next_u64()).collect();
+            let r: Vec<f64> = draws.iter().map(|&u| unit_interval(u)).collect();
+            let g = Gains {
+                inertia: 0.9,
+                cognitive: 1.5,
+                social: 1.5,
+            };
+            let (mut x1, mut v1) = (x0.clone(), v0.clone());
+            let (mut x2, mut v2) = (x0.clone(), v0.clone());
+            move_particle(&space, g, &draws, &p, &b, &mut x1, &mut v1);
+            reference_move(&space, g, &r, &p, &b, &mut x2, &mut v2);
+            for d in 0..4 {
+                assert_eq!(
+                    (x1[d].to_bits(), v1[d].to_bits()),
+                    (x2[d].to_bits(), v2[d].to_bits())
+                );
+                let bounced = v2[d] != 0.0 && (x2[d] == space.lower[d] || x2[d] == space.upper[d]);
+                hits[usize::from(bounced)] += 1;
+            }
+        }
+        // Both the free and the mirrored branch are exercised.
+        assert!(hits[0] > 1000 && hits[1] > 1000, "{hits:?}");
+    }
 
     fn config(parallel: bool) -> SwarmConfig {
         SwarmConfig {

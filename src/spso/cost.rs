@@ -22,6 +22,9 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
 /// validation allows, and start and goal.
 pub const MAX_POINTS: usize = crate::mission::SPSO_MAX_NODES + 2;
 
+// J2 keeps one bit per segment in a u64.
+const _: () = assert!(MAX_POINTS - 1 <= 64);
+
 /// A vertical cylinder threat: centre (x, y) and radius; only the x-y
 /// distance counts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -121,6 +124,35 @@ impl Model {
         }
     }
 
+    /// [`Self::pixel_index`] of every point into `index`; false when one is
+    /// off the map. On the benchmark's own grid without a branch per point
+    /// (the points' pixels are as good as random to the branch predictor).
+    #[inline(always)]
+    fn pixel_indices(&self, xs: &[f64], ys: &[f64], index: &mut [usize]) -> bool {
+        let m = &*self.map;
+        if !self.unit_grid {
+            for ((&x, &y), k) in xs.iter().zip(ys).zip(index.iter_mut()) {
+                match self.pixel_index(x, y) {
+                    Some(i) => *k = i,
+                    None => return false,
+                }
+            }
+            return true;
+        }
+        let (width, height) = (m.width as f64, m.height as f64);
+        let mut inside = true;
+        for ((&x, &y), k) in xs.iter().zip(ys).zip(index.iter_mut()) {
+            let (c, r) = (round_half_away(x), round_half_away(y));
+            inside &= (c >= 1.0) & (r >= 1.0) & (c <= width) & (r <= height);
+            // Meaningless (but harmless) when off the map: not read then.
+            *k = (r as usize)
+                .wrapping_sub(1)
+                .wrapping_mul(m.width)
+                .wrapping_add((c as usize).wrapping_sub(1));
+        }
+        inside
+    }
+
     /// J for free nodes given as x1..xn, y1..yn, z1..zn (z above the ground).
     pub fn cost(&self, xyz: &[f64]) -> f64 {
         self.cost_below(xyz, f64::INFINITY)
@@ -199,15 +231,12 @@ impl Model {
         // a double array. Every pixel index first, then the reads, so the
         // cache misses on the map overlap.
         let mut index = [0usize; MAX_POINTS];
-        for i in 0..points {
-            let Some(k) = self.pixel_index(px[i], py[i]) else {
-                return Terms {
-                    total: f64::INFINITY,
-                    off_map: true,
-                    ..Terms::default()
-                };
+        if !self.pixel_indices(&px[..points], &py[..points], &mut index) {
+            return Terms {
+                total: f64::INFINITY,
+                off_map: true,
+                ..Terms::default()
             };
-            index[i] = k;
         }
         let heights = &self.map.heights;
         let mut za = [0.0f64; MAX_POINTS];
@@ -237,19 +266,33 @@ impl Model {
             return terms;
         }
 
-        // J2, threat-major.
+        // J2, threat-major. A threat whose centre lies outside a segment's
+        // x-y box grown by its danger radius is certainly farther than
+        // that (cost 0): the boxes once, then per threat one bit per
+        // segment, built without branches, and only the near segments
+        // measured.
+        let (mut x0, mut x1) = ([0.0f64; MAX_POINTS], [0.0f64; MAX_POINTS]);
+        let (mut y0, mut y1) = ([0.0f64; MAX_POINTS], [0.0f64; MAX_POINTS]);
+        for k in 0..segments {
+            (x0[k], x1[k]) = (px[k].min(px[k + 1]), px[k].max(px[k + 1]));
+            (y0[k], y1[k]) = (py[k].min(py[k + 1]), py[k].max(py[k + 1]));
+        }
         let mut j2 = 0.0;
         for t in &self.threats {
             let inner = t.radius + self.drone_size;
             let outer = t.radius + self.drone_size + self.danger_distance;
+            let reach = outer * (1.0 + 1e-9) + 1e-9;
+            let mut near = 0u64;
             for k in 0..segments {
-                // Far from the segment's box: certainly d > outer, cost 0.
-                let (x0, x1) = (px[k].min(px[k + 1]), px[k].max(px[k + 1]));
-                let (y0, y1) = (py[k].min(py[k + 1]), py[k].max(py[k + 1]));
-                let reach = outer * (1.0 + 1e-9) + 1e-9;
-                if t.x < x0 - reach || t.x > x1 + reach || t.y < y0 - reach || t.y > y1 + reach {
-                    continue;
-                }
+                let far = (t.x < x0[k] - reach)
+                    | (t.x > x1[k] + reach)
+                    | (t.y < y0[k] - reach)
+                    | (t.y > y1[k] + reach);
+                near |= u64::from(!far) << k;
+            }
+            while near != 0 {
+                let k = near.trailing_zeros() as usize;
+                near &= near - 1;
                 let d = dist_p2s([t.x, t.y], [px[k], py[k]], [px[k + 1], py[k + 1]]);
                 j2 += if d > outer {
                     0.0
@@ -259,13 +302,17 @@ impl Model {
                     outer - d
                 };
             }
+            // J2 only grows, so the sum so far bounds J from below (∞ once
+            // a threat is crossed).
+            let partial = b1 * j1 + b2 * j2 + b3 * j3;
+            if bound.is_finite() && partial >= bound {
+                terms.threat = j2;
+                terms.total = partial;
+                return terms;
+            }
         }
         terms.threat = j2;
         let partial = b1 * j1 + b2 * j2 + b3 * j3;
-        if bound.is_finite() && partial >= bound {
-            terms.total = partial;
-            return terms;
-        }
 
         // J4: for each interior point, the borrowed projections.
         let nonzero = |k: usize| dx[k] != 0.0 || dy[k] != 0.0;
@@ -309,6 +356,12 @@ impl Model {
                     j4 += change.abs();
                 }
             }
+            // As for J2: J4 only grows.
+            if bound.is_finite() && partial + b4 * j4 >= bound {
+                terms.smoothness = j4;
+                terms.total = partial + b4 * j4;
+                return terms;
+            }
         }
         terms.smoothness = j4;
         terms.total = ((b1 * j1 + b2 * j2) + b3 * j3) + b4 * j4;
@@ -343,13 +396,8 @@ pub fn dist_p2s(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 fn round_half_away(x: f64) -> f64 {
     let whole = x as i64 as f64;
     let fraction = x - whole;
-    if fraction >= 0.5 {
-        whole + 1.0
-    } else if fraction <= -0.5 {
-        whole - 1.0
-    } else {
-        whole
-    }
+    // Without branches: the fraction's half step is unpredictable.
+    whole + f64::from(u8::from(fraction >= 0.5)) - f64::from(u8::from(fraction <= -0.5))
 }
 
 #[inline]
@@ -570,5 +618,56 @@ mod tests {
         assert_eq!(m.cost_below(&p, f64::INFINITY), full);
         let partial = m.cost_below(&p, 100.0);
         assert!(partial >= 100.0 && partial <= full);
+        // Through a threat: infinite under any bound the path could beat,
+        // and the terms still all computed without one.
+        let m = flat(S, [100.0, 130.0, 150.0], 2, &[[25.0, 30.0, 5.0]], 0.0);
+        let p = nodes(&[[40.0, 50.0, 150.0], [70.0, 90.0, 150.0]]);
+        assert_eq!(m.cost_below(&p, 1e6), f64::INFINITY);
+        assert_eq!(m.terms(&p).length, 150.0);
+    }
+
+    /// What the swarm relies on: under a bound, the cost is exact when
+    /// below it, and otherwise some value between the bound and J.
+    #[test]
+    fn a_bounded_cost_is_exact_below_the_bound_and_a_lower_bound_above() {
+        let threats = [
+            [100.0, 120.0, 8.0],
+            [200.0, 150.0, 6.0],
+            [150.0, 250.0, 5.0],
+        ];
+        let m = flat([20.0, 20.0, 150.0], [280.0, 280.0, 150.0], 6, &threats, 0.0);
+        let mut state = 12345u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut exact, mut stopped) = (0, 0);
+        for _ in 0..20_000 {
+            let mut p: Vec<f64> = (0..12).map(|_| 1.0 + 298.0 * next()).collect();
+            p.extend((0..6).map(|_| 80.0 + 140.0 * next()));
+            let full = m.cost(&p);
+            let bound = if full.is_finite() {
+                full * (0.5 + next())
+            } else {
+                1e3 + 1e4 * next()
+            };
+            let got = m.cost_below(&p, bound);
+            if full < bound {
+                assert_eq!(got.to_bits(), full.to_bits());
+                exact += 1;
+            } else {
+                assert!(
+                    got >= bound && got <= full,
+                    "{got} not in [{bound}, {full}]"
+                );
+                stopped += 1;
+            }
+        }
+        assert!(
+            exact > 1000 && stopped > 1000,
+            "{exact} exact, {stopped} stopped"
+        );
     }
 }
