@@ -871,6 +871,24 @@ fn opening_another_mission_drops_the_jobs_of_the_first() {
 }
 
 #[test]
+fn opening_another_mission_stops_a_drag_and_the_add_tool_of_the_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    let start = app.mission().obstacles[0].center;
+    app.update(Action::DragStart(Item::Obstacle(0), start));
+    app.update(Action::ToggleAddTool);
+    assert!(app.editor().add_tool());
+    app.open(skyform::tui::app::Entry::Builtin("narrow-passage.toml"));
+    let before = app.mission().clone();
+    // The rest of the old drag lands on the new mission: nothing moves.
+    app.update(Action::DragTo(start + nalgebra::Vector2::new(40.0, 25.0)));
+    app.update(Action::DragEnd);
+    assert_eq!(app.mission(), &before);
+    assert!(!app.doc().is_modified());
+    assert!(!app.editor().add_tool());
+}
+
+#[test]
 fn drags_snap_to_the_nudge_step_and_huge_values_show_short() {
     let dir = tempfile::tempdir().unwrap();
     let mut app = app_in(dir.path());

@@ -123,12 +123,15 @@ impl Editor {
     }
 
     /// Another document (a mission opened): the selection goes back to the
-    /// mission item.
+    /// mission item, and a drag or the add tool of the old one stops (its
+    /// item may not exist in the new one).
     pub fn replace(&mut self, doc: Document) {
         self.doc = doc;
         self.selected = Item::Mission;
         self.field = 0;
         self.editing = None;
+        self.drag = None;
+        self.add_tool = false;
         self.refresh();
     }
 
