@@ -216,9 +216,9 @@ impl Model {
             flat_sum += flat[k];
         }
         // Each 3-D length is ≥ its x-y length in floating point too (adding
-        // dz² ≥ 0, sqrt and sums are monotone), so 5 Σ|xy| + 10 J3 ≤ J: a
-        // candidate that cannot beat `bound` stops before touching the map,
-        // whose random reads are the slowest part of an evaluation.
+        // dz² ≥ 0, sqrt and sums are monotone), so 5 Σ|xy| (+ J2) + 10 J3 ≤
+        // J: a candidate that cannot beat `bound` stops before touching the
+        // map, whose random reads are the slowest part of an evaluation.
         if bound.is_finite() && b1 * flat_sum + b3 * j3 >= bound {
             return Terms {
                 total: b1 * flat_sum + b3 * j3,
@@ -227,50 +227,12 @@ impl Model {
             };
         }
 
-        // z_abs = z + H: single + double is single in MATLAB, then stored in
-        // a double array. Every pixel index first, then the reads, so the
-        // cache misses on the map overlap.
-        let mut index = [0usize; MAX_POINTS];
-        if !self.pixel_indices(&px[..points], &py[..points], &mut index) {
-            return Terms {
-                total: f64::INFINITY,
-                off_map: true,
-                ..Terms::default()
-            };
-        }
-        let heights = &self.map.heights;
-        let mut za = [0.0f64; MAX_POINTS];
-        for i in 0..points {
-            let h = heights[index[i]];
-            let h = if h < 0.0 { 0.0 } else { h };
-            za[i] = f64::from(pz[i] as f32 + h);
-        }
-
-        let mut dz = [0.0f64; MAX_POINTS];
-        let mut j1 = 0.0;
-        for k in 0..segments {
-            dz[k] = za[k + 1] - za[k];
-            j1 += (dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]).sqrt();
-        }
-        let mut terms = Terms {
-            length: j1,
-            altitude: j3,
-            ..Terms::default()
-        };
-        // (5 J1 + J2) + 10 J3 ≥ 5 J1 + 10 J3 in floating point (rounding is
-        // monotone, J2, J4 ≥ 0): a lower bound that stops early. Without a
-        // bound every term is computed (`terms`).
-        let low = b1 * j1 + b3 * j3;
-        if bound.is_finite() && low >= bound {
-            terms.total = low;
-            return terms;
-        }
-
-        // J2, threat-major. A threat whose centre lies outside a segment's
-        // x-y box grown by its danger radius is certainly farther than
-        // that (cost 0): the boxes once, then per threat one bit per
-        // segment, built without branches, and only the near segments
-        // measured.
+        // J2 needs no heights, so it comes before the map reads: a path
+        // through a threat stops without them. Threat-major. A threat whose
+        // centre lies outside a segment's x-y box grown by its danger
+        // radius is certainly farther than that (cost 0): the boxes once,
+        // then per threat one bit per segment, built without branches, and
+        // only the near segments measured.
         let (mut x0, mut x1) = ([0.0f64; MAX_POINTS], [0.0f64; MAX_POINTS]);
         let (mut y0, mut y1) = ([0.0f64; MAX_POINTS], [0.0f64; MAX_POINTS]);
         for k in 0..segments {
@@ -304,15 +266,53 @@ impl Model {
             }
             // J2 only grows, so the sum so far bounds J from below (∞ once
             // a threat is crossed).
-            let partial = b1 * j1 + b2 * j2 + b3 * j3;
-            if bound.is_finite() && partial >= bound {
-                terms.threat = j2;
-                terms.total = partial;
-                return terms;
+            let low = b1 * flat_sum + b2 * j2 + b3 * j3;
+            if bound.is_finite() && low >= bound {
+                return Terms {
+                    total: low,
+                    threat: j2,
+                    altitude: j3,
+                    ..Terms::default()
+                };
             }
         }
-        terms.threat = j2;
+
+        // z_abs = z + H: single + double is single in MATLAB, then stored in
+        // a double array. Every pixel index first, then the reads, so the
+        // cache misses on the map overlap.
+        let mut index = [0usize; MAX_POINTS];
+        if !self.pixel_indices(&px[..points], &py[..points], &mut index) {
+            return Terms {
+                total: f64::INFINITY,
+                off_map: true,
+                ..Terms::default()
+            };
+        }
+        let heights = &self.map.heights;
+        let mut za = [0.0f64; MAX_POINTS];
+        for i in 0..points {
+            let h = heights[index[i]];
+            let h = if h < 0.0 { 0.0 } else { h };
+            za[i] = f64::from(pz[i] as f32 + h);
+        }
+
+        let mut dz = [0.0f64; MAX_POINTS];
+        let mut j1 = 0.0;
+        for k in 0..segments {
+            dz[k] = za[k + 1] - za[k];
+            j1 += (dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]).sqrt();
+        }
+        let mut terms = Terms {
+            length: j1,
+            threat: j2,
+            altitude: j3,
+            ..Terms::default()
+        };
         let partial = b1 * j1 + b2 * j2 + b3 * j3;
+        if bound.is_finite() && partial >= bound {
+            terms.total = partial;
+            return terms;
+        }
 
         // J4: for each interior point, the borrowed projections.
         let nonzero = |k: usize| dx[k] != 0.0 || dy[k] != 0.0;
