@@ -60,7 +60,7 @@ fn cost_evaluation(c: &mut Criterion) {
                     .collect()
             })
             .collect();
-        let mut buffer = vec![0.0; 3 * decoder.nodes];
+        let mut buffer = vec![0.0; 3 * decoder.nodes()];
         let mut k = 0;
         c.bench_function(&format!("spso/decode_and_cost_{encoding:?}"), |b| {
             b.iter(|| {

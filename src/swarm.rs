@@ -281,6 +281,11 @@ where
     let mut draws = vec![0u64; 2 * dims];
     for iteration in 1..=config.iterations {
         let mut improved = false;
+        let gains = Gains {
+            inertia: w,
+            cognitive: config.cognitive,
+            social: config.social,
+        };
         for (i, rng) in rngs.iter_mut().enumerate() {
             let (x, v) = (&mut positions[i], &mut velocities[i]);
             // r1, r2 of each dimension in turn: the draws `rng.random::<f64>()`
@@ -289,11 +294,6 @@ where
             for u in draws.iter_mut() {
                 *u = rng.next_u64();
             }
-            let gains = Gains {
-                inertia: w,
-                cognitive: config.cognitive,
-                social: config.social,
-            };
             move_particle(
                 space,
                 gains,

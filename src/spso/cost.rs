@@ -106,51 +106,54 @@ impl Model {
     }
 
     /// The index into the height array of the pixel under (x, y), or `None`
-    /// off the map. With the benchmark's own convention (origin 1, step 1)
-    /// the 1-based pixel is round(x), round(y), rounded half away from zero
-    /// without a libm call ([`round_half_away`]).
+    /// off the map.
     #[inline(always)]
     fn pixel_index(&self, x: f64, y: f64) -> Option<usize> {
-        let m = &*self.map;
         if self.unit_grid {
-            let (c, r) = (round_half_away(x), round_half_away(y));
-            if c >= 1.0 && r >= 1.0 && c <= m.width as f64 && r <= m.height as f64 {
-                Some((r as usize - 1) * m.width + (c as usize - 1))
-            } else {
-                None
-            }
+            let (inside, k) = self.unit_grid_pixel(x, y);
+            inside.then_some(k)
         } else {
+            let m = &*self.map;
             m.nearest_index(x, y).map(|(c, r)| r * m.width + c)
         }
     }
 
+    /// With the benchmark's own convention (origin 1, step 1): whether the
+    /// 1-based pixel round(x), round(y) is on the map, and its index
+    /// (meaningless, but harmless, when it is not). MATLAB's round without
+    /// a libm call ([`round_half_away`]) and without branches (the points'
+    /// pixels are as good as random to the branch predictor).
+    #[inline(always)]
+    fn unit_grid_pixel(&self, x: f64, y: f64) -> (bool, usize) {
+        let m = &*self.map;
+        let (c, r) = (round_half_away(x), round_half_away(y));
+        let inside = (c >= 1.0) & (r >= 1.0) & (c <= m.width as f64) & (r <= m.height as f64);
+        let k = (r as usize)
+            .wrapping_sub(1)
+            .wrapping_mul(m.width)
+            .wrapping_add((c as usize).wrapping_sub(1));
+        (inside, k)
+    }
+
     /// [`Self::pixel_index`] of every point into `index`; false when one is
-    /// off the map. On the benchmark's own grid without a branch per point
-    /// (the points' pixels are as good as random to the branch predictor).
+    /// off the map. On the benchmark's own grid, every point without a
+    /// branch, then one test.
     #[inline(always)]
     fn pixel_indices(&self, xs: &[f64], ys: &[f64], index: &mut [usize]) -> bool {
-        let m = &*self.map;
-        if !self.unit_grid {
-            for ((&x, &y), k) in xs.iter().zip(ys).zip(index.iter_mut()) {
+        let mut all_inside = true;
+        for ((&x, &y), k) in xs.iter().zip(ys).zip(index.iter_mut()) {
+            if self.unit_grid {
+                let (inside, i) = self.unit_grid_pixel(x, y);
+                all_inside &= inside;
+                *k = i;
+            } else {
                 match self.pixel_index(x, y) {
                     Some(i) => *k = i,
                     None => return false,
                 }
             }
-            return true;
         }
-        let (width, height) = (m.width as f64, m.height as f64);
-        let mut inside = true;
-        for ((&x, &y), k) in xs.iter().zip(ys).zip(index.iter_mut()) {
-            let (c, r) = (round_half_away(x), round_half_away(y));
-            inside &= (c >= 1.0) & (r >= 1.0) & (c <= width) & (r <= height);
-            // Meaningless (but harmless) when off the map: not read then.
-            *k = (r as usize)
-                .wrapping_sub(1)
-                .wrapping_mul(m.width)
-                .wrapping_add((c as usize).wrapping_sub(1));
-        }
-        inside
+        all_inside
     }
 
     /// J for free nodes given as x1..xn, y1..yn, z1..zn (z above the ground).

@@ -31,12 +31,14 @@ const SINE_TAYLOR: [f64; 11] = [
 /// (tested).
 #[inline]
 fn sin_within_quarter_turn(theta: f64) -> f64 {
-    let t2 = theta * theta;
-    let mut p = SINE_TAYLOR[10];
-    for &c in SINE_TAYLOR[..10].iter().rev() {
-        p = p * t2 + c;
-    }
-    theta * p
+    theta * horner(&SINE_TAYLOR, theta * theta)
+}
+
+/// Σ c_k t^k in Horner form, the last coefficient first.
+#[inline(always)]
+fn horner(coefficients: &[f64], t: f64) -> f64 {
+    let (&last, rest) = coefficients.split_last().unwrap_or((&0.0, &[]));
+    rest.iter().rev().fold(last, |p, &c| p * t + c)
 }
 
 /// |δ| up to which [`series_sin_cos`] is used: a little over π/4, the
@@ -54,15 +56,10 @@ const SERIES_RANGE: f64 = 0.8;
 fn series_sin_cos(delta: f64) -> (f64, f64) {
     let d2 = delta * delta;
     // Sine: (−1)^k / (2k + 1)!, k = 0..8; cosine: (−1)^k / (2k)!, k = 0..9.
-    let mut sine = SINE_TAYLOR[8];
-    for &c in SINE_TAYLOR[..8].iter().rev() {
-        sine = sine * d2 + c;
-    }
-    let mut cosine = COSINE_TAYLOR[9];
-    for &c in COSINE_TAYLOR[..9].iter().rev() {
-        cosine = cosine * d2 + c;
-    }
-    (delta * sine, cosine)
+    (
+        delta * horner(&SINE_TAYLOR[..9], d2),
+        horner(&COSINE_TAYLOR, d2),
+    )
 }
 
 /// (−1)^k / (2k)!, k = 0..9: the Taylor coefficients of cosine to δ¹⁸.
@@ -82,25 +79,59 @@ const COSINE_TAYLOR: [f64; 10] = [
 /// Decodes particles of one encoding for one scenario.
 #[derive(Debug, Clone)]
 pub struct Decoder {
-    pub encoding: Encoding,
-    pub nodes: usize,
+    encoding: Encoding,
+    nodes: usize,
     /// [x_min, x_max], [y_min, y_max], [z_min, z_max] (z above the ground).
-    pub bounds: [[f64; 2]; 3],
-    pub start: [f64; 3],
-    pub goal: [f64; 3],
+    bounds: [[f64; 2]; 3],
+    start: [f64; 3],
+    goal: [f64; 3],
+    /// φ0 = atan2(Δy, Δx), start to goal (the middle of the φ box), and its
+    /// sine and cosine: once here rather than in every decoding.
+    heading: [f64; 3],
 }
 
 impl Decoder {
     pub fn new(mission: &Mission, encoding: Encoding) -> Self {
         let b = &mission.bounds;
         let (s, g) = (mission.route.start, mission.route.goal);
+        Self::from_parts(
+            encoding,
+            mission.theta_pso.waypoints,
+            [b.x, b.y, b.z],
+            [s.x, s.y, s.z],
+            [g.x, g.y, g.z],
+        )
+    }
+
+    /// A decoder of `nodes` free nodes in `bounds` between `start` and
+    /// `goal` (z above the ground).
+    pub fn from_parts(
+        encoding: Encoding,
+        nodes: usize,
+        bounds: [[f64; 2]; 3],
+        start: [f64; 3],
+        goal: [f64; 3],
+    ) -> Self {
+        let phi0 = (goal[1] - start[1]).atan2(goal[0] - start[0]);
+        let (sin_phi0, cos_phi0) = phi0.sin_cos();
         Decoder {
             encoding,
-            nodes: mission.theta_pso.waypoints,
-            bounds: [b.x, b.y, b.z],
-            start: [s.x, s.y, s.z],
-            goal: [g.x, g.y, g.z],
+            nodes,
+            bounds,
+            start,
+            goal,
+            heading: [phi0, sin_phi0, cos_phi0],
         }
+    }
+
+    /// n, the free nodes a particle decodes into.
+    pub fn nodes(&self) -> usize {
+        self.nodes
+    }
+
+    /// [x_min, x_max], [y_min, y_max], [z_min, z_max] (z above the ground).
+    pub fn bounds(&self) -> [[f64; 2]; 3] {
+        self.bounds
     }
 
     /// The box and velocity limits.
@@ -119,7 +150,7 @@ impl Decoder {
                     .sum::<f64>()
                     .sqrt();
                 let r_max = 2.0 * d / n.max(1) as f64;
-                let phi0 = self.heading();
+                let phi0 = self.heading[0];
                 let ranges = [
                     [0.0, r_max],
                     [-FRAC_PI_4, FRAC_PI_4],
@@ -140,11 +171,6 @@ impl Decoder {
                 space
             }
         }
-    }
-
-    /// φ0 = atan2(Δy, Δx), start to goal: the middle of the φ box.
-    fn heading(&self) -> f64 {
-        (self.goal[1] - self.start[1]).atan2(self.goal[0] - self.start[0])
     }
 
     /// The particle's free nodes into `out` (3 n numbers: x…, y…, z…).
@@ -171,11 +197,10 @@ impl Decoder {
                     if v < b[0] { b[0] } else { v }
                 };
                 // φ as φ0 + δ, |δ| ≤ π/4 in the box: sin and cos of δ by
-                // series, then the angle sum with φ0's, computed once. The
+                // series, then the angle sum with φ0's. The
                 // steps first (independent, so they vectorise), then the
                 // chain of sums and clamps in place.
-                let phi0 = self.heading();
-                let (sin_phi0, cos_phi0) = phi0.sin_cos();
+                let [phi0, sin_phi0, cos_phi0] = self.heading;
                 let (r, rest) = position.split_at(n);
                 let (psi, phi) = rest.split_at(n);
                 let (sx, rest) = out.split_at_mut(n);
@@ -267,12 +292,14 @@ mod tests {
 
     #[test]
     fn encoding_then_decoding_gives_the_nodes_back() {
-        let decoder = |encoding| Decoder {
-            encoding,
-            nodes: 3,
-            bounds: [[0.0, 100.0], [0.0, 100.0], [10.0, 20.0]],
-            start: [5.0, 5.0, 15.0],
-            goal: [95.0, 95.0, 15.0],
+        let decoder = |encoding| {
+            Decoder::from_parts(
+                encoding,
+                3,
+                [[0.0, 100.0], [0.0, 100.0], [10.0, 20.0]],
+                [5.0, 5.0, 15.0],
+                [95.0, 95.0, 15.0],
+            )
         };
         let nodes = [20.0, 40.0, 70.0, 10.0, 35.0, 60.0, 15.0, 17.0, 12.0];
         for encoding in [Encoding::Angle, Encoding::Spherical] {
@@ -302,13 +329,13 @@ mod tests {
     fn spherical_decoding_agrees_with_libm_trigonometry() {
         // SphericalToCart.m with libm's sin and cos, on random particles:
         // the nodes agree to a few ulp of the map's size.
-        let d = Decoder {
-            encoding: Encoding::Spherical,
-            nodes: 10,
-            bounds: [[1.0, 1045.0], [1.0, 879.0], [100.0, 200.0]],
-            start: [200.0, 100.0, 150.0],
-            goal: [800.0, 800.0, 150.0],
-        };
+        let d = Decoder::from_parts(
+            Encoding::Spherical,
+            10,
+            [[1.0, 1045.0], [1.0, 879.0], [100.0, 200.0]],
+            [200.0, 100.0, 150.0],
+            [800.0, 800.0, 150.0],
+        );
         let space = d.space();
         let mut out = [0.0; 30];
         for k in 0..2000u64 {

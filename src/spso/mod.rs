@@ -72,8 +72,8 @@ pub fn optimise(
 ) -> Run {
     let space = decoder.space();
     let config = decoder.published(particles, iterations);
-    let mut buffer = vec![0.0; 3 * decoder.nodes];
-    let mut shown = vec![0.0; 3 * decoder.nodes];
+    let mut buffer = vec![0.0; 3 * decoder.nodes()];
+    let mut shown = vec![0.0; 3 * decoder.nodes()];
     let mut convergence = Vec::with_capacity(iterations + 1);
     let result = swarm::minimize_sequential(
         &space,
@@ -90,7 +90,7 @@ pub fn optimise(
             on_iteration(report.iteration, report.best.cost, &shown)
         },
     );
-    let mut nodes = vec![0.0; 3 * decoder.nodes];
+    let mut nodes = vec![0.0; 3 * decoder.nodes()];
     decoder.decode(&result.best.position, &mut nodes);
     let terms = model.terms(&nodes);
     Run {

@@ -68,7 +68,7 @@ fn route_nodes(model: &Model, decoder: &Decoder) -> Option<Vec<f64>> {
             radius: t.radius + model.drone_size + 0.5 * model.danger_distance,
         })
         .collect();
-    let [bx, by, bz] = decoder.bounds;
+    let [bx, by, bz] = decoder.bounds();
     let start = Point2::new(model.start[0], model.start[1]);
     let goal = Point2::new(model.goal[0], model.goal[1]);
     let route = detour::shortest_route(start, goal, &discs, &[], Some([bx, by]))?;
@@ -124,7 +124,7 @@ mod tests {
             let decoder = Decoder::new(&m, encoding);
             let seeds = particles(&model, &decoder, 5, 1);
             assert_eq!(seeds.len(), 5);
-            let mut nodes = vec![0.0; 3 * decoder.nodes];
+            let mut nodes = vec![0.0; 3 * decoder.nodes()];
             decoder.decode(&seeds[0], &mut nodes);
             let terms = model.terms(&nodes);
             // J2 small: the equal steps cut the corners a little; J3 = 0:
