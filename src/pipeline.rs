@@ -168,6 +168,10 @@ pub enum PipelineError {
     /// The run would exceed a documented limit (`limits`).
     #[error("the run is too large to start:\n{0}")]
     OverBudget(String),
+    /// θ-PSO's route stage found no way from start to goal within its model;
+    /// the text names what closes it.
+    #[error("{0}")]
+    NoRoute(String),
 }
 
 /// Every pipeline's first step: a mission with errors is refused, naming them.

@@ -66,7 +66,7 @@ fn judge(hill: bool) -> (f64, bool) {
         .collect();
     let path = CentroidPath::bare(points);
     let terms = CostModel::new(&m, &[]).terms(&path);
-    let (trajectories, _) = trajectory::generate(&path, &[], &m.formation, heading_span(&m));
+    let (trajectories, _) = trajectory::generate(&path, &[], &[], &m.formation, heading_span(&m));
     let v = verify::verify(&m, &trajectories);
     (terms.altitude, v.feasible)
 }

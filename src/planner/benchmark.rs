@@ -110,7 +110,7 @@ pub fn plan(
     }
     let span = path::heading_span(mission);
     let (trajectories, reconfigurations) =
-        trajectory::generate(&centroid, &[], &mission.formation, span);
+        trajectory::generate(&centroid, &[], &[], &mission.formation, span);
     observer.on_event(Event::Stage("verification"));
     let verification = verify::verify(mission, &trajectories);
     observer.on_event(Event::Progress(1.0));
@@ -137,6 +137,9 @@ pub fn plan(
         passes: Vec::new(),
         centroid_path: centroid.points,
         reconfigurations,
+        bypassed: Vec::new(),
+        source: super::PlanSource::Swarm,
+        route_length: length,
         trajectories,
         verification,
     })

@@ -34,7 +34,7 @@
 
 use nalgebra::{Point2, Point3, Vector3};
 
-use super::iwp::{Iwp, Shape};
+use super::iwp::{Iwp, Shape, column_place};
 use super::motion::Motion;
 use super::path::{CentroidPath, heading_span};
 use crate::geometry::Cylinder;
@@ -46,6 +46,12 @@ use crate::pipeline::CostTerms;
 const CHORD_TOLERANCE: f64 = 0.02;
 /// Longest piece where the shape blends, metres.
 const BLEND_STEP: f64 = 2.0;
+/// Room the cost asks between two UAVs beyond 2 r_Q, metres (eq. 7 as
+/// verified is ≥ 2 r_Q); below the room the smallest shrink and the column
+/// leave (`route::SQUEEZE_SPACING_MARGIN`).
+pub const PAIR_FLOOR: f64 = 0.02;
+/// Step of the pair check along the changes of shape, metres.
+const PAIR_STEP: f64 = 0.5;
 /// Halvings of one knot interval at most (2^8 pieces).
 const MAX_DEPTH: u32 = 8;
 
@@ -77,6 +83,23 @@ pub struct CostModel {
     max_turn_cos: f64,
 }
 
+/// What the swarm adds to J for a path that breaks a constraint anywhere
+/// (Deb's feasibility rule, IEEE TEC 2000, as a penalty step): any path that
+/// keeps every UAV clear ranks before any that does not, whatever their
+/// lengths. Larger than any feasible J (J1 of a path within the trajectory
+/// budget is far below 10⁶ m).
+pub const INFEASIBLE_STEP: f64 = 1.0e6;
+
+/// A path's J, its terms, and the objective the swarm minimises.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Evaluation {
+    pub terms: CostTerms,
+    /// J for a path the cost finds clear; else J + [`INFEASIBLE_STEP`] +
+    /// β2 Σ violation / J1 (J2 not averaged over the UAVs and obstacles, so
+    /// one UAV clipping one post of a 200-post wall is not 1/200 as bad).
+    pub objective: f64,
+}
+
 /// Running sums of the per-UAV terms.
 #[derive(Default)]
 struct Sums {
@@ -86,6 +109,15 @@ struct Sums {
     altitude: f64,
     /// Σ arc length × metres outside the bounds over UAVs, pieces.
     bounds: f64,
+    /// Σ arc length × metres closer than 2 r_Q + `PAIR_FLOOR`, over the
+    /// pairs of UAVs where they can change (eq. 7).
+    spacing: f64,
+}
+
+impl Sums {
+    fn violated(&self) -> bool {
+        self.obstacle > 0.0 || self.altitude > 0.0 || self.bounds > 0.0 || self.spacing > 0.0
+    }
 }
 
 impl CostModel {
@@ -162,15 +194,30 @@ impl CostModel {
 
     /// J and its terms for a centroid path.
     pub fn terms(&self, path: &CentroidPath) -> CostTerms {
-        self.terms_below(path, f64::INFINITY)
+        self.evaluate_below(path, f64::INFINITY).terms
     }
 
-    /// J and its terms, or, as soon as J is known to reach `bound`, a partial
-    /// sum that already does (every term is ≥ 0, so a partial sum is a lower
-    /// bound of J). The swarm passes a particle's personal best: a candidate
-    /// that cannot beat it changes nothing, whatever its exact cost, so the
-    /// search is the same as with full evaluations, only faster.
-    pub fn terms_below(&self, path: &CentroidPath, bound: f64) -> CostTerms {
+    /// J, its terms and the swarm's objective, or, as soon as the objective
+    /// is known to reach `bound`, partial sums that already do (every term is
+    /// ≥ 0, so a partial sum is a lower bound). The swarm passes a particle's
+    /// personal best: a candidate that cannot beat it changes nothing,
+    /// whatever its exact cost, so the search is the same as with full
+    /// evaluations, only faster.
+    pub fn evaluate_below(&self, path: &CentroidPath, bound: f64) -> Evaluation {
+        let (terms, violation) = self.terms_below(path, bound);
+        let objective = if violation > 0.0 {
+            terms.total + INFEASIBLE_STEP + self.params.weight_obstacle * violation
+        } else {
+            terms.total
+        };
+        Evaluation { terms, objective }
+    }
+
+    /// J's terms (partial once the objective reaches `bound`) and the
+    /// undiluted obstacle violation: Σ over UAVs and obstacles of the
+    /// violation integral, over J1 (J2 before the paper's mean over N and K).
+    /// Any band or bounds violation counts as a violation too.
+    fn terms_below(&self, path: &CentroidPath, bound: f64) -> (CostTerms, f64) {
         let points = &path.points;
         let p = &self.params;
         let motion = Motion::new(path, &self.slots, self.span);
@@ -184,8 +231,10 @@ impl CostModel {
             total: p.weight_length * total + p.weight_waypoints * jr + p.weight_turning * turning,
             ..CostTerms::default()
         };
+        // Until a violation shows, the objective is at least J's sum so far
+        // (an infeasible path's is larger still, by the step).
         if terms.total >= bound {
-            return terms;
+            return (terms, 0.0);
         }
         let arcs = motion.walker().arcs();
         let mut sums = Sums::default();
@@ -199,7 +248,9 @@ impl CostModel {
             0.0
         };
         let share = if total > 0.0 { l / (n * total) } else { 0.0 };
+        let undiluted = if total > 0.0 { 1.0 / total } else { 0.0 };
         let base = terms.total;
+        sums.spacing = self.pair_deficit(&motion, path, &mut scratch.current);
         for (i, leg) in points.windows(2).enumerate() {
             let (a, b) = (leg[0], leg[1]);
             // Outside the zones the formation keeps its nominal extent.
@@ -239,9 +290,13 @@ impl CostModel {
                 &mut scratch,
                 &mut sums,
             );
-            let so_far = base
+            let mut so_far = base
                 + p.weight_obstacle * sums.obstacle * obstacle_scale
                 + (p.weight_altitude * sums.altitude + p.weight_bounds * sums.bounds) * share;
+            if sums.violated() {
+                so_far += INFEASIBLE_STEP
+                    + p.weight_obstacle * (sums.obstacle + sums.spacing) * undiluted;
+            }
             if so_far >= bound {
                 break;
             }
@@ -253,7 +308,13 @@ impl CostModel {
             + p.weight_obstacle * terms.obstacle
             + p.weight_altitude * terms.altitude
             + p.weight_bounds * terms.bounds;
-        terms
+        let violation = if sums.violated() {
+            // Positive even for a band or bounds violation alone.
+            ((sums.obstacle + sums.spacing) * undiluted).max(f64::MIN_POSITIVE)
+        } else {
+            0.0
+        };
+        (terms, violation)
     }
 
     /// J_R (eq. 11) over about L segments (each leg a share proportional to
@@ -393,6 +454,23 @@ impl CostModel {
                         knots.push(s);
                     }
                 }
+                // In file along the path, UAV n passes a vertex when the
+                // centroid is its place in the column short of it.
+                let [z0, _, _, z3] = zone.arcs();
+                let column = [Some(zone.shape), zone.from, zone.into]
+                    .into_iter()
+                    .flatten()
+                    .find(|s| matches!(s, Shape::Alignment { .. }));
+                if let Some(Shape::Alignment { spacing }) = column {
+                    for &a in motion.walker().arcs() {
+                        for n in 0..self.slots.len() {
+                            let s = a - column_place(&self.slots, n, spacing);
+                            if w0 < s && s < w1 && z0 <= s && s <= z3 {
+                                knots.push(s);
+                            }
+                        }
+                    }
+                }
             }
             // Over terrain, sample the band at the map's resolution (at most
             // 4096 samples a window): the ground changes between vertices.
@@ -417,8 +495,7 @@ impl CostModel {
             for w in knots.windows(2) {
                 let (k0, k1) = (w[0], w[1]);
                 let heading_after = motion.walker().heading(k1, span);
-                let mid_blend = motion.shape_at((k0 + k1) / 2.0).map_or(0.0, |(_, b)| b);
-                let blend_step = if mid_blend > 0.0 && mid_blend < 1.0 {
+                let blend_step = if motion.state_at((k0 + k1) / 2.0).is_changing() {
                     BLEND_STEP
                 } else {
                     f64::INFINITY
@@ -452,6 +529,52 @@ impl CostModel {
                 std::mem::swap(previous, current);
             }
         }
+    }
+
+    /// How far two UAVs come closer than [`PAIR_FLOOR`] to each other
+    /// (eq. 7), integrated over the stretches where the pairs can change: the
+    /// changes of shape (a straight blend between two shapes can bring two
+    /// UAVs closer than either shape does) and a column's hold (a UAV flies at
+    /// the centroid path's point its place ahead, so a hairpin or a sharp
+    /// corner brings two of them together). A rigid shape held keeps its
+    /// pairs, which validation checked.
+    fn pair_deficit(&self, motion: &Motion<'_>, path: &CentroidPath, scratch: &mut Vec<Point3<f64>>) -> f64 {
+        let n = self.slots.len();
+        if n < 2 {
+            return 0.0;
+        }
+        let floor = 2.0 * self.uav_radius + PAIR_FLOOR;
+        let mut deficit = 0.0;
+        let mut follow = |from: f64, to: f64, deficit: &mut f64| {
+            let samples = (((to - from) / PAIR_STEP).ceil() as usize).max(1);
+            let step = (to - from) / samples as f64;
+            for k in 0..=samples {
+                motion.positions_into(from + k as f64 * step, scratch);
+                for i in 0..n {
+                    for j in (i + 1)..n {
+                        let gap = floor - (scratch[i] - scratch[j]).norm();
+                        if gap > 0.0 {
+                            *deficit += gap * step;
+                        }
+                    }
+                }
+            }
+        };
+        for zone in &path.zones {
+            let [t1, t2, t3, t4] = zone.arcs();
+            let column = matches!(zone.shape, Shape::Alignment { .. });
+            if column {
+                follow(t1, t4, &mut deficit);
+            } else {
+                if t2 > t1 {
+                    follow(t1, t2, &mut deficit);
+                }
+                if t4 > t3 {
+                    follow(t3, t4, &mut deficit);
+                }
+            }
+        }
+        deficit
     }
 
     /// Band and bounds violations of the UAVs at one sample, weighted by the

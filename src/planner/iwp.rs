@@ -52,8 +52,13 @@ pub struct Iwp {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub unusable: Option<String>,
     /// h: the new shape is held this far each side of the gap line, metres
-    /// of centroid path (`hold_distance` plus the depth of the wall).
+    /// of centroid path (`hold_distance` plus the depth of the wall; for a
+    /// column, plus its length, so that every UAV passes in file).
     pub hold: f64,
+    /// The crossing is straight this far each side of the gap line, metres:
+    /// h plus the heading's span for a rigid shape, only through the posts
+    /// for a column (whose UAVs follow the path).
+    pub straight: f64,
 }
 
 impl Iwp {
@@ -103,8 +108,7 @@ impl Shape {
         let o = nominal[n];
         match *self {
             Shape::Alignment { spacing } => {
-                let count = nominal.len() as f64;
-                let x = (column_rank(nominal, n) as f64 - (count - 1.0) / 2.0) * spacing;
+                let x = column_place(nominal, n, spacing);
                 o.lerp(&Vector3::new(x, 0.0, 0.0), blend)
             }
             Shape::Rotation => {
@@ -123,6 +127,13 @@ impl Shape {
             Shape::Shrink { .. } => "shrink",
         }
     }
+}
+
+/// How far ahead of the centroid (negative: behind) slot `n` flies in the
+/// column, metres along the path.
+pub fn column_place(nominal: &[Vector3<f64>], n: usize, spacing: f64) -> f64 {
+    let count = nominal.len() as f64;
+    (column_rank(nominal, n) as f64 - (count - 1.0) / 2.0) * spacing
 }
 
 /// Place of slot `n` in the column, front to back by forward offset (ties by
@@ -162,12 +173,39 @@ pub fn min_pair_distance(offsets: &[Vector3<f64>]) -> f64 {
 /// The spacing of the alignment column: the closest nominal pair, at least 2 r_Q.
 pub fn column_spacing(formation: &Formation) -> f64 {
     let nominal = min_pair_distance(&formation.slots);
-    let floor = 2.0 * formation.uav_radius;
-    if nominal.is_finite() {
+    let floor = 2.0 * formation.uav_radius + COLUMN_SPARE;
+    let spacing = if nominal.is_finite() {
         nominal.max(floor)
     } else {
         floor
+    };
+    // Eq. 7: the column's first and last UAVs stay within d_com of each
+    // other, with room to spare for the sampling.
+    let gaps = formation.slots.len().saturating_sub(1) as f64;
+    if gaps > 0.0 {
+        spacing
+            .min((formation.comm_range - COLUMN_SPARE) / gaps)
+            .max(floor)
+    } else {
+        spacing
     }
+}
+
+/// What a column leaves of d_com at its ends, and beyond 2 r_Q between two
+/// UAVs, metres (room for the sampling).
+const COLUMN_SPARE: f64 = 0.05;
+
+/// Whether a column of the formation keeps eq. 7: 2 r_Q apart and its ends
+/// within d_com.
+fn column_keeps_eq7(formation: &Formation) -> bool {
+    let gaps = formation.slots.len().saturating_sub(1) as f64;
+    gaps * column_spacing(formation) <= formation.comm_range + FIT_EPS
+}
+
+/// Half length of the chord the formation frame's heading is taken from
+/// (see `path::ArcWalker::heading`).
+pub fn heading_span(mission: &Mission) -> f64 {
+    mission.formation.radius().max(1.0)
 }
 
 /// Tolerance of the width comparisons, metres.
@@ -198,8 +236,16 @@ pub fn resolve_shape(
     let alignment = Shape::Alignment {
         spacing: column_spacing(formation),
     };
+    let column_ok = column_keeps_eq7(formation);
     let explicit = |shape: Shape| {
-        if fits(&shape) {
+        if matches!(shape, Shape::Alignment { .. }) && !column_ok {
+            Err(format!(
+                "a column of {} UAVs at least 2 r_Q = {:.2} m apart is longer than d_com = {} m (eq. 7)",
+                slots.len(),
+                2.0 * r_q,
+                formation.comm_range
+            ))
+        } else if fits(&shape) {
             Ok(Some(shape))
         } else {
             Err(format!(
@@ -221,7 +267,7 @@ pub fn resolve_shape(
             if nominal_width <= gap + 2.0 * FIT_EPS {
                 return Ok(None);
             }
-            let mut candidates = vec![alignment];
+            let mut candidates = if column_ok { vec![alignment] } else { Vec::new() };
             let widest = slots.iter().map(|o| o.y.abs()).fold(0.0, f64::max);
             if widest > 0.0 {
                 let fit = (gap / 2.0 - r_q - margin.max(0.0)) / widest;
@@ -287,7 +333,7 @@ fn crossing_hold(
     center: Point2<f64>,
     normal: Vector2<f64>,
     shape: Option<Shape>,
-) -> Result<f64, String> {
+) -> Result<(f64, f64), String> {
     let f = &mission.formation;
     let r_q = f.uav_radius;
     let margin = mission.theta_pso.clearance_margin.max(0.0);
@@ -322,6 +368,25 @@ fn crossing_hold(
         }
     }
     let hold = mission.reconfiguration.hold_distance + depth;
+    // A column flies along the path: the straight through the gap is the
+    // hold above, the shape is held until its last UAV is that far past the
+    // gap line (and from when its first is that far before it).
+    // A column flies along the path: it is held from before its first UAV
+    // reaches the wall until its last has left it (and at least as long as a
+    // rigid shape would be), but the path need only be straight through the
+    // posts themselves. A rigid shape is straight for the whole hold, and
+    // for the heading's span beyond it so the heading points along the
+    // crossing throughout.
+    let through_posts = deepest + r_q + margin + mission.reconfiguration.hold_distance;
+    let (hold, line) = match shape {
+        Some(Shape::Alignment { spacing }) => {
+            let half = (0..f.slots.len())
+                .map(|n| column_place(&f.slots, n, spacing).abs())
+                .fold(0.0, f64::max);
+            (hold.max(half + through_posts), through_posts)
+        }
+        _ => (hold, hold + heading_span(mission)),
+    };
     for sign in [1.0, -1.0] {
         let forward = normal * sign;
         let left = Vector2::new(-forward.y, forward.x);
@@ -329,9 +394,15 @@ fn crossing_hold(
             let d = obstacles[k].center - center;
             let (x_k, y_k) = (d.dot(&forward), d.dot(&left));
             let reach = obstacles[k].radius + r_q;
+            // Only where the UAV is on the straight: a column's UAVs beyond
+            // it are on the path's other legs, which the cost judges.
+            let on_line = |o: &Vector3<f64>, (lo, hi): (f64, f64)| {
+                let (lo, hi) = (lo.max(-line - o.x), hi.min(line - o.x));
+                (lo < hi).then_some((lo, hi))
+            };
             if held
                 .iter()
-                .filter_map(|o| conflict(o, x_k, y_k, reach))
+                .filter_map(|o| conflict(o, x_k, y_k, reach).and_then(|c| on_line(o, c)))
                 .any(|(lo, hi)| lo < hold && hi > -hold)
             {
                 return Err(format!(
@@ -342,7 +413,53 @@ fn crossing_hold(
             }
         }
     }
-    Ok(hold)
+    Ok((hold, line))
+}
+
+/// The enabled IWPs no shape can pass, counted by reason (the reason's
+/// text less the obstacles it names), most common first.
+pub fn unusable_by_reason(iwps: &[Iwp]) -> Vec<(String, usize)> {
+    let mut counts: Vec<(String, usize)> = Vec::new();
+    for reason in iwps
+        .iter()
+        .filter(|i| i.enabled)
+        .filter_map(|i| i.unusable.as_deref())
+    {
+        let key = general_reason(reason);
+        match counts.iter_mut().find(|(r, _)| *r == key) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((key, 1)),
+        }
+    }
+    counts.sort_by(|a, b| b.1.cmp(&a.1));
+    counts
+}
+
+/// A reason with what is particular to one IWP taken out: the names in
+/// quotes and the figures.
+fn general_reason(reason: &str) -> String {
+    let mut out = String::with_capacity(reason.len());
+    let mut quoted = false;
+    for part in reason.split('\'') {
+        if quoted {
+            out.push_str("another obstacle");
+        } else {
+            out.push_str(part);
+        }
+        quoted = !quoted;
+    }
+    // Figures: "0.42 m" → "… m".
+    let words: Vec<String> = out
+        .split(' ')
+        .map(|w| {
+            if w.trim_end_matches([',', ';', ':']).parse::<f64>().is_ok() {
+                "…".to_owned()
+            } else {
+                w.to_owned()
+            }
+        })
+        .collect();
+    words.join(" ")
 }
 
 /// Every IWP of the mission by eq. 9, with the operator's choices applied.
@@ -399,9 +516,9 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
             let resolved = resolve_shape(shape_choice, gap, f, scale, margin).and_then(|shape| {
                 crossing_hold(mission, [p, q], position, normal, shape).map(|hold| (shape, hold))
             });
-            let (shape, hold, unusable) = match resolved {
+            let (shape, (hold, straight), unusable) = match resolved {
                 Ok((shape, hold)) => (shape, hold, None),
-                Err(reason) => (None, 0.0, Some(reason)),
+                Err(reason) => (None, (0.0, 0.0), Some(reason)),
             };
             found.push(Iwp {
                 between: [a.name.clone(), b.name.clone()],
@@ -414,6 +531,7 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
                 shape,
                 unusable,
                 hold,
+                straight,
             });
         }
     }

@@ -11,6 +11,8 @@ pub mod iwp;
 pub mod motion;
 pub mod path;
 pub mod reference;
+pub mod repair;
+pub mod route;
 pub mod seeding;
 pub mod trajectory;
 pub mod verify;
@@ -82,6 +84,13 @@ pub struct ThetaPsoOutcome {
     /// Where each inspection pass lies along the centroid path, seconds.
     pub passes: Vec<PlannedPass>,
     pub reconfigurations: Vec<Reconfiguration>,
+    /// Usable, enabled IWPs the plan does not cross (it goes round them),
+    /// as indices into `iwps`.
+    pub bypassed: Vec<usize>,
+    /// Where the plan kept comes from: the swarm, its repair, or the corridor.
+    pub source: PlanSource,
+    /// The route stage's corridor length, metres.
+    pub route_length: f64,
     pub trajectories: Vec<Trajectory>,
     pub verification: Verification,
 }
@@ -130,6 +139,16 @@ impl Problem {
         })
     }
 
+    /// Particles follow the route stage's corridor: as many free waypoints
+    /// as it needs, and its squeezed stretches flown shrunk.
+    pub fn follow(&mut self, mission: &Mission, corridor: &route::Corridor) {
+        let free = seeding::free_waypoints(mission, corridor);
+        self.builder.set_free_waypoints(free);
+        self.builder.set_squeeze(corridor.squeeze.clone());
+        let inspected = mission.obstacles.iter().filter(|o| o.inspect).count();
+        self.space = SearchSpace::uniform(3 * free + inspected, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2);
+    }
+
     /// The centroid path a particle stands for.
     pub fn path(&self, angles: &[f64]) -> CentroidPath {
         self.builder.build(angles)
@@ -140,10 +159,10 @@ impl Problem {
         self.cost.terms(&self.path(angles))
     }
 
-    /// J for a particle, or a partial sum once it reaches `bound`
-    /// (`CostModel::terms_below`).
-    pub fn evaluate_below(&self, angles: &[f64], bound: f64) -> CostTerms {
-        self.cost.terms_below(&self.path(angles), bound)
+    /// The swarm's objective for a particle, or a partial sum once it
+    /// reaches `bound` (`CostModel::evaluate_below`).
+    pub fn objective_below(&self, angles: &[f64], bound: f64) -> f64 {
+        self.cost.evaluate_below(&self.path(angles), bound).objective
     }
 }
 
@@ -281,24 +300,113 @@ fn trajectory_samples(duration: f64, uavs: usize) -> f64 {
     (duration / trajectory::SAMPLE_PERIOD + 1.0) * uavs as f64
 }
 
-/// One run of the swarm, built into a plan and verified.
+/// A particle built into a plan and verified.
 struct Attempt {
-    swarm: swarm::SwarmResult,
+    position: Vec<f64>,
     convergence: Vec<f64>,
     path: CentroidPath,
     cost: CostTerms,
     trajectories: Vec<Trajectory>,
     reconfigurations: Vec<Reconfiguration>,
     verification: Verification,
+    source: PlanSource,
+}
+
+/// Where the plan kept comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanSource {
+    /// The swarm's best, as it came out.
+    Swarm,
+    /// The swarm's best, moved out of its violations by the repair step.
+    Repaired,
+    /// The route stage's corridor (the swarm's plans all failed).
+    Corridor,
+}
+
+impl Attempt {
+    /// `position` built, sampled and verified (`OverBudget` when the path is
+    /// too long to sample).
+    fn new(
+        mission: &Mission,
+        problem: &Problem,
+        position: Vec<f64>,
+        convergence: Vec<f64>,
+        source: PlanSource,
+    ) -> Result<Self, PipelineError> {
+        let speed = mission.formation.ground_speed;
+        let path = problem.path(&position);
+        let cost = problem.cost.terms(&path);
+        // The budget checked the straight distance; the planned path is longer.
+        let samples = trajectory_samples(cost.length / speed, mission.formation.slots.len());
+        if crate::pipeline::exceeds(samples, crate::pipeline::limits::TRAJECTORY_SAMPLES) {
+            return Err(PipelineError::OverBudget(format!(
+                "formation.ground_speed: the planned path ({:.1} m at {} m/s) needs {} \
+                 trajectory samples (limit {})",
+                cost.length,
+                crate::pipeline::figure(speed),
+                crate::pipeline::figure(samples),
+                crate::pipeline::figure(crate::pipeline::limits::TRAJECTORY_SAMPLES)
+            )));
+        }
+        let names: Vec<String> = mission.obstacles.iter().map(|o| o.name.clone()).collect();
+        let (trajectories, reconfigurations) = trajectory::generate(
+            &path,
+            &problem.iwps,
+            &names,
+            &mission.formation,
+            path::heading_span(mission),
+        );
+        let verification = verify::verify(mission, &trajectories);
+        Ok(Attempt {
+            position,
+            convergence,
+            path,
+            cost,
+            trajectories,
+            reconfigurations,
+            verification,
+            source,
+        })
+    }
+
+    /// Feasible first, then the lower J.
+    fn better_than(&self, other: &Attempt) -> bool {
+        (self.verification.feasible, -self.cost.total)
+            > (other.verification.feasible, -other.cost.total)
+    }
+}
+
+/// The IWPs in a few log lines: each usable one, the unusable ones counted
+/// by reason (a forest has hundreds).
+fn log_iwps(observer: &mut dyn Observer, iwps: &[Iwp]) {
+    for iwp in iwps.iter().filter(|i| i.unusable.is_none()) {
+        let state = if iwp.enabled { "enabled" } else { "disabled" };
+        let message = format!(
+            "IWP between '{}' and '{}': gap {:.2} m, {} ({state})",
+            iwp.between[0],
+            iwp.between[1],
+            iwp.gap,
+            iwp.shape_name()
+        );
+        observer.on_event(Event::Log(Level::Info, &message));
+    }
+    for (reason, count) in iwp::unusable_by_reason(iwps) {
+        let message = format!("{count} IWP(s) unusable: {reason}");
+        observer.on_event(Event::Log(Level::Info, &message));
+    }
 }
 
 /// Plans `mission` with `seed`. Reports to `observer`, stops early (keeping
-/// the best so far) when `cancel` is set. Fails only on an invalid mission;
-/// an unreachable goal is an infeasible outcome, not an error.
+/// the best so far) when `cancel` is set. Fails on an invalid mission and
+/// when the route stage finds no corridor (naming what closes the way);
+/// a plan that fails verification is an infeasible outcome, not an error.
 ///
-/// When the swarm's best fails verification, the swarm runs again with new
-/// random streams of the same seed, up to `theta_pso.restarts` times; the
-/// first feasible plan is kept, else the one of lowest cost.
+/// The swarm starts partly on the route stage's corridor. When its best
+/// fails verification, the repair step moves it locally; when that fails
+/// too, the swarm runs again with new random streams of the same seed, up to
+/// `theta_pso.restarts` times; when every run fails, the corridor itself is
+/// tried. The first feasible plan is kept, else the one of lowest cost.
 pub fn plan(
     mission: &Mission,
     seed: u64,
@@ -321,23 +429,29 @@ pub fn plan(
     }
 
     observer.on_event(Event::Stage("intermediate waypoints"));
-    let problem = Problem::new(mission).map_err(|(_, e)| PipelineError::InvalidMission(e))?;
-    for iwp in &problem.iwps {
-        let state = if iwp.enabled { "enabled" } else { "disabled" };
-        let message = format!(
-            "IWP between '{}' and '{}': gap {:.2} m, {} ({state})",
-            iwp.between[0],
-            iwp.between[1],
-            iwp.gap,
-            iwp.shape_name()
-        );
-        observer.on_event(Event::Log(Level::Info, &message));
-    }
-    let span = path::heading_span(mission);
+    let mut problem = Problem::new(mission).map_err(|(_, e)| PipelineError::InvalidMission(e))?;
+    log_iwps(observer, &problem.iwps);
+    observer.on_event(Event::Stage("route"));
+    let corridor = route::find(mission, &problem.builder, &problem.iwps, problem.cost.margin())
+        .map_err(|blocked| PipelineError::NoRoute(blocked.reason))?;
+    problem.follow(mission, &corridor);
+    observer.on_event(Event::Log(
+        Level::Info,
+        &format!(
+            "route: a corridor of {:.1} m, {} free waypoints{}",
+            corridor.length,
+            problem.builder.free_waypoints(),
+            if corridor.squeeze.is_some() {
+                ", squeezed where the site is narrower than the formation"
+            } else {
+                ""
+            }
+        ),
+    ));
     let speed = mission.formation.ground_speed;
     let resolution = speed * trajectory::SAMPLE_PERIOD;
     let reference = reference::lower_bound(mission, &problem.iwps, resolution);
-    let starts = seeding::particles(mission, &problem, seed);
+    let starts = seeding::particles(mission, &problem, &corridor, seed);
 
     let p = &mission.theta_pso;
     let mut kept: Option<Attempt> = None;
@@ -356,48 +470,8 @@ pub fn plan(
             observer.on_event(Event::Log(Level::Warn, &message));
         }
         observer.on_event(Event::Stage("planning"));
-        let config = SwarmConfig {
-            particles: p.swarm_size,
-            iterations: p.iterations,
-            inertia: p.inertia,
-            cognitive: p.cognitive,
-            social: p.social,
-            parallel: options.parallel,
-            streams: attempt as u64,
-        };
-        let mut convergence = Vec::with_capacity(p.iterations + 1);
-        let mut shown: Option<(CentroidPath, CostTerms)> = None;
-        let offset = iterations + attempt;
-        let result = swarm::minimize(
-            &problem.space,
-            &config,
-            seed,
-            &starts,
-            |angles, bound| problem.evaluate_below(angles, bound).total,
-            |report| {
-                convergence.push(report.best.cost);
-                // The best only changes on improvement; rebuild its path only then.
-                if report.improved || shown.is_none() {
-                    let path = problem.path(&report.best.position);
-                    let cost = problem.cost.terms(&path);
-                    shown = Some((path, cost));
-                }
-                if let Some((path, cost)) = &shown {
-                    observer.on_event(Event::PathIteration {
-                        iteration: offset + report.iteration,
-                        cost,
-                        path: &path.points,
-                    });
-                }
-                observer.on_event(Event::Progress(
-                    0.95 * report.iteration as f64 / p.iterations.max(1) as f64,
-                ));
-                if cancel.is_cancelled() {
-                    ControlFlow::Break(())
-                } else {
-                    ControlFlow::Continue(())
-                }
-            },
+        let (result, convergence) = run_swarm(
+            &problem, p, options, seed, attempt, iterations, &starts, observer, cancel,
         );
         iterations += result.iterations;
         evaluations += result.evaluations;
@@ -411,45 +485,50 @@ pub fn plan(
             ));
             completion = Completion::Cancelled;
         }
-
-        observer.on_event(Event::Stage("trajectories"));
-        let path = problem.path(&result.best.position);
-        let cost = problem.cost.terms(&path);
-        // The budget checked the straight distance; the planned path is longer.
-        let samples = trajectory_samples(cost.length / speed, mission.formation.slots.len());
-        if crate::pipeline::exceeds(samples, crate::pipeline::limits::TRAJECTORY_SAMPLES) {
-            return Err(PipelineError::OverBudget(format!(
-                "formation.ground_speed: the planned path ({:.1} m at {} m/s) needs {} \
-                 trajectory samples (limit {})",
-                cost.length,
-                crate::pipeline::figure(speed),
-                crate::pipeline::figure(samples),
-                crate::pipeline::figure(crate::pipeline::limits::TRAJECTORY_SAMPLES)
-            )));
-        }
-        let (trajectories, reconfigurations) =
-            trajectory::generate(&path, &problem.iwps, &mission.formation, span);
         observer.on_event(Event::Stage("verification"));
-        let verification = verify::verify(mission, &trajectories);
-        let attempt = Attempt {
-            swarm: result,
+        let mut tried = Attempt::new(
+            mission,
+            &problem,
+            result.best.position,
             convergence,
-            path,
-            cost,
-            trajectories,
-            reconfigurations,
-            verification,
-        };
-        let better = kept.as_ref().is_none_or(|k| {
-            (attempt.verification.feasible, -attempt.cost.total)
-                > (k.verification.feasible, -k.cost.total)
-        });
-        let done = attempt.verification.feasible || completion == Completion::Cancelled;
-        if better {
-            kept = Some(attempt);
+            PlanSource::Swarm,
+        )?;
+        if !tried.verification.feasible
+            && completion == Completion::Finished
+            && let Some(fixed) = repair::repair(mission, &problem, &tried.position)
+        {
+            observer.on_event(Event::Log(
+                Level::Info,
+                &format!(
+                    "the best plan failed verification ({}); the repair step moved it clear",
+                    tried.verification.first_failure().unwrap_or_default()
+                ),
+            ));
+            let convergence = std::mem::take(&mut tried.convergence);
+            tried = Attempt::new(mission, &problem, fixed, convergence, PlanSource::Repaired)?;
+        }
+        let done = tried.verification.feasible || completion == Completion::Cancelled;
+        if kept.as_ref().is_none_or(|k| tried.better_than(k)) {
+            kept = Some(tried);
         }
         if done {
             break;
+        }
+    }
+    // Every run of the swarm failed: fly the corridor itself, if it verifies.
+    if let (Some(k), Some(start)) = (&kept, starts.first())
+        && !k.verification.feasible
+        && completion == Completion::Finished
+    {
+        let position = repair::repair(mission, &problem, start).unwrap_or_else(|| start.clone());
+        let convergence = k.convergence.clone();
+        let fallback = Attempt::new(mission, &problem, position, convergence, PlanSource::Corridor)?;
+        if fallback.verification.feasible {
+            observer.on_event(Event::Log(
+                Level::Warn,
+                "every run of the swarm failed verification; the route stage's corridor is flown",
+            ));
+            kept = Some(fallback);
         }
     }
     let Some(best) = kept else {
@@ -479,7 +558,14 @@ pub fn plan(
         observer.on_event(Event::Progress(1.0));
     }
 
-    let waypoints = problem.builder.decode(&best.swarm.best.position);
+    let waypoints = problem.builder.decode(&best.position);
+    let bypassed = problem
+        .iwps
+        .iter()
+        .enumerate()
+        .filter(|(i, iwp)| iwp.is_via() && !best.path.crossed.contains(i))
+        .map(|(i, _)| i)
+        .collect();
     let passes = best
         .path
         .passes
@@ -512,7 +598,73 @@ pub fn plan(
         passes,
         centroid_path: best.path.points,
         reconfigurations: best.reconfigurations,
+        bypassed,
+        source: best.source,
+        route_length: corridor.length,
         trajectories: best.trajectories,
         verification: best.verification,
     })
+}
+
+/// One run of the swarm from `starts` (the rest at random) on the `attempt`-th
+/// set of random streams, reporting each iteration's best path and J; the
+/// result and the convergence of J (iteration 0 = the initial swarm).
+#[allow(clippy::too_many_arguments)]
+fn run_swarm(
+    problem: &Problem,
+    p: &crate::mission::ThetaPsoParams,
+    options: PlanOptions,
+    seed: u64,
+    attempt: usize,
+    iterations_before: usize,
+    starts: &[Vec<f64>],
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> (swarm::SwarmResult, Vec<f64>) {
+    let config = SwarmConfig {
+        particles: p.swarm_size,
+        iterations: p.iterations,
+        inertia: p.inertia,
+        cognitive: p.cognitive,
+        social: p.social,
+        parallel: options.parallel,
+        streams: attempt as u64,
+    };
+    let mut convergence = Vec::with_capacity(p.iterations + 1);
+    let mut shown: Option<(CentroidPath, CostTerms)> = None;
+    let offset = iterations_before + attempt;
+    let result = swarm::minimize(
+        &problem.space,
+        &config,
+        seed,
+        starts,
+        |angles, bound| problem.objective_below(angles, bound),
+        |report| {
+            // The best only changes on improvement; rebuild its path only then.
+            if report.improved || shown.is_none() {
+                let path = problem.path(&report.best.position);
+                let cost = problem.cost.terms(&path);
+                shown = Some((path, cost));
+            }
+            if let Some((path, cost)) = &shown {
+                // J of the best, not the objective (which adds the
+                // infeasibility step while the best still breaks a constraint).
+                convergence.push(cost.total);
+                observer.on_event(Event::PathIteration {
+                    iteration: offset + report.iteration,
+                    cost,
+                    path: &path.points,
+                });
+            }
+            observer.on_event(Event::Progress(
+                0.95 * report.iteration as f64 / p.iterations.max(1) as f64,
+            ));
+            if cancel.is_cancelled() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+    );
+    (result, convergence)
 }

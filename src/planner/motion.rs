@@ -5,11 +5,19 @@
 //! its path, the formation frame turned to the heading (x forward along the
 //! horizontal direction of travel, y left, z up; eq. 13), and the slot offsets
 //! of the current shape added to the centroid (eq. 14).
+//!
+//! One exception to the rigid frame: in the alignment (Fig. 2) the UAVs fly
+//! in single file *along the path*, each at the centroid path's point its
+//! place in the column ahead of or behind the centroid, as a real column
+//! follows its leader. A rigid column of nine 2.5 m apart is 20 m long; turned
+//! with the heading between two walls, its ends would sweep into them. Into
+//! and out of the column each UAV moves straight between its place in the
+//! formation frame and its place on the path.
 
 use nalgebra::{Point3, Vector3};
 
-use super::iwp::Shape;
-use super::path::{ArcWalker, CentroidPath, Zone};
+use super::iwp::{Shape, column_place};
+use super::path::{ArcWalker, CentroidPath, ShapeState, Zone};
 
 /// The formation frame at one arc length.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,32 +82,44 @@ impl<'a> Motion<'a> {
         }
     }
 
-    /// The shape the formation is changing into at `s` and how far (the zone
-    /// furthest into its reconfiguration), or `None` in the nominal shape.
-    pub fn shape_at(&self, s: f64) -> Option<(Shape, f64)> {
-        let mut best: Option<(Shape, f64)> = None;
-        for zone in self.zones {
-            let b = zone.blend(s);
-            if b > 0.0 && best.is_none_or(|(_, old)| b > old) {
-                best = Some((zone.shape, b));
-            }
-        }
-        best
+    /// The formation's shape at `s`: nominal outside every zone.
+    pub fn state_at(&self, s: f64) -> ShapeState {
+        // The zones are in path order and only touch at shared changes.
+        self.zones
+            .iter()
+            .find_map(|zone| zone.state(s))
+            .unwrap_or(ShapeState::NOMINAL)
     }
 
-    /// Slot `n`'s offset in the formation frame for the shape state `shape`.
-    pub fn offset(&self, n: usize, shape: Option<(Shape, f64)>) -> Vector3<f64> {
-        match shape {
-            Some((shape, blend)) => shape.offset(self.slots, n, blend),
-            None => self.slots[n],
+    /// Where UAV `n` is at `s` in the shape state `state`, the frame there
+    /// being `frame`.
+    pub fn place(&self, n: usize, s: f64, frame: &Frame, state: ShapeState) -> Point3<f64> {
+        let column = |shape: Option<Shape>| match shape {
+            Some(Shape::Alignment { spacing }) => {
+                Some(self.walker.at_extended(s + column_place(self.slots, n, spacing)))
+            }
+            _ => None,
+        };
+        match (column(state.from), column(state.to)) {
+            (None, None) => frame.place(&state.offset(self.slots, n)),
+            (from, to) => {
+                let end = |shape: Option<Shape>, on_path: Option<Point3<f64>>| {
+                    on_path.unwrap_or_else(|| {
+                        frame.place(&ShapeState::held_or_nominal(shape).offset(self.slots, n))
+                    })
+                };
+                let a = end(state.from, from);
+                let b = end(state.to, to);
+                a + (b - a) * state.blend
+            }
         }
     }
 
     /// Every UAV's position at `s`, into `out` (cleared first).
     pub fn positions_into(&self, s: f64, out: &mut Vec<Point3<f64>>) {
         let frame = self.frame(s);
-        let shape = self.shape_at(s);
+        let state = self.state_at(s);
         out.clear();
-        out.extend((0..self.slots.len()).map(|n| frame.place(&self.offset(n, shape))));
+        out.extend((0..self.slots.len()).map(|n| self.place(n, s, &frame, state)));
     }
 }

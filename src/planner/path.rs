@@ -20,64 +20,142 @@
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 
 use super::inspection::PassGeometry;
-use super::iwp::{Iwp, Shape, vertical_half_height};
+use super::iwp::{Iwp, Shape, lateral_half_width, vertical_half_height};
 use crate::mission::Mission;
 pub use crate::swarm::{decode_angle, encode_angle};
 
-/// Where along the path the formation changes shape for one IWP.
+/// Why the formation changes shape over a zone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ZoneCause {
+    /// The crossing of IWP `iwp` (index into the IWP list) between the
+    /// obstacles `pair`.
+    Iwp { iwp: usize, pair: [usize; 2] },
+    /// A squeezed region of the route stage (1-based), passed between the
+    /// obstacles `pair` (nearest on the left and the right where it is
+    /// narrowest; the same twice against a bound).
+    Squeeze { region: u16, pair: [usize; 2] },
+}
+
+/// Where along the path the formation changes shape, and into what.
 ///
-/// Arc lengths s along the centroid path, metres:
-/// [s_j − h − T_in, s_j − h] transform (t1..t2), [s_j − h, s_j + h] hold
-/// (t2..t3), [s_j + h, s_j + h + T_out] return (t3..t4), with T the
-/// transition distance (shortened where the start or the goal is nearer) and
-/// h the hold: the mission's hold distance plus the depth at which the
-/// formation could touch the wall (see [`conflict_depth`]), so the new shape
+/// Arc lengths s along the centroid path, metres: [t1, t2] the change into
+/// the shape (from the nominal shape, or from the zone before when the two
+/// follow each other too closely to return in between), [t2, t3] the hold,
+/// [t3, t4] the change out of it (into the nominal shape or the next zone's).
+/// For an IWP the hold is s_j ± h, with h the mission's hold distance plus
+/// the depth at which the formation could touch the wall, so the new shape
 /// is complete `hold_distance` before any UAV reaches the obstacles (the
-/// paper's "1 m before").
+/// paper's "1 m before"); for a squeeze it is the stretch inside the region
+/// ± the hold distance.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Zone {
-    /// Index into the IWP list.
-    pub iwp: usize,
-    /// Obstacles of the gap.
-    pub pair: [usize; 2],
+    /// Why: one cause, or several when consecutive zones merged into one hold.
+    pub causes: Vec<ZoneCause>,
     pub shape: Shape,
-    /// s_j, arc length of the IWP.
+    /// s_j, arc length of the IWP (the middle of the hold for a squeeze).
     pub arc: f64,
-    /// h, half length of the hold.
-    pub hold: f64,
-    /// Length of the transformation before the hold.
+    /// [t2, t3] as arc lengths.
+    pub hold: [f64; 2],
+    /// Length of the change into the shape before the hold.
     pub transition_in: f64,
-    /// Length of the return after it.
+    /// Length of the change out of it after the hold.
     pub transition_out: f64,
+    /// The shape the change in starts from (`None`: the nominal shape).
+    pub from: Option<Shape>,
+    /// The shape the change out ends in (`None`: the nominal shape).
+    pub into: Option<Shape>,
+}
+
+/// The formation's shape at one arc length: the change from `from` to `to`
+/// (`None`: the nominal shape), `blend` of the way (0 = `from`, 1 = `to`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeState {
+    pub from: Option<Shape>,
+    pub to: Option<Shape>,
+    pub blend: f64,
+}
+
+impl ShapeState {
+    /// The nominal shape.
+    pub const NOMINAL: ShapeState = ShapeState {
+        from: None,
+        to: None,
+        blend: 0.0,
+    };
+
+    /// A shape held.
+    pub fn held(shape: Shape) -> Self {
+        ShapeState {
+            from: Some(shape),
+            to: Some(shape),
+            blend: 1.0,
+        }
+    }
+
+    /// `shape` held, or the nominal shape for `None`.
+    pub fn held_or_nominal(shape: Option<Shape>) -> Self {
+        shape.map_or(ShapeState::NOMINAL, ShapeState::held)
+    }
+
+    /// Part-way between two shapes (not at either end).
+    pub fn is_changing(&self) -> bool {
+        self.from != self.to && self.blend > 0.0 && self.blend < 1.0
+    }
+
+    /// Slot `n`'s offset (formation frame) in this state. From or to the
+    /// nominal shape it is the shape's own change (rotation turns rigidly,
+    /// the others move each UAV along a straight line); between two shapes,
+    /// each UAV moves straight from one to the other.
+    pub fn offset(&self, nominal: &[Vector3<f64>], n: usize) -> Vector3<f64> {
+        match (self.from, self.to) {
+            (None, None) => nominal[n],
+            (None, Some(to)) => to.offset(nominal, n, self.blend),
+            (Some(from), None) => from.offset(nominal, n, 1.0 - self.blend),
+            (Some(from), Some(to)) if from == to => from.offset(nominal, n, 1.0),
+            (Some(from), Some(to)) => from
+                .offset(nominal, n, 1.0)
+                .lerp(&to.offset(nominal, n, 1.0), self.blend),
+        }
+    }
+}
+
+/// The smoothstep of a linear progress in [0, 1]: each UAV's velocity stays
+/// continuous through a change of shape.
+fn smoothstep(u: f64) -> f64 {
+    let u = u.clamp(0.0, 1.0);
+    u * u * (3.0 - 2.0 * u)
 }
 
 impl Zone {
-    /// 0 outside the zone, 1 in the hold, a smoothstep in between (so each
-    /// UAV's velocity stays continuous through the transition).
-    pub fn blend(&self, s: f64) -> f64 {
-        let from_hold = (s - self.arc).abs() - self.hold;
-        let transition = if s < self.arc {
-            self.transition_in
+    /// The shape state at `s`, or `None` outside the zone.
+    pub fn state(&self, s: f64) -> Option<ShapeState> {
+        let [t1, t2, t3, t4] = self.arcs();
+        if s < t1 || s > t4 {
+            None
+        } else if s < t2 {
+            (self.transition_in > 0.0).then(|| ShapeState {
+                from: self.from,
+                to: Some(self.shape),
+                blend: smoothstep((s - t1) / self.transition_in),
+            })
+        } else if s <= t3 {
+            Some(ShapeState::held(self.shape))
         } else {
-            self.transition_out
-        };
-        if from_hold <= 0.0 {
-            1.0
-        } else if from_hold >= transition {
-            0.0
-        } else {
-            let u = 1.0 - from_hold / transition;
-            u * u * (3.0 - 2.0 * u)
+            (self.transition_out > 0.0).then(|| ShapeState {
+                from: Some(self.shape),
+                to: self.into,
+                blend: smoothstep((s - t3) / self.transition_out),
+            })
         }
     }
 
     /// Arc lengths of t1, t2, t3, t4.
     pub fn arcs(&self) -> [f64; 4] {
         [
-            self.arc - self.hold - self.transition_in,
-            self.arc - self.hold,
-            self.arc + self.hold,
-            self.arc + self.hold + self.transition_out,
+            self.hold[0] - self.transition_in,
+            self.hold[0],
+            self.hold[1],
+            self.hold[1] + self.transition_out,
         ]
     }
 
@@ -85,6 +163,75 @@ impl Zone {
         let [a1, _, _, a4] = self.arcs();
         a1 < s && s < a4
     }
+}
+
+/// Shorter than this, a change between two shapes is not flown: the holds
+/// of two zones this close join into one, in the narrower shape.
+pub const MIN_BLEND: f64 = 2.0;
+
+/// The zones in path order, with the ones that follow each other too
+/// closely for the formation to return to its nominal shape in between
+/// joined up: between two rigid shapes (shrinks, rotation) the change out of
+/// one blends straight into the next one's shape over the stretch between
+/// their holds; when that stretch is shorter than [`MIN_BLEND`], the holds
+/// overlap, or either shape is the column, the two holds become one in the
+/// narrower of the two shapes (lateral width, UAV radius included), which
+/// fits both gaps. The column takes over its neighbours because it flies
+/// along the path, clear wherever one UAV is, and because a straight blend
+/// between a column and a spread shape can bring two UAVs closer than
+/// either shape does. Not in the paper, whose experiment has one IWP (Fig. 2
+/// shows each reconfiguration on its own).
+pub fn schedule(mut zones: Vec<Zone>, slots: &[Vector3<f64>], r_q: f64) -> Vec<Zone> {
+    zones.sort_by(|a, b| a.hold[0].total_cmp(&b.hold[0]));
+    let width = |s: &Shape| lateral_half_width(&s.offsets(slots, 1.0), r_q);
+    let mut i = 0;
+    while i + 1 < zones.len() {
+        let gap = zones[i + 1].hold[0] - zones[i].hold[1];
+        if gap >= zones[i].transition_out + zones[i + 1].transition_in {
+            i += 1;
+            continue;
+        }
+        let column = |s: &Shape| matches!(s, Shape::Alignment { .. });
+        let rigid = !column(&zones[i].shape) && !column(&zones[i + 1].shape);
+        if gap >= MIN_BLEND && rigid && zones[i].shape != zones[i + 1].shape {
+            let (a, b) = (zones[i].shape, zones[i + 1].shape);
+            zones[i].transition_out = gap;
+            zones[i].into = Some(b);
+            zones[i + 1].transition_in = gap;
+            zones[i + 1].from = Some(a);
+            i += 1;
+            continue;
+        }
+        // One hold over both, in the narrower shape; then look again at the
+        // zone before, whose change now leads into a different hold.
+        let next = zones.remove(i + 1);
+        let zone = &mut zones[i];
+        if width(&next.shape) < width(&zone.shape) {
+            zone.shape = next.shape;
+        }
+        zone.hold = [zone.hold[0].min(next.hold[0]), zone.hold[1].max(next.hold[1])];
+        zone.transition_out = next.transition_out;
+        zone.into = next.into;
+        for cause in next.causes {
+            // One squeezed region entered twice is one cause.
+            let same = |c: &ZoneCause| match (c, &cause) {
+                (ZoneCause::Squeeze { region: a, .. }, ZoneCause::Squeeze { region: b, .. }) => a == b,
+                (a, b) => a == b,
+            };
+            if !zone.causes.iter().any(same) {
+                zone.causes.push(cause);
+            }
+        }
+        if i > 0 {
+            let shape = zones[i].shape;
+            if zones[i - 1].into.is_some() {
+                zones[i - 1].into = Some(shape);
+                zones[i].from = Some(zones[i - 1].shape);
+            }
+            i -= 1;
+        }
+    }
+    zones
 }
 
 /// An inspection pass as placed on one path: which obstacle, and the arc
@@ -104,6 +251,8 @@ pub struct CentroidPath {
     pub points: Vec<Point3<f64>>,
     pub zones: Vec<Zone>,
     pub passes: Vec<Pass>,
+    /// The IWPs the path crosses (indices into the IWP list).
+    pub crossed: Vec<usize>,
 }
 
 impl CentroidPath {
@@ -113,6 +262,7 @@ impl CentroidPath {
             points,
             zones: Vec::new(),
             passes: Vec::new(),
+            crossed: Vec::new(),
         }
     }
 }
@@ -131,6 +281,14 @@ pub struct PathBuilder {
     /// With terrain, the path is planned above the ground and lifted onto it
     /// at its vertices.
     ground: Option<crate::terrain::Ground>,
+    /// The nominal slots and r_Q (to choose the narrower of two shapes).
+    slots: Vec<Vector3<f64>>,
+    uav_radius: f64,
+    /// The mission's hold and transition distances (squeezed stretches).
+    hold_distance: f64,
+    transition: f64,
+    /// Where the route stage found the site narrower than the formation.
+    squeeze: Option<std::sync::Arc<super::route::SqueezeMap>>,
 }
 
 /// A usable IWP as a via: its straight crossing.
@@ -170,11 +328,7 @@ pub fn dimensions(mission: &Mission) -> usize {
     3 * mission.theta_pso.waypoints + mission.obstacles.iter().filter(|o| o.inspect).count()
 }
 
-/// Half length of the chord the formation frame's heading is taken from
-/// (see `ArcWalker::heading`).
-pub fn heading_span(mission: &Mission) -> f64 {
-    mission.formation.radius().max(1.0)
-}
+pub use super::iwp::heading_span;
 
 impl PathBuilder {
     pub fn new(mission: &Mission, iwps: &[Iwp], passes: &[(usize, PassGeometry)]) -> Self {
@@ -202,10 +356,11 @@ impl PathBuilder {
                     .map_or_else(|| nominal.clone(), |s| s.offsets(nominal, 1.0));
                 let hold = iwp.hold;
                 // Straight far enough that the heading, taken from a chord of
-                // ± span, points along the crossing for the whole hold. No
+                // ± span, points along the crossing for the whole hold (a
+                // column's UAVs follow the path, so not for its length). No
                 // longer: the swarm may extend it, a fixed longer one could
                 // run into a nearby obstacle.
-                let straight = hold + span;
+                let straight = iwp.straight;
                 let half_height = vertical_half_height(&shaped).max(vertical_half_height(nominal));
                 Crossing {
                     iwp: i,
@@ -249,7 +404,28 @@ impl PathBuilder {
             crossings,
             inspections,
             ground: mission.ground_model(),
+            slots: f.slots.clone(),
+            uav_radius: f.uav_radius,
+            hold_distance: mission.reconfiguration.hold_distance,
+            transition: mission.reconfiguration.transition_distance,
+            squeeze: None,
         }
+    }
+
+    /// Paths of this builder fly squeezed through `map`'s regions.
+    pub fn set_squeeze(&mut self, map: Option<std::sync::Arc<super::route::SqueezeMap>>) {
+        self.squeeze = map;
+    }
+
+    /// The number of free waypoints a particle decodes.
+    pub fn free_waypoints(&self) -> usize {
+        self.free
+    }
+
+    /// Particles decode `free` waypoints (more than the mission's when the
+    /// route stage's corridor has more corners).
+    pub fn set_free_waypoints(&mut self, free: usize) {
+        self.free = free;
     }
 
     /// The straight crossings of the usable IWPs, end to end (portals of
@@ -286,6 +462,15 @@ impl PathBuilder {
         };
         let center = ins.axis + radial * radius;
         [center - direction * ins.half, center + direction * ins.half]
+    }
+
+    /// Start and goal of every path, metres ENU.
+    pub fn start(&self) -> Point3<f64> {
+        self.start
+    }
+
+    pub fn goal(&self) -> Point3<f64> {
+        self.goal
     }
 
     /// The decoding box of the free waypoints (x, y, z ranges).
@@ -365,6 +550,74 @@ impl PathBuilder {
             passes.push((i, leg + 1, on_left));
         }
 
+        self.finish(points, &crossings, &passes)
+    }
+
+    /// The path of a corridor found by the route stage, as a particle's path
+    /// would be built: its points lifted to heights along start → goal (in
+    /// each via's band), its crossings and passes as vias.
+    pub fn from_corridor(&self, corridor: &super::route::Corridor) -> CentroidPath {
+        use super::route::Leg;
+        let plane = &corridor.points;
+        let total = corridor.length.max(1e-9);
+        let mut s = 0.0;
+        let mut points = Vec::with_capacity(plane.len() + corridor.legs.len());
+        let mut crossings = Vec::new();
+        let mut passes = Vec::new();
+        let height = |s: f64| {
+            let u = s / total;
+            (self.start.z + (self.goal.z - self.start.z) * u).clamp(self.bounds[2][0], self.bounds[2][1])
+        };
+        points.push(self.start);
+        for (k, leg) in corridor.legs.iter().enumerate() {
+            let (a, b) = (plane[k], plane[k + 1]);
+            match *leg {
+                Leg::Crossing(c) => {
+                    let via = &self.crossings[c];
+                    let z = height(s).clamp(via.z_range[0], via.z_range[1]);
+                    // The leg into the crossing ends at its first point.
+                    if let Some(last) = points.last_mut() {
+                        last.z = z;
+                    }
+                    crossings.push((c, points.len() - 1));
+                    points.push(Point3::new(via.center.x, via.center.y, z));
+                    points.push(Point3::new(b.x, b.y, z));
+                }
+                Leg::Pass(i) => {
+                    let ins = &self.inspections[i];
+                    let z = height(s).clamp(ins.z_range[0], ins.z_range[1]);
+                    if let Some(last) = points.last_mut() {
+                        last.z = z;
+                    }
+                    passes.push((i, points.len() - 1, corridor.passes[i].1));
+                    points.push(Point3::new(b.x, b.y, z));
+                }
+                Leg::Free { .. } => {
+                    let z = if k + 1 == corridor.legs.len() {
+                        self.goal.z
+                    } else {
+                        height(s + (b - a).norm())
+                    };
+                    points.push(Point3::new(b.x, b.y, z));
+                }
+            }
+            s += (b - a).norm();
+        }
+        if let Some(last) = points.last_mut() {
+            *last = self.goal;
+        }
+        self.finish(points, &crossings, &passes)
+    }
+
+    /// The path's zones and passes once its points and vias are placed:
+    /// `crossings` (crossing index, index of its first point), `passes`
+    /// (inspection index, index of its first point, obstacle on the left).
+    fn finish(
+        &self,
+        mut points: Vec<Point3<f64>>,
+        crossings: &[(usize, usize)],
+        passes: &[(usize, usize, bool)],
+    ) -> CentroidPath {
         if let Some(g) = &self.ground {
             for p in &mut points {
                 p.z += g.at(p.x, p.y);
@@ -372,23 +625,35 @@ impl PathBuilder {
         }
         let arcs = cumulative_lengths(&points);
         let total = arcs.last().copied().unwrap_or(0.0);
-        let zones = crossings
+        let mut zones: Vec<Zone> = crossings
             .iter()
             .filter_map(|&(i, first)| {
                 let c = &self.crossings[i];
                 let shape = c.shape?;
                 let arc = arcs[first + 1];
                 Some(Zone {
-                    iwp: c.iwp,
-                    pair: c.pair,
+                    causes: vec![ZoneCause::Iwp {
+                        iwp: c.iwp,
+                        pair: c.pair,
+                    }],
                     shape,
                     arc,
-                    hold: c.hold,
+                    hold: [arc - c.hold, arc + c.hold],
                     transition_in: c.transition.min((arc - c.hold).max(0.0)),
                     transition_out: c.transition.min((total - arc - c.hold).max(0.0)),
+                    from: None,
+                    into: None,
                 })
             })
             .collect();
+        if let Some(map) = &self.squeeze {
+            zones.extend(self.squeeze_zones(map, &points, &arcs));
+        }
+        let zones = if zones.len() > 1 {
+            schedule(zones, &self.slots, self.uav_radius)
+        } else {
+            zones
+        };
         let passes = passes
             .iter()
             .map(|&(i, first, on_left)| {
@@ -405,7 +670,78 @@ impl PathBuilder {
             points,
             zones,
             passes,
+            crossed: crossings.iter().map(|&(i, _)| self.crossings[i].iwp).collect(),
         }
+    }
+
+    /// A zone for each stretch of the path inside a squeezed region of the
+    /// route stage: the shrink at the region's scale, held from
+    /// `hold_distance` before the region to `hold_distance` after it.
+    fn squeeze_zones(
+        &self,
+        map: &super::route::SqueezeMap,
+        points: &[Point3<f64>],
+        arcs: &[f64],
+    ) -> Vec<Zone> {
+        let total = arcs.last().copied().unwrap_or(0.0);
+        let step = map.resolution() / 2.0;
+        // (region, shape, first s, last s)
+        let mut runs: Vec<(u16, Shape, f64, f64)> = Vec::new();
+        let mut current: Option<(u16, Shape, f64, f64)> = None;
+        for (i, w) in points.windows(2).enumerate() {
+            let (a, b) = (w[0].xy(), w[1].xy());
+            let length = arcs[i + 1] - arcs[i];
+            let n = ((length / step).ceil() as usize).max(1);
+            for k in 0..=n {
+                let u = k as f64 / n as f64;
+                let s = arcs[i] + length * u;
+                match (map.at(a + (b - a) * u), current.as_mut()) {
+                    (Some((r, _)), Some(run)) if run.0 == r => run.3 = s,
+                    (hit, _) => {
+                        if let Some(run) = current.take() {
+                            runs.push(run);
+                        }
+                        current = hit.map(|(r, shape)| (r, shape, s, s));
+                    }
+                }
+            }
+        }
+        runs.extend(current);
+        runs.into_iter()
+            .map(|(region, shape, first, last)| {
+                // A column is complete before its first UAV enters and held
+                // until its last has left.
+                let half = match shape {
+                    Shape::Alignment { spacing } => {
+                        (0..self.slots.len())
+                            .map(|n| super::iwp::column_place(&self.slots, n, spacing).abs())
+                            .fold(0.0, f64::max)
+                    }
+                    _ => 0.0,
+                };
+                let hold = [
+                    (first - self.hold_distance - half).max(0.0),
+                    (last + self.hold_distance + half).min(total),
+                ];
+                let middle = (first + last) / 2.0;
+                let walker = ArcWalker::new(points);
+                let at = walker.at(middle).xy();
+                let along = walker.heading(middle, 1.0).xy();
+                Zone {
+                    causes: vec![ZoneCause::Squeeze {
+                        region,
+                        pair: map.sides(at, along),
+                    }],
+                    shape,
+                    arc: middle,
+                    hold,
+                    transition_in: self.transition.min(hold[0]),
+                    transition_out: self.transition.min(total - hold[1]),
+                    from: None,
+                    into: None,
+                }
+            })
+            .collect()
     }
 
     /// The first free leg that goes through the IWP's gap (the gap line,
@@ -572,6 +908,41 @@ impl<'a> ArcWalker<'a> {
             return b;
         }
         a + (b - a) * ((s - self.arcs[i - 1]) / len)
+    }
+
+    /// Position at arc length `s`, continued straight beyond either end
+    /// along the first or the last leg (where a column's first and last UAVs
+    /// are while the centroid is near the start or the goal).
+    pub fn at_extended(&self, s: f64) -> Point3<f64> {
+        let length = self.length();
+        let n = self.points.len();
+        if n < 2 || (0.0..=length).contains(&s) {
+            return self.at(s);
+        }
+        let (from, to, beyond) = if s < 0.0 {
+            (self.points[1], self.points[0], -s)
+        } else {
+            (self.points[n - 2], self.points[n - 1], s - length)
+        };
+        // The nearest leg with a direction (legs of zero length are skipped).
+        let direction = {
+            let d = to - from;
+            if d.norm() > 1e-9 {
+                d / d.norm()
+            } else {
+                let whole = if s < 0.0 {
+                    self.points[0] - self.at(length.min(1.0))
+                } else {
+                    self.points[n - 1] - self.at((length - 1.0).max(0.0))
+                };
+                if whole.norm() > 1e-9 {
+                    whole / whole.norm()
+                } else {
+                    Vector3::x()
+                }
+            }
+        };
+        to + direction * beyond
     }
 
     /// Unit horizontal direction of travel around `s`, from the chord between

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::iwp::Iwp;
 use super::motion::Motion;
-use super::path::CentroidPath;
+use super::path::{CentroidPath, ZoneCause};
 use crate::mission::Formation;
 
 /// One sample of a UAV's trajectory. Seconds, metres ENU, m/s.
@@ -30,10 +30,15 @@ pub struct Trajectory {
     pub samples: Vec<Sample>,
 }
 
-/// A reconfiguration as flown: which IWP, which shape, and when.
+/// A reconfiguration as flown: which IWP (or squeezed stretch), which
+/// shape, and when.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Reconfiguration {
-    pub iwp: usize,
+    /// The IWP crossed; `None` for a squeezed stretch of the route stage,
+    /// where the site is narrower than the formation but no IWP says so.
+    pub iwp: Option<usize>,
+    /// The obstacles of the IWP, or the nearest on either side of the
+    /// squeezed stretch where it is narrowest.
     pub between: [String; 2],
     pub shape: super::iwp::Shape,
     /// Centroid position at the IWP.
@@ -50,9 +55,11 @@ pub struct Reconfiguration {
 pub const SAMPLE_PERIOD: f64 = 0.1;
 
 /// The per-UAV trajectories and the reconfiguration timetable.
+/// `names`: the mission's obstacle names (for squeezed stretches).
 pub fn generate(
     path: &CentroidPath,
     iwps: &[Iwp],
+    names: &[String],
     formation: &Formation,
     span: f64,
 ) -> (Vec<Trajectory>, Vec<Reconfiguration>) {
@@ -83,20 +90,32 @@ pub fn generate(
         })
         .collect();
 
+    let name = |k: usize| names.get(k).cloned().unwrap_or_default();
     let reconfigurations = path
         .zones
         .iter()
-        .map(|z| {
+        .flat_map(|z| z.causes.iter().map(move |cause| (z, cause)))
+        .map(|(z, cause)| {
             let [a1, a2, a3, a4] = z.arcs();
             let at = |s: f64| (s / speed).clamp(0.0, duration);
+            let (iwp, between) = match *cause {
+                ZoneCause::Iwp { iwp, pair } => (
+                    Some(iwp),
+                    iwps.get(iwp)
+                        .map(|i| i.between.clone())
+                        .unwrap_or_else(|| [name(pair[0]), name(pair[1])]),
+                ),
+                ZoneCause::Squeeze { pair, .. } => (None, [name(pair[0]), name(pair[1])]),
+            };
+            let arc = match *cause {
+                ZoneCause::Iwp { .. } => z.arc,
+                ZoneCause::Squeeze { .. } => (a2 + a3) / 2.0,
+            };
             Reconfiguration {
-                iwp: z.iwp,
-                between: iwps
-                    .get(z.iwp)
-                    .map(|i| i.between.clone())
-                    .unwrap_or_default(),
+                iwp,
+                between,
                 shape: z.shape,
-                position: motion.walker().at(z.arc),
+                position: motion.walker().at(arc),
                 t1: at(a1),
                 t2: at(a2),
                 t3: at(a3),

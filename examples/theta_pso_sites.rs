@@ -1,0 +1,206 @@
+//! θ-PSO over the generated sites of `tests/sites`: the feasible rate per
+//! dimension (walls, shape, size, inspection, narrow gaps) and every failure
+//! with its reason.
+//!
+//! ```text
+//! cargo run --release --no-default-features --example theta_pso_sites -- 100 3
+//! cargo run --release --no-default-features --example theta_pso_sites -- 100 3 200
+//! ```
+//! Arguments: sites, seeds per site (default 100 × 3), and the index of the
+//! first site (default 0; a different range is a set the planner was not
+//! tuned on).
+
+#[path = "../tests/sites/mod.rs"]
+mod sites;
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use skyform::pipeline::{CancelToken, Silent};
+use skyform::planner::{PlanOptions, plan};
+
+struct Run {
+    site: u64,
+    seed: u64,
+    dims: Vec<(&'static str, String)>,
+    feasible: bool,
+    reason: String,
+    seconds: f64,
+}
+
+/// One site and seed in detail: its IWPs, the seeding route, the result.
+fn detail(site: u64, seed: u64) {
+    use skyform::planner::{Problem, seeding};
+    let s = sites::generated(site);
+    let m = &s.mission;
+    println!("{} — {} obstacles, bounds x {:?} y {:?}", m.name, m.obstacles.len(), m.bounds.x, m.bounds.y);
+    println!("start {:?} goal {:?}", m.route.start, m.route.goal);
+    let problem = match Problem::new(m) {
+        Ok(p) => p,
+        Err(e) => return println!("problem: {e:?}"),
+    };
+    for iwp in &problem.iwps {
+        println!(
+            "  IWP {} | {}: gap {:.2} {} hold {:.1} {}",
+            iwp.between[0], iwp.between[1], iwp.gap, iwp.shape_name(), iwp.hold,
+            iwp.unusable.as_deref().unwrap_or("")
+        );
+    }
+    let mut problem = problem;
+    let t = Instant::now();
+    let corridor = match skyform::planner::route::find(m, &problem.builder, &problem.iwps, problem.cost.margin()) {
+        Ok(c) => c,
+        Err(b) => return println!("  route: {} ({:.1} ms)", b.reason, t.elapsed().as_secs_f64() * 1e3),
+    };
+    println!("  route: {:.1} m, {} points, squeeze {} ({:.1} ms)", corridor.length, corridor.points.len(), corridor.squeeze.is_some(), t.elapsed().as_secs_f64() * 1e3);
+    for (q, l) in corridor.points.iter().zip(&corridor.legs) { print!(" ({:.1},{:.1}) {l:?}", q.x, q.y); }
+    println!();
+    problem.follow(m, &corridor);
+    let starts = seeding::particles(m, &problem, &corridor, seed);
+    if let Some(p) = starts.first() {
+        let path = problem.path(p);
+        let t = problem.evaluate(p);
+        println!("  seed particle: {} points, J {:.2} J2 {:.5} J3 {:.4} JB {:.4}, zones {}", path.points.len(), t.total, t.obstacle, t.altitude, t.bounds, path.zones.len());
+        for q in &path.points { print!(" ({:.1},{:.1})", q.x, q.y); }
+        println!();
+    } else {
+        println!("  no seeding route");
+    }
+    match plan(m, seed, PlanOptions { parallel: false }, &mut Silent, &CancelToken::new()) {
+        Ok(o) => {
+            println!("  result: feasible {} J {:.2} J2 {:.5} restarts {} zones {}", o.feasible(), o.cost.total, o.cost.obstacle, o.restarts, o.reconfigurations.len());
+            println!("  {}", o.verification.first_failure().unwrap_or_default());
+            for r in &o.reconfigurations {
+                println!("    reconfig {:?} {:?} {} t {:.1} {:.1} {:.1} {:.1}", r.iwp, r.between, r.shape.name(), r.t1, r.t2, r.t3, r.t4);
+            }
+            for q in &o.centroid_path { print!(" ({:.1},{:.1})", q.x, q.y); }
+            println!();
+        }
+        Err(e) => println!("  refused: {e}"),
+    }
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let raw: Vec<String> = std::env::args().skip(1).collect();
+    if raw.first().map(String::as_str) == Some("detail") {
+        let n = |i: usize| raw.get(i).and_then(|v| v.parse().ok()).unwrap_or(0);
+        detail(n(1), n(2));
+        return Ok(());
+    }
+    let args: Vec<u64> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse())
+        .collect::<Result<_, _>>()?;
+    let count = args.first().copied().unwrap_or(100);
+    let seeds = args.get(1).copied().unwrap_or(3);
+    let first = args.get(2).copied().unwrap_or(0);
+    if seeds == 0 {
+        // A census of the sites alone, no planning.
+        let mut by: BTreeMap<String, usize> = BTreeMap::new();
+        for i in first..first + count {
+            let site = sites::generated(i);
+            for key in [
+                format!("walls {}", site.walls),
+                format!("shape {}", site.shape),
+                format!("inspected {}", site.inspected),
+                format!("narrow {}", site.narrow),
+            ] {
+                *by.entry(key).or_default() += 1;
+            }
+        }
+        for (k, v) in by {
+            println!("{k:<20} {v}");
+        }
+        return Ok(());
+    }
+    let jobs: Vec<(u64, u64)> = (first..first + count)
+        .flat_map(|i| (0..seeds).map(move |s| (i, s)))
+        .collect();
+    let started = Instant::now();
+    let runs: Vec<Run> = jobs
+        .par_iter()
+        .map(|&(i, seed)| {
+            let site = sites::generated(i);
+            let dims = vec![
+                ("walls", site.walls.to_string()),
+                ("narrow gaps", site.narrow.to_string()),
+                ("shape", site.shape.to_owned()),
+                ("UAVs", site.uavs.to_string()),
+                ("inspected", site.inspected.to_string()),
+                (
+                    "closest walls",
+                    if site.closest_walls < 22.0 {
+                        "< 22 m".to_owned()
+                    } else {
+                        "≥ 22 m".to_owned()
+                    },
+                ),
+            ];
+            let t = Instant::now();
+            let outcome = plan(
+                &site.mission,
+                seed,
+                PlanOptions { parallel: false },
+                &mut Silent,
+                &CancelToken::new(),
+            );
+            let seconds = t.elapsed().as_secs_f64();
+            let (feasible, reason) = match outcome {
+                Ok(o) => (
+                    o.feasible(),
+                    o.verification.first_failure().unwrap_or_default(),
+                ),
+                Err(e) => (false, format!("refused: {e}")),
+            };
+            Run {
+                site: i,
+                seed,
+                dims,
+                feasible,
+                reason,
+                seconds,
+            }
+        })
+        .collect();
+    let feasible = runs.iter().filter(|r| r.feasible).count();
+    println!(
+        "sites {first}..{}: {feasible} of {} runs feasible ({:.1} %), {:.0} s wall",
+        first + count,
+        runs.len(),
+        100.0 * feasible as f64 / runs.len().max(1) as f64,
+        started.elapsed().as_secs_f64()
+    );
+    let mut by: BTreeMap<(&str, String), (usize, usize)> = BTreeMap::new();
+    for r in &runs {
+        for (dim, value) in &r.dims {
+            let e = by.entry((dim, value.clone())).or_default();
+            e.1 += 1;
+            if r.feasible {
+                e.0 += 1;
+            }
+        }
+    }
+    let mut last = "";
+    for ((dim, value), (ok, all)) in &by {
+        if *dim != last {
+            println!("  {dim}:");
+            last = dim;
+        }
+        println!("    {value:<12} {ok:>4} / {all:<4}");
+    }
+    let slowest = runs.iter().map(|r| r.seconds).fold(0.0, f64::max);
+    let mean = runs.iter().map(|r| r.seconds).sum::<f64>() / runs.len().max(1) as f64;
+    println!("  time per run: mean {mean:.2} s, slowest {slowest:.2} s");
+    for r in runs.iter().filter(|r| !r.feasible) {
+        let dims: Vec<String> = r.dims.iter().map(|(d, v)| format!("{d} {v}")).collect();
+        println!(
+            "  FAIL site {} seed {} ({}): {}",
+            r.site,
+            r.seed,
+            dims.join(", "),
+            r.reason
+        );
+    }
+    Ok(())
+}

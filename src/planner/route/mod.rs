@@ -1,0 +1,562 @@
+//! The route stage: before the swarm, a deterministic search for a corridor
+//! the formation can fly from start to goal, or the place that closes the way.
+//!
+//! Not in the paper, which starts its swarm at random (Fig. 3, line 9) and
+//! has no answer when no plan exists. The search runs on a grid over the site
+//! (`field`), in three layers:
+//! - *nominal*: the centroid keeps the nominal shape's reach r + r_Q + margin
+//!   from every obstacle and r from the bounds (r: the farthest UAV from the
+//!   centroid in the plane), so every UAV is clear whatever the heading;
+//! - *shrunk*: the same for the shape shrunk to the smallest scale eq. 7
+//!   allows (the closest two UAVs 2 r_Q + 5 cm apart), for the stretches
+//!   where the site is narrower than the formation but no IWP says so (a
+//!   street between two walls);
+//! - *column*: the centroid keeps r_Q + margin, the UAVs in single file
+//!   along the path (the alignment of Fig. 2 flown as a real column flies),
+//!   where even the shrink does not fit.
+//!
+//! A change of layer costs the transition distance. Each usable IWP crossing
+//! (eq. 9, Fig. 2) is an edge of its own, straight through its gap, in
+//! either direction; each inspection pass (eq. 8) is one too, at 16 angles
+//! and both sides, flown in order (the search has a stage per pass). The
+//! cheapest route is pulled tight within each layer and handed to the swarm
+//! as seeded particles and kept as a plan of its own (`plan`).
+//!
+//! When no route exists the stage names what closes the way (`blocked`): the
+//! chain of obstacles between the reached and the unreached part of the site,
+//! which bounds it runs between, and why its widest gap does not let the
+//! formation through. The grid resolution makes the search complete up to
+//! the cell size; the disc model makes it conservative (a plan the route
+//! stage finds keeps every UAV clear; a formation turned to just the right
+//! heading might squeeze through where the disc model says it cannot).
+
+mod blocked;
+pub mod field;
+mod search;
+
+use std::f64::consts::{PI, TAU};
+use std::sync::Arc;
+
+use nalgebra::Point2;
+
+use self::field::{Disc, Field};
+use self::search::{Graph, Jump, LAYERS, Step, bit};
+use super::iwp::{Iwp, Shape as FormationShape, column_spacing, min_pair_distance};
+use super::path::PathBuilder;
+use crate::mission::Mission;
+
+/// Angles tried round each inspected obstacle.
+const PASS_ANGLES: usize = 16;
+/// Cells the grid has at most (per layer and stage).
+const MAX_CELLS: f64 = 160_000.0;
+/// Extra spacing the squeezed shape keeps beyond 2 r_Q between two UAVs.
+const SQUEEZE_SPACING_MARGIN: f64 = 0.05;
+
+/// A leg of the corridor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Leg {
+    /// Flown in layer 0 (nominal), 1 (shrunk) or 2 (column).
+    Free { layer: usize },
+    /// Crossing `i` of the path builder (a usable IWP), straight.
+    Crossing(usize),
+    /// The pass of inspection `i` of the path builder.
+    Pass(usize),
+}
+
+/// The route found: start, corners, crossings and passes, goal.
+#[derive(Debug, Clone)]
+pub struct Corridor {
+    pub points: Vec<Point2<f64>>,
+    /// `legs[i]` joins `points[i]` and `points[i + 1]`.
+    pub legs: Vec<Leg>,
+    /// Per inspection (builder order): the angle round the axis and the side.
+    pub passes: Vec<(f64, bool)>,
+    pub length: f64,
+    /// Where the formation flies squeezed, for every path the swarm tries.
+    pub squeeze: Option<Arc<SqueezeMap>>,
+}
+
+/// Why no corridor exists.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Blocked {
+    /// In words, naming the obstacles and the widths involved.
+    pub reason: String,
+    /// The obstacles that close the way (indices into `mission.obstacles`).
+    pub obstacles: Vec<usize>,
+}
+
+/// The squeezed stretches of the site the corridor uses: a path whose
+/// centroid enters one flies it in the region's shape (a shrink, or the
+/// column).
+#[derive(Debug, Clone)]
+pub struct SqueezeMap {
+    field: Field,
+    /// Per cell, the region (1-based) or 0.
+    region: Vec<u16>,
+    /// Per region, the shape flown there.
+    shapes: Vec<FormationShape>,
+    /// The mission's index and the centre of each of the field's discs.
+    obstacle_of: Vec<(usize, Point2<f64>)>,
+}
+
+impl SqueezeMap {
+    /// The region at `p` and its shape, if `p` is in one.
+    pub fn at(&self, p: Point2<f64>) -> Option<(u16, FormationShape)> {
+        let r = self.region[self.field.index_of(p)];
+        (r > 0).then(|| (r, self.shapes[r as usize - 1]))
+    }
+
+    /// Side of the grid's cells, metres: the resolution to sample paths at.
+    pub fn resolution(&self) -> f64 {
+        self.field.cell()
+    }
+
+    /// The obstacles nearest `p` on the left and on the right of the
+    /// direction `along` (mission indices; one twice when the other side is
+    /// open or a bound).
+    pub fn sides(&self, p: Point2<f64>, along: nalgebra::Vector2<f64>) -> [usize; 2] {
+        let left = nalgebra::Vector2::new(-along.y, along.x).normalize();
+        let probe = |sign: f64| {
+            let mut d = 0.0;
+            while d <= 50.0 {
+                let i = self.field.index_of(p + left * sign * d);
+                if let Some(&(k, center)) = self.field.nearest_disc(i).and_then(|k| self.obstacle_of.get(k))
+                    && (center - p).dot(&left) * sign > 0.0
+                {
+                    return Some(k);
+                }
+                d += self.field.cell();
+            }
+            None
+        };
+        match (probe(1.0), probe(-1.0)) {
+            (Some(a), Some(b)) => [a, b],
+            (Some(a), None) | (None, Some(a)) => [a, a],
+            (None, None) => [0, 0],
+        }
+    }
+}
+
+/// What the route stage needs of the formation.
+struct Shape {
+    /// Farthest UAV from the centroid in the plane, nominal shape, metres.
+    reach: f64,
+    /// The smallest shrink scale.
+    smallest: f64,
+    r_q: f64,
+    margin: f64,
+    /// The column, when eq. 7 allows one (its ends within d_com).
+    column: Option<FormationShape>,
+}
+
+impl Shape {
+    fn new(mission: &Mission, margin: f64) -> Self {
+        let f = &mission.formation;
+        let reach = f.slots.iter().map(|o| o.xy().norm()).fold(0.0, f64::max);
+        let closest = min_pair_distance(&f.slots);
+        let smallest = if closest.is_finite() && closest > 0.0 {
+            ((2.0 * f.uav_radius + SQUEEZE_SPACING_MARGIN) / closest).min(1.0)
+        } else {
+            0.0
+        };
+        let spacing = column_spacing(f);
+        let gaps = f.slots.len().saturating_sub(1) as f64;
+        let column = (f.slots.len() > 1 && gaps * spacing <= f.comm_range)
+            .then_some(FormationShape::Alignment { spacing });
+        Shape {
+            reach,
+            smallest,
+            r_q: f.uav_radius,
+            margin,
+            column,
+        }
+    }
+
+    /// Clearance the centroid needs in each layer (∞: the layer is closed).
+    fn need(&self) -> [f64; LAYERS] {
+        [
+            self.reach + self.r_q + self.margin,
+            self.smallest * self.reach + self.r_q + self.margin,
+            if self.column.is_some() {
+                self.r_q + self.margin
+            } else {
+                f64::INFINITY
+            },
+        ]
+    }
+
+    /// The scale that keeps every UAV clear at a centroid `clearance` from
+    /// the nearest obstacle and `inside` from the nearest side of the bounds.
+    fn scale_for(&self, clearance: f64, inside: f64) -> f64 {
+        if self.reach <= 0.0 {
+            return 1.0;
+        }
+        ((clearance - self.r_q - self.margin) / self.reach)
+            .min(inside / self.reach)
+            .clamp(self.smallest, 1.0)
+    }
+}
+
+/// The obstacles a formation in the band cannot fly over, as discs.
+fn blocking(mission: &Mission) -> Vec<(usize, Disc)> {
+    mission
+        .obstacles
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| o.height > mission.bounds.z[0])
+        .map(|(k, o)| {
+            (
+                k,
+                Disc {
+                    center: o.center,
+                    radius: o.radius,
+                },
+            )
+        })
+        .collect()
+}
+
+/// The route stage for `mission`: the cheapest corridor, or why none exists.
+pub fn find(
+    mission: &Mission,
+    builder: &PathBuilder,
+    iwps: &[Iwp],
+    margin: f64,
+) -> Result<Corridor, Blocked> {
+    let shape = Shape::new(mission, margin);
+    let need = shape.need();
+    let b = &mission.bounds;
+    let area = (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]);
+    let cell = (area / MAX_CELLS).sqrt().clamp(0.2, 2.0);
+    let obstacles = blocking(mission);
+    let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| *d).collect();
+    let field = Field::new([b.x, b.y], &discs, cell, need[0] + 2.0 * cell);
+    let boxes = [
+        [dx_dy(builder)[0], dx_dy(builder)[1]],
+        [
+            shrink(b.x, shape.smallest * shape.reach),
+            shrink(b.y, shape.smallest * shape.reach),
+        ],
+        [b.x, b.y],
+    ];
+
+    let inside = |p: Point2<f64>, [x, y]: [[f64; 2]; 2]| {
+        x[0] <= p.x && p.x <= x[1] && y[0] <= p.y && p.y <= y[1]
+    };
+    let (start, goal) = (mission.route.start.xy(), mission.route.goal.xy());
+    let mut open: Vec<u8> = (0..field.len())
+        .map(|i| {
+            let (c, p) = (field.clearance(i), field.center(i));
+            // Half a cell's diagonal of slack: a straight between two open
+            // cell centres stays clear in between.
+            let slack = cell * std::f64::consts::FRAC_1_SQRT_2;
+            (0..LAYERS)
+                .filter(|&l| c >= need[l] + slack && inside(p, boxes[l]))
+                .fold(0, |bits, l| bits | bit(l))
+        })
+        .collect();
+    // Round the start and the goal the disc model is too strict: validation
+    // has checked the formation fits there; let the centroid leave them
+    // wherever it is itself clear.
+    for end in [start, goal] {
+        let around = shape.reach + cell;
+        for i in 0..field.len() {
+            let p = field.center(i);
+            if (p - end).norm() <= around
+                && field.clearance(i) >= shape.r_q + margin
+                && b.contains_xy(&p)
+            {
+                open[i] |= bit(0) | bit(1) | bit(2);
+            }
+        }
+    }
+
+    // The crossings and the passes as jumps.
+    let crossings = builder.crossings();
+    let mut jumps = Vec::new();
+    for (c, [a, z]) in crossings.iter().enumerate() {
+        for (direction, (from, to)) in [(*a, *z), (*z, *a)].into_iter().enumerate() {
+            jumps.push(Jump {
+                from: field.index_of(from),
+                to: field.index_of(to),
+                length: (to - from).norm(),
+                pass_at: None,
+                tag: 2 * c + direction,
+            });
+        }
+    }
+    let order = pass_order(builder, start, goal);
+    let mut candidates: Vec<(usize, f64, bool, [Point2<f64>; 2])> = Vec::new();
+    for (stage, &i) in order.iter().enumerate() {
+        let (k, _) = builder.inspections()[i];
+        for j in 0..PASS_ANGLES {
+            let phi = TAU * j as f64 / PASS_ANGLES as f64 - PI;
+            for on_left in [true, false] {
+                let ends = builder.pass_ends(i, phi, on_left);
+                let obstacle = obstacles.iter().position(|(o, _)| *o == k);
+                let clear = field.cells_along(ends[0], ends[1]).all(|c| {
+                    open[c] & bit(0) != 0
+                        || (field.nearest_disc(c) == obstacle && field.clearance(c) > shape.r_q)
+                }) && [ends[0], ends[1]]
+                    .iter()
+                    .all(|p| open[field.index_of(*p)] & bit(0) != 0);
+                if clear {
+                    jumps.push(Jump {
+                        from: field.index_of(ends[0]),
+                        to: field.index_of(ends[1]),
+                        length: (ends[1] - ends[0]).norm(),
+                        pass_at: Some(stage),
+                        tag: 2 * crossings.len() + candidates.len(),
+                    });
+                    candidates.push((i, phi, on_left, ends));
+                }
+            }
+        }
+    }
+
+    let graph = Graph {
+        field: &field,
+        open: &open,
+        jumps: &jumps,
+        stages: order.len(),
+        switch_cost: mission.reconfiguration.transition_distance.max(field.cell()),
+    };
+    let (s, g) = (field.index_of(start), field.index_of(goal));
+    let steps = match search::search(&graph, s, g) {
+        Ok(steps) => steps,
+        Err(reached) => {
+            return Err(blocked::explain(
+                mission,
+                iwps,
+                &field,
+                &obstacles,
+                &reached,
+                &order,
+                builder,
+                // The narrowest layer's: what nothing at all fits through.
+                if shape.column.is_some() { need[2] } else { need[1] },
+                if shape.column.is_some() { 0.0 } else { shape.smallest * shape.reach },
+            ));
+        }
+    };
+
+    let mut corridor = assemble(
+        &field,
+        &open,
+        &steps,
+        start,
+        goal,
+        &crossings,
+        &candidates,
+        builder.inspections().len(),
+    );
+    corridor.squeeze = squeeze_map(&field, &open, &corridor, &shape, mission, &discs).map(
+        |mut map| {
+            map.obstacle_of = obstacles.iter().map(|(k, d)| (*k, d.center)).collect();
+            Arc::new(map)
+        },
+    );
+    Ok(corridor)
+}
+
+/// The x and y ranges of the builder's decoding box (the nominal layer's).
+fn dx_dy(builder: &PathBuilder) -> [[f64; 2]; 2] {
+    let [x, y, _] = builder.decoding_box();
+    [x, y]
+}
+
+/// The inspections (builder indices) in the order they lie along start → goal.
+fn pass_order(builder: &PathBuilder, start: Point2<f64>, goal: Point2<f64>) -> Vec<usize> {
+    let axis = goal - start;
+    let mut order: Vec<(usize, f64)> = builder
+        .inspections()
+        .iter()
+        .enumerate()
+        .map(|(i, (_, c))| (i, (c - start).dot(&axis)))
+        .collect();
+    order.sort_by(|a, b| a.1.total_cmp(&b.1));
+    order.into_iter().map(|(i, _)| i).collect()
+}
+
+fn shrink([lo, hi]: [f64; 2], by: f64) -> [f64; 2] {
+    if hi - lo > 2.0 * by {
+        [lo + by, hi - by]
+    } else {
+        let mid = (lo + hi) / 2.0;
+        [mid, mid]
+    }
+}
+
+/// The search's steps as a corridor: runs of cells pulled tight within their
+/// layer, the jumps kept exact.
+#[allow(clippy::too_many_arguments)]
+fn assemble(
+    field: &Field,
+    open: &[u8],
+    steps: &[Step],
+    start: Point2<f64>,
+    goal: Point2<f64>,
+    crossings: &[[Point2<f64>; 2]],
+    candidates: &[(usize, f64, bool, [Point2<f64>; 2])],
+    inspections: usize,
+) -> Corridor {
+    let mut points = vec![start];
+    let mut legs = Vec::new();
+    let mut passes = vec![(0.0, true); inspections];
+    // The current run: its points and layer.
+    let mut run: Vec<Point2<f64>> = vec![start];
+    let mut layer = 0;
+    let flush = |run: &mut Vec<Point2<f64>>,
+                 layer: usize,
+                 points: &mut Vec<Point2<f64>>,
+                 legs: &mut Vec<Leg>,
+                 end: Point2<f64>| {
+        run.push(end);
+        let pulled = pull_tight(field, open, bit(layer), run);
+        for p in pulled.into_iter().skip(1) {
+            if (p - points[points.len() - 1]).norm() > 1e-9 {
+                points.push(p);
+                legs.push(Leg::Free { layer });
+            }
+        }
+        run.clear();
+    };
+    for (k, step) in steps.iter().enumerate().skip(1) {
+        match *step {
+            Step::Cell { cell, layer: l } => {
+                if l != layer {
+                    // A change of layer: a vertex where the transition is.
+                    flush(&mut run, layer, &mut points, &mut legs, field.center(cell));
+                    run.push(field.center(cell));
+                    layer = l;
+                } else if k + 1 == steps.len() {
+                    flush(&mut run, layer, &mut points, &mut legs, goal);
+                } else {
+                    run.push(field.center(cell));
+                }
+            }
+            Step::Jump { tag, layer: l, .. } => {
+                let (ends, leg) = if tag < 2 * crossings.len() {
+                    let [a, z] = crossings[tag / 2];
+                    let ends = if tag % 2 == 0 { [a, z] } else { [z, a] };
+                    (ends, Leg::Crossing(tag / 2))
+                } else {
+                    let (i, phi, on_left, ends) = candidates[tag - 2 * crossings.len()];
+                    passes[i] = (phi, on_left);
+                    (ends, Leg::Pass(i))
+                };
+                flush(&mut run, layer, &mut points, &mut legs, ends[0]);
+                points.push(ends[1]);
+                legs.push(leg);
+                run.push(ends[1]);
+                layer = l;
+                if k + 1 == steps.len() {
+                    flush(&mut run, layer, &mut points, &mut legs, goal);
+                }
+            }
+        }
+    }
+    if points.last() != Some(&goal) {
+        flush(&mut run, layer, &mut points, &mut legs, goal);
+    }
+    let length = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    Corridor {
+        points,
+        legs,
+        passes,
+        length,
+        squeeze: None,
+    }
+}
+
+/// The run's points with every corner removed that a straight line on open
+/// cells can skip: from each kept point, the farthest one in sight.
+fn pull_tight(field: &Field, open: &[u8], bit: u8, run: &[Point2<f64>]) -> Vec<Point2<f64>> {
+    if run.len() <= 2 {
+        return run.to_vec();
+    }
+    let mut kept = vec![run[0]];
+    let mut anchor = 0;
+    while anchor + 1 < run.len() {
+        // The farthest point of the run in sight (from the far end back).
+        let next = ((anchor + 2)..run.len())
+            .rev()
+            .find(|&j| search::visible(field, open, bit, run[anchor], run[j]))
+            .unwrap_or(anchor + 1);
+        kept.push(run[next]);
+        anchor = next;
+    }
+    kept
+}
+
+/// The squeezed regions the corridor passes: the connected cells where only
+/// the shrink fits (flown at the scale the corridor needs through it) or
+/// only the column does; `None` when the corridor never squeezes.
+fn squeeze_map(
+    field: &Field,
+    open: &[u8],
+    corridor: &Corridor,
+    shape: &Shape,
+    mission: &Mission,
+    discs: &[Disc],
+) -> Option<SqueezeMap> {
+    // The narrowest layer a cell is open in, when it is not open in the nominal.
+    let narrow = |i: usize| -> Option<usize> {
+        (open[i] & bit(0) == 0)
+            .then(|| (1..LAYERS).find(|&l| open[i] & bit(l) != 0))
+            .flatten()
+    };
+    let mut region = vec![0u16; field.len()];
+    let mut shapes: Vec<FormationShape> = Vec::new();
+    for (leg, w) in corridor.legs.iter().zip(corridor.points.windows(2)) {
+        if matches!(leg, Leg::Free { layer: 0 } | Leg::Pass(_)) {
+            continue;
+        }
+        let (a, b) = (w[0], w[1]);
+        let steps = (((b - a).norm() / (field.cell() / 3.0)).ceil() as usize).max(1);
+        for k in 0..=steps {
+            let p = a + (b - a) * (k as f64 / steps as f64);
+            let i = field.index_of(p);
+            let Some(layer) = narrow(i) else { continue };
+            if region[i] == 0 {
+                if shapes.len() >= u16::MAX as usize - 1 {
+                    break;
+                }
+                shapes.push(match (layer, shape.column) {
+                    (2, Some(column)) => column,
+                    _ => FormationShape::Shrink { scale: 1.0 },
+                });
+                let label = shapes.len() as u16;
+                flood(field, &mut region, i, label, &|j| narrow(j) == Some(layer));
+            }
+            let r = region[i] as usize - 1;
+            if let FormationShape::Shrink { scale } = &mut shapes[r] {
+                let fits = shape.scale_for(
+                    field.clearance_at(p, discs),
+                    mission.bounds.horizontal_margin(&nalgebra::Point3::new(p.x, p.y, 0.0)),
+                );
+                *scale = scale.min(fits);
+            }
+        }
+    }
+    (!shapes.is_empty()).then(|| SqueezeMap {
+        field: field.clone(),
+        region,
+        shapes,
+        obstacle_of: Vec::new(),
+    })
+}
+
+/// Labels the connected narrow cells round `seed` with `label`.
+fn flood(field: &Field, region: &mut [u16], seed: usize, label: u16, narrow: &dyn Fn(usize) -> bool) {
+    let mut stack = vec![seed];
+    region[seed] = label;
+    while let Some(i) = stack.pop() {
+        for j in field.neighbourhood(i) {
+            if region[j] == 0 && narrow(j) {
+                region[j] = label;
+                stack.push(j);
+            }
+        }
+    }
+}

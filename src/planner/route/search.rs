@@ -1,0 +1,219 @@
+//! A* over the clearance field's cells, in three layers (the nominal shape,
+//! the smallest shrink, the column) and in stages (the inspection passes
+//! flown so far), with the IWP crossings and the passes as edges of their own.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use nalgebra::Point2;
+
+use super::field::Field;
+
+/// The layers, widest first: the nominal shape, the smallest shrink, the
+/// column (single file along the path).
+pub const LAYERS: usize = 3;
+
+/// The bit of `layer` in a cell's open bits.
+pub const fn bit(layer: usize) -> u8 {
+    1 << layer
+}
+
+/// A straight edge of its own: an IWP crossing (any layer, stage kept) or an
+/// inspection pass (nominal layer, to the next stage).
+#[derive(Debug, Clone, Copy)]
+pub struct Jump {
+    pub from: usize,
+    pub to: usize,
+    pub length: f64,
+    /// `Some(stage)`: a pass taken at that stage, to the next one.
+    pub pass_at: Option<usize>,
+    /// Index of the crossing or of the pass candidate, for the caller.
+    pub tag: usize,
+}
+
+/// What the search works on.
+pub struct Graph<'a> {
+    pub field: &'a Field,
+    /// Per cell, one bit per layer it may be entered in.
+    pub open: &'a [u8],
+    pub jumps: &'a [Jump],
+    /// Inspection passes to fly, in order: the stages are 0..=passes.
+    pub stages: usize,
+    /// Cost of changing layer, metres (a transition flown).
+    pub switch_cost: f64,
+}
+
+/// One step of the found route.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Step {
+    /// Moved to a neighbouring cell (or started there), in a layer.
+    Cell { cell: usize, layer: usize },
+    /// Took jump `tag` (a crossing or a pass) ending at `cell`.
+    Jump { cell: usize, tag: usize, layer: usize },
+}
+
+/// The cells reached by the search, for explaining a failure.
+pub struct Reached {
+    /// Per cell, the highest stage reached there (`None`: never reached).
+    pub stage: Vec<Option<usize>>,
+}
+
+/// The cheapest route from `start` to `goal` through every stage, or the
+/// cells reached when there is none.
+pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>, Reached> {
+    let field = graph.field;
+    let cells = field.len();
+    let layers = LAYERS;
+    let states = cells * layers * (graph.stages + 1);
+    let state = |cell: usize, layer: usize, stage: usize| (stage * layers + layer) * cells + cell;
+    let mut cost = vec![f64::INFINITY; states];
+    let mut parent = vec![u32::MAX; states];
+    let mut via = vec![u32::MAX; states];
+    let goal_point = field.center(goal);
+    let heuristic = |cell: usize| (field.center(cell) - goal_point).norm();
+    let mut index: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
+    for (j, jump) in graph.jumps.iter().enumerate() {
+        index.entry(jump.from).or_default().push(j);
+    }
+
+    let mut open = BinaryHeap::new();
+    let first = state(start, 0, 0);
+    cost[first] = 0.0;
+    open.push(Entry {
+        estimate: heuristic(start),
+        state: first,
+    });
+    let mut done = None;
+    while let Some(Entry { state: s, estimate }) = open.pop() {
+        let cell = s % cells;
+        let layer = (s / cells) % layers;
+        let stage = s / (cells * layers);
+        let g = cost[s];
+        if estimate > g + heuristic(cell) + 1e-9 {
+            continue; // stale entry
+        }
+        if cell == goal && stage == graph.stages {
+            done = Some(s);
+            break;
+        }
+        let mut relax = |to: usize, g_to: f64, through: u32, open: &mut BinaryHeap<Entry>| {
+            if g_to < cost[to] {
+                cost[to] = g_to;
+                parent[to] = s as u32;
+                via[to] = through;
+                open.push(Entry {
+                    estimate: g_to + heuristic(to % cells),
+                    state: to,
+                });
+            }
+        };
+        let here = bit(layer);
+        for (next, length) in field.steps(cell) {
+            if graph.open[next] & here != 0 || next == goal {
+                relax(state(next, layer, stage), g + length, u32::MAX, &mut open);
+            }
+        }
+        // A transition to another layer, flown where the wider shape fits.
+        for other in (0..layers).filter(|&l| l != layer) {
+            if graph.open[cell] & bit(other.min(layer)) != 0 {
+                relax(
+                    state(cell, other, stage),
+                    g + graph.switch_cost,
+                    u32::MAX,
+                    &mut open,
+                );
+            }
+        }
+        if let Some(list) = index.get(&cell) {
+            for &j in list {
+                let jump = &graph.jumps[j];
+                match jump.pass_at {
+                    Some(at) if at == stage && layer == 0 => relax(
+                        state(jump.to, 0, stage + 1),
+                        g + jump.length,
+                        j as u32,
+                        &mut open,
+                    ),
+                    Some(_) => {}
+                    None => {
+                        // Out of a crossing in the widest layer the far
+                        // side allows, no wider than the one it came in.
+                        let Some(arrive) =
+                            (layer..layers).find(|&l| graph.open[jump.to] & bit(l) != 0)
+                        else {
+                            continue;
+                        };
+                        relax(
+                            state(jump.to, arrive, stage),
+                            g + jump.length,
+                            j as u32,
+                            &mut open,
+                        );
+                    }
+                }
+            }
+        }
+    }
+    let Some(end) = done else {
+        let mut stage = vec![None; cells];
+        for (s, c) in cost.iter().enumerate() {
+            if c.is_finite() {
+                let (cell, st) = (s % cells, s / (cells * layers));
+                if stage[cell].is_none_or(|old| st > old) {
+                    stage[cell] = Some(st);
+                }
+            }
+        }
+        return Err(Reached { stage });
+    };
+    let mut steps = Vec::new();
+    let mut s = end;
+    loop {
+        let cell = s % cells;
+        let layer = (s / cells) % layers;
+        let step = if via[s] != u32::MAX {
+            Step::Jump {
+                cell,
+                tag: graph.jumps[via[s] as usize].tag,
+                layer,
+            }
+        } else {
+            Step::Cell { cell, layer }
+        };
+        steps.push(step);
+        if parent[s] == u32::MAX {
+            break;
+        }
+        s = parent[s] as usize;
+    }
+    steps.reverse();
+    Ok(steps)
+}
+
+#[derive(Debug, PartialEq)]
+struct Entry {
+    estimate: f64,
+    state: usize,
+}
+
+impl Eq for Entry {}
+
+impl Ord for Entry {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .estimate
+            .total_cmp(&self.estimate)
+            .then(other.state.cmp(&self.state))
+    }
+}
+
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+/// Whether the straight from `a` to `b` stays on cells open in `bit`.
+pub fn visible(field: &Field, open: &[u8], bit: u8, a: Point2<f64>, b: Point2<f64>) -> bool {
+    field.cells_along(a, b).all(|i| open[i] & bit != 0)
+}
