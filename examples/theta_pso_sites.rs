@@ -30,11 +30,15 @@ struct Run {
 }
 
 /// One site and seed in detail: its IWPs, the seeding route, the result.
-fn detail(site: u64, seed: u64) {
+fn detail(m: &skyform::mission::Mission, seed: u64) {
     use skyform::planner::{Problem, seeding};
-    let s = sites::generated(site);
-    let m = &s.mission;
-    println!("{} — {} obstacles, bounds x {:?} y {:?}", m.name, m.obstacles.len(), m.bounds.x, m.bounds.y);
+    println!(
+        "{} — {} obstacles, bounds x {:?} y {:?}",
+        m.name,
+        m.obstacles.len(),
+        m.bounds.x,
+        m.bounds.y
+    );
     println!("start {:?} goal {:?}", m.route.start, m.route.goal);
     let problem = match Problem::new(m) {
         Ok(p) => p,
@@ -43,38 +47,113 @@ fn detail(site: u64, seed: u64) {
     for iwp in &problem.iwps {
         println!(
             "  IWP {} | {}: gap {:.2} {} hold {:.1} {}",
-            iwp.between[0], iwp.between[1], iwp.gap, iwp.shape_name(), iwp.hold,
+            iwp.between[0],
+            iwp.between[1],
+            iwp.gap,
+            iwp.shape_name(),
+            iwp.hold,
             iwp.unusable.as_deref().unwrap_or("")
         );
     }
     let mut problem = problem;
+    for [a, z] in problem.builder.crossings() {
+        println!(
+            "  crossing ({:.2},{:.2}) -> ({:.2},{:.2})",
+            a.x, a.y, z.x, z.y
+        );
+    }
     let t = Instant::now();
-    let corridor = match skyform::planner::route::find(m, &problem.builder, &problem.iwps, problem.cost.margin()) {
+    let corridor = match skyform::planner::route::find(
+        m,
+        &problem.builder,
+        &problem.iwps,
+        problem.cost.margin(),
+    ) {
         Ok(c) => c,
-        Err(b) => return println!("  route: {} ({:.1} ms)", b.reason, t.elapsed().as_secs_f64() * 1e3),
+        Err(b) => {
+            return println!(
+                "  route: {} ({:.1} ms)",
+                b.reason,
+                t.elapsed().as_secs_f64() * 1e3
+            );
+        }
     };
-    println!("  route: {:.1} m, {} points, squeeze {} ({:.1} ms)", corridor.length, corridor.points.len(), corridor.squeeze.is_some(), t.elapsed().as_secs_f64() * 1e3);
-    for (q, l) in corridor.points.iter().zip(&corridor.legs) { print!(" ({:.1},{:.1}) {l:?}", q.x, q.y); }
+    println!(
+        "  route: {:.1} m, {} points, squeeze {} ({:.1} ms)",
+        corridor.length,
+        corridor.points.len(),
+        corridor.squeeze.is_some(),
+        t.elapsed().as_secs_f64() * 1e3
+    );
+    for (q, l) in corridor.points.iter().zip(&corridor.legs) {
+        print!(" ({:.1},{:.1}) {l:?}", q.x, q.y);
+    }
     println!();
     problem.follow(m, &corridor);
     let starts = seeding::particles(m, &problem, &corridor, seed);
     if let Some(p) = starts.first() {
         let path = problem.path(p);
         let t = problem.evaluate(p);
-        println!("  seed particle: {} points, J {:.2} J2 {:.5} J3 {:.4} JB {:.4}, zones {}", path.points.len(), t.total, t.obstacle, t.altitude, t.bounds, path.zones.len());
-        for q in &path.points { print!(" ({:.1},{:.1})", q.x, q.y); }
+        println!(
+            "  seed particle: {} points, J {:.2} J2 {:.5} J3 {:.4} JB {:.4}, zones {}",
+            path.points.len(),
+            t.total,
+            t.obstacle,
+            t.altitude,
+            t.bounds,
+            path.zones.len()
+        );
+        for q in &path.points {
+            print!(" ({:.1},{:.1})", q.x, q.y);
+        }
         println!();
     } else {
         println!("  no seeding route");
     }
-    match plan(m, seed, PlanOptions { parallel: false }, &mut Silent, &CancelToken::new()) {
+    let t0 = Instant::now();
+    let mut stages = |event: skyform::pipeline::Event<'_>| match event {
+        skyform::pipeline::Event::Stage(s) => {
+            println!("    {:>7.3} s  stage {s}", t0.elapsed().as_secs_f64())
+        }
+        skyform::pipeline::Event::Log(_, l) if !l.contains("unusable") && !l.starts_with("IWP") => {
+            println!("    {:>7.3} s  {l}", t0.elapsed().as_secs_f64())
+        }
+        _ => {}
+    };
+    match plan(
+        m,
+        seed,
+        PlanOptions { parallel: false },
+        &mut stages,
+        &CancelToken::new(),
+    ) {
         Ok(o) => {
-            println!("  result: feasible {} J {:.2} J2 {:.5} restarts {} zones {}", o.feasible(), o.cost.total, o.cost.obstacle, o.restarts, o.reconfigurations.len());
+            println!(
+                "  result: feasible {} J {:.2} J2 {:.5} restarts {} zones {} source {:?} ({:.2} s)",
+                o.feasible(),
+                o.cost.total,
+                o.cost.obstacle,
+                o.restarts,
+                o.reconfigurations.len(),
+                o.source,
+                t0.elapsed().as_secs_f64()
+            );
             println!("  {}", o.verification.first_failure().unwrap_or_default());
             for r in &o.reconfigurations {
-                println!("    reconfig {:?} {:?} {} t {:.1} {:.1} {:.1} {:.1}", r.iwp, r.between, r.shape.name(), r.t1, r.t2, r.t3, r.t4);
+                println!(
+                    "    reconfig {:?} {:?} {} t {:.1} {:.1} {:.1} {:.1}",
+                    r.iwp,
+                    r.between,
+                    r.shape.name(),
+                    r.t1,
+                    r.t2,
+                    r.t3,
+                    r.t4
+                );
             }
-            for q in &o.centroid_path { print!(" ({:.1},{:.1})", q.x, q.y); }
+            for q in &o.centroid_path {
+                print!(" ({:.1},{:.1})", q.x, q.y);
+            }
             println!();
         }
         Err(e) => println!("  refused: {e}"),
@@ -85,7 +164,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let raw: Vec<String> = std::env::args().skip(1).collect();
     if raw.first().map(String::as_str) == Some("detail") {
         let n = |i: usize| raw.get(i).and_then(|v| v.parse().ok()).unwrap_or(0);
-        detail(n(1), n(2));
+        detail(&sites::generated(n(1)).mission, n(2));
+        return Ok(());
+    }
+    if raw.first().map(String::as_str) == Some("mission") {
+        // A mission file in the same detail: `mission PATH SEED`.
+        let path = raw.get(1).ok_or("mission PATH SEED")?;
+        let seed = raw.get(2).and_then(|v| v.parse().ok()).unwrap_or(0);
+        let loaded = skyform::mission::load(std::path::Path::new(path))?;
+        detail(&loaded.mission, seed);
         return Ok(());
     }
     let args: Vec<u64> = std::env::args()
@@ -192,6 +279,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let slowest = runs.iter().map(|r| r.seconds).fold(0.0, f64::max);
     let mean = runs.iter().map(|r| r.seconds).sum::<f64>() / runs.len().max(1) as f64;
     println!("  time per run: mean {mean:.2} s, slowest {slowest:.2} s");
+    let mut by_time: Vec<&Run> = runs.iter().collect();
+    by_time.sort_by(|a, b| b.seconds.total_cmp(&a.seconds));
+    for r in by_time.iter().take(5) {
+        println!(
+            "    slow: site {} seed {} {:.2} s",
+            r.site, r.seed, r.seconds
+        );
+    }
     for r in runs.iter().filter(|r| !r.feasible) {
         let dims: Vec<String> = r.dims.iter().map(|(d, v)| format!("{d} {v}")).collect();
         println!(

@@ -95,11 +95,19 @@ pub enum Command {
 pub enum RunCommand {
     /// θ-PSO formation path planning with reconfiguration at intermediate waypoints.
     ///
-    /// Progress goes to stderr, a summary to stdout. Exit status: 0 feasible
-    /// plan, 1 error, 2 infeasible plan, 130 cancelled (Ctrl-C).
+    /// Before the swarm, a route stage searches for a corridor the formation
+    /// can fly (through the IWPs, shrunk or in a column where the site is
+    /// narrower than it); with none, the run stops there and names what
+    /// closes the way. Progress goes to stderr, a summary to stdout (the
+    /// verdict first). Exit status: 0 feasible plan, 1 error, 2 infeasible
+    /// plan or no corridor, 130 cancelled (Ctrl-C).
     ThetaPso {
         /// Mission TOML file.
         mission: PathBuf,
+        /// List every unusable IWP in the summary (default: counted by
+        /// reason, the few nearest the path named).
+        #[arg(long)]
+        verbose: bool,
         /// Seed of the swarm (default: the mission's `seed`).
         #[arg(long)]
         seed: Option<u64>,
@@ -211,6 +219,7 @@ pub fn main() -> ExitCode {
         } => ExitCode::from(check(&files, strict, json)),
         Command::Run(RunCommand::ThetaPso {
             mission,
+            verbose,
             seed,
             json,
             sequential,
@@ -226,6 +235,7 @@ pub fn main() -> ExitCode {
                 json.as_deref(),
                 &record.sinks(),
                 options,
+                verbose,
             ))
         }
         Command::Run(RunCommand::Fleet(a)) => ExitCode::from(run_pipeline(
@@ -235,6 +245,7 @@ pub fn main() -> ExitCode {
             a.json.as_deref(),
             &a.record.sinks(),
             PlanOptions::default(),
+            false,
         )),
         Command::Run(RunCommand::Flatlo {
             mission,
@@ -248,6 +259,7 @@ pub fn main() -> ExitCode {
             json.as_deref(),
             &record.sinks(),
             PlanOptions::default(),
+            false,
         )),
         Command::Record { mission, record } => {
             ExitCode::from(record_mission(&mission, &record.sinks()))
@@ -422,6 +434,7 @@ fn run_pipeline(
     json: Option<&std::path::Path>,
     sinks: &Sinks,
     options: PlanOptions,
+    verbose: bool,
 ) -> u8 {
     let plan = |m: &mission::Mission, seed, observer: &mut dyn Observer, cancel: &CancelToken| {
         outcome::run(kind, m, seed, options, observer, cancel)
@@ -452,6 +465,17 @@ fn run_pipeline(
     };
     let outcome = match result {
         Ok(o) => o,
+        // No plan exists within the planner's model: not an error of the
+        // program or the file, the answer (with the place that closes the way).
+        Err(crate::pipeline::PipelineError::NoRoute(reason)) => {
+            let finished = recorder.map(Recorder::finish);
+            if progress.terminal {
+                eprintln!();
+            }
+            report_recording(finished.as_ref());
+            println!("result       NO PLAN: {reason}");
+            return exit::INFEASIBLE;
+        }
         Err(e) => {
             eprintln!("\nerror: {e}");
             return exit::ERROR;
@@ -468,7 +492,7 @@ fn run_pipeline(
     }
     report_recording(finished.as_ref());
     let json_to_stdout = json.is_some_and(|p| p.as_os_str() == "-");
-    let summary = outcome.summary();
+    let summary = outcome.summary_with(verbose);
     if json_to_stdout {
         eprint!("{summary}");
     } else {

@@ -69,7 +69,7 @@ fn run_theta_pso_prints_a_summary_and_the_outcome_as_json() {
     let stderr = text(&out.stderr);
     assert!(
         stderr.contains("FEASIBLE")
-            && stderr.contains("alignment between 'light pole 4' and 'pier 5'")
+            && stderr.contains("alignment at the IWP between 'light pole 4' and 'pier 5'")
     );
     assert!(
         stderr.contains("progress: 100%"),
@@ -103,8 +103,11 @@ fn run_theta_pso_exits_2_on_an_infeasible_plan() {
     std::fs::write(&path, text_toml).unwrap_or_else(|e| panic!("{e}"));
     let out = skyform(&["run", "theta-pso", &path.display().to_string()]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("INFEASIBLE"));
-    assert!(text(&out.stdout).contains("FAIL obstacle clearance"));
+    // The route stage refuses before the swarm flies: no plan, and where.
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("NO PLAN"), "{stdout}");
+    assert!(stdout.contains("24 obstacles ('ring 0'"), "{stdout}");
+    assert!(stdout.contains("round the start"), "{stdout}");
 }
 
 #[test]

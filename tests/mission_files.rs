@@ -182,8 +182,9 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
             };
             let z = z0 + band / 2.0;
             let route = Route {
-                start: Point3::new(-w / 2.0, 0.0, z),
-                goal: Point3::new(w / 2.0, d, z),
+                // 3 m in from the corners: the whole formation fits there.
+                start: Point3::new(-w / 2.0 + 3.0, 3.0, z),
+                goal: Point3::new(w / 2.0 - 3.0, d - 3.0, z),
             };
             let obstacles = obstacles
                 .into_iter()

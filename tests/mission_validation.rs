@@ -202,17 +202,37 @@ fn start_and_goal_must_be_inside_the_bounds() {
 }
 
 #[test]
-fn start_inside_an_obstacles_safe_radius_is_an_error() {
-    // Default triangle: r_F = √5 ≈ 2.236 m, r_Q = 0.5 m → needs 2.736 m of clearance.
+fn a_start_where_the_formation_fits_in_no_heading_is_an_error() {
+    // Default triangle, start at (10, 10): a pole of 3 m radius 1 m east of
+    // the start is inside the formation whatever its heading.
     let text = mission_with(
-        "[[obstacles]]\nname = \"pole\"\ncenter = [12.0, 10.0]\nradius = 0.5\nheight = 20.0\n",
+        "[[obstacles]]\nname = \"pole\"\ncenter = [11.0, 10.0]\nradius = 3.0\nheight = 20.0\n",
     );
     let d = error_at(&text, "route.start");
     assert!(
-        d.message.contains("'pole'") && d.message.contains("safe radius"),
+        d.message
+            .contains("does not fit at the start in any heading")
+            && d.message.contains("'pole'"),
         "{d}"
     );
     assert_eq!(d.location.map(|l| l.line), Some(line_of(&text, "start =")));
+}
+
+#[test]
+fn a_start_the_formation_fits_only_in_some_headings_is_a_warning_naming_one() {
+    // A pole 2 m east of the start, inside the old r_F + r_Q disc (2.74 m)
+    // but clear of the triangle turned to face it edge-on: only a warning.
+    let text = mission_with(
+        "[[obstacles]]\nname = \"pole\"\ncenter = [12.0, 10.0]\nradius = 0.5\nheight = 20.0\n",
+    );
+    let all = diagnostics(&text);
+    assert!(all.iter().all(|d| d.severity != Severity::Error), "{all:?}");
+    let w = all
+        .iter()
+        .find(|d| d.path.to_string() == "route.start")
+        .unwrap_or_else(|| panic!("no warning at route.start: {all:?}"));
+    assert_eq!(w.severity, Severity::Warning);
+    assert!(w.message.contains("of 72 headings"), "{w}");
 }
 
 #[test]

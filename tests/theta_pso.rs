@@ -6,10 +6,10 @@ use std::f64::consts::FRAC_PI_2;
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use rayon::prelude::*;
 use skyform::mission::{self, Mission, Obstacle, ShapeChoice};
-use skyform::pipeline::{CancelToken, Completion, Event, Silent};
+use skyform::pipeline::{CancelToken, Completion, Event, PipelineError, Silent};
 use skyform::planner::iwp::{lateral_half_width, resolve_shape};
-use skyform::planner::path::Zone;
 use skyform::planner::path::{ArcWalker, decode_angle};
+use skyform::planner::path::{Zone, ZoneCause};
 use skyform::planner::{
     CentroidPath, CostModel, Iwp, PlanOptions, Shape, ThetaPsoOutcome, find_iwps, plan,
 };
@@ -218,19 +218,25 @@ fn j3_sees_the_height_of_a_rotated_shape_eq5() {
         shape: Some(Shape::Rotation),
         unusable: None,
         hold: 5.0,
+        straight: 8.0,
     };
     let path = |z: f64| CentroidPath {
         points: vec![Point3::new(20.0, 50.0, z), Point3::new(80.0, 50.0, z)],
         zones: vec![Zone {
-            iwp: 0,
-            pair: [0, 0],
+            causes: vec![ZoneCause::Iwp {
+                iwp: 0,
+                pair: [0, 0],
+            }],
             shape: Shape::Rotation,
             arc: 30.0,
-            hold: 5.0,
+            hold: [25.0, 35.0],
             transition_in: 6.0,
             transition_out: 6.0,
+            from: None,
+            into: None,
         }],
         passes: Vec::new(),
+        crossed: vec![0],
     };
     let model = CostModel::new(&m, &[iwp]);
     assert_eq!(
@@ -286,6 +292,7 @@ fn jr_is_the_mean_horizontal_distance_to_enabled_iwps_eq11() {
         shape: Some(Shape::Rotation),
         unusable: None,
         hold: 1.0,
+        straight: 4.0,
     };
     let iwps = [iwp(0.0, 4.0, true), iwp(100.0, 100.0, false)];
     let model = CostModel::new(&m, &iwps);
@@ -510,11 +517,50 @@ fn the_uavs_centroid_follows_the_planned_path_eq6() {
             .sum::<Vector3<f64>>()
             / n;
         let planned = walker.at(t * speed);
-        assert!(
-            (mean - planned.coords).norm() < 1e-9,
-            "t = {t}: centroid {mean:?} vs path {planned:?}"
-        );
+        // In the column (Fig. 2's alignment, flown along the path) the UAVs
+        // follow the path itself: in its hold each one is on the path, and
+        // their mean is not (on a bend it sits inside it). Everywhere outside
+        // the alignment's [t1, t4] the shape is rigid and eq. 6 holds exactly.
+        let column = o
+            .reconfigurations
+            .iter()
+            .find(|r| r.shape.name() == "alignment" && r.t1 <= t && t <= r.t4);
+        match column {
+            None => assert!(
+                (mean - planned.coords).norm() < 1e-9,
+                "t = {t}: centroid {mean:?} vs path {planned:?}"
+            ),
+            Some(r) if r.t2 <= t && t <= r.t3 => {
+                for tr in &o.trajectories {
+                    let p = tr.samples[k].position;
+                    let off = distance_to_polyline(&o.centroid_path, &p);
+                    assert!(
+                        off < 1e-6,
+                        "t = {t}: UAV {} is {off} m off the path",
+                        tr.uav
+                    );
+                }
+            }
+            Some(_) => {}
+        }
     }
+}
+
+/// Horizontal distance from `p` to the polyline through `points`.
+fn distance_to_polyline(points: &[Point3<f64>], p: &Point3<f64>) -> f64 {
+    points
+        .windows(2)
+        .map(|w| {
+            let (a, b) = (w[0].xy(), w[1].xy());
+            let ab = b - a;
+            let u = if ab.norm_squared() > 0.0 {
+                ((p.xy() - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (a + ab * u - p.xy()).norm()
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The open field with a wall of touching poles across it at x = 50 and one
@@ -706,30 +752,21 @@ fn the_reference_is_a_lower_bound_and_an_open_field_plan_meets_it() {
 
 #[test]
 fn a_plan_that_fails_verification_restarts_and_says_so() {
-    let mut m = open_field();
-    // A ring of poles around the start: no restart can get out.
-    m.obstacles = (0..24)
-        .map(|i| {
-            let a = i as f64 * std::f64::consts::TAU / 24.0;
-            pole(
-                &format!("ring {i}"),
-                20.0 + 6.0 * a.cos(),
-                50.0 + 6.0 * a.sin(),
-                0.7,
-            )
-        })
-        .collect();
-    m.route.start = Point3::new(20.0, 50.0, 10.0);
+    // A wall across the field with one gap, and a swarm too small to find
+    // it on its own: no particle starts on the route stage's corridor.
+    let mut m = walled_field(6.0);
+    m.theta_pso.seeded_particles = 0;
+    m.theta_pso.swarm_size = 4;
     m.theta_pso.restarts = 2;
-    m.theta_pso.iterations = 10;
+    m.theta_pso.iterations = 1;
     let o = run(&m, 1);
     assert!(!o.feasible());
     assert_eq!(o.restarts, 2);
-    assert_eq!(o.iterations, 3 * 10);
-    assert_eq!(o.evaluations, 3 * 11 * m.theta_pso.swarm_size);
+    assert_eq!(o.iterations, 3);
+    assert_eq!(o.evaluations, 3 * 2 * m.theta_pso.swarm_size);
     let why = o.verification.first_failure().unwrap_or_default();
     assert!(
-        why.contains("obstacle clearance") && why.contains("UAV") && why.contains("ring"),
+        why.contains("obstacle clearance") && why.contains("UAV") && why.contains("wall"),
         "{why}"
     );
 }
@@ -760,7 +797,7 @@ fn the_same_seed_gives_bit_identical_json_on_one_or_many_threads() {
 }
 
 #[test]
-fn a_walled_in_start_is_reported_infeasible() {
+fn a_walled_in_start_is_refused_by_the_route_stage_naming_the_ring() {
     let mut m = open_field();
     // A ring of poles around the start, 6 m out, gaps far narrower than a UAV.
     m.obstacles = (0..24)
@@ -775,11 +812,26 @@ fn a_walled_in_start_is_reported_infeasible() {
         })
         .collect();
     m.route.start = Point3::new(20.0, 50.0, 10.0);
-    let o = run(&m, 1);
-    assert!(!o.feasible());
-    let clearance = &o.verification.checks[0];
-    assert!(!clearance.ok && clearance.worst.is_some_and(|w| w < m.formation.uav_radius));
-    assert!(o.verification.violation_count > 0 && !o.verification.violations.is_empty());
+    let refused = plan(
+        &m,
+        1,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    );
+    let Err(PipelineError::NoRoute(why)) = refused else {
+        panic!("expected the route stage to refuse: {refused:?}")
+    };
+    assert!(why.contains("round the start"), "{why}");
+    assert!(
+        why.contains("24 obstacles ('ring 0', 'ring 1', 'ring 2', …)"),
+        "{why}"
+    );
+    // 2 π 6 m / 24 − 1.4 m: each gap is 0.17 m, narrower than one UAV.
+    assert!(
+        why.contains("is 0.17 m: narrower than one UAV (2 r_Q = 1.00 m)"),
+        "{why}"
+    );
 }
 
 #[test]
@@ -851,8 +903,8 @@ fn the_observer_sees_every_iteration_with_a_non_increasing_best() {
         stages,
         [
             "intermediate waypoints",
+            "route",
             "planning",
-            "trajectories",
             "verification"
         ]
     );

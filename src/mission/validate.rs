@@ -316,30 +316,66 @@ impl Checker {
                 ),
             );
         }
-        let r_f = mission.formation.radius();
-        let margin = mission.bounds.horizontal_margin(p);
-        if margin >= 0.0 && margin < r_f {
-            self.warning(
-                path.clone(),
+        self.formation_fits(path, what, p, mission);
+    }
+
+    /// The formation standing at `p` in its nominal shape: an error when no
+    /// heading keeps every UAV inside the bounds and r_Q clear of every
+    /// obstacle (naming the UAV and by how much, at the best heading), a
+    /// warning when only some headings do (the plan must leave that way).
+    fn formation_fits(&mut self, path: FieldPath, what: &str, p: &Point3<f64>, mission: &Mission) {
+        let f = &mission.formation;
+        if f.slots.is_empty() || !f.uav_radius.is_finite() {
+            return;
+        }
+        // Every UAV within `reach` of the centroid: clear of everything by
+        // that much, every heading fits (the usual case, decided at once).
+        let reach = f.slots.iter().map(|o| o.xy().norm()).fold(0.0, f64::max);
+        let roomy = mission.bounds.horizontal_margin(p) >= reach
+            && mission
+                .obstacles
+                .iter()
+                .all(|o| mission.cylinder(o).clearance(p) >= reach + f.uav_radius);
+        if roomy {
+            return;
+        }
+        let misfit = |heading: f64| fit_at(mission, p, heading);
+        let headings: Vec<(f64, Misfit)> = (0..HEADINGS)
+            .map(|k| {
+                let degrees = 360.0 * k as f64 / HEADINGS as f64;
+                (degrees, misfit(degrees.to_radians()))
+            })
+            .collect();
+        let fitting = headings.iter().filter(|(_, m)| m.depth <= 0.0).count();
+        if fitting == headings.len() {
+            return;
+        }
+        let Some((best, worst)) = headings
+            .iter()
+            .min_by(|a, b| a.1.depth.total_cmp(&b.1.depth))
+            .map(|(h, m)| (*h, m.clone()))
+        else {
+            return;
+        };
+        if fitting == 0 {
+            self.error(
+                path,
                 format!(
-                    "{what} is {margin:.2} m from the edge of the bounds, less than the \
-                     formation radius r_F = {r_f:.2} m: UAVs may leave the bounds"
+                    "the formation does not fit at the {what} in any heading: even facing {best:.0}° \
+                     (from east, anticlockwise), UAV {} is {:.2} m {}",
+                    worst.uav + 1,
+                    worst.depth,
+                    worst.what
                 ),
             );
-        }
-        let safe = mission.formation.safe_radius();
-        for o in &mission.obstacles {
-            let clearance = o.cylinder().clearance(p);
-            if clearance < safe {
-                self.error(
-                    path.clone(),
-                    format!(
-                        "{what} is within the formation's safe radius of obstacle '{}': \
-                         clearance {clearance:.2} m < r_F + r_Q = {safe:.2} m",
-                        o.name
-                    ),
-                );
-            }
+        } else {
+            self.warning(
+                path,
+                format!(
+                    "the formation fits at the {what} only in {fitting} of {HEADINGS} headings (facing \
+                     {best:.0}° from east, anticlockwise, is one): the plan must leave that way"
+                ),
+            );
         }
     }
 
@@ -942,4 +978,63 @@ pub fn compact_digits(x: f64, digits: usize) -> String {
     } else {
         format!("{x:.digits$}")
     }
+}
+
+/// Headings the start and the goal are tried in, evenly round.
+const HEADINGS: usize = 72;
+
+/// How badly a formation fails to fit at one heading: the UAV that fails
+/// worst, by how much (metres; ≤ 0 when every UAV fits), and what it hits.
+#[derive(Debug, Clone)]
+struct Misfit {
+    uav: usize,
+    depth: f64,
+    what: String,
+}
+
+/// The nominal formation with its centroid at `p`, turned to `heading`
+/// (radians from east, anticlockwise): the worst UAV's distance outside the
+/// x-y bounds or inside r_Q of an obstacle.
+fn fit_at(mission: &Mission, p: &Point3<f64>, heading: f64) -> Misfit {
+    let f = &mission.formation;
+    let b = &mission.bounds;
+    let (sin, cos) = heading.sin_cos();
+    let mut worst = Misfit {
+        uav: 0,
+        depth: f64::NEG_INFINITY,
+        what: String::new(),
+    };
+    for (n, o) in f.slots.iter().enumerate() {
+        let q = Point3::new(
+            p.x + cos * o.x - sin * o.y,
+            p.y + sin * o.x + cos * o.y,
+            p.z + o.z,
+        );
+        let sides = [
+            (b.x[0] - q.x, "west of x min"),
+            (q.x - b.x[1], "east of x max"),
+            (b.y[0] - q.y, "south of y min"),
+            (q.y - b.y[1], "north of y max"),
+        ];
+        for (out, side) in sides {
+            if out > worst.depth {
+                worst = Misfit {
+                    uav: n,
+                    depth: out,
+                    what: format!("outside the bounds ({side})"),
+                };
+            }
+        }
+        for obstacle in &mission.obstacles {
+            let inside = f.uav_radius - mission.cylinder(obstacle).clearance(&q);
+            if inside > worst.depth {
+                worst = Misfit {
+                    uav: n,
+                    depth: inside,
+                    what: format!("inside r_Q of '{}'", obstacle.name),
+                };
+            }
+        }
+    }
+    worst
 }

@@ -174,8 +174,14 @@ impl Outcome {
 
     /// The multi-line summary `skyform run` prints.
     pub fn summary(&self) -> String {
+        self.summary_with(false)
+    }
+
+    /// The summary; `verbose` lists every unusable IWP instead of counting
+    /// them by reason.
+    pub fn summary_with(&self, verbose: bool) -> String {
         match self {
-            Outcome::ThetaPso(o) => summary::theta_pso(o),
+            Outcome::ThetaPso(o) => summary::theta_pso(o, verbose),
             Outcome::Flatlo(o) => summary::flatlo(o),
             Outcome::Fleet(o) => summary::fleet(o),
         }

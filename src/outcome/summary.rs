@@ -6,11 +6,22 @@ use crate::flatlo::FlatloOutcome;
 use crate::fleet::FleetOutcome;
 use crate::planner::ThetaPsoOutcome;
 
-/// The human summary of a θ-PSO outcome.
-pub fn theta_pso(o: &ThetaPsoOutcome) -> String {
+/// How many unusable IWPs the summary names (the nearest the route).
+const NAMED_UNUSABLE: usize = 3;
+
+/// The human summary of a θ-PSO outcome: the verdict and the first failing
+/// check first, then the run, the cost, the route and the IWPs (the unusable
+/// ones counted by reason and the few nearest the path named; all of them
+/// when `verbose`), the reconfigurations and the verification table.
+pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(s, "θ-PSO plan for \"{}\" (seed {})", o.mission, o.seed);
+    let verdict = match o.verification.first_failure() {
+        None => "FEASIBLE".to_owned(),
+        Some(why) => format!("INFEASIBLE: {why}"),
+    };
+    let _ = writeln!(s, "  result       {verdict}");
     let restarts = match o.restarts {
         0 => String::new(),
         n => format!(" ({n} restart(s): the best plan failed verification)"),
@@ -37,25 +48,28 @@ pub fn theta_pso(o: &ThetaPsoOutcome) -> String {
         o.duration,
         o.waypoints.len()
     );
-    let enabled = o.iwps.iter().filter(|i| i.enabled).count();
+    let source = match o.source {
+        crate::planner::PlanSource::Swarm => "the swarm's best",
+        crate::planner::PlanSource::Repaired => "the swarm's best, moved clear by the repair step",
+        crate::planner::PlanSource::Corridor => {
+            "the route stage's corridor (every run of the swarm failed)"
+        }
+    };
     let _ = writeln!(
         s,
-        "  IWPs         {} found, {enabled} enabled",
-        o.iwps.len()
+        "  route        corridor {:.1} m; the plan is {source}",
+        o.route_length
     );
-    for i in o.iwps.iter().filter(|i| i.enabled && i.unusable.is_some()) {
-        let _ = writeln!(
-            s,
-            "  IWP          '{}' | '{}' unusable: {}",
-            i.between[0],
-            i.between[1],
-            i.unusable.as_deref().unwrap_or_default()
-        );
-    }
+    iwps(&mut s, o, verbose);
     for r in &o.reconfigurations {
+        let why = if r.iwp.is_some() {
+            "at the IWP"
+        } else {
+            "squeezed"
+        };
         let _ = writeln!(
             s,
-            "  reconfig     {} between '{}' and '{}': t1 {:.1} s, t2 {:.1} s, t3 {:.1} s, t4 {:.1} s",
+            "  reconfig     {} {why} between '{}' and '{}': t1 {:.1} s, t2 {:.1} s, t3 {:.1} s, t4 {:.1} s",
             r.shape.name(),
             r.between[0],
             r.between[1],
@@ -100,13 +114,80 @@ pub fn theta_pso(o: &ThetaPsoOutcome) -> String {
             i.band[1]
         );
     }
-    let verdict = if o.feasible() {
-        "FEASIBLE"
-    } else {
-        "INFEASIBLE"
-    };
-    let _ = writeln!(s, "  result       {verdict}");
     s
+}
+
+/// The IWP lines of the θ-PSO summary.
+fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
+    use std::fmt::Write as _;
+    let enabled = o.iwps.iter().filter(|i| i.enabled).count();
+    let unusable: Vec<&crate::planner::Iwp> = o
+        .iwps
+        .iter()
+        .filter(|i| i.enabled && i.unusable.is_some())
+        .collect();
+    let _ = writeln!(
+        s,
+        "  IWPs         {} found, {enabled} enabled, {} usable, {} unusable, {} bypassed",
+        o.iwps.len(),
+        enabled - unusable.len(),
+        unusable.len(),
+        o.bypassed.len()
+    );
+    for &i in &o.bypassed {
+        if let Some(iwp) = o.iwps.get(i) {
+            let _ = writeln!(
+                s,
+                "  IWP          '{}' | '{}' not crossed: the plan goes round it",
+                iwp.between[0], iwp.between[1]
+            );
+        }
+    }
+    if verbose {
+        for i in &unusable {
+            let _ = writeln!(
+                s,
+                "  IWP          '{}' | '{}' unusable: {}",
+                i.between[0],
+                i.between[1],
+                i.unusable.as_deref().unwrap_or_default()
+            );
+        }
+        return;
+    }
+    for (reason, count) in crate::planner::iwp::unusable_by_reason(&o.iwps) {
+        let _ = writeln!(s, "  IWP          {count} unusable: {reason}");
+    }
+    if unusable.is_empty() {
+        return;
+    }
+    // The few nearest the path: those a user most likely meant the plan to take.
+    let distance = |i: &crate::planner::Iwp| {
+        o.centroid_path
+            .windows(2)
+            .map(|w| crate::geometry::segment_point_distance(&w[0].xy(), &w[1].xy(), &i.position))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut nearest: Vec<(f64, &crate::planner::Iwp)> =
+        unusable.iter().map(|i| (distance(i), *i)).collect();
+    nearest.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (d, i) in nearest.iter().take(NAMED_UNUSABLE) {
+        let _ = writeln!(
+            s,
+            "  IWP          '{}' | '{}' ({:.1} m from the path) unusable: {}",
+            i.between[0],
+            i.between[1],
+            d,
+            i.unusable.as_deref().unwrap_or_default()
+        );
+    }
+    if nearest.len() > NAMED_UNUSABLE {
+        let _ = writeln!(
+            s,
+            "  IWP          … and {} more (--verbose lists them all)",
+            nearest.len() - NAMED_UNUSABLE
+        );
+    }
 }
 
 /// The human summary of a FLATLO outcome.

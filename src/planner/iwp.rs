@@ -267,7 +267,11 @@ pub fn resolve_shape(
             if nominal_width <= gap + 2.0 * FIT_EPS {
                 return Ok(None);
             }
-            let mut candidates = if column_ok { vec![alignment] } else { Vec::new() };
+            let mut candidates = if column_ok {
+                vec![alignment]
+            } else {
+                Vec::new()
+            };
             let widest = slots.iter().map(|o| o.y.abs()).fold(0.0, f64::max);
             if widest > 0.0 {
                 let fit = (gap / 2.0 - r_q - margin.max(0.0)) / widest;

@@ -162,7 +162,9 @@ impl Problem {
     /// The swarm's objective for a particle, or a partial sum once it
     /// reaches `bound` (`CostModel::evaluate_below`).
     pub fn objective_below(&self, angles: &[f64], bound: f64) -> f64 {
-        self.cost.evaluate_below(&self.path(angles), bound).objective
+        self.cost
+            .evaluate_below(&self.path(angles), bound)
+            .objective
     }
 }
 
@@ -335,7 +337,8 @@ impl Attempt {
         source: PlanSource,
     ) -> Result<Self, PipelineError> {
         let speed = mission.formation.ground_speed;
-        let path = problem.path(&position);
+        let mut path = problem.path(&position);
+        problem.builder.name_squeezes(&mut path);
         let cost = problem.cost.terms(&path);
         // The budget checked the straight distance; the planned path is longer.
         let samples = trajectory_samples(cost.length / speed, mission.formation.slots.len());
@@ -432,8 +435,13 @@ pub fn plan(
     let mut problem = Problem::new(mission).map_err(|(_, e)| PipelineError::InvalidMission(e))?;
     log_iwps(observer, &problem.iwps);
     observer.on_event(Event::Stage("route"));
-    let corridor = route::find(mission, &problem.builder, &problem.iwps, problem.cost.margin())
-        .map_err(|blocked| PipelineError::NoRoute(blocked.reason))?;
+    let corridor = route::find(
+        mission,
+        &problem.builder,
+        &problem.iwps,
+        problem.cost.margin(),
+    )
+    .map_err(|blocked| PipelineError::NoRoute(blocked.reason))?;
     problem.follow(mission, &corridor);
     observer.on_event(Event::Log(
         Level::Info,
@@ -522,7 +530,13 @@ pub fn plan(
     {
         let position = repair::repair(mission, &problem, start).unwrap_or_else(|| start.clone());
         let convergence = k.convergence.clone();
-        let fallback = Attempt::new(mission, &problem, position, convergence, PlanSource::Corridor)?;
+        let fallback = Attempt::new(
+            mission,
+            &problem,
+            position,
+            convergence,
+            PlanSource::Corridor,
+        )?;
         if fallback.verification.feasible {
             observer.on_event(Event::Log(
                 Level::Warn,

@@ -95,9 +95,10 @@ impl<'a> Motion<'a> {
     /// being `frame`.
     pub fn place(&self, n: usize, s: f64, frame: &Frame, state: ShapeState) -> Point3<f64> {
         let column = |shape: Option<Shape>| match shape {
-            Some(Shape::Alignment { spacing }) => {
-                Some(self.walker.at_extended(s + column_place(self.slots, n, spacing)))
-            }
+            Some(Shape::Alignment { spacing }) => Some(
+                self.walker
+                    .at_extended(s + column_place(self.slots, n, spacing)),
+            ),
             _ => None,
         };
         match (column(state.from), column(state.to)) {

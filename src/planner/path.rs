@@ -209,13 +209,18 @@ pub fn schedule(mut zones: Vec<Zone>, slots: &[Vector3<f64>], r_q: f64) -> Vec<Z
         if width(&next.shape) < width(&zone.shape) {
             zone.shape = next.shape;
         }
-        zone.hold = [zone.hold[0].min(next.hold[0]), zone.hold[1].max(next.hold[1])];
+        zone.hold = [
+            zone.hold[0].min(next.hold[0]),
+            zone.hold[1].max(next.hold[1]),
+        ];
         zone.transition_out = next.transition_out;
         zone.into = next.into;
         for cause in next.causes {
             // One squeezed region entered twice is one cause.
             let same = |c: &ZoneCause| match (c, &cause) {
-                (ZoneCause::Squeeze { region: a, .. }, ZoneCause::Squeeze { region: b, .. }) => a == b,
+                (ZoneCause::Squeeze { region: a, .. }, ZoneCause::Squeeze { region: b, .. }) => {
+                    a == b
+                }
                 (a, b) => a == b,
             };
             if !zone.causes.iter().any(same) {
@@ -437,6 +442,11 @@ impl PathBuilder {
             .collect()
     }
 
+    /// The IWP (index into the problem's IWPs) of each crossing.
+    pub fn crossing_iwps(&self) -> Vec<usize> {
+        self.crossings.iter().map(|c| c.iwp).collect()
+    }
+
     /// Inspected obstacles, in the order their pass angles follow the
     /// waypoints in a particle: (index in `mission.obstacles`, axis).
     pub fn inspections(&self) -> Vec<(usize, Point2<f64>)> {
@@ -566,7 +576,8 @@ impl PathBuilder {
         let mut passes = Vec::new();
         let height = |s: f64| {
             let u = s / total;
-            (self.start.z + (self.goal.z - self.start.z) * u).clamp(self.bounds[2][0], self.bounds[2][1])
+            (self.start.z + (self.goal.z - self.start.z) * u)
+                .clamp(self.bounds[2][0], self.bounds[2][1])
         };
         points.push(self.start);
         for (k, leg) in corridor.legs.iter().enumerate() {
@@ -647,7 +658,8 @@ impl PathBuilder {
             })
             .collect();
         if let Some(map) = &self.squeeze {
-            zones.extend(self.squeeze_zones(map, &points, &arcs));
+            let squeezes = self.squeeze_zones(map, &points, &arcs, &zones);
+            zones.extend(squeezes);
         }
         let zones = if zones.len() > 1 {
             schedule(zones, &self.slots, self.uav_radius)
@@ -670,21 +682,44 @@ impl PathBuilder {
             points,
             zones,
             passes,
-            crossed: crossings.iter().map(|&(i, _)| self.crossings[i].iwp).collect(),
+            crossed: crossings
+                .iter()
+                .map(|&(i, _)| self.crossings[i].iwp)
+                .collect(),
+        }
+    }
+
+    /// Names the obstacles each squeezed stretch of `path` passes between
+    /// (where it is narrowest: in its middle), for the plan as reported.
+    pub fn name_squeezes(&self, path: &mut CentroidPath) {
+        let Some(map) = &self.squeeze else { return };
+        let walker = ArcWalker::new(&path.points);
+        for zone in &mut path.zones {
+            let middle = (zone.hold[0] + zone.hold[1]) / 2.0;
+            for cause in &mut zone.causes {
+                if let ZoneCause::Squeeze { pair, .. } = cause {
+                    *pair = map.sides(walker.at(middle).xy(), walker.heading(middle, 1.0).xy());
+                }
+            }
         }
     }
 
     /// A zone for each stretch of the path inside a squeezed region of the
     /// route stage: the shrink at the region's scale, held from
     /// `hold_distance` before the region to `hold_distance` after it.
+    ///
+    /// A stretch within an IWP's zone ([t1, t4]) is that IWP's: its shape
+    /// was chosen (by the operator or as the least change) and checked for
+    /// that gap, so the squeeze does not override it.
     fn squeeze_zones(
         &self,
         map: &super::route::SqueezeMap,
         points: &[Point3<f64>],
         arcs: &[f64],
+        crossings: &[Zone],
     ) -> Vec<Zone> {
         let total = arcs.last().copied().unwrap_or(0.0);
-        let step = map.resolution() / 2.0;
+        let step = map.resolution();
         // (region, shape, first s, last s)
         let mut runs: Vec<(u16, Shape, f64, f64)> = Vec::new();
         let mut current: Option<(u16, Shape, f64, f64)> = None;
@@ -707,16 +742,21 @@ impl PathBuilder {
             }
         }
         runs.extend(current);
+        let within_a_crossing = |first: f64, last: f64| {
+            crossings.iter().any(|z| {
+                let [t1, _, _, t4] = z.arcs();
+                t1 <= first && last <= t4
+            })
+        };
         runs.into_iter()
+            .filter(|&(_, _, first, last)| !within_a_crossing(first, last))
             .map(|(region, shape, first, last)| {
                 // A column is complete before its first UAV enters and held
                 // until its last has left.
                 let half = match shape {
-                    Shape::Alignment { spacing } => {
-                        (0..self.slots.len())
-                            .map(|n| super::iwp::column_place(&self.slots, n, spacing).abs())
-                            .fold(0.0, f64::max)
-                    }
+                    Shape::Alignment { spacing } => (0..self.slots.len())
+                        .map(|n| super::iwp::column_place(&self.slots, n, spacing).abs())
+                        .fold(0.0, f64::max),
                     _ => 0.0,
                 };
                 let hold = [
@@ -724,13 +764,12 @@ impl PathBuilder {
                     (last + self.hold_distance + half).min(total),
                 ];
                 let middle = (first + last) / 2.0;
-                let walker = ArcWalker::new(points);
-                let at = walker.at(middle).xy();
-                let along = walker.heading(middle, 1.0).xy();
                 Zone {
+                    // Named only for the plan kept (`name_squeezes`): the
+                    // swarm does not need the names.
                     causes: vec![ZoneCause::Squeeze {
                         region,
-                        pair: map.sides(at, along),
+                        pair: [usize::MAX; 2],
                     }],
                     shape,
                     arc: middle,

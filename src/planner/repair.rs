@@ -127,6 +127,10 @@ fn closest_on(walker: &ArcWalker<'_>, p: Point3<f64>) -> Point3<f64> {
     let steps = (length.ceil() as usize).max(1);
     (0..=steps)
         .map(|k| walker.at(length * k as f64 / steps as f64))
-        .min_by(|a, b| (a.xy() - p.xy()).norm().total_cmp(&(b.xy() - p.xy()).norm()))
+        .min_by(|a, b| {
+            (a.xy() - p.xy())
+                .norm()
+                .total_cmp(&(b.xy() - p.xy()).norm())
+        })
         .unwrap_or(p)
 }

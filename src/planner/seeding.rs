@@ -20,7 +20,7 @@ use rand::rngs::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
 use super::Problem;
-use super::route::Corridor;
+use super::route::{Corridor, Leg};
 use crate::mission::Mission;
 
 /// Most free waypoints a particle gets to follow a corridor with many corners.
@@ -82,7 +82,14 @@ fn waypoints(problem: &Problem, corridor: &Corridor) -> (Vec<Point3<f64>>, Vec<f
         .take(corridor.points.len().saturating_sub(2))
         .copied()
         .collect();
-    let chosen = fit_corners(start.xy(), goal.xy(), inner, builder.free_waypoints());
+    // Only free legs take extra points: the builder flies crossings and
+    // passes straight, a point inside one would send the path back over it.
+    let free: Vec<bool> = corridor
+        .legs
+        .iter()
+        .map(|leg| matches!(leg, Leg::Free { .. }))
+        .collect();
+    let chosen = fit_corners(start.xy(), goal.xy(), inner, free, builder.free_waypoints());
     let total = chosen.len() + 1;
     let waypoints = chosen
         .iter()
@@ -100,13 +107,16 @@ fn waypoints(problem: &Problem, corridor: &Corridor) -> (Vec<Point3<f64>>, Vec<f
 /// Exactly `count` points from the route's corners: the corners that turn
 /// the route most when there are too many (each removal is the corner whose
 /// triangle with its neighbours has the least area), extra points halving the
-/// longest legs when there are too few.
+/// longest free legs when there are too few (`free[i]`: leg `i`, from corner
+/// `i - 1` or the start to corner `i` or the goal, may be split).
 fn fit_corners(
     start: Point2<f64>,
     goal: Point2<f64>,
     mut corners: Vec<Point2<f64>>,
+    mut free: Vec<bool>,
     count: usize,
 ) -> Vec<Point2<f64>> {
+    free.resize(corners.len() + 1, true);
     let at = |corners: &[Point2<f64>], i: isize| -> Point2<f64> {
         if i < 0 {
             start
@@ -129,22 +139,25 @@ fn fit_corners(
             .min_by(|p, q| p.1.total_cmp(&q.1))
             .map_or(0, |(i, _)| i);
         corners.remove(weakest);
+        // The two legs round it become one, free when either was.
+        let merged = free[weakest] || free[weakest + 1];
+        free.remove(weakest + 1);
+        free[weakest] = merged;
     }
     while corners.len() < count {
+        let length = |i: usize| (at(&corners, i as isize) - at(&corners, i as isize - 1)).norm();
         let longest = (0..=corners.len())
-            .map(|i| {
-                (
-                    i,
-                    (at(&corners, i as isize) - at(&corners, i as isize - 1)).norm(),
-                )
-            })
-            .max_by(|p, q| p.1.total_cmp(&q.1))
-            .map_or(0, |(i, _)| i);
+            .filter(|&i| free[i])
+            .max_by(|p, q| length(*p).total_cmp(&length(*q)))
+            .or_else(|| (0..=corners.len()).max_by(|p, q| length(*p).total_cmp(&length(*q))))
+            .unwrap_or(0);
         let mid = nalgebra::center(
             &at(&corners, longest as isize - 1),
             &at(&corners, longest as isize),
         );
         corners.insert(longest, mid);
+        let was = free[longest];
+        free.insert(longest, was);
     }
     corners
 }
@@ -161,13 +174,26 @@ mod tests {
             Point2::new(5.0, 5.0),
             Point2::new(8.0, 0.1),
         ];
+        let all = vec![true; 4];
         assert_eq!(
-            fit_corners(s, g, corners.clone(), 1),
+            fit_corners(s, g, corners.clone(), all.clone(), 1),
             vec![Point2::new(5.0, 5.0)]
         );
-        let four = fit_corners(s, g, vec![Point2::new(5.0, 5.0)], 3);
+        let four = fit_corners(s, g, vec![Point2::new(5.0, 5.0)], all.clone(), 3);
         assert_eq!(four.len(), 3);
         assert!(four.contains(&Point2::new(5.0, 5.0)));
-        assert_eq!(fit_corners(s, g, corners.clone(), 3), corners);
+        assert_eq!(fit_corners(s, g, corners.clone(), all, 3), corners);
+    }
+
+    #[test]
+    fn a_crossing_leg_is_never_split() {
+        // start → A, A → B a long crossing, B → goal: the extra points go on
+        // the short free legs, never between A and B.
+        let (s, g) = (Point2::new(0.0, 0.0), Point2::new(30.0, 0.0));
+        let (a, b) = (Point2::new(5.0, 0.0), Point2::new(25.0, 0.0));
+        let fitted = fit_corners(s, g, vec![a, b], vec![true, false, true], 4);
+        assert_eq!(fitted.len(), 4);
+        let between = fitted.iter().filter(|p| p.x > 5.0 && p.x < 25.0).count();
+        assert_eq!(between, 0, "{fitted:?}");
     }
 }

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::iwp::Iwp;
 use super::motion::Motion;
-use super::path::{CentroidPath, ZoneCause};
+use super::path::{CentroidPath, Zone, ZoneCause};
 use crate::mission::Formation;
 
 /// One sample of a UAV's trajectory. Seconds, metres ENU, m/s.
@@ -91,14 +91,29 @@ pub fn generate(
         .collect();
 
     let name = |k: usize| names.get(k).cloned().unwrap_or_default();
+    // One reconfiguration per IWP a zone crosses; a zone that crosses none
+    // is one squeezed stretch (the first of its causes names it).
+    let reported = |z: &'_ Zone| -> Vec<ZoneCause> {
+        let crossings: Vec<ZoneCause> = z
+            .causes
+            .iter()
+            .filter(|c| matches!(c, ZoneCause::Iwp { .. }))
+            .copied()
+            .collect();
+        if crossings.is_empty() {
+            z.causes.first().copied().into_iter().collect()
+        } else {
+            crossings
+        }
+    };
     let reconfigurations = path
         .zones
         .iter()
-        .flat_map(|z| z.causes.iter().map(move |cause| (z, cause)))
+        .flat_map(|z| reported(z).into_iter().map(move |cause| (z, cause)))
         .map(|(z, cause)| {
             let [a1, a2, a3, a4] = z.arcs();
             let at = |s: f64| (s / speed).clamp(0.0, duration);
-            let (iwp, between) = match *cause {
+            let (iwp, between) = match cause {
                 ZoneCause::Iwp { iwp, pair } => (
                     Some(iwp),
                     iwps.get(iwp)
@@ -107,7 +122,7 @@ pub fn generate(
                 ),
                 ZoneCause::Squeeze { pair, .. } => (None, [name(pair[0]), name(pair[1])]),
             };
-            let arc = match *cause {
+            let arc = match cause {
                 ZoneCause::Iwp { .. } => z.arc,
                 ZoneCause::Squeeze { .. } => (a2 + a3) / 2.0,
             };

@@ -53,7 +53,13 @@ pub fn slots(index: usize) -> Vec<Vector3<f64>> {
     };
     let line = |n: usize, spacing: f64| -> Vec<Vector3<f64>> {
         (0..n)
-            .map(|i| Vector3::new(0.0, (n as f64 - 1.0) / 2.0 * spacing - i as f64 * spacing, 0.0))
+            .map(|i| {
+                Vector3::new(
+                    0.0,
+                    (n as f64 - 1.0) / 2.0 * spacing - i as f64 * spacing,
+                    0.0,
+                )
+            })
             .collect()
     };
     let vee = |n: usize, spacing: f64| -> Vec<Vector3<f64>> {
@@ -61,7 +67,11 @@ pub fn slots(index: usize) -> Vec<Vector3<f64>> {
         for i in 1..n {
             let k = i.div_ceil(2) as f64;
             let side = if i % 2 == 1 { 1.0 } else { -1.0 };
-            s.push(Vector3::new(-k * spacing * 0.8, side * k * spacing * 0.6, 0.0));
+            s.push(Vector3::new(
+                -k * spacing * 0.8,
+                side * k * spacing * 0.6,
+                0.0,
+            ));
         }
         centred(s)
     };
@@ -205,7 +215,8 @@ pub fn generated(index: u64) -> Site {
             rng.random_range((2.0 * safe + 0.3)..(2.0 * safe + 3.0))
         };
         gaps.push((origin + along * gap_at, Vector2::new(along.y, -along.x)));
-        let inside = |p: &Point2<f64>| (0.0..=length).contains(&p.x) && (0.0..=width).contains(&p.y);
+        let inside =
+            |p: &Point2<f64>| (0.0..=length).contains(&p.x) && (0.0..=width).contains(&p.y);
         for side in [1.0, -1.0] {
             let mut edge = gap_at + side * gap / 2.0;
             loop {
@@ -302,10 +313,8 @@ pub fn generated(index: u64) -> Site {
             };
             (o.center - c).norm() > need
         });
-        let inside = c.x - room > 0.0
-            && c.x + room < length
-            && c.y - room > 0.0
-            && c.y + room < width;
+        let inside =
+            c.x - room > 0.0 && c.x + room < length && c.y - room > 0.0 && c.y + room < width;
         let ok = clear_of_others
             && off_corridor(&c, room)
             && (!inspect || inside)

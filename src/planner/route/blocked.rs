@@ -11,6 +11,7 @@
 
 use nalgebra::Point2;
 
+use super::Stop;
 use super::field::{Disc, Field};
 use super::search::Reached;
 use crate::mission::Mission;
@@ -28,18 +29,26 @@ pub fn explain(
     field: &Field,
     obstacles: &[(usize, Disc)],
     reached: &Reached,
-    order: &[usize],
+    order: &[super::Stop],
     builder: &PathBuilder,
     need: f64,
     squeezed_reach: f64,
 ) -> super::Blocked {
     let top = reached.stage.iter().flatten().copied().max().unwrap_or(0);
     // Where the search got stuck: the inspection it could not fly, or the goal.
-    let stuck = if top < order.len() {
-        let (k, _) = builder.inspections()[order[top]];
-        format!(" to the inspection of '{}'", mission.obstacles[k].name)
-    } else {
-        String::new()
+    let stuck = match order.get(top) {
+        Some(Stop::Pass(i)) => {
+            let (k, _) = builder.inspections()[*i];
+            format!(" to the inspection of '{}'", mission.obstacles[k].name)
+        }
+        Some(Stop::Crossing(c)) => {
+            let iwp = &iwps[builder.crossing_iwps()[*c]];
+            format!(
+                " through the IWP asked for between '{}' and '{}'",
+                iwp.between[0], iwp.between[1]
+            )
+        }
+        None => String::new(),
     };
     let region = |i: usize| reached.stage[i] == Some(top);
     // Obstacles (indices into `obstacles`) bordering the reached region.
@@ -93,7 +102,10 @@ pub fn explain(
         let r = root(&mut parent, i);
         weight[r] += w;
     }
-    let Some(chain) = (0..n + 4).filter(|&r| weight[r] > 0).max_by_key(|&r| weight[r]) else {
+    let Some(chain) = (0..n + 4)
+        .filter(|&r| weight[r] > 0)
+        .max_by_key(|&r| weight[r])
+    else {
         return super::Blocked {
             reason: format!(
                 "no corridor from start to goal{stuck}: the formation has no room to move \
@@ -113,8 +125,18 @@ pub fn explain(
     let (first, last) = extremes(&members, obstacles);
     let span = if members.len() == 1 {
         name(first)
+    } else if sides.is_empty() {
+        // A ring has no ends: name its first few members instead.
+        let few: Vec<String> = members.iter().take(3).map(|&i| name(i)).collect();
+        let more = if members.len() > 3 { ", …" } else { "" };
+        format!("{} obstacles ({}{more})", members.len(), few.join(", "))
     } else {
-        format!("{} obstacles from {} to {}", members.len(), name(first), name(last))
+        format!(
+            "{} obstacles from {} to {}",
+            members.len(),
+            name(first),
+            name(last)
+        )
     };
     let start_inside = region(field.index_of(mission.route.start.xy()));
     let place = match sides.as_slice() {
@@ -123,7 +145,8 @@ pub fn explain(
         [one] => format!("against the {one} bound"),
         many => format!(
             "between the {} bounds",
-            many.join(" and ").replacen(" and ", ", ", many.len().saturating_sub(2))
+            many.join(" and ")
+                .replacen(" and ", ", ", many.len().saturating_sub(2))
         ),
     };
 
@@ -140,9 +163,10 @@ pub fn explain(
         let (p, q) = (obstacles[i].0, obstacles[j].0);
         let why = if gap < 2.0 * r_q {
             format!("narrower than one UAV (2 r_Q = {:.2} m)", 2.0 * r_q)
-        } else if let Some(iwp) = iwps.iter().find(|w| {
-            (w.obstacles == [p, q]) || (w.obstacles == [q, p])
-        }) {
+        } else if let Some(iwp) = iwps
+            .iter()
+            .find(|w| (w.obstacles == [p, q]) || (w.obstacles == [q, p]))
+        {
             match (&iwp.unusable, iwp.enabled) {
                 (_, false) => "its IWP is disabled".to_owned(),
                 (Some(reason), _) => format!("its IWP is unusable: {reason}"),
@@ -163,7 +187,9 @@ pub fn explain(
         )
     });
     super::Blocked {
-        reason: format!("no corridor from start to goal{stuck}: {span} close the way {place}{gap_text}"),
+        reason: format!(
+            "no corridor from start to goal{stuck}: {span} close the way {place}{gap_text}"
+        ),
         obstacles: members.iter().map(|&i| obstacles[i].0).collect(),
     }
 }

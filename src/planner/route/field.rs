@@ -147,10 +147,12 @@ impl Field {
     /// The eight neighbours of cell `i` with the length of the step there.
     pub fn steps(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let diagonal = self.cell * std::f64::consts::SQRT_2;
-        self.neighbourhood(i).filter(move |&j| j != i).map(move |j| {
-            let straight = j % self.nx == i % self.nx || j / self.nx == i / self.nx;
-            (j, if straight { self.cell } else { diagonal })
-        })
+        self.neighbourhood(i)
+            .filter(move |&j| j != i)
+            .map(move |j| {
+                let straight = j % self.nx == i % self.nx || j / self.nx == i / self.nx;
+                (j, if straight { self.cell } else { diagonal })
+            })
     }
 
     /// The cells a segment passes, sampled at a third of a cell.
@@ -186,8 +188,11 @@ mod tests {
         let f = Field::new([[0.0, 10.0], [0.0, 10.0]], &discs, 0.5, 3.0);
         let at = |x: f64, y: f64| f.clearance(f.index_of(Point2::new(x, y)));
         assert!((at(5.25, 5.25) - (0.25f64.hypot(0.25) - 1.0)).abs() < 1e-6);
-        assert!((at(6.75, 5.25) - (1.25f64.hypot(0.25) - 0.5)).abs() < 1e-6, "nearer the small one");
-        assert_eq!(f.nearest_disc(f.index_of(Point2::new(6.75, 5.25))), Some(1));
+        assert!(
+            (at(7.25, 5.25) - (0.75f64.hypot(0.25) - 0.5)).abs() < 1e-6,
+            "nearer the small one"
+        );
+        assert_eq!(f.nearest_disc(f.index_of(Point2::new(7.25, 5.25))), Some(1));
         assert_eq!(at(0.25, 9.75), 3.0, "capped far away");
         assert_eq!(f.nearest_disc(f.index_of(Point2::new(0.25, 9.75))), None);
     }

@@ -120,7 +120,10 @@ impl SqueezeMap {
             let mut d = 0.0;
             while d <= 50.0 {
                 let i = self.field.index_of(p + left * sign * d);
-                if let Some(&(k, center)) = self.field.nearest_disc(i).and_then(|k| self.obstacle_of.get(k))
+                if let Some(&(k, center)) = self
+                    .field
+                    .nearest_disc(i)
+                    .and_then(|k| self.obstacle_of.get(k))
                     && (center - p).dot(&left) * sign > 0.0
                 {
                     return Some(k);
@@ -271,8 +274,20 @@ pub fn find(
         }
     }
 
-    // The crossings and the passes as jumps.
+    // The stops, in order along start → goal: every inspection pass, and
+    // every crossing the user asked for by name (a `[[reconfiguration.
+    // waypoints]]` entry): the route must take those; the others it may.
     let crossings = builder.crossings();
+    let requested: Vec<bool> = builder
+        .crossing_iwps()
+        .iter()
+        .map(|&i| {
+            let [a, b] = &iwps[i].between;
+            mission.reconfiguration.choice(a, b).is_some()
+        })
+        .collect();
+    let order = stop_order(builder, &crossings, &requested, start, goal);
+    let stage_of_crossing = |c: usize| order.iter().position(|s| *s == Stop::Crossing(c));
     let mut jumps = Vec::new();
     for (c, [a, z]) in crossings.iter().enumerate() {
         for (direction, (from, to)) in [(*a, *z), (*z, *a)].into_iter().enumerate() {
@@ -280,14 +295,15 @@ pub fn find(
                 from: field.index_of(from),
                 to: field.index_of(to),
                 length: (to - from).norm(),
-                pass_at: None,
+                pass_at: stage_of_crossing(c),
+                crossing: true,
                 tag: 2 * c + direction,
             });
         }
     }
-    let order = pass_order(builder, start, goal);
     let mut candidates: Vec<(usize, f64, bool, [Point2<f64>; 2])> = Vec::new();
-    for (stage, &i) in order.iter().enumerate() {
+    for (stage, stop) in order.iter().enumerate() {
+        let Stop::Pass(i) = *stop else { continue };
         let (k, _) = builder.inspections()[i];
         for j in 0..PASS_ANGLES {
             let phi = TAU * j as f64 / PASS_ANGLES as f64 - PI;
@@ -306,6 +322,7 @@ pub fn find(
                         to: field.index_of(ends[1]),
                         length: (ends[1] - ends[0]).norm(),
                         pass_at: Some(stage),
+                        crossing: false,
                         tag: 2 * crossings.len() + candidates.len(),
                     });
                     candidates.push((i, phi, on_left, ends));
@@ -319,7 +336,10 @@ pub fn find(
         open: &open,
         jumps: &jumps,
         stages: order.len(),
-        switch_cost: mission.reconfiguration.transition_distance.max(field.cell()),
+        switch_cost: mission
+            .reconfiguration
+            .transition_distance
+            .max(field.cell()),
     };
     let (s, g) = (field.index_of(start), field.index_of(goal));
     let steps = match search::search(&graph, s, g) {
@@ -334,8 +354,16 @@ pub fn find(
                 &order,
                 builder,
                 // The narrowest layer's: what nothing at all fits through.
-                if shape.column.is_some() { need[2] } else { need[1] },
-                if shape.column.is_some() { 0.0 } else { shape.smallest * shape.reach },
+                if shape.column.is_some() {
+                    need[2]
+                } else {
+                    need[1]
+                },
+                if shape.column.is_some() {
+                    0.0
+                } else {
+                    shape.smallest * shape.reach
+                },
             ));
         }
     };
@@ -350,12 +378,11 @@ pub fn find(
         &candidates,
         builder.inspections().len(),
     );
-    corridor.squeeze = squeeze_map(&field, &open, &corridor, &shape, mission, &discs).map(
-        |mut map| {
+    corridor.squeeze =
+        squeeze_map(&field, &open, &corridor, &shape, mission, &discs).map(|mut map| {
             map.obstacle_of = obstacles.iter().map(|(k, d)| (*k, d.center)).collect();
             Arc::new(map)
-        },
-    );
+        });
     Ok(corridor)
 }
 
@@ -365,17 +392,41 @@ fn dx_dy(builder: &PathBuilder) -> [[f64; 2]; 2] {
     [x, y]
 }
 
-/// The inspections (builder indices) in the order they lie along start → goal.
-fn pass_order(builder: &PathBuilder, start: Point2<f64>, goal: Point2<f64>) -> Vec<usize> {
+/// A stop the route must make, in order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stop {
+    /// Inspection `i` of the path builder.
+    Pass(usize),
+    /// Crossing `c` of the path builder (a requested IWP).
+    Crossing(usize),
+}
+
+/// The inspections and the requested crossings (builder indices) in the
+/// order they lie along start → goal.
+fn stop_order(
+    builder: &PathBuilder,
+    crossings: &[[Point2<f64>; 2]],
+    requested: &[bool],
+    start: Point2<f64>,
+    goal: Point2<f64>,
+) -> Vec<Stop> {
     let axis = goal - start;
-    let mut order: Vec<(usize, f64)> = builder
+    let along = |p: Point2<f64>| (p - start).dot(&axis);
+    let mut order: Vec<(Stop, f64)> = builder
         .inspections()
         .iter()
         .enumerate()
-        .map(|(i, (_, c))| (i, (c - start).dot(&axis)))
+        .map(|(i, (_, c))| (Stop::Pass(i), along(*c)))
+        .chain(
+            crossings
+                .iter()
+                .enumerate()
+                .filter(|(c, _)| requested[*c])
+                .map(|(c, [a, z])| (Stop::Crossing(c), along(nalgebra::center(a, z)))),
+        )
         .collect();
     order.sort_by(|a, b| a.1.total_cmp(&b.1));
-    order.into_iter().map(|(i, _)| i).collect()
+    order.into_iter().map(|(s, _)| s).collect()
 }
 
 fn shrink([lo, hi]: [f64; 2], by: f64) -> [f64; 2] {
@@ -533,7 +584,9 @@ fn squeeze_map(
             if let FormationShape::Shrink { scale } = &mut shapes[r] {
                 let fits = shape.scale_for(
                     field.clearance_at(p, discs),
-                    mission.bounds.horizontal_margin(&nalgebra::Point3::new(p.x, p.y, 0.0)),
+                    mission
+                        .bounds
+                        .horizontal_margin(&nalgebra::Point3::new(p.x, p.y, 0.0)),
                 );
                 *scale = scale.min(fits);
             }
@@ -548,7 +601,13 @@ fn squeeze_map(
 }
 
 /// Labels the connected narrow cells round `seed` with `label`.
-fn flood(field: &Field, region: &mut [u16], seed: usize, label: u16, narrow: &dyn Fn(usize) -> bool) {
+fn flood(
+    field: &Field,
+    region: &mut [u16],
+    seed: usize,
+    label: u16,
+    narrow: &dyn Fn(usize) -> bool,
+) {
     let mut stack = vec![seed];
     region[seed] = label;
     while let Some(i) = stack.pop() {

@@ -25,8 +25,11 @@ pub struct Jump {
     pub from: usize,
     pub to: usize,
     pub length: f64,
-    /// `Some(stage)`: a pass taken at that stage, to the next one.
+    /// `Some(stage)`: a stop of the route (a pass, or a crossing the user
+    /// asked for) taken at that stage, to the next one.
     pub pass_at: Option<usize>,
+    /// A crossing: flown in the layer it is entered in (a pass: nominal).
+    pub crossing: bool,
     /// Index of the crossing or of the pass candidate, for the caller.
     pub tag: usize,
 }
@@ -37,7 +40,8 @@ pub struct Graph<'a> {
     /// Per cell, one bit per layer it may be entered in.
     pub open: &'a [u8],
     pub jumps: &'a [Jump],
-    /// Inspection passes to fly, in order: the stages are 0..=passes.
+    /// Stops to make, in order (passes, requested crossings): the stages
+    /// are 0..=stops.
     pub stages: usize,
     /// Cost of changing layer, metres (a transition flown).
     pub switch_cost: f64,
@@ -49,7 +53,11 @@ pub enum Step {
     /// Moved to a neighbouring cell (or started there), in a layer.
     Cell { cell: usize, layer: usize },
     /// Took jump `tag` (a crossing or a pass) ending at `cell`.
-    Jump { cell: usize, tag: usize, layer: usize },
+    Jump {
+        cell: usize,
+        tag: usize,
+        layer: usize,
+    },
 }
 
 /// The cells reached by the search, for explaining a failure.
@@ -127,30 +135,34 @@ pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>,
         if let Some(list) = index.get(&cell) {
             for &j in list {
                 let jump = &graph.jumps[j];
-                match jump.pass_at {
-                    Some(at) if at == stage && layer == 0 => relax(
-                        state(jump.to, 0, stage + 1),
-                        g + jump.length,
-                        j as u32,
-                        &mut open,
-                    ),
-                    Some(_) => {}
-                    None => {
-                        // Out of a crossing in the widest layer the far
-                        // side allows, no wider than the one it came in.
-                        let Some(arrive) =
-                            (layer..layers).find(|&l| graph.open[jump.to] & bit(l) != 0)
-                        else {
-                            continue;
-                        };
+                let next_stage = match jump.pass_at {
+                    None => stage,
+                    Some(at) if at == stage => stage + 1,
+                    Some(_) => continue,
+                };
+                if !jump.crossing {
+                    if layer == 0 {
                         relax(
-                            state(jump.to, arrive, stage),
+                            state(jump.to, 0, next_stage),
                             g + jump.length,
                             j as u32,
                             &mut open,
                         );
                     }
+                    continue;
                 }
+                // Out of a crossing in the widest layer the far side
+                // allows, no wider than the one it came in.
+                let Some(arrive) = (layer..layers).find(|&l| graph.open[jump.to] & bit(l) != 0)
+                else {
+                    continue;
+                };
+                relax(
+                    state(jump.to, arrive, next_stage),
+                    g + jump.length,
+                    j as u32,
+                    &mut open,
+                );
             }
         }
     }
