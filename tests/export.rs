@@ -539,6 +539,42 @@ fn without_an_origin_csv_works_in_enu_and_geodetic_formats_say_to_add_it() {
     );
 }
 
+/// Issue 24, item 9: under umask 022 every exported file is 0644, as the
+/// mission, the JSON and the sweep CSV are (not the 0600 of a private
+/// temporary file): a ground station running as another user reads them.
+#[cfg(unix)]
+#[test]
+fn exported_files_honour_the_umask_like_any_file() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempdir();
+    let out = dir.path().join("out");
+    let script = format!(
+        "umask 022 && exec '{}' export missions/narrow-passage.toml --format plan \
+         --format wpl --format csv --out '{}'",
+        env!("CARGO_BIN_EXE_skyform"),
+        out.display()
+    );
+    let run = std::process::Command::new("sh")
+        .args(["-c", &script])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    let files: Vec<PathBuf> = std::fs::read_dir(&out)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .map(|e| e.map(|e| e.path()).unwrap_or_else(|e| panic!("{e}")))
+        .collect();
+    assert!(files.len() >= 3, "{files:?}");
+    for f in &files {
+        let mode = std::fs::metadata(f)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .permissions()
+            .mode()
+            & 0o777;
+        assert_eq!(mode, 0o644, "{} is {mode:o}", f.display());
+    }
+}
+
 // ------------------------------------------------ independent readers
 
 /// The expectation files of `tests/export_readers` for every exported

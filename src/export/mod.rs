@@ -18,7 +18,6 @@ pub mod reverify;
 pub mod simplify;
 pub mod wpl;
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use nalgebra::Point3;
@@ -427,22 +426,14 @@ pub fn export(
     })
 }
 
-/// Writes a temporary file in the same directory, syncs it, then renames it
-/// over `path`: a reader never sees half a file.
+/// Writes atomically (`mission::write_atomically`: a synced temporary file
+/// renamed over `path`, so a reader never sees half a file), with the
+/// permissions of any file the user creates.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
-    let io = |source| ExportError::Io {
+    crate::mission::write_atomically(path, bytes).map_err(|source| ExportError::Io {
         path: path.to_owned(),
         source,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
-        _ => PathBuf::from("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(&dir).map_err(io)?;
-    tmp.write_all(bytes).map_err(io)?;
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    })
 }
 
 /// One mission item, as `.plan` and `.waypoints` both write it.
