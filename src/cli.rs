@@ -84,8 +84,10 @@ pub enum Command {
     /// above the ground. Exit status: 0 printed, 1 error.
     Eval(eval_cmd::EvalArgs),
     /// Run a pipeline over many seeds in parallel and print a table:
-    /// feasible/passed counts, the best cost (or headline figure) mean ± sd,
-    /// median, min, max, wall and CPU time, cost evaluations per CPU-second.
+    /// how many gave a result (θ-PSO: J finite; FLATLO, fleet: finished),
+    /// how many the verdict passed (θ-PSO: feasible; FLATLO, fleet: passed),
+    /// the best cost (or headline figure) mean ± sd, median, min, max, wall
+    /// and CPU time, cost evaluations per CPU-second.
     ///
     /// Exit status: 0 every run finished, 1 an error.
     Sweep(sweep_cmd::SweepArgs),
