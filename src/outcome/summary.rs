@@ -166,7 +166,7 @@ pub fn flatlo(o: &FlatloOutcome) -> String {
     let spacing: Vec<String> = v
         .final_spacing
         .iter()
-        .map(|x| format!("{}→{} {:.1} m", x.front, x.back, x.spacing))
+        .map(|x| format!("{}→{} {:.1} m", x.front + 1, x.back + 1, x.spacing))
         .collect();
     let _ = writeln!(s, "  final line   {}", spacing.join(", "));
     let _ = writeln!(
