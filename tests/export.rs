@@ -774,10 +774,21 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
     lat.set(&mut edited, &Item::Mission, "-34.5")
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(edited.origin.as_ref().map(|o| o.latitude), Some(-34.5));
-    lat.set(&mut edited, &Item::Mission, "")
+    // Issue 24, item 18: clearing the latitude does not drop the whole
+    // [origin] silently; it says how to remove it, and `none` does.
+    let before = edited.clone();
+    let refused = lat.set(&mut edited, &Item::Mission, "").unwrap_err();
+    assert!(refused.contains("type none"), "{refused}");
+    assert_eq!(edited, before, "the origin stays");
+    let alt = fields
+        .iter()
+        .find(|f| f.label() == "origin alt (m)")
+        .unwrap_or_else(|| panic!("no field"));
+    alt.set(&mut edited, &Item::Mission, "")
         .unwrap_or_else(|e| panic!("{e}"));
-    assert!(
-        edited.origin.is_none(),
-        "an empty latitude removes [origin]"
-    );
+    assert_eq!(edited.origin.as_ref().map(|o| o.altitude), Some(0.0));
+    assert_eq!(edited.origin.as_ref().map(|o| o.latitude), Some(-34.5));
+    lat.set(&mut edited, &Item::Mission, "none")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(edited.origin.is_none(), "none removes [origin]");
 }

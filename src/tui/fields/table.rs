@@ -36,9 +36,9 @@ static MISSION: Table = Table { base: &[], fields: &[
     Spec { name: "name", unit: "", keys: &["name"], get: |m, _| text(&m.name), set: |m, _, t| put(&mut m.name, Ok(t.to_owned())) },
     Spec { name: "description", unit: "", keys: &["description"], get: |m, _| text(&m.description), set: |m, _, t| put(&mut m.description, Ok(t.to_owned())) },
     Spec { name: "seed", unit: "", keys: &["seed"], get: |m, _| text(m.seed), set: |m, _, t| put(&mut m.seed, seed(t)) },
-    Spec { name: "origin lat", unit: "°", keys: &["origin", "latitude"], get: |m, _| origin(m, |o| o.latitude), set: |m, _, t| set_origin(m, t, |o, v| o.latitude = v) },
-    Spec { name: "origin lon", unit: "°", keys: &["origin", "longitude"], get: |m, _| origin(m, |o| o.longitude), set: |m, _, t| set_origin(m, t, |o, v| o.longitude = v) },
-    Spec { name: "origin alt", unit: "m", keys: &["origin", "altitude"], get: |m, _| origin(m, |o| o.altitude), set: |m, _, t| set_origin(m, t, |o, v| o.altitude = v) },
+    Spec { name: "origin lat", unit: "°", keys: &["origin", "latitude"], get: |m, _| origin(m, |o| o.latitude), set: |m, _, t| set_origin(m, t, OriginPart::Latitude) },
+    Spec { name: "origin lon", unit: "°", keys: &["origin", "longitude"], get: |m, _| origin(m, |o| o.longitude), set: |m, _, t| set_origin(m, t, OriginPart::Longitude) },
+    Spec { name: "origin alt", unit: "m", keys: &["origin", "altitude"], get: |m, _| origin(m, |o| o.altitude), set: |m, _, t| set_origin(m, t, OriginPart::Altitude) },
 ]};
 
 #[rustfmt::skip]
@@ -379,19 +379,44 @@ fn origin(m: &Mission, get: fn(&GeoOrigin) -> f64) -> Option<String> {
     )
 }
 
-/// Sets one `[origin]` value (creating the section at 0°, 0°, 0 m); an empty
-/// text removes the section (exports then offer CSV in ENU only).
-fn set_origin(m: &mut Mission, text: &str, set: fn(&mut GeoOrigin, f64)) -> Result<(), String> {
-    if text.trim().is_empty() {
+/// One value of `[origin]`.
+#[derive(Clone, Copy, PartialEq)]
+enum OriginPart {
+    Latitude,
+    Longitude,
+    Altitude,
+}
+
+/// Sets one `[origin]` value (creating the section at 0°, 0°, 0 m). An
+/// empty text clears that value alone: the altitude goes back to 0 m; an
+/// origin cannot lack its latitude or longitude, so the message says how to
+/// remove the whole section (`none`; exports then write CSV in ENU only).
+fn set_origin(m: &mut Mission, text: &str, part: OriginPart) -> Result<(), String> {
+    let text = text.trim();
+    if text.eq_ignore_ascii_case("none") {
         m.origin = None;
         return Ok(());
     }
-    let v = number(text)?;
+    let value = match (text.is_empty(), part) {
+        (false, _) => number(text)?,
+        (true, OriginPart::Altitude) => 0.0,
+        (true, _) if m.origin.is_none() => return Ok(()),
+        (true, _) => {
+            return Err(
+                "an [origin] needs a latitude and a longitude; type none to remove the origin"
+                    .into(),
+            );
+        }
+    };
     let origin = m.origin.get_or_insert(GeoOrigin {
         latitude: 0.0,
         longitude: 0.0,
         altitude: 0.0,
     });
-    set(origin, v);
+    match part {
+        OriginPart::Latitude => origin.latitude = value,
+        OriginPart::Longitude => origin.longitude = value,
+        OriginPart::Altitude => origin.altitude = value,
+    }
     Ok(())
 }
