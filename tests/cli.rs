@@ -19,7 +19,16 @@ fn check_passes_on_the_shipped_missions() {
         "missions/narrow-passage.toml",
     ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
-    assert_eq!(text(&out.stdout).matches(": ok (0 error(s)").count(), 4);
+    // Issue 24, item 18: and without a warning (the fleet's route stood
+    // closer to the bounds than its formation's radius).
+    assert_eq!(
+        text(&out.stdout)
+            .matches(": ok (0 error(s), 0 warning(s))")
+            .count(),
+        4,
+        "{}",
+        text(&out.stdout)
+    );
 }
 
 #[test]
