@@ -261,6 +261,16 @@ fn shipped_missions_export_and_re_verify_as_flown() {
         );
         assert!(r.passed(), "{}", r.failure_text());
         assert!(!done.forced);
+        // Issue 24, item 7: the plans as flown (rounded speeds, holds)
+        // stay within the tolerance the export announces.
+        assert!(
+            r.max_deviation <= done.tolerance,
+            "{} {}: deviation {} > tolerance {}",
+            s.stem,
+            s.pipeline,
+            r.max_deviation,
+            done.tolerance
+        );
         assert_eq!(done.files.len(), 3 * p.tracks.len());
         // Timing: speeds are written to 0.01 m/s and corrected leg by leg.
         assert!(r.max_timing_error < 0.5, "{}", r.max_timing_error);
@@ -286,7 +296,10 @@ fn shipped_missions_export_and_re_verify_as_flown() {
         let stray = std::fs::read_dir(dir.path())
             .unwrap_or_else(|e| panic!("{e}"))
             .filter_map(Result::ok)
-            .filter(|e| e.file_name().to_string_lossy().starts_with(".tmp"))
+            .filter(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                name.starts_with(".tmp") || name.starts_with(".skyform-save-")
+            })
             .count();
         assert_eq!(stray, 0);
     }
