@@ -1313,3 +1313,28 @@ fn every_binding_dispatches_and_every_key_that_acts_is_in_the_table() {
         }
     }
 }
+
+/// Issue 24, item 12: Ctrl-u in an inspector field clears the line typed
+/// (not appends a 'u'), as in the save-as prompt and a shell.
+#[test]
+fn ctrl_u_clears_the_field_being_typed() {
+    use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    use skyform::tui::input::key_action;
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::FocusOn(Focus::Inspector));
+    app.update(Action::EditStart(None));
+    assert_eq!(
+        app.editor().editing().map(|e| e.buffer.as_str()),
+        Some(app.mission().name.as_str())
+    );
+    let ctrl_u = KeyEvent::new(KeyCode::Char('u'), KeyModifiers::CONTROL);
+    let action = key_action(&app, ctrl_u).expect("Ctrl-u acts while typing");
+    app.update(action);
+    assert_eq!(app.editor().editing().map(|e| e.buffer.as_str()), Some(""));
+    for c in "Turbines".chars() {
+        app.update(Action::EditInput(c));
+    }
+    app.update(Action::EditCommit);
+    assert_eq!(app.mission().name, "Turbines");
+}

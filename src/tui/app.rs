@@ -338,7 +338,7 @@ impl App {
             SelectNext | SelectPrevious | Select(_) | Nudge(..) | AddObstacle(_)
             | ToggleAddTool | Duplicate | Delete | AddSlot | CyclePreset | CycleShape
             | ToggleWaypoint | ToggleInspect | FieldUp | FieldDown | EditStart(_)
-            | EditInput(_) | EditBackspace | EditCommit | EditCancel | Undo | Redo
+            | EditInput(_) | EditBackspace | EditClear | EditCommit | EditCancel | Undo | Redo
             | DragStart(..) | DragTo(_) | DragEnd => self.update_editor(action),
         }
     }

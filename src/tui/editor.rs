@@ -240,6 +240,12 @@ impl Editor {
                     self.check_editing();
                 }
             }
+            EditClear => {
+                if let Some(e) = &mut self.editing {
+                    e.buffer.clear();
+                    self.check_editing();
+                }
+            }
             EditCommit => self.commit_edit(status),
             EditCancel => self.editing = None,
             Undo => self.step_history(true, status),

@@ -32,6 +32,7 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
             KeyCode::Enter | KeyCode::Tab => Some(Action::EditCommit),
             KeyCode::Esc => Some(Action::EditCancel),
             KeyCode::Backspace => Some(Action::EditBackspace),
+            KeyCode::Char('u') if ctrl => Some(Action::EditClear),
             KeyCode::Up => Some(Action::FieldUp),
             KeyCode::Down => Some(Action::FieldDown),
             KeyCode::Char(c) if !ctrl => Some(Action::EditInput(c)),

@@ -140,7 +140,7 @@ fn draw_status(frame: &mut Frame, app: &App, area: Rect) {
         spans.push(Span::styled(status.text.clone(), style));
     }
     let hints = match (app.focus(), app.pane()) {
-        _ if app.editor().editing().is_some() => "Enter apply · Esc cancel",
+        _ if app.editor().editing().is_some() => "Enter apply · Esc cancel · Ctrl-u clear",
         (Focus::Map, Pane::Map) => "n/p select · arrows move · a add · r run · ? help",
         (Focus::Map, Pane::Formation) => "n/p select · arrows move · P preset · s shape · ? help",
         (Focus::Inspector, _) => "↑↓ field · Enter edit · Tab focus · ? help",
