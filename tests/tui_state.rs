@@ -1338,3 +1338,39 @@ fn ctrl_u_clears_the_field_being_typed() {
     app.update(Action::EditCommit);
     assert_eq!(app.mission().name, "Turbines");
 }
+
+/// Issue 24, item 15: quitting while a job runs says so and asks; yes
+/// cancels the run and quits, Esc stays with the run going.
+#[test]
+fn quitting_with_a_job_running_says_so_and_asks() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("long.toml");
+    let mut m = default_mission().mission;
+    m.theta_pso.iterations = 20_000;
+    mission::save(&m, &path).unwrap();
+    let mut app = App::new(Document::new(m, Some(path)), dir.path().to_path_buf());
+    app.update(Action::Run);
+    assert!(app.jobs()[0].is_running());
+    app.update(Action::Quit);
+    assert!(!app.should_quit(), "a running job is not dropped silently");
+    assert_eq!(app.overlay(), Some(&Overlay::QuitRunning));
+    let screen = {
+        let mut t = ratatui::Terminal::new(ratatui::backend::TestBackend::new(100, 30)).unwrap();
+        t.draw(|f| {
+            skyform::tui::view::draw(f, &app, std::time::Instant::now());
+        })
+        .unwrap();
+        t.backend().to_string()
+    };
+    assert!(
+        screen.contains("job 1 θ-PSO s7 is running: quitting cancels it."),
+        "{screen}"
+    );
+    app.update(Action::Dismiss);
+    assert!(!app.should_quit() && app.jobs()[0].is_running());
+    app.update(Action::Quit);
+    app.update(Action::Confirm);
+    assert!(app.should_quit());
+    assert!(app.wait_for_jobs(Duration::from_secs(60)));
+    assert_eq!(app.jobs()[0].state, JobState::Cancelled);
+}

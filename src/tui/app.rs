@@ -349,6 +349,9 @@ impl App {
             Action::Quit => {
                 if self.editor.doc().is_modified() {
                     self.overlays.show(Overlay::Quit);
+                } else if self.board.any_running() {
+                    // A run would be lost without a word: ask.
+                    self.overlays.show(Overlay::QuitRunning);
                 } else {
                     self.shutdown();
                 }
@@ -488,6 +491,11 @@ impl App {
         self.shutdown();
     }
 
+    /// How many jobs are running (quitting cancels them).
+    pub fn running_jobs(&self) -> usize {
+        self.board.jobs().iter().filter(|j| j.is_running()).count()
+    }
+
     /// Cancels running jobs (they return their best at once) and stops.
     fn shutdown(&mut self) {
         self.board.cancel_all();
@@ -601,6 +609,10 @@ impl App {
                 if let Some(mut r) = self.recovery.take() {
                     r.discard();
                 }
+                self.shutdown();
+            }
+            Some(Overlay::QuitRunning) => {
+                self.overlays.close();
                 self.shutdown();
             }
             Some(Overlay::SaveAs { input, then }) => {

@@ -86,6 +86,11 @@ fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
             KeyCode::Char(c) if !ctrl => Some(Action::PromptInput(c)),
             _ => None,
         },
+        Overlay::QuitRunning => match key.code {
+            KeyCode::Char('y') | KeyCode::Char('q') => Some(Action::Confirm),
+            KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
+            _ => None,
+        },
         Overlay::Recover(_) => match key.code {
             KeyCode::Char('y') => Some(Action::Confirm),
             KeyCode::Char('n') => Some(Action::Dismiss),

@@ -44,6 +44,8 @@ pub enum Overlay {
     Help,
     /// Unsaved changes: save, discard or stay.
     Quit,
+    /// Jobs are running and would be cancelled: quit or stay.
+    QuitRunning,
     SaveAs {
         input: String,
         then: AfterSave,
