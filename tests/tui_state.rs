@@ -1374,3 +1374,48 @@ fn quitting_with_a_job_running_says_so_and_asks() {
     assert!(app.wait_for_jobs(Duration::from_secs(60)));
     assert_eq!(app.jobs()[0].state, JobState::Cancelled);
 }
+
+/// Issue 24, item 14: a rerun with the same seed records to a new file
+/// (`-2`) instead of over the first, and the status line names the file
+/// written; the built-in mission's recordings follow `<mission>-…`
+/// (`bridge-inspection-theta-pso-seed7.rrd`, not the name's slug).
+#[test]
+fn recordings_never_overwrite_and_the_status_names_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = default_mission().mission;
+    m.theta_pso.iterations = 5;
+    let doc = Document::new(m, None).with_builtin("bridge-inspection.toml");
+    let mut app = App::new(doc, dir.path().to_path_buf());
+    app.update(Action::ToggleRecording);
+    let first = dir.path().join("bridge-inspection-theta-pso-seed7.rrd");
+    let second = dir.path().join("bridge-inspection-theta-pso-seed7-2.rrd");
+    app.update(Action::Run);
+    assert!(
+        app.status()
+            .unwrap()
+            .text
+            .contains("recording to bridge-inspection-theta-pso-seed7.rrd"),
+        "{:?}",
+        app.status()
+    );
+    assert!(app.wait_for_jobs(Duration::from_secs(120)));
+    let status = app.status().unwrap().text.clone();
+    assert!(
+        status.contains("job 1 done") && status.contains(&format!("recorded {}", first.display())),
+        "{status}"
+    );
+    let size = std::fs::metadata(&first).unwrap().len();
+    app.update(Action::Run);
+    assert!(app.wait_for_jobs(Duration::from_secs(120)));
+    let status = app.status().unwrap().text.clone();
+    assert!(
+        status.contains(&format!("recorded {}", second.display())),
+        "{status}"
+    );
+    assert_eq!(
+        std::fs::metadata(&first).unwrap().len(),
+        size,
+        "the first is kept"
+    );
+    assert!(second.exists());
+}

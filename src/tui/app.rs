@@ -329,8 +329,8 @@ impl App {
                 }
             }
             Export => {
-                let path = self.editor.doc().path();
-                match super::export::export_shown(self.board.shown(), path, &self.cwd) {
+                let doc = self.editor.doc();
+                match super::export::export_shown(self.board.shown(), doc, &self.cwd) {
                     Ok(text) => self.status.say(text),
                     Err(text) => self.status.error(text),
                 }
@@ -683,9 +683,11 @@ impl App {
             path,
             errors,
         } = loaded;
-        let doc = Document::new(m, path)
-            .with_source(text)
-            .with_label(entry.label());
+        let doc = Document::new(m, path).with_source(text);
+        let doc = match &entry {
+            Entry::Builtin(name) => doc.with_builtin(name),
+            Entry::File(_) => doc.with_label(entry.label()),
+        };
         // The jobs were of the other mission: not "stale", gone.
         self.board.clear();
         self.editor.replace(doc);

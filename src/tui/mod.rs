@@ -57,7 +57,9 @@ pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), 
     let builtin = mission::BUILTIN[0].text;
     let Some(path) = path else {
         return Ok((
-            Document::new(mission::default_mission().mission, None).with_source(builtin),
+            Document::new(mission::default_mission().mission, None)
+                .with_source(builtin)
+                .with_builtin(mission::BUILTIN[0].file_name),
             None,
         ));
     };
