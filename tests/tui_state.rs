@@ -1045,12 +1045,13 @@ fn opening_a_missing_or_invalid_file_says_which_and_loses_nothing() {
     let edited = app.mission().clone();
 
     app.update(Action::Open);
-    type_prompt(&mut app, "nope/missing.toml");
+    // Not a .toml name: not a new mission, a missing file.
+    type_prompt(&mut app, "nope/missing");
     app.update(Action::Confirm);
     let status = app.status().cloned().expect("a status");
     assert!(status.error, "{status:?}");
     assert!(
-        status.text.contains("missing.toml") && status.text.contains("no such file"),
+        status.text.contains("missing") && status.text.contains("no such file"),
         "{}",
         status.text
     );
@@ -1418,4 +1419,61 @@ fn recordings_never_overwrite_and_the_status_names_the_file() {
         "the first is kept"
     );
     assert!(second.exists());
+}
+
+/// Issue 24, items 1 and 18: a new file starts from the minimal mission,
+/// not a copy of the bridge: `skyform NEW.toml` and a `.toml` path typed
+/// into the open dialog (which can now create one) both give a box, a
+/// start, a goal and the default formation, named after the file, unsaved.
+#[test]
+fn a_new_file_starts_from_the_minimal_mission_from_the_command_line_and_the_open_dialog() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("turbines.toml");
+    let (doc, note) = skyform::tui::open_document(Some(&path)).unwrap();
+    let minimal = |m: &Mission| {
+        m.origin.is_none()
+            && m.obstacles.is_empty()
+            && m.reconfiguration.waypoints.is_empty()
+            && m.formation == mission::Formation::default()
+            && m.name == "turbines"
+    };
+    assert!(minimal(doc.mission()), "{:?}", doc.mission());
+    assert!(doc.is_modified(), "not written until saved");
+    assert!(!path.exists());
+    assert!(note.unwrap().contains("new mission"));
+    let source = doc.source().unwrap();
+    let section = |text: &str, name: &str| text.lines().any(|l| l.trim_start().starts_with(name));
+    assert!(
+        !source.contains("bridge") && !section(source, "[origin]"),
+        "{source}"
+    );
+
+    // The open dialog: a .toml path that does not exist is a new mission.
+    let mut app = App::new(
+        Document::new(default_mission().mission, None),
+        dir.path().into(),
+    );
+    app.update(Action::Open);
+    type_prompt(&mut app, "site/north.toml");
+    let Some(Overlay::Open { matches, .. }) = app.overlay() else {
+        panic!("no open dialog: {:?}", app.overlay());
+    };
+    let wanted = dir.path().join("site/north.toml");
+    assert_eq!(
+        matches.first(),
+        Some(&skyform::tui::app::Entry::New(wanted.clone()))
+    );
+    app.update(Action::Confirm);
+    assert!(app.overlay().is_none(), "{:?}", app.overlay());
+    assert_eq!(app.mission().name, "north");
+    assert!(app.mission().origin.is_none() && app.mission().obstacles.is_empty());
+    assert_eq!(app.doc().path(), Some(wanted.as_path()));
+    assert!(app.doc().is_modified());
+    app.update(Action::Save);
+    let saved = std::fs::read_to_string(&wanted).unwrap();
+    assert!(saved.contains("name = \"north\""), "{saved}");
+    assert!(
+        !section(&saved, "[origin]") && !saved.contains("bridge"),
+        "{saved}"
+    );
 }

@@ -8,6 +8,7 @@ mod file;
 mod model;
 mod presets;
 mod source;
+mod template;
 mod validate;
 
 pub use builtin::{BUILTIN, Builtin, default_mission};
@@ -20,4 +21,5 @@ pub use file::{
 pub use model::*;
 pub use presets::Preset;
 pub use source::{FieldPath, LineCol, PathSegment, SourceMap};
+pub use template::{name_for, template, template_text};
 pub use validate::{compact, compact_digits, validate};

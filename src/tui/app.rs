@@ -682,11 +682,16 @@ impl App {
             name,
             path,
             errors,
+            new,
         } = loaded;
-        let doc = Document::new(m, path).with_source(text);
+        let doc = match (&entry, path) {
+            (Entry::New(p), _) => Document::new_file(m, p.clone()),
+            (_, path) => Document::new(m, path),
+        }
+        .with_source(text);
         let doc = match &entry {
             Entry::Builtin(name) => doc.with_builtin(name),
-            Entry::File(_) => doc.with_label(entry.label()),
+            Entry::File(_) | Entry::New(_) => doc.with_label(entry.label()),
         };
         // The jobs were of the other mission: not "stale", gone.
         self.board.clear();
@@ -696,12 +701,16 @@ impl App {
             // (the user was asked); its copy goes with them.
             r.discard();
             self.enable_recovery(match &entry {
-                Entry::File(p) => Origin::File(p.clone()),
+                Entry::File(p) | Entry::New(p) => Origin::File(p.clone()),
                 Entry::Builtin(name) => Origin::Builtin((*name).to_owned()),
             });
         }
         self.camera.fit_map();
-        if errors > 0 {
+        if new {
+            self.status.say(format!(
+                "new mission {name} (a box, a start, a goal): Ctrl-s creates the file"
+            ));
+        } else if errors > 0 {
             self.status
                 .error(format!("opened {name}: {errors} error(s) to fix"));
         } else {
