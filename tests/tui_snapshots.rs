@@ -163,6 +163,23 @@ fn a_flatlo_result_on_the_kilometre_map_with_its_verification_table() {
     insta::assert_snapshot!(screen);
 }
 
+/// Issue 24, item 17: the mission's summary counts each pipeline's
+/// vehicles: the FLATLO squadron's 4 aircraft, not the formation's 3 UAVs alone.
+#[test]
+fn the_mission_summary_counts_every_pipelines_vehicles() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/flatlo-squadron.toml");
+    let m = skyform::mission::load(std::path::Path::new(path))
+        .unwrap()
+        .mission;
+    let app = App::new(Document::new(m, None), PathBuf::from("."));
+    let screen = render(&app, Instant::now());
+    assert!(
+        screen.contains("0 obstacles · valid")
+            && screen.contains("θ-PSO 3 UAVs · FLATLO 4 aircraft · fleet 3 agents"),
+        "{screen}"
+    );
+}
+
 /// The README's screenshot is what the designer draws (issue 16): the
 /// finished-result snapshot above, character for character.
 #[test]
@@ -344,8 +361,18 @@ fn the_open_dialog_filters_and_takes_a_typed_path_at_80_by_24() {
         app.update(Action::PromptInput(c));
     }
     let screen = render_at(&app, Instant::now(), (80, 24));
+    // Issue 24, item 18: a .toml path that does not exist is a new mission.
     assert!(
-        screen.contains("elsewhere/mine.toml  (not listed: Enter opens this path)"),
+        screen.contains("elsewhere/mine.toml  (new: Enter starts a new mission there)"),
+        "{screen}"
+    );
+    app.update(Action::PromptClear);
+    for c in "elsewhere/mine".chars() {
+        app.update(Action::PromptInput(c));
+    }
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    assert!(
+        screen.contains("elsewhere/mine  (not listed: Enter opens this path)"),
         "{screen}"
     );
 

@@ -1477,3 +1477,88 @@ fn a_new_file_starts_from_the_minimal_mission_from_the_command_line_and_the_open
         "{saved}"
     );
 }
+
+/// The slot errors (eq. 7) of the app's mission.
+fn slot_errors(app: &App) -> Vec<String> {
+    app.doc()
+        .diagnostics()
+        .iter()
+        .filter(|d| d.is_error() && d.path.to_string().starts_with("formation.slots"))
+        .map(|d| d.to_string())
+        .collect()
+}
+
+/// Issue 24, items 4 and 11: growing a formation keeps its shape and stays
+/// valid for the mission's d_com and r_Q: a diamond of 4 typed to 20 UAVs
+/// is a diamond of 20 without an error (it had 32), `a` grows a preset as
+/// itself, P skips a preset that cannot fit (the line abreast of 20: 141
+/// errors) and says why, the spacing is a field, slots are millimetres.
+#[test]
+fn presets_grow_valid_for_the_mission_with_their_spacing_as_a_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::ShowFormation);
+    app.update(Action::Select(Item::Formation));
+    type_into(&mut app, "UAVs", "4");
+    type_into(&mut app, "preset", "diamond");
+    assert_eq!(
+        app.current_preset(),
+        Some(skyform::mission::Preset::Diamond)
+    );
+    assert_eq!(app.mission().formation.slots.len(), 4);
+    assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
+
+    type_into(&mut app, "UAVs", "20");
+    assert_eq!(app.mission().formation.slots.len(), 20);
+    assert_eq!(
+        app.current_preset(),
+        Some(skyform::mission::Preset::Diamond)
+    );
+    assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
+
+    // P never lands on a shape that cannot fit, and says which it skipped.
+    for _ in 0..6 {
+        app.update(Action::CyclePreset);
+        assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
+        assert_ne!(
+            app.current_preset(),
+            Some(skyform::mission::Preset::LineAbreast)
+        );
+    }
+    let status = app.status().unwrap().text.clone();
+    assert!(
+        status.contains("line abreast") && status.contains("d_com"),
+        "{status}"
+    );
+
+    // The spacing is a field; the slots follow it, to the millimetre.
+    type_into(&mut app, "preset", "diamond");
+    type_into(&mut app, "UAVs", "4");
+    type_into(&mut app, "spacing (m)", "3.3333");
+    let spacing = skyform::mission::min_pair_distance(&app.mission().formation.slots);
+    assert!((spacing - 3.333).abs() < 2e-3, "{spacing}");
+    for s in &app.mission().formation.slots {
+        for c in s.iter() {
+            assert_eq!(*c, skyform::mission::round_mm(*c), "{c}");
+        }
+    }
+    // `a` grows the diamond as a diamond.
+    app.update(Action::AddSlot);
+    assert_eq!(app.mission().formation.slots.len(), 5);
+    assert_eq!(
+        app.current_preset(),
+        Some(skyform::mission::Preset::Diamond)
+    );
+    assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
+    // A line abreast of 20 does not fit d_com = 20 m: refused, said why.
+    app.update(Action::Select(Item::Formation));
+    type_into(&mut app, "UAVs", "20");
+    let before = app.mission().clone();
+    type_into(&mut app, "preset", "line abreast");
+    assert_eq!(app.mission(), &before);
+    let status = app.status().unwrap();
+    assert!(
+        status.error && status.text.contains("does not fit"),
+        "{status:?}"
+    );
+}
