@@ -104,8 +104,19 @@ fn jobs_panel_with_a_finished_result() {
     app.update(Action::FocusOn(Focus::Jobs));
     let started = app.jobs()[0].started;
     let screen = render(&app, started);
-    assert!(screen.contains("feasible"), "{screen}");
-    assert!(screen.contains("all checks pass"), "{screen}");
+    // The verdict, then the CLI's verification table, row by row.
+    assert!(
+        screen.contains("✓ FEASIBLE · all 8 checks pass"),
+        "{screen}"
+    );
+    assert!(
+        screen.contains("✓ obstacle clearance worst 0.682 ≥ 0.5"),
+        "{screen}"
+    );
+    assert!(
+        screen.contains("✓ inspection of 'pier 1' 13.8 m ≥ 6 m"),
+        "{screen}"
+    );
     insta::assert_snapshot!(screen);
 }
 
@@ -385,4 +396,113 @@ fn the_open_dialog_filters_and_takes_a_typed_path_at_80_by_24() {
     assert!(screen.contains("s save, then open"), "{screen}");
     assert!(screen.contains("y discard and open"), "{screen}");
     assert!(screen.contains("Esc cancel"), "{screen}");
+}
+
+/// The bridge with four clusters of three posts near the start: each
+/// cluster's gaps are narrower than the formation, and the third post stands
+/// where the shape would be held, so every IWP there is unusable.
+fn bridge_with_post_clusters() -> skyform::mission::Mission {
+    let mut m = default_mission().mission;
+    for (k, x) in [20.0, 35.0, 50.0, 65.0].into_iter().enumerate() {
+        for (j, (dx, dy)) in [(0.0, 0.0), (2.5, 0.0), (1.25, 2.0)]
+            .into_iter()
+            .enumerate()
+        {
+            m.obstacles.push(skyform::mission::Obstacle {
+                name: format!("post {}{}", k + 1, ["a", "b", "c"][j]),
+                center: nalgebra::Point2::new(x + dx, 8.0 + dy),
+                radius: 0.5,
+                height: 20.0,
+                kind: Some("post".into()),
+                inspect: false,
+                stand_off: None,
+            });
+        }
+    }
+    m
+}
+
+/// The rows of the jobs panel below its title, at a screen where it is the
+/// rightmost pane.
+fn jobs_panel(screen: &str) -> Vec<String> {
+    screen
+        .lines()
+        .skip_while(|l| !l.contains("╭ Jobs"))
+        .skip(1)
+        .take_while(|l| !l.contains('╰'))
+        .map(|l| {
+            let row = l.trim_matches('"');
+            let row = row.rsplit("││").next().unwrap_or(row);
+            row.trim_end_matches('│').trim_end().to_owned()
+        })
+        .collect()
+}
+
+/// Issue 23, item 4 (the designer half): a dozen unusable IWPs read as a
+/// count by reason with the nearest named, not a dozen lines.
+#[test]
+fn the_jobs_panel_groups_unusable_iwps_and_names_the_nearest_at_80_by_24() {
+    let mut app = app_with_result(bridge_with_post_clusters(), 7, 20);
+    app.update(Action::FocusOn(Focus::Jobs));
+    let screen = render_at(&app, app.jobs()[0].started, (80, 24));
+    let panel = jobs_panel(&screen).join(" ");
+    assert!(panel.contains("12 unusable"), "{screen}");
+    assert!(
+        panel.contains("12 held through the gap, the alignment would pass within r_Q of '…'"),
+        "{screen}"
+    );
+    // The two nearest the route are named, the other ten are not.
+    assert!(
+        panel.contains("post 4a ↔ post 4c, post 4b ↔ post 4c, …"),
+        "{screen}"
+    );
+    assert!(!panel.contains("post 1a"), "{screen}");
+}
+
+/// Issue 24, item 13: an infeasible result says so and names its first
+/// failing check in the panel's first row under the job list, where an
+/// 80 × 24 terminal shows it without scrolling.
+#[test]
+fn the_jobs_panel_puts_the_verdict_and_the_first_failure_on_top_at_80_by_24() {
+    use skyform::pipeline::{CancelToken, Silent};
+    use skyform::planner::{PlanOptions, plan};
+    use skyform::tui::jobs::Outcome;
+
+    let mut mission = default_mission().mission;
+    mission.theta_pso.iterations = 20;
+    let mut outcome = plan(
+        &mission,
+        7,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    )
+    .unwrap();
+    // The flown result as if a UAV had come within 0.31 m of an obstacle:
+    // what the panel draws of a failed check, from the outcome's table.
+    let clearance = &mut outcome.verification.checks[0];
+    assert_eq!(clearance.name, "obstacle clearance");
+    clearance.worst = Some(0.31);
+    clearance.ok = false;
+    outcome.verification.feasible = false;
+    let mut app = App::new(
+        Document::new(mission.clone(), Some(PathBuf::from("mission.toml"))),
+        PathBuf::from("."),
+    );
+    let started = Instant::now();
+    app.adopt_job(Job::new(1, Kind::ThetaPso, 7, mission, started));
+    app.on_job_msg(
+        JobMsg::Done(1, Ok(Outcome::ThetaPso(Box::new(outcome)))),
+        started,
+    );
+    app.update(Action::FocusOn(Focus::Jobs));
+    let screen = render_at(&app, started, (80, 24));
+    let panel = jobs_panel(&screen);
+    assert!(panel[0].contains("θ-PSO s7"), "{screen}");
+    assert!(panel[1].starts_with("✗ INFEASIBLE · "), "{screen}");
+    let detail = panel[1..].join(" ");
+    assert!(
+        detail.starts_with("✗ INFEASIBLE · obstacle clearance worst 0.310 ≥ 0.5 (UAV 1 at t ="),
+        "{screen}"
+    );
 }
