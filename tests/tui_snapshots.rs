@@ -506,3 +506,28 @@ fn the_jobs_panel_puts_the_verdict_and_the_first_failure_on_top_at_80_by_24() {
         "{screen}"
     );
 }
+
+/// Issue 24, item 5: the side view draws every inspected obstacle (a tower
+/// the path keeps its distance from too), named, and its altitude axis has
+/// numbers.
+#[test]
+fn the_side_view_draws_the_inspected_towers_and_numbers_the_altitudes() {
+    let mut m = default_mission().mission;
+    m.obstacles.push(skyform::mission::Obstacle {
+        name: "far tower".into(),
+        center: nalgebra::Point2::new(70.0, 95.0),
+        radius: 2.0,
+        height: 12.0,
+        kind: Some("tower".into()),
+        inspect: true,
+        stand_off: None,
+    });
+    let mut app = App::new(Document::new(m, None), PathBuf::from("."));
+    app.update(Action::ToggleSideView);
+    let screen = render(&app, Instant::now());
+    assert!(screen.contains("Side view"), "{screen}");
+    assert!(screen.contains("far tower"), "{screen}");
+    assert!(screen.contains("pier 6"), "{screen}");
+    assert!(screen.contains("z max 15 m"), "{screen}");
+    assert!(screen.contains("z min 7 m"), "{screen}");
+}

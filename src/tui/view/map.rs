@@ -705,29 +705,44 @@ fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
                     Span::styled("ground", Style::default().fg(Color::Yellow)),
                 );
             }
-            ctx.print(
-                0.0,
-                m.bounds.z[1],
-                Span::styled("z max", Style::default().fg(Color::DarkGray)),
-            );
-            ctx.print(
-                0.0,
-                m.bounds.z[0],
-                Span::styled("z min", Style::default().fg(Color::DarkGray)),
-            );
-            // Obstacles the formation passes within its safe radius.
+            // The altitude axis: the band's limits with their numbers.
+            for (z, name) in [(m.bounds.z[1], "z max"), (m.bounds.z[0], "z min")] {
+                ctx.print(
+                    0.0,
+                    z,
+                    Span::styled(
+                        format!("{name} {} m", crate::tui::fields::fmt_num(z)),
+                        Style::default().fg(Color::DarkGray),
+                    ),
+                );
+            }
+            // Obstacles the formation passes within its safe radius, and
+            // every inspected one (the mission's subject, however far the
+            // path stays from it), at its closest point along the path.
             let reach = m.formation.safe_radius();
             for o in &m.obstacles {
                 if let Some((s, d)) = closest_along(&centroid, &along, &o.center)
-                    && d < o.radius + reach
+                    && (o.inspect || d < o.radius + reach)
                 {
+                    let color = if o.inspect {
+                        Color::LightMagenta
+                    } else {
+                        Color::LightRed
+                    };
                     ctx.draw(&Rectangle {
                         x: s - o.radius,
                         y: 0.0,
                         width: 2.0 * o.radius,
                         height: o.height,
-                        color: Color::LightRed,
+                        color,
                     });
+                    if o.inspect {
+                        ctx.print(
+                            s,
+                            o.height,
+                            Span::styled(o.name.clone(), Style::default().fg(color)),
+                        );
+                    }
                 }
             }
             ctx.layer();
