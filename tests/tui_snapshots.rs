@@ -531,3 +531,20 @@ fn the_side_view_draws_the_inspected_towers_and_numbers_the_altitudes() {
     assert!(screen.contains("z max 15 m"), "{screen}");
     assert!(screen.contains("z min 7 m"), "{screen}");
 }
+
+/// Issue 24, item 3: while the mission has an error, the IWP table does
+/// not say that no gap is narrower than the formation (it did, for a 7 m
+/// gap a 24 m formation meets): it says the IWPs wait for the fix.
+#[test]
+fn the_iwp_table_does_not_say_none_while_the_mission_has_errors() {
+    let mut m = default_mission().mission;
+    m.bounds.z = [15.0, 7.0];
+    let mut app = App::new(Document::new(m, None), PathBuf::from("."));
+    app.update(Action::ShowFormation);
+    let screen = render(&app, Instant::now());
+    assert!(
+        screen.contains("IWPs (eq. 9): not found until the mission's errors are fixed"),
+        "{screen}"
+    );
+    assert!(!screen.contains("no gap narrower"), "{screen}");
+}

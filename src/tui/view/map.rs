@@ -937,7 +937,11 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
         })
         .collect();
     let empty = app.iwps().is_empty();
+    // With errors elsewhere the IWPs are not looked for: "none" would say
+    // no gap needs one.
+    let errors = app.doc().diagnostics().iter().any(|d| d.is_error());
     let title = match (empty, narrow) {
+        (true, _) if errors => " IWPs (eq. 9): not found until the mission's errors are fixed ",
         (true, false) => " IWPs (eq. 9): none: no gap narrower than the formation ",
         (true, true) => " IWPs (eq. 9): none ",
         (false, false) => " IWPs (eq. 9) · s cycle shape · space on/off ",
