@@ -548,3 +548,19 @@ fn the_iwp_table_does_not_say_none_while_the_mission_has_errors() {
     );
     assert!(!screen.contains("no gap narrower"), "{screen}");
 }
+
+/// Issue 24, item 16: at 80 × 24 the map's title keeps the result's state
+/// whole ("STALE" was cut to "STAL" behind the scale), the scale after it.
+#[test]
+fn a_stale_result_is_marked_on_the_map_at_80_by_24() {
+    let mut app = app_with_result(default_mission().mission, 7, 20);
+    app.update(Action::Select(Item::Goal));
+    app.update(Action::FocusOn(Focus::Map));
+    let fresh = render_at(&app, app.jobs()[0].started, (80, 24));
+    let title = fresh.lines().next().unwrap_or_default().to_owned();
+    assert!(title.contains("Map  job 1 ✓ "), "{title}");
+    app.update(Action::Nudge(-1.0, 0.0));
+    let screen = render_at(&app, app.jobs()[0].started, (80, 24));
+    let title = screen.lines().next().unwrap_or_default().to_owned();
+    assert!(title.contains("Map  STALE job 1 "), "{title}");
+}
