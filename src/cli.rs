@@ -25,7 +25,8 @@ pub mod sweep_cmd;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// Mission file to open in the designer (created on first save if missing).
+    /// Mission file to open in the designer (a new, minimal mission when it
+    /// does not exist; written on the first save).
     pub file: Option<PathBuf>,
 }
 
@@ -33,8 +34,25 @@ pub struct Cli {
 pub enum Command {
     /// Open a mission file in the designer (TUI); same as `skyform FILE`.
     Edit {
-        /// Mission TOML file (created on first save if missing).
+        /// Mission TOML file (a new, minimal mission when it does not exist;
+        /// written on the first save).
         file: PathBuf,
+    },
+    /// Start a new mission file and open it in the designer.
+    ///
+    /// Without --from the file is the minimal mission (a box, a start, a goal,
+    /// the default formation; no origin, no obstacles); with --from it is a
+    /// copy of that mission, comments and all. Refuses to replace a file.
+    New {
+        /// The mission file to create.
+        file: PathBuf,
+        /// Copy this mission instead: a file, or a shipped mission by name
+        /// (bridge-inspection, narrow-passage, flatlo-squadron, fleet-triangle).
+        #[arg(long, value_name = "MISSION")]
+        from: Option<String>,
+        /// Only write the file; do not open the designer.
+        #[arg(long)]
+        no_open: bool,
     },
     /// Validate mission files: print every error and warning with its line.
     ///
@@ -84,8 +102,10 @@ pub enum Command {
     /// above the ground. Exit status: 0 printed, 1 error.
     Eval(eval_cmd::EvalArgs),
     /// Run a pipeline over many seeds in parallel and print a table:
-    /// feasible/passed counts, the best cost (or headline figure) mean ± sd,
-    /// median, min, max, wall and CPU time, cost evaluations per CPU-second.
+    /// how many gave a result (θ-PSO: J finite; FLATLO, fleet: finished),
+    /// how many the verdict passed (θ-PSO: feasible; FLATLO, fleet: passed),
+    /// the best cost (or headline figure) mean ± sd, median, min, max, wall
+    /// and CPU time, cost evaluations per CPU-second.
     ///
     /// Exit status: 0 every run finished, 1 an error.
     Sweep(sweep_cmd::SweepArgs),
@@ -212,6 +232,11 @@ pub fn main() -> ExitCode {
     };
     match command {
         Command::Edit { file } => ExitCode::from(edit(Some(file))),
+        Command::New {
+            file,
+            from,
+            no_open,
+        } => ExitCode::from(new_mission(&file, from.as_deref(), no_open)),
         Command::Check {
             files,
             strict,
@@ -279,6 +304,81 @@ fn edit(file: Option<PathBuf>) -> u8 {
             exit::ERROR
         }
     }
+}
+
+/// `skyform new`: writes the template or a copy of `from` at `file`, then
+/// opens the designer on it (unless `no_open`).
+fn new_mission(file: &std::path::Path, from: Option<&str>, no_open: bool) -> u8 {
+    if file.exists() {
+        eprintln!(
+            "error: {} exists; open it with `skyform {}` or choose another name",
+            file.display(),
+            file.display()
+        );
+        return exit::ERROR;
+    }
+    let (text, source) = match from {
+        None => (
+            mission::template_text(&mission::name_for(file)),
+            "the minimal mission".to_owned(),
+        ),
+        Some(from) => match copied_mission(from) {
+            Ok(found) => found,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return exit::ERROR;
+            }
+        },
+    };
+    if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty())
+        && let Err(e) = std::fs::create_dir_all(dir)
+    {
+        eprintln!("error: cannot create {}: {e}", dir.display());
+        return exit::ERROR;
+    }
+    if let Err(e) = mission::write_atomically(file, text.as_bytes()) {
+        eprintln!("error: cannot write {}: {e}", file.display());
+        return exit::ERROR;
+    }
+    eprintln!("created {} from {source}", file.display());
+    if no_open {
+        exit::OK
+    } else {
+        edit(Some(file.to_path_buf()))
+    }
+}
+
+/// The text of the mission `from` names (a file, else a shipped mission by
+/// file name or stem) and what to call it; it must be a mission.
+fn copied_mission(from: &str) -> Result<(String, String), String> {
+    let path = std::path::Path::new(from);
+    let (text, source) = if path.is_file() {
+        let text = mission::read(path).map_err(|e| e.to_string())?;
+        (text, path.display().to_string())
+    } else {
+        let wanted = path.file_name().map(|n| n.to_string_lossy().into_owned());
+        let wanted = wanted.unwrap_or_else(|| from.to_owned());
+        let builtin = mission::BUILTIN
+            .iter()
+            .find(|b| b.file_name == wanted || b.file_name.strip_suffix(".toml") == Some(&wanted));
+        let Some(b) = builtin else {
+            let names: Vec<&str> = mission::BUILTIN.iter().map(|b| b.file_name).collect();
+            return Err(format!(
+                "no mission {from}: give a mission file or a shipped one ({})",
+                names.join(", ")
+            ));
+        };
+        (b.text.to_owned(), format!("the shipped {}", b.file_name))
+    };
+    if crate::diagnose::check_text(&text, Some(&source))
+        .mission
+        .is_none()
+    {
+        return Err(format!(
+            "{source} is not a mission (`skyform check {source}` says why)"
+        ));
+    }
+    Ok((text, source))
 }
 
 /// `skyform record`.

@@ -19,7 +19,16 @@ fn check_passes_on_the_shipped_missions() {
         "missions/narrow-passage.toml",
     ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
-    assert_eq!(text(&out.stdout).matches(": ok (0 error(s)").count(), 4);
+    // Issue 24, item 18: and without a warning (the fleet's route stood
+    // closer to the bounds than its formation's radius).
+    assert_eq!(
+        text(&out.stdout)
+            .matches(": ok (0 error(s), 0 warning(s))")
+            .count(),
+        4,
+        "{}",
+        text(&out.stdout)
+    );
 }
 
 #[test]
@@ -200,4 +209,58 @@ fn run_fleet_reports_each_target_and_exits_by_its_verdict() {
     let out = skyform(&["run", "fleet", short.to_str().unwrap_or_default()]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stdout));
     assert!(text(&out.stdout).contains("NOT REACHED"));
+}
+
+/// Issue 24, item 1: `skyform new FILE` writes the minimal mission;
+/// `--from` copies a shipped mission on purpose (its text, comments and
+/// all); neither replaces a file.
+#[test]
+fn new_writes_the_minimal_mission_or_a_copy_on_purpose() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let file = dir.path().join("turbines.toml");
+    let name = file.display().to_string();
+    let out = skyform(&["new", &name, "--no-open"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let written = std::fs::read_to_string(&file).unwrap_or_default();
+    let m = skyform::mission::load(&file)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    assert_eq!(m.name, "turbines");
+    assert!(m.origin.is_none() && m.obstacles.is_empty(), "{written}");
+    assert!(!written.contains("bridge"), "{written}");
+
+    let again = skyform(&["new", &name, "--no-open"]);
+    assert_eq!(again.status.code(), Some(1));
+    assert!(
+        text(&again.stderr).contains("exists"),
+        "{}",
+        text(&again.stderr)
+    );
+
+    let copy = dir.path().join("my-bridge.toml");
+    let copy_name = copy.display().to_string();
+    let out = skyform(&[
+        "new",
+        &copy_name,
+        "--from",
+        "missions/bridge-inspection.toml",
+        "--no-open",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert_eq!(
+        std::fs::read_to_string(&copy).unwrap_or_default(),
+        std::fs::read_to_string("missions/bridge-inspection.toml").unwrap_or_default()
+    );
+    let by_name = dir.path().join("fleet.toml");
+    let out = skyform(&[
+        "new",
+        &by_name.display().to_string(),
+        "--from",
+        "fleet-triangle",
+        "--no-open",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let bad = skyform(&["new", "x.toml", "--from", "no-such-mission", "--no-open"]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(text(&bad.stderr).contains("bridge-inspection.toml"));
 }

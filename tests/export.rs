@@ -261,6 +261,16 @@ fn shipped_missions_export_and_re_verify_as_flown() {
         );
         assert!(r.passed(), "{}", r.failure_text());
         assert!(!done.forced);
+        // Issue 24, item 7: the plans as flown (rounded speeds, holds)
+        // stay within the tolerance the export announces.
+        assert!(
+            r.max_deviation <= done.tolerance,
+            "{} {}: deviation {} > tolerance {}",
+            s.stem,
+            s.pipeline,
+            r.max_deviation,
+            done.tolerance
+        );
         assert_eq!(done.files.len(), 3 * p.tracks.len());
         // Timing: speeds are written to 0.01 m/s and corrected leg by leg.
         assert!(r.max_timing_error < 0.5, "{}", r.max_timing_error);
@@ -286,7 +296,10 @@ fn shipped_missions_export_and_re_verify_as_flown() {
         let stray = std::fs::read_dir(dir.path())
             .unwrap_or_else(|e| panic!("{e}"))
             .filter_map(Result::ok)
-            .filter(|e| e.file_name().to_string_lossy().starts_with(".tmp"))
+            .filter(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                name.starts_with(".tmp") || name.starts_with(".skyform-save-")
+            })
             .count();
         assert_eq!(stray, 0);
     }
@@ -539,6 +552,42 @@ fn without_an_origin_csv_works_in_enu_and_geodetic_formats_say_to_add_it() {
     );
 }
 
+/// Issue 24, item 9: under umask 022 every exported file is 0644, as the
+/// mission, the JSON and the sweep CSV are (not the 0600 of a private
+/// temporary file): a ground station running as another user reads them.
+#[cfg(unix)]
+#[test]
+fn exported_files_honour_the_umask_like_any_file() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempdir();
+    let out = dir.path().join("out");
+    let script = format!(
+        "umask 022 && exec '{}' export missions/narrow-passage.toml --format plan \
+         --format wpl --format csv --out '{}'",
+        env!("CARGO_BIN_EXE_skyform"),
+        out.display()
+    );
+    let run = std::process::Command::new("sh")
+        .args(["-c", &script])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    let files: Vec<PathBuf> = std::fs::read_dir(&out)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .map(|e| e.map(|e| e.path()).unwrap_or_else(|e| panic!("{e}")))
+        .collect();
+    assert!(files.len() >= 3, "{files:?}");
+    for f in &files {
+        let mode = std::fs::metadata(f)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .permissions()
+            .mode()
+            & 0o777;
+        assert_eq!(mode, 0o644, "{} is {mode:o}", f.display());
+    }
+}
+
 // ------------------------------------------------ independent readers
 
 /// The expectation files of `tests/export_readers` for every exported
@@ -738,10 +787,21 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
     lat.set(&mut edited, &Item::Mission, "-34.5")
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(edited.origin.as_ref().map(|o| o.latitude), Some(-34.5));
-    lat.set(&mut edited, &Item::Mission, "")
+    // Issue 24, item 18: clearing the latitude does not drop the whole
+    // [origin] silently; it says how to remove it, and `none` does.
+    let before = edited.clone();
+    let refused = lat.set(&mut edited, &Item::Mission, "").unwrap_err();
+    assert!(refused.contains("type none"), "{refused}");
+    assert_eq!(edited, before, "the origin stays");
+    let alt = fields
+        .iter()
+        .find(|f| f.label() == "origin alt (m)")
+        .unwrap_or_else(|| panic!("no field"));
+    alt.set(&mut edited, &Item::Mission, "")
         .unwrap_or_else(|e| panic!("{e}"));
-    assert!(
-        edited.origin.is_none(),
-        "an empty latitude removes [origin]"
-    );
+    assert_eq!(edited.origin.as_ref().map(|o| o.altitude), Some(0.0));
+    assert_eq!(edited.origin.as_ref().map(|o| o.latitude), Some(-34.5));
+    lat.set(&mut edited, &Item::Mission, "none")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(edited.origin.is_none(), "none removes [origin]");
 }

@@ -163,6 +163,32 @@ fn the_paper_case_flies_into_line_without_coming_close() {
     assert!((slowest - 14.381).abs() < 1e-3, "{slowest}");
 }
 
+/// Issue 24, item 17: the summary numbers the aircraft of the final line
+/// from 1, as it numbers them everywhere else (aircraft 1-4, not 0→1).
+#[test]
+fn the_summary_numbers_the_final_line_from_one() {
+    let m = paper_mission();
+    let out = flatlo::plan(&m, m.seed, &mut Silent, &CancelToken::new()).unwrap();
+    let summary = skyform::outcome::summary::flatlo(&out);
+    let line = summary
+        .lines()
+        .find(|l| l.contains("final line"))
+        .unwrap_or_else(|| panic!("no final line in\n{summary}"));
+    let mut named: Vec<usize> = line
+        .split(", ")
+        .flat_map(|pair| {
+            let pair = pair.trim_start_matches("  final line").trim();
+            let ends = pair.split(' ').next().unwrap_or_default();
+            ends.split('→')
+                .map(|n| n.parse::<usize>().unwrap_or_else(|_| panic!("{line}")))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    named.sort_unstable();
+    named.dedup();
+    assert_eq!(named, [1, 2, 3, 4], "{line}");
+}
+
 #[test]
 fn the_same_seed_gives_the_same_flight_and_another_seed_another() {
     let mut m = paper_mission();

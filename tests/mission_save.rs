@@ -152,3 +152,25 @@ fn a_new_obstacle_is_written_like_the_others() {
         "[[obstacles]]\nname = \"new\"\ncenter = [20.0, 7.0]\nradius = 7.0\nheight = 20.0\nkind = \"wall\"\n"
     );
 }
+
+/// Issue 24, item 18: a section the file lacked (an [origin] removed, then
+/// set again) goes where the model has it, before [bounds], not after the
+/// obstacles at the end of the file.
+#[test]
+fn a_section_added_again_goes_where_the_model_has_it() {
+    let text = BUILTIN[0].text;
+    let mut m = parse(text);
+    let origin = m.origin.take().expect("the bridge has an origin");
+    let without = edit_in_place(&m, text).unwrap();
+    assert!(!without.contains("[origin]"), "{without}");
+    m.origin = Some(origin);
+    let again = edit_in_place(&m, &without).unwrap();
+    let at = |section: &str| {
+        again
+            .find(section)
+            .unwrap_or_else(|| panic!("no {section} in\n{again}"))
+    };
+    assert!(at("[origin]") < at("[bounds]"), "{again}");
+    assert!(at("[origin]") > at("seed ="), "{again}");
+    assert_eq!(parse(&again), m);
+}

@@ -195,10 +195,12 @@ fn obstacles_outside_the_bounds_are_errors() {
 #[test]
 fn start_and_goal_must_be_inside_the_bounds() {
     let text = mission_with("").replace("start = [10.0, 10.0, 10.0]", "start = [-5.0, 10.0, 10.0]");
-    assert_error(&text, "route.start", "start =", "outside the bounds");
+    // On the coordinate that is out (issue 24, item 6: the inspector shows
+    // it under that field).
+    assert_error(&text, "route.start[0]", "start =", "outside the bounds");
     // Outside the altitude band counts too.
     let text = mission_with("").replace("goal = [90.0, 90.0, 10.0]", "goal = [90.0, 90.0, 30.0]");
-    assert_error(&text, "route.goal", "goal =", "outside the bounds");
+    assert_error(&text, "route.goal[2]", "goal =", "altitude band");
 }
 
 #[test]

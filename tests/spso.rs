@@ -193,7 +193,7 @@ fn sweep_writes_one_csv_row_per_seed_and_counts_them() {
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
         lines[0],
-        "seed,feasible,passed,best J,evaluations,wall_s,cpu_s,error"
+        "seed,j_finite,feasible,best J,evaluations,wall_s,cpu_s,error"
     );
     assert_eq!(lines.len(), 5);
     let mut finite = 0;
@@ -214,7 +214,7 @@ fn sweep_writes_one_csv_row_per_seed_and_counts_them() {
     }
     assert!(stdout.contains("runs                  4"), "{stdout}");
     assert!(
-        stdout.contains(&format!("feasible / passed     {finite} / ")),
+        stdout.contains(&format!("J finite              {finite} of 4")),
         "{stdout}"
     );
     assert!(stdout.contains("per CPU-second"), "{stdout}");
@@ -265,7 +265,8 @@ fn sweep_runs_flatlo_and_the_fleet() {
         ]);
         let stdout = String::from_utf8_lossy(&out.stdout);
         assert!(out.status.success(), "{pipeline}: {stdout}");
-        assert!(stdout.contains("feasible / passed     2 / "), "{stdout}");
+        assert!(stdout.contains("finished              2 of 2"), "{stdout}");
+        assert!(stdout.contains("passed                "), "{stdout}");
         let text = std::fs::read_to_string(&csv).expect("csv");
         assert_eq!(text.lines().count(), 3, "{text}");
     }

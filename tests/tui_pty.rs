@@ -349,3 +349,114 @@ fn at_80_by_24_help_scrolls_to_the_run_keys_and_a_cancel_shows_its_share() {
     assert_eq!(s.wait_exit(Duration::from_secs(20)), 0);
     assert!(s.cooked());
 }
+
+/// Sends `keys` and waits for `shown` (the status line's report of the edit,
+/// a title): one step of a user's session.
+fn step(s: &mut Session, keys: &str, shown: &str) {
+    s.send(keys);
+    s.wait_for(shown, Duration::from_secs(10));
+}
+
+/// Issue 24, "Done when": the turbines mission built from `skyform NEW.toml`
+/// with keys only (four UAVs in a diamond inspecting two towers 12 m apart,
+/// the route between them, 200 m × 150 m, band 20-40 m), saved: the file has
+/// no [origin], nothing of the bridge, the two towers and the four slots.
+#[test]
+fn a_new_mission_built_with_keys_only_saves_what_was_typed() {
+    const DOWN: &str = "\x1b[B";
+    const UP: &str = "\x1b[A";
+    let dir = tempfile::tempdir().unwrap();
+    let state = tempfile::tempdir().unwrap();
+    let file = dir.path().join("turbines.toml");
+    let mut s = launch(&file, state.path());
+    s.wait_for("is a new mission", Duration::from_secs(30));
+
+    // The box and the band.
+    step(&mut s, "n", "Inspector · Bounds");
+    step(&mut s, &format!("\t{DOWN}200\r"), "x max (m) = 200");
+    step(&mut s, &format!("{DOWN}{DOWN}150\r"), "y max (m) = 150");
+    step(&mut s, &format!("{DOWN}{DOWN}40\r"), "z max (m) = 40");
+    step(&mut s, &format!("{UP}20\r"), "z min (m) = 20");
+    // Start and goal inside it, on the line between the towers.
+    step(&mut s, "n", "Inspector · Start");
+    step(&mut s, &format!("{DOWN}75\r"), "y (m) = 75");
+    step(&mut s, &format!("{DOWN}30\r"), "z (m) = 30");
+    step(&mut s, "n", "Inspector · Goal");
+    step(&mut s, &format!("{UP}{UP}190\r"), "x (m) = 190");
+    step(&mut s, &format!("{DOWN}75\r"), "y (m) = 75");
+    step(&mut s, &format!("{DOWN}30\r"), "z (m) = 30");
+    // Two inspected towers 12 m apart, centre to centre.
+    for (k, y) in [(1, "69"), (2, "81")] {
+        step(&mut s, "a", &format!("added 'obstacle {k}'"));
+        step(
+            &mut s,
+            &format!("\r\x15tower {k}\r"),
+            &format!("Obstacle {k} 'tower {k}'"),
+        );
+        step(
+            &mut s,
+            &format!("{DOWN}{DOWN}{DOWN}{y}\r"),
+            &format!("centre y (m) = {y}"),
+        );
+        step(&mut s, &format!("{DOWN}2\r"), "radius (m) = 2");
+        step(&mut s, &format!("{DOWN}60\r"), "height (m) = 60");
+        step(
+            &mut s,
+            &format!("{DOWN}\r\x15yes\r"),
+            "inspect (eq. 8) = yes",
+        );
+    }
+    // Four UAVs in a diamond, in the formation editor.
+    step(&mut s, "\t2", "Formation · 3 UAVs");
+    step(&mut s, "\t\t", "Inspector · Formation");
+    step(&mut s, "4\r", "UAVs = 4");
+    step(
+        &mut s,
+        &format!("{DOWN}\r\x15diamond\r"),
+        "preset = diamond",
+    );
+    step(&mut s, "\x13", "saved"); // Ctrl-s
+    s.send("q");
+    assert_eq!(s.wait_exit(Duration::from_secs(20)), 0);
+
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(
+        !text.lines().any(|l| l.trim_start().starts_with("[origin]")),
+        "{text}"
+    );
+    for other in ["bridge", "pier", "light pole", "ΔT", "eq. 8", "Sydney"] {
+        assert!(!text.contains(other), "'{other}' in the new file:\n{text}");
+    }
+    let m = mission::load(&file).unwrap().mission;
+    assert!(m.origin.is_none(), "{text}");
+    assert_eq!(m.name, "turbines");
+    assert_eq!(m.bounds.x, [0.0, 200.0]);
+    assert_eq!(m.bounds.y, [0.0, 150.0]);
+    assert_eq!(m.bounds.z, [20.0, 40.0]);
+    assert_eq!(m.route.start, nalgebra::Point3::new(10.0, 75.0, 30.0));
+    assert_eq!(m.route.goal, nalgebra::Point3::new(190.0, 75.0, 30.0));
+    let towers: Vec<_> = m
+        .obstacles
+        .iter()
+        .map(|o| (o.name.as_str(), o.center.x, o.center.y, o.radius, o.inspect))
+        .collect();
+    assert_eq!(
+        towers,
+        [
+            ("tower 1", 100.0, 69.0, 2.0, true),
+            ("tower 2", 100.0, 81.0, 2.0, true)
+        ]
+    );
+    // A diamond: one ahead, one behind, one each side, at one distance
+    // from the centroid, written to the millimetre.
+    let slots = &m.formation.slots;
+    assert_eq!(slots.len(), 4, "{text}");
+    let r = slots[0].norm();
+    for slot in slots {
+        assert!((slot.norm() - r).abs() < 1e-9, "{slots:?}");
+        assert!(slot.x == 0.0 || slot.y == 0.0, "{slots:?}");
+        for v in slot.iter() {
+            assert_eq!((v * 1000.0).round() / 1000.0, *v, "{slots:?}");
+        }
+    }
+}

@@ -104,8 +104,19 @@ fn jobs_panel_with_a_finished_result() {
     app.update(Action::FocusOn(Focus::Jobs));
     let started = app.jobs()[0].started;
     let screen = render(&app, started);
-    assert!(screen.contains("feasible"), "{screen}");
-    assert!(screen.contains("all checks pass"), "{screen}");
+    // The verdict, then the CLI's verification table, row by row.
+    assert!(
+        screen.contains("✓ FEASIBLE · all 8 checks pass"),
+        "{screen}"
+    );
+    assert!(
+        screen.contains("✓ obstacle clearance worst 0.682 ≥ 0.5"),
+        "{screen}"
+    );
+    assert!(
+        screen.contains("✓ inspection of 'pier 1' 13.8 m ≥ 6 m"),
+        "{screen}"
+    );
     insta::assert_snapshot!(screen);
 }
 
@@ -161,6 +172,23 @@ fn a_flatlo_result_on_the_kilometre_map_with_its_verification_table() {
         "the aircraft are on the map: {screen}"
     );
     insta::assert_snapshot!(screen);
+}
+
+/// Issue 24, item 17: the mission's summary counts each pipeline's
+/// vehicles: the FLATLO squadron's 4 aircraft, not the formation's 3 UAVs alone.
+#[test]
+fn the_mission_summary_counts_every_pipelines_vehicles() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/flatlo-squadron.toml");
+    let m = skyform::mission::load(std::path::Path::new(path))
+        .unwrap()
+        .mission;
+    let app = App::new(Document::new(m, None), PathBuf::from("."));
+    let screen = render(&app, Instant::now());
+    assert!(
+        screen.contains("0 obstacles · valid")
+            && screen.contains("θ-PSO 3 UAVs · FLATLO 4 aircraft · fleet 3 agents"),
+        "{screen}"
+    );
 }
 
 /// The README's screenshot is what the designer draws (issue 16): the
@@ -344,8 +372,18 @@ fn the_open_dialog_filters_and_takes_a_typed_path_at_80_by_24() {
         app.update(Action::PromptInput(c));
     }
     let screen = render_at(&app, Instant::now(), (80, 24));
+    // Issue 24, item 18: a .toml path that does not exist is a new mission.
     assert!(
-        screen.contains("elsewhere/mine.toml  (not listed: Enter opens this path)"),
+        screen.contains("elsewhere/mine.toml  (new: Enter starts a new mission there)"),
+        "{screen}"
+    );
+    app.update(Action::PromptClear);
+    for c in "elsewhere/mine".chars() {
+        app.update(Action::PromptInput(c));
+    }
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    assert!(
+        screen.contains("elsewhere/mine  (not listed: Enter opens this path)"),
         "{screen}"
     );
 
@@ -358,4 +396,171 @@ fn the_open_dialog_filters_and_takes_a_typed_path_at_80_by_24() {
     assert!(screen.contains("s save, then open"), "{screen}");
     assert!(screen.contains("y discard and open"), "{screen}");
     assert!(screen.contains("Esc cancel"), "{screen}");
+}
+
+/// The bridge with four clusters of three posts near the start: each
+/// cluster's gaps are narrower than the formation, and the third post stands
+/// where the shape would be held, so every IWP there is unusable.
+fn bridge_with_post_clusters() -> skyform::mission::Mission {
+    let mut m = default_mission().mission;
+    for (k, x) in [20.0, 35.0, 50.0, 65.0].into_iter().enumerate() {
+        for (j, (dx, dy)) in [(0.0, 0.0), (2.5, 0.0), (1.25, 2.0)]
+            .into_iter()
+            .enumerate()
+        {
+            m.obstacles.push(skyform::mission::Obstacle {
+                name: format!("post {}{}", k + 1, ["a", "b", "c"][j]),
+                center: nalgebra::Point2::new(x + dx, 8.0 + dy),
+                radius: 0.5,
+                height: 20.0,
+                kind: Some("post".into()),
+                inspect: false,
+                stand_off: None,
+            });
+        }
+    }
+    m
+}
+
+/// The rows of the jobs panel below its title, at a screen where it is the
+/// rightmost pane.
+fn jobs_panel(screen: &str) -> Vec<String> {
+    screen
+        .lines()
+        .skip_while(|l| !l.contains("╭ Jobs"))
+        .skip(1)
+        .take_while(|l| !l.contains('╰'))
+        .map(|l| {
+            let row = l.trim_matches('"');
+            let row = row.rsplit("││").next().unwrap_or(row);
+            row.trim_end_matches('│').trim_end().to_owned()
+        })
+        .collect()
+}
+
+/// Issue 23, item 4 (the designer half): a dozen unusable IWPs read as a
+/// count by reason with the nearest named, not a dozen lines.
+#[test]
+fn the_jobs_panel_groups_unusable_iwps_and_names_the_nearest_at_80_by_24() {
+    let mut app = app_with_result(bridge_with_post_clusters(), 7, 20);
+    app.update(Action::FocusOn(Focus::Jobs));
+    let screen = render_at(&app, app.jobs()[0].started, (80, 24));
+    let panel = jobs_panel(&screen).join(" ");
+    assert!(panel.contains("12 unusable"), "{screen}");
+    assert!(
+        panel.contains("12 held through the gap, the alignment would pass within r_Q of '…'"),
+        "{screen}"
+    );
+    // The two nearest the route are named, the other ten are not.
+    assert!(
+        panel.contains("post 4a ↔ post 4c, post 4b ↔ post 4c, …"),
+        "{screen}"
+    );
+    assert!(!panel.contains("post 1a"), "{screen}");
+}
+
+/// Issue 24, item 13: an infeasible result says so and names its first
+/// failing check in the panel's first row under the job list, where an
+/// 80 × 24 terminal shows it without scrolling.
+#[test]
+fn the_jobs_panel_puts_the_verdict_and_the_first_failure_on_top_at_80_by_24() {
+    use skyform::pipeline::{CancelToken, Silent};
+    use skyform::planner::{PlanOptions, plan};
+    use skyform::tui::jobs::Outcome;
+
+    let mut mission = default_mission().mission;
+    mission.theta_pso.iterations = 20;
+    let mut outcome = plan(
+        &mission,
+        7,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    )
+    .unwrap();
+    // The flown result as if a UAV had come within 0.31 m of an obstacle:
+    // what the panel draws of a failed check, from the outcome's table.
+    let clearance = &mut outcome.verification.checks[0];
+    assert_eq!(clearance.name, "obstacle clearance");
+    clearance.worst = Some(0.31);
+    clearance.ok = false;
+    outcome.verification.feasible = false;
+    let mut app = App::new(
+        Document::new(mission.clone(), Some(PathBuf::from("mission.toml"))),
+        PathBuf::from("."),
+    );
+    let started = Instant::now();
+    app.adopt_job(Job::new(1, Kind::ThetaPso, 7, mission, started));
+    app.on_job_msg(
+        JobMsg::Done(1, Ok(Outcome::ThetaPso(Box::new(outcome)))),
+        started,
+    );
+    app.update(Action::FocusOn(Focus::Jobs));
+    let screen = render_at(&app, started, (80, 24));
+    let panel = jobs_panel(&screen);
+    assert!(panel[0].contains("θ-PSO s7"), "{screen}");
+    assert!(panel[1].starts_with("✗ INFEASIBLE · "), "{screen}");
+    let detail = panel[1..].join(" ");
+    assert!(
+        detail.starts_with("✗ INFEASIBLE · obstacle clearance worst 0.310 ≥ 0.5 (UAV 1 at t ="),
+        "{screen}"
+    );
+}
+
+/// Issue 24, item 5: the side view draws every inspected obstacle (a tower
+/// the path keeps its distance from too), named, and its altitude axis has
+/// numbers.
+#[test]
+fn the_side_view_draws_the_inspected_towers_and_numbers_the_altitudes() {
+    let mut m = default_mission().mission;
+    m.obstacles.push(skyform::mission::Obstacle {
+        name: "far tower".into(),
+        center: nalgebra::Point2::new(70.0, 95.0),
+        radius: 2.0,
+        height: 12.0,
+        kind: Some("tower".into()),
+        inspect: true,
+        stand_off: None,
+    });
+    let mut app = App::new(Document::new(m, None), PathBuf::from("."));
+    app.update(Action::ToggleSideView);
+    let screen = render(&app, Instant::now());
+    assert!(screen.contains("Side view"), "{screen}");
+    assert!(screen.contains("far tower"), "{screen}");
+    assert!(screen.contains("pier 6"), "{screen}");
+    assert!(screen.contains("z max 15 m"), "{screen}");
+    assert!(screen.contains("z min 7 m"), "{screen}");
+}
+
+/// Issue 24, item 3: while the mission has an error, the IWP table does
+/// not say that no gap is narrower than the formation (it did, for a 7 m
+/// gap a 24 m formation meets): it says the IWPs wait for the fix.
+#[test]
+fn the_iwp_table_does_not_say_none_while_the_mission_has_errors() {
+    let mut m = default_mission().mission;
+    m.bounds.z = [15.0, 7.0];
+    let mut app = App::new(Document::new(m, None), PathBuf::from("."));
+    app.update(Action::ShowFormation);
+    let screen = render(&app, Instant::now());
+    assert!(
+        screen.contains("IWPs (eq. 9): not found until the mission's errors are fixed"),
+        "{screen}"
+    );
+    assert!(!screen.contains("no gap narrower"), "{screen}");
+}
+
+/// Issue 24, item 16: at 80 × 24 the map's title keeps the result's state
+/// whole ("STALE" was cut to "STAL" behind the scale), the scale after it.
+#[test]
+fn a_stale_result_is_marked_on_the_map_at_80_by_24() {
+    let mut app = app_with_result(default_mission().mission, 7, 20);
+    app.update(Action::Select(Item::Goal));
+    app.update(Action::FocusOn(Focus::Map));
+    let fresh = render_at(&app, app.jobs()[0].started, (80, 24));
+    let title = fresh.lines().next().unwrap_or_default().to_owned();
+    assert!(title.contains("Map  job 1 ✓ "), "{title}");
+    app.update(Action::Nudge(-1.0, 0.0));
+    let screen = render_at(&app, app.jobs()[0].started, (80, 24));
+    let title = screen.lines().next().unwrap_or_default().to_owned();
+    assert!(title.contains("Map  STALE job 1 "), "{title}");
 }

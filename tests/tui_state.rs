@@ -1045,12 +1045,13 @@ fn opening_a_missing_or_invalid_file_says_which_and_loses_nothing() {
     let edited = app.mission().clone();
 
     app.update(Action::Open);
-    type_prompt(&mut app, "nope/missing.toml");
+    // Not a .toml name: not a new mission, a missing file.
+    type_prompt(&mut app, "nope/missing");
     app.update(Action::Confirm);
     let status = app.status().cloned().expect("a status");
     assert!(status.error, "{status:?}");
     assert!(
-        status.text.contains("missing.toml") && status.text.contains("no such file"),
+        status.text.contains("missing") && status.text.contains("no such file"),
         "{}",
         status.text
     );
@@ -1312,4 +1313,252 @@ fn every_binding_dispatches_and_every_key_that_acts_is_in_the_table() {
             }
         }
     }
+}
+
+/// Issue 24, item 12: Ctrl-u in an inspector field clears the line typed
+/// (not appends a 'u'), as in the save-as prompt and a shell.
+#[test]
+fn ctrl_u_clears_the_field_being_typed() {
+    use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    use skyform::tui::input::key_action;
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::FocusOn(Focus::Inspector));
+    app.update(Action::EditStart(None));
+    assert_eq!(
+        app.editor().editing().map(|e| e.buffer.as_str()),
+        Some(app.mission().name.as_str())
+    );
+    let ctrl_u = KeyEvent::new(KeyCode::Char('u'), KeyModifiers::CONTROL);
+    let action = key_action(&app, ctrl_u).expect("Ctrl-u acts while typing");
+    app.update(action);
+    assert_eq!(app.editor().editing().map(|e| e.buffer.as_str()), Some(""));
+    for c in "Turbines".chars() {
+        app.update(Action::EditInput(c));
+    }
+    app.update(Action::EditCommit);
+    assert_eq!(app.mission().name, "Turbines");
+}
+
+/// Issue 24, item 15: quitting while a job runs says so and asks; yes
+/// cancels the run and quits, Esc stays with the run going.
+#[test]
+fn quitting_with_a_job_running_says_so_and_asks() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("long.toml");
+    let mut m = default_mission().mission;
+    m.theta_pso.iterations = 20_000;
+    mission::save(&m, &path).unwrap();
+    let mut app = App::new(Document::new(m, Some(path)), dir.path().to_path_buf());
+    app.update(Action::Run);
+    assert!(app.jobs()[0].is_running());
+    app.update(Action::Quit);
+    assert!(!app.should_quit(), "a running job is not dropped silently");
+    assert_eq!(app.overlay(), Some(&Overlay::QuitRunning));
+    let screen = {
+        let mut t = ratatui::Terminal::new(ratatui::backend::TestBackend::new(100, 30)).unwrap();
+        t.draw(|f| {
+            skyform::tui::view::draw(f, &app, std::time::Instant::now());
+        })
+        .unwrap();
+        t.backend().to_string()
+    };
+    assert!(
+        screen.contains("job 1 θ-PSO s7 is running: quitting cancels it."),
+        "{screen}"
+    );
+    app.update(Action::Dismiss);
+    assert!(!app.should_quit() && app.jobs()[0].is_running());
+    app.update(Action::Quit);
+    app.update(Action::Confirm);
+    assert!(app.should_quit());
+    assert!(app.wait_for_jobs(Duration::from_secs(60)));
+    assert_eq!(app.jobs()[0].state, JobState::Cancelled);
+}
+
+/// Issue 24, item 14: a rerun with the same seed records to a new file
+/// (`-2`) instead of over the first, and the status line names the file
+/// written; the built-in mission's recordings follow `<mission>-…`
+/// (`bridge-inspection-theta-pso-seed7.rrd`, not the name's slug).
+#[test]
+fn recordings_never_overwrite_and_the_status_names_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = default_mission().mission;
+    m.theta_pso.iterations = 5;
+    let doc = Document::new(m, None).with_builtin("bridge-inspection.toml");
+    let mut app = App::new(doc, dir.path().to_path_buf());
+    app.update(Action::ToggleRecording);
+    let first = dir.path().join("bridge-inspection-theta-pso-seed7.rrd");
+    let second = dir.path().join("bridge-inspection-theta-pso-seed7-2.rrd");
+    app.update(Action::Run);
+    assert!(
+        app.status()
+            .unwrap()
+            .text
+            .contains("recording to bridge-inspection-theta-pso-seed7.rrd"),
+        "{:?}",
+        app.status()
+    );
+    assert!(app.wait_for_jobs(Duration::from_secs(120)));
+    let status = app.status().unwrap().text.clone();
+    assert!(
+        status.contains("job 1 done") && status.contains(&format!("recorded {}", first.display())),
+        "{status}"
+    );
+    let size = std::fs::metadata(&first).unwrap().len();
+    app.update(Action::Run);
+    assert!(app.wait_for_jobs(Duration::from_secs(120)));
+    let status = app.status().unwrap().text.clone();
+    assert!(
+        status.contains(&format!("recorded {}", second.display())),
+        "{status}"
+    );
+    assert_eq!(
+        std::fs::metadata(&first).unwrap().len(),
+        size,
+        "the first is kept"
+    );
+    assert!(second.exists());
+}
+
+/// Issue 24, items 1 and 18: a new file starts from the minimal mission,
+/// not a copy of the bridge: `skyform NEW.toml` and a `.toml` path typed
+/// into the open dialog (which can now create one) both give a box, a
+/// start, a goal and the default formation, named after the file, unsaved.
+#[test]
+fn a_new_file_starts_from_the_minimal_mission_from_the_command_line_and_the_open_dialog() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("turbines.toml");
+    let (doc, note) = skyform::tui::open_document(Some(&path)).unwrap();
+    let minimal = |m: &Mission| {
+        m.origin.is_none()
+            && m.obstacles.is_empty()
+            && m.reconfiguration.waypoints.is_empty()
+            && m.formation == mission::Formation::default()
+            && m.name == "turbines"
+    };
+    assert!(minimal(doc.mission()), "{:?}", doc.mission());
+    assert!(doc.is_modified(), "not written until saved");
+    assert!(!path.exists());
+    assert!(note.unwrap().contains("new mission"));
+    let source = doc.source().unwrap();
+    let section = |text: &str, name: &str| text.lines().any(|l| l.trim_start().starts_with(name));
+    assert!(
+        !source.contains("bridge") && !section(source, "[origin]"),
+        "{source}"
+    );
+
+    // The open dialog: a .toml path that does not exist is a new mission.
+    let mut app = App::new(
+        Document::new(default_mission().mission, None),
+        dir.path().into(),
+    );
+    app.update(Action::Open);
+    type_prompt(&mut app, "site/north.toml");
+    let Some(Overlay::Open { matches, .. }) = app.overlay() else {
+        panic!("no open dialog: {:?}", app.overlay());
+    };
+    let wanted = dir.path().join("site/north.toml");
+    assert_eq!(
+        matches.first(),
+        Some(&skyform::tui::app::Entry::New(wanted.clone()))
+    );
+    app.update(Action::Confirm);
+    assert!(app.overlay().is_none(), "{:?}", app.overlay());
+    assert_eq!(app.mission().name, "north");
+    assert!(app.mission().origin.is_none() && app.mission().obstacles.is_empty());
+    assert_eq!(app.doc().path(), Some(wanted.as_path()));
+    assert!(app.doc().is_modified());
+    app.update(Action::Save);
+    let saved = std::fs::read_to_string(&wanted).unwrap();
+    assert!(saved.contains("name = \"north\""), "{saved}");
+    assert!(
+        !section(&saved, "[origin]") && !saved.contains("bridge"),
+        "{saved}"
+    );
+}
+
+/// The slot errors (eq. 7) of the app's mission.
+fn slot_errors(app: &App) -> Vec<String> {
+    app.doc()
+        .diagnostics()
+        .iter()
+        .filter(|d| d.is_error() && d.path.to_string().starts_with("formation.slots"))
+        .map(|d| d.to_string())
+        .collect()
+}
+
+/// Issue 24, items 4 and 11: growing a formation keeps its shape and stays
+/// valid for the mission's d_com and r_Q: a diamond of 4 typed to 20 UAVs
+/// is a diamond of 20 without an error (it had 32), `a` grows a preset as
+/// itself, P skips a preset that cannot fit (the line abreast of 20: 141
+/// errors) and says why, the spacing is a field, slots are millimetres.
+#[test]
+fn presets_grow_valid_for_the_mission_with_their_spacing_as_a_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut app = app_in(dir.path());
+    app.update(Action::ShowFormation);
+    app.update(Action::Select(Item::Formation));
+    type_into(&mut app, "UAVs", "4");
+    type_into(&mut app, "preset", "diamond");
+    assert_eq!(
+        app.current_preset(),
+        Some(skyform::mission::Preset::Diamond)
+    );
+    assert_eq!(app.mission().formation.slots.len(), 4);
+    assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
+
+    type_into(&mut app, "UAVs", "20");
+    assert_eq!(app.mission().formation.slots.len(), 20);
+    assert_eq!(
+        app.current_preset(),
+        Some(skyform::mission::Preset::Diamond)
+    );
+    assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
+
+    // P never lands on a shape that cannot fit, and says which it skipped.
+    for _ in 0..6 {
+        app.update(Action::CyclePreset);
+        assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
+        assert_ne!(
+            app.current_preset(),
+            Some(skyform::mission::Preset::LineAbreast)
+        );
+    }
+    let status = app.status().unwrap().text.clone();
+    assert!(
+        status.contains("line abreast") && status.contains("d_com"),
+        "{status}"
+    );
+
+    // The spacing is a field; the slots follow it, to the millimetre.
+    type_into(&mut app, "preset", "diamond");
+    type_into(&mut app, "UAVs", "4");
+    type_into(&mut app, "spacing (m)", "3.3333");
+    let spacing = skyform::mission::min_pair_distance(&app.mission().formation.slots);
+    assert!((spacing - 3.333).abs() < 2e-3, "{spacing}");
+    for s in &app.mission().formation.slots {
+        for c in s.iter() {
+            assert_eq!(*c, skyform::mission::round_mm(*c), "{c}");
+        }
+    }
+    // `a` grows the diamond as a diamond.
+    app.update(Action::AddSlot);
+    assert_eq!(app.mission().formation.slots.len(), 5);
+    assert_eq!(
+        app.current_preset(),
+        Some(skyform::mission::Preset::Diamond)
+    );
+    assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
+    // A line abreast of 20 does not fit d_com = 20 m: refused, said why.
+    app.update(Action::Select(Item::Formation));
+    type_into(&mut app, "UAVs", "20");
+    let before = app.mission().clone();
+    type_into(&mut app, "preset", "line abreast");
+    assert_eq!(app.mission(), &before);
+    let status = app.status().unwrap();
+    assert!(
+        status.error && status.text.contains("does not fit"),
+        "{status:?}"
+    );
 }

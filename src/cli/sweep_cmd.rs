@@ -73,9 +73,11 @@ pub fn parse_seeds(s: &str) -> Result<(u64, u64), String> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeedRow {
     pub seed: u64,
-    /// θ-PSO: J finite; FLATLO and fleet: the run finished.
-    pub feasible: bool,
-    /// The pipeline's own verdict (verification passed).
+    /// The run gave a result to judge: θ-PSO a finite J, FLATLO and the
+    /// fleet a finished flight.
+    pub completed: bool,
+    /// The pipeline's own verdict, the one its `run` prints: θ-PSO
+    /// FEASIBLE (verification passed), FLATLO and the fleet PASS.
     pub passed: bool,
     /// θ-PSO: best J; FLATLO: the closest pair (m); fleet: the closest two agents (m).
     pub figure: f64,
@@ -115,7 +117,7 @@ pub fn run_seed(mission: &Mission, pipeline: PipelineArg, seed: u64) -> SeedRow 
     let cpu0 = thread_cpu();
     let mut row = SeedRow {
         seed,
-        feasible: false,
+        completed: false,
         passed: false,
         figure: f64::NAN,
         evaluations: 0,
@@ -133,7 +135,7 @@ pub fn run_seed(mission: &Mission, pipeline: PipelineArg, seed: u64) -> SeedRow 
                 &cancel,
             ) {
                 Ok(o) => {
-                    row.feasible = o.cost.total.is_finite();
+                    row.completed = o.cost.total.is_finite();
                     row.passed = o.feasible();
                     row.figure = o.cost.total;
                     row.evaluations = o.evaluations;
@@ -143,7 +145,7 @@ pub fn run_seed(mission: &Mission, pipeline: PipelineArg, seed: u64) -> SeedRow 
         }
         PipelineArg::Flatlo => match flatlo::plan(mission, seed, &mut Silent, &cancel) {
             Ok(o) => {
-                row.feasible = o.verification.is_some();
+                row.completed = o.verification.is_some();
                 row.passed = o.passed();
                 row.figure = o.closest.as_ref().map_or(f64::NAN, |c| c.min_distance);
             }
@@ -151,7 +153,7 @@ pub fn run_seed(mission: &Mission, pipeline: PipelineArg, seed: u64) -> SeedRow 
         },
         PipelineArg::Fleet => match fleet::plan(mission, seed, &mut Silent, &cancel) {
             Ok(o) => {
-                row.feasible = o.completion == crate::pipeline::Completion::Finished;
+                row.completed = o.completion == crate::pipeline::Completion::Finished;
                 row.passed = o.converged() && o.kept_apart() && o.obstacles_clear();
                 row.figure = o.closest_agents.as_ref().map_or(f64::NAN, |c| c.distance);
                 row.evaluations = o.agents.iter().map(|a| a.evaluations).sum();
@@ -171,7 +173,9 @@ pub fn run_seed(mission: &Mission, pipeline: PipelineArg, seed: u64) -> SeedRow 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Summary {
     pub runs: usize,
-    pub feasible: usize,
+    /// Runs with a result to judge ([`SeedRow::completed`]).
+    pub completed: usize,
+    /// Runs the verdict passed ([`SeedRow::passed`]).
     pub passed: usize,
     pub errors: usize,
     /// Over the finite figures: mean, sample sd, median, min, max.
@@ -210,7 +214,7 @@ pub fn summarise(rows: &[SeedRow], wall: Duration, cpu: Duration) -> Summary {
     let figures: Vec<f64> = rows.iter().map(|r| r.figure).collect();
     Summary {
         runs: rows.len(),
-        feasible: rows.iter().filter(|r| r.feasible).count(),
+        completed: rows.iter().filter(|r| r.completed).count(),
         passed: rows.iter().filter(|r| r.passed).count(),
         errors: rows.iter().filter(|r| r.error.is_some()).count(),
         stats: stats(&figures),
@@ -221,14 +225,48 @@ pub fn summarise(rows: &[SeedRow], wall: Duration, cpu: Duration) -> Summary {
     }
 }
 
+/// What a sweep's counts are called: one word, one meaning. The verdict
+/// has the word the pipeline's own `run` prints (θ-PSO "feasible",
+/// FLATLO and the fleet "passed"); the count of runs that gave a result to
+/// judge has another ("J finite", "finished").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Words {
+    pub completed: &'static str,
+    pub verdict: &'static str,
+}
+
+impl Words {
+    pub fn of(pipeline: PipelineArg) -> Words {
+        match pipeline {
+            PipelineArg::ThetaPso => Words {
+                completed: "J finite",
+                verdict: "feasible",
+            },
+            PipelineArg::Flatlo | PipelineArg::Fleet => Words {
+                completed: "finished",
+                verdict: "passed",
+            },
+        }
+    }
+
+    /// The CSV column names: `j_finite`, `feasible`, …
+    fn column(word: &str) -> String {
+        word.to_lowercase().replace(' ', "_")
+    }
+}
+
 /// The CSV: a header and one row per seed.
-pub fn csv(rows: &[SeedRow], figure: &str) -> String {
-    let mut out = format!("seed,feasible,passed,{figure},evaluations,wall_s,cpu_s,error\n");
+pub fn csv(rows: &[SeedRow], figure: &str, words: Words) -> String {
+    let mut out = format!(
+        "seed,{},{},{figure},evaluations,wall_s,cpu_s,error\n",
+        Words::column(words.completed),
+        Words::column(words.verdict)
+    );
     for r in rows {
         out.push_str(&format!(
             "{},{},{},{},{},{:.6},{:.6},{}\n",
             r.seed,
-            r.feasible,
+            r.completed,
             r.passed,
             crate::spso::g17(r.figure),
             r.evaluations,
@@ -244,14 +282,19 @@ pub fn csv(rows: &[SeedRow], figure: &str) -> String {
 }
 
 /// The table printed after a sweep.
-pub fn table(s: &Summary, figure: &str) -> String {
+pub fn table(s: &Summary, figure: &str, words: Words) -> String {
     let mut out = String::new();
     let line = |out: &mut String, k: &str, v: String| out.push_str(&format!("{k:<22}{v}\n"));
     line(&mut out, "runs", format!("{}", s.runs));
     line(
         &mut out,
-        "feasible / passed",
-        format!("{} / {} of {}", s.feasible, s.passed, s.runs),
+        words.completed,
+        format!("{} of {}", s.completed, s.runs),
+    );
+    line(
+        &mut out,
+        words.verdict,
+        format!("{} of {}", s.passed, s.runs),
     );
     if s.errors > 0 {
         line(&mut out, "errors", format!("{}", s.errors));
@@ -397,10 +440,11 @@ pub fn sweep_command(args: &SweepArgs) -> u8 {
         }
     }
     let summary = summarise(&rows, wall, cpu);
-    print!("{}", table(&summary, figure));
+    let words = Words::of(args.pipeline);
+    print!("{}", table(&summary, figure, words));
     let _ = std::io::stdout().flush();
     if let Some(path) = &args.csv
-        && let Err(e) = crate::mission::write_atomically(path, csv(&rows, figure).as_bytes())
+        && let Err(e) = crate::mission::write_atomically(path, csv(&rows, figure, words).as_bytes())
     {
         eprintln!("error: cannot write {}: {e}", path.display());
         return exit::ERROR;
@@ -415,6 +459,44 @@ pub fn sweep_command(args: &SweepArgs) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 24, item 8: "feasible" is the verdict and nothing else: a run
+    /// with a finite J that failed verification is counted as "J finite",
+    /// not as feasible (the run's own summary says INFEASIBLE).
+    #[test]
+    fn the_sweep_table_says_feasible_only_for_the_verdict() {
+        let summary = Summary {
+            runs: 10,
+            completed: 10,
+            passed: 9,
+            errors: 0,
+            stats: None,
+            finite: 10,
+            wall: Duration::from_secs(1),
+            cpu: Duration::from_secs(1),
+            evaluations: 0,
+        };
+        let text = table(&summary, "best J", Words::of(PipelineArg::ThetaPso));
+        let feasible: Vec<&str> = text.lines().filter(|l| l.contains("feasible")).collect();
+        assert_eq!(feasible, ["feasible              9 of 10"], "{text}");
+        assert!(text.contains("J finite              10 of 10"), "{text}");
+        let text = table(&summary, "closest pair (m)", Words::of(PipelineArg::Flatlo));
+        assert!(text.contains("passed                9 of 10"), "{text}");
+        assert!(!text.contains("feasible"), "{text}");
+        let row = SeedRow {
+            seed: 4,
+            completed: true,
+            passed: false,
+            figure: 1.5,
+            evaluations: 0,
+            wall: Duration::ZERO,
+            cpu: Duration::ZERO,
+            error: None,
+        };
+        let csv = csv(&[row], "best J", Words::of(PipelineArg::ThetaPso));
+        assert!(csv.starts_with("seed,j_finite,feasible,best J,"), "{csv}");
+        assert!(csv.contains("\n4,true,false,"), "{csv}");
+    }
 
     #[test]
     fn thousands_are_separated() {

@@ -18,7 +18,6 @@ pub mod reverify;
 pub mod simplify;
 pub mod wpl;
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use nalgebra::Point3;
@@ -224,47 +223,74 @@ impl VehiclePlan {
     }
 }
 
-/// Reduces every track to waypoints within `tolerance` (SED) and gives each
-/// leg the speed that arrives on time, rounded to [`SPEED_STEP`]; a rounding
-/// early on is made up on the next leg, so timing errors do not add up.
+/// Reduces every track to waypoints and gives each leg the speed that
+/// arrives on time, rounded to [`SPEED_STEP`]; a rounding early on is made
+/// up on the next leg, so timing errors do not add up. Every sample of a
+/// track stays within `tolerance` of where the plan *as flown* (rounded
+/// speeds, holds) puts the vehicle at the same instant: the SED tolerance
+/// of the reduction is tightened until the flight is within it, down to
+/// keeping every sample.
 pub fn reduce(tracks: &[Track], tolerance: f64, fixed_wing: bool) -> Vec<VehiclePlan> {
     tracks
         .iter()
-        .map(|track| {
-            let kept = simplify::simplify(&track.samples, tolerance);
-            let mut waypoints: Vec<Waypoint> = Vec::with_capacity(kept.len());
-            // When the vehicle flown as planned reaches the last waypoint.
-            let mut flown = 0.0;
-            for &k in &kept {
-                let s = &track.samples[k];
-                let Some(prev) = waypoints.last_mut() else {
-                    flown = s.t;
-                    waypoints.push(Waypoint {
-                        t: s.t,
-                        position: s.position,
-                        speed: 0.0,
-                        hold: 0.0,
-                    });
-                    continue;
-                };
-                let length = (s.position - prev.position).norm();
-                let available = s.t - flown;
-                let (hold, speed) = leg_speed(length, available, fixed_wing);
-                prev.hold = hold;
-                flown += hold + if speed > 0.0 { length / speed } else { 0.0 };
-                waypoints.push(Waypoint {
-                    t: s.t,
-                    position: s.position,
-                    speed,
-                    hold: 0.0,
-                });
-            }
-            VehiclePlan {
-                vehicle: track.vehicle,
-                waypoints,
-            }
-        })
+        .map(|track| reduce_track(track, tolerance, fixed_wing))
         .collect()
+}
+
+/// One track's plan within `tolerance` as flown (see [`reduce`]).
+fn reduce_track(track: &Track, tolerance: f64, fixed_wing: bool) -> VehiclePlan {
+    /// Tightenings tried before every sample is kept.
+    const TRIES: usize = 12;
+    let mut sed = tolerance;
+    for _ in 0..TRIES {
+        let kept = simplify::simplify(&track.samples, sed);
+        let plan = plan_through(track, &kept, fixed_wing);
+        let deviation = reverify::deviation(&plan, track);
+        if deviation <= tolerance {
+            return plan;
+        }
+        // Rounding and holds add what the reduction did not see: ask the
+        // reduction for less, in proportion to the excess.
+        sed *= 0.9 * tolerance / deviation;
+    }
+    let every: Vec<usize> = (0..track.samples.len()).collect();
+    plan_through(track, &every, fixed_wing)
+}
+
+/// The plan whose waypoints are `track`'s samples `kept`, each leg at the
+/// speed (or hold, then the slowest speed) that reaches it on time.
+fn plan_through(track: &Track, kept: &[usize], fixed_wing: bool) -> VehiclePlan {
+    let mut waypoints: Vec<Waypoint> = Vec::with_capacity(kept.len());
+    // When the vehicle flown as planned reaches the last waypoint.
+    let mut flown = 0.0;
+    for &k in kept {
+        let s = &track.samples[k];
+        let Some(prev) = waypoints.last_mut() else {
+            flown = s.t;
+            waypoints.push(Waypoint {
+                t: s.t,
+                position: s.position,
+                speed: 0.0,
+                hold: 0.0,
+            });
+            continue;
+        };
+        let length = (s.position - prev.position).norm();
+        let available = s.t - flown;
+        let (hold, speed) = leg_speed(length, available, fixed_wing);
+        prev.hold = hold;
+        flown += hold + if speed > 0.0 { length / speed } else { 0.0 };
+        waypoints.push(Waypoint {
+            t: s.t,
+            position: s.position,
+            speed,
+            hold: 0.0,
+        });
+    }
+    VehiclePlan {
+        vehicle: track.vehicle,
+        waypoints,
+    }
 }
 
 /// Hold (seconds, to [`HOLD_STEP`]) and commanded speed for a leg of
@@ -427,22 +453,14 @@ pub fn export(
     })
 }
 
-/// Writes a temporary file in the same directory, syncs it, then renames it
-/// over `path`: a reader never sees half a file.
+/// Writes atomically (`mission::write_atomically`: a synced temporary file
+/// renamed over `path`, so a reader never sees half a file), with the
+/// permissions of any file the user creates.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
-    let io = |source| ExportError::Io {
+    crate::mission::write_atomically(path, bytes).map_err(|source| ExportError::Io {
         path: path.to_owned(),
         source,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
-        _ => PathBuf::from("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(&dir).map_err(io)?;
-    tmp.write_all(bytes).map_err(io)?;
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    })
 }
 
 /// One mission item, as `.plan` and `.waypoints` both write it.

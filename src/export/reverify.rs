@@ -186,6 +186,20 @@ fn track_at(samples: &[TrackSample], t: f64) -> Option<Point3<f64>> {
     }
 }
 
+/// The largest distance between where `plan`, flown, puts its vehicle and
+/// where `track` has it, at the track's instants and at the flight's end.
+pub fn deviation(plan: &VehiclePlan, track: &Track) -> f64 {
+    let flight = Flight::new(plan);
+    let end = flight.arrivals().last().copied();
+    track
+        .samples
+        .iter()
+        .map(|s| s.t)
+        .chain(end)
+        .filter_map(|t| Some((flight.at(t).0 - track_at(&track.samples, t)?).norm()))
+        .fold(0.0, f64::max)
+}
+
 /// Flies `plans` and checks them against `limits` and the mission's band and
 /// bounds; measures deviation from `tracks` and timing errors.
 pub fn reverify(

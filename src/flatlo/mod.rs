@@ -210,6 +210,7 @@ pub struct PairDistance {
 /// Along-line distance between consecutive aircraft of the final line.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Spacing {
+    /// The aircraft in front and the one behind it (0-based indices).
     pub front: usize,
     pub back: usize,
     pub spacing: f64,

@@ -48,7 +48,12 @@ fn apply(table: &mut dyn TableLike, old: &toml::Table, new: &toml::Table) {
                     _ => &empty,
                 };
                 if table.get(key).and_then(Item::as_table_like).is_none() {
-                    table.insert(key, Item::Table(Table::new()));
+                    let mut fresh = Table::new();
+                    // In the model's order: before the next section the
+                    // file has (an [origin] added again goes above
+                    // [bounds], not after the obstacles).
+                    fresh.set_position(position_before(table, new, key));
+                    table.insert(key, Item::Table(fresh));
                 }
                 if let Some(child) = table.get_mut(key).and_then(Item::as_table_like_mut) {
                     apply(child, old_sub, sub);
@@ -72,6 +77,23 @@ fn apply(table: &mut dyn TableLike, old: &toml::Table, new: &toml::Table) {
     for key in gone {
         table.remove(&key);
     }
+}
+
+/// The document position for a new section `key` of `table` that puts it
+/// just before the first section after `key` in `model`'s order that the
+/// file already has; `None` (the end) when the file has none after it.
+fn position_before(table: &dyn TableLike, model: &toml::Table, key: &str) -> Option<isize> {
+    let first = |item: &Item| match item {
+        Item::Table(t) => t.position(),
+        Item::ArrayOfTables(a) => a.iter().next().and_then(Table::position),
+        _ => None,
+    };
+    model
+        .keys()
+        .skip_while(|k| k.as_str() != key)
+        .skip(1)
+        .find_map(|k| table.get(k).and_then(first))
+        .map(|p| p - 1)
 }
 
 fn is_array_of_tables(items: &[toml::Value]) -> bool {

@@ -164,20 +164,30 @@ pub fn save_edited(
 }
 
 /// Writes `bytes` to `path` through a synced temporary file and a rename.
+///
+/// The result has the permissions a plain `File::create` would give a new
+/// file (0666 less the umask: 0644 under the usual umask 022), or the mode
+/// of the file it replaces: a ground station running as another user, or a
+/// shared folder, reads an export as it reads any file the user writes.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let dir = match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => dir,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".skyform-save-")
-        .suffix(".tmp")
-        .tempfile_in(dir)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".skyform-save-").suffix(".tmp");
+    // Created with the mode `File::create` asks for, so the kernel applies
+    // the umask as it does for any new file (tempfile's own default is 0600).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(dir)?;
     tmp.write_all(bytes)?;
-    // The temporary file is private (0600); give the result the permissions
-    // the replaced file had, or the usual ones for a new file.
-    if let Some(permissions) = permissions_for(path) {
-        tmp.as_file().set_permissions(permissions)?;
+    // Replacing a file keeps its mode (a private mission stays private).
+    if let Ok(meta) = fs::metadata(path) {
+        tmp.as_file().set_permissions(meta.permissions())?;
     }
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
@@ -189,18 +199,30 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     Ok(())
 }
 
-/// Permissions for the file at `path` after a save.
-fn permissions_for(path: &Path) -> Option<fs::Permissions> {
-    if let Ok(meta) = fs::metadata(path) {
-        return Some(meta.permissions());
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+    use std::os::unix::fs::PermissionsExt;
+
+    fn mode(path: &Path) -> u32 {
+        fs::metadata(path).unwrap().permissions().mode() & 0o777
     }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        Some(fs::Permissions::from_mode(0o644))
-    }
-    #[cfg(not(unix))]
-    {
-        None
+
+    /// Issue 24, item 9: a new file gets what `File::create` gives (the
+    /// umask applied), a replaced one keeps its mode.
+    #[test]
+    fn atomic_writes_create_files_as_file_create_does_and_keep_a_replaced_mode() {
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("plain.txt");
+        fs::File::create(&plain).unwrap();
+        let atomic = dir.path().join("atomic.txt");
+        write_atomically(&atomic, b"one").unwrap();
+        assert_eq!(mode(&atomic), mode(&plain));
+        assert_ne!(mode(&atomic), 0o600, "not tempfile's private default");
+
+        fs::set_permissions(&atomic, fs::Permissions::from_mode(0o640)).unwrap();
+        write_atomically(&atomic, b"two").unwrap();
+        assert_eq!(mode(&atomic), 0o640);
+        assert_eq!(fs::read(&atomic).unwrap(), b"two");
     }
 }

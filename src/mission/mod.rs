@@ -8,6 +8,7 @@ mod file;
 mod model;
 mod presets;
 mod source;
+mod template;
 mod validate;
 
 pub use builtin::{BUILTIN, Builtin, default_mission};
@@ -18,6 +19,10 @@ pub use file::{
     to_toml_string, write_atomically,
 };
 pub use model::*;
-pub use presets::Preset;
+pub use presets::{
+    Preset, max_pair_distance, min_pair_distance, rescale, reshape, resize_custom, round_mm,
+    smallest_scale, spacing_of,
+};
 pub use source::{FieldPath, LineCol, PathSegment, SourceMap};
+pub use template::{name_for, template, template_text};
 pub use validate::{compact, compact_digits, validate};

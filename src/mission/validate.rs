@@ -122,8 +122,10 @@ impl Checker {
         let root = FieldPath::root();
         let b = &mission.bounds;
         for (key, [lo, hi]) in [("x", b.x), ("y", b.y)] {
+            // On the end that is far off (the one a typo made huge).
+            let end = usize::from(hi.abs() >= lo.abs());
             self.at_most(
-                root.key("bounds").key(key),
+                root.key("bounds").key(key).index(end),
                 hi - lo,
                 SPAN,
                 " m",
@@ -131,7 +133,7 @@ impl Checker {
             );
         }
         self.at_most(
-            root.key("bounds").key("z"),
+            root.key("bounds").key("z").index(1),
             b.z[1],
             CEILING,
             " m",
@@ -306,15 +308,30 @@ impl Checker {
         if !p.iter().all(|v| v.is_finite()) {
             return;
         }
-        if !mission.bounds.contains(p) {
-            let b = &mission.bounds;
-            self.error(
-                path.clone(),
-                format!(
-                    "{what} ({}, {}, {}) is outside the bounds x {:?}, y {:?}, z {:?}",
-                    p.x, p.y, p.z, b.x, b.y, b.z
-                ),
-            );
+        // Each coordinate outside its range is an error on that coordinate.
+        let b = &mission.bounds;
+        for (k, (v, [lo, hi], range)) in [
+            (p.x, b.x, "the bounds' x"),
+            (p.y, b.y, "the bounds' y"),
+            (p.z, b.z, "the altitude band z"),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if !(lo..=hi).contains(&v) {
+                self.error(
+                    path.index(k),
+                    format!(
+                        "{what} ({}, {}, {}) is outside the bounds: {} m is not in {range} [{}, {}] m",
+                        p.x,
+                        p.y,
+                        p.z,
+                        compact(v),
+                        compact(lo),
+                        compact(hi)
+                    ),
+                );
+            }
         }
         self.formation_fits(path, what, p, mission);
     }
@@ -403,7 +420,9 @@ impl Checker {
         }
         self.slot_spacing(&slots, f, 1.0, "slots");
         let centroid = f.slot_centroid();
-        if centroid.norm() > 1e-6 {
+        // Slots are written to the millimetre: a centroid within one of the
+        // origin is at it.
+        if centroid.norm() > 1e-3 {
             self.warning(
                 slots,
                 format!(
@@ -470,6 +489,24 @@ impl Checker {
         let names: Vec<&str> = mission.obstacles.iter().map(|o| o.name.as_str()).collect();
         for (i, w) in r.waypoints.iter().enumerate() {
             let at = path.key("waypoints").index(i);
+            // A second entry for one IWP is never used: said on the first,
+            // the one the designer shows (its Del removes both).
+            if let Some(first) = r.waypoints[..i]
+                .iter()
+                .position(|v| super::model::same_pair(&v.between, &w.between[0], &w.between[1]))
+            {
+                self.error(
+                    path.key("waypoints").index(first),
+                    format!(
+                        "entry {} names this IWP ('{}' ↔ '{}') again and is never used: \
+                         delete it in the file (Del on the IWP deletes both)",
+                        i + 1,
+                        w.between[0],
+                        w.between[1]
+                    ),
+                );
+                continue;
+            }
             for name in &w.between {
                 if !names.contains(&name.as_str()) {
                     self.error(

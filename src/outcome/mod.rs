@@ -12,6 +12,7 @@
 //! `Kind` variant and an `Outcome` variant with their arms here, its
 //! recorder layout (`record.rs`) and its export limits (`export::Planned`).
 
+pub mod iwp_groups;
 pub mod summary;
 
 use serde::Serialize;

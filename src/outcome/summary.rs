@@ -80,6 +80,32 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
         );
     }
     let _ = writeln!(s, "  verification");
+    for row in verification_rows(o) {
+        let verdict = if row.ok { "ok  " } else { "FAIL" };
+        let _ = writeln!(s, "    {verdict} {}", row.text);
+    }
+    let verdict = if o.feasible() {
+        "FEASIBLE"
+    } else {
+        "INFEASIBLE"
+    };
+    let _ = writeln!(s, "  result       {verdict}");
+    s
+}
+
+/// One row of θ-PSO's verification table: a check or an inspection pass,
+/// whether it holds, and the text the CLI prints after `ok`/`FAIL` (the
+/// designer shows the same rows).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VerificationRow {
+    pub ok: bool,
+    pub text: String,
+}
+
+/// The verification table of a θ-PSO outcome: each check with its worst
+/// value and where, then each inspection with its stretch and band.
+pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
+    let mut rows = Vec::new();
     for check in &o.verification.checks {
         let worst = check
             .worst
@@ -91,30 +117,32 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
                 .map_or_else(String::new, |o| format!(" vs {o}"));
             format!("  (UAV {} at t = {:.1} s{other})", a.uav + 1, a.time)
         });
-        let verdict = if check.ok { "ok  " } else { "FAIL" };
-        let _ = writeln!(
-            s,
-            "    {verdict} {:<32} worst {worst:>9} {} {}{at}",
-            check.name, check.relation, check.limit
-        );
+        rows.push(VerificationRow {
+            ok: check.ok,
+            text: format!(
+                "{:<32} worst {worst:>9} {} {}{at}",
+                check.name, check.relation, check.limit
+            ),
+        });
     }
     for i in &o.verification.inspections {
-        let verdict = if i.ok { "ok  " } else { "FAIL" };
         let band = i.distance.map_or_else(
             || "never within the band".to_owned(),
             |[lo, hi]| format!("facing UAV at {lo:.2}-{hi:.2} m"),
         );
-        let _ = writeln!(
-            s,
-            "    {verdict} inspection of {:<19} {:>5.1} m ≥ {} m within [{}, {}] m, {band}",
-            format!("'{}'", i.obstacle),
-            i.achieved,
-            i.required,
-            i.band[0],
-            i.band[1]
-        );
+        rows.push(VerificationRow {
+            ok: i.ok,
+            text: format!(
+                "inspection of {:<19} {:>5.1} m ≥ {} m within [{}, {}] m, {band}",
+                format!("'{}'", i.obstacle),
+                i.achieved,
+                i.required,
+                i.band[0],
+                i.band[1]
+            ),
+        });
     }
-    s
+    rows
 }
 
 /// The IWP lines of the θ-PSO summary.
@@ -247,7 +275,7 @@ pub fn flatlo(o: &FlatloOutcome) -> String {
     let spacing: Vec<String> = v
         .final_spacing
         .iter()
-        .map(|x| format!("{}→{} {:.1} m", x.front, x.back, x.spacing))
+        .map(|x| format!("{}→{} {:.1} m", x.front + 1, x.back + 1, x.spacing))
         .collect();
     let _ = writeln!(s, "  final line   {}", spacing.join(", "));
     let _ = writeln!(

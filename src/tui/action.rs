@@ -78,6 +78,8 @@ pub enum Action {
     EditStart(Option<char>),
     EditInput(char),
     EditBackspace,
+    /// Clear the line being typed (Ctrl-u), as in a shell.
+    EditClear,
     EditCommit,
     EditCancel,
 

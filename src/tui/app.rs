@@ -329,8 +329,8 @@ impl App {
                 }
             }
             Export => {
-                let path = self.editor.doc().path();
-                match super::export::export_shown(self.board.shown(), path, &self.cwd) {
+                let doc = self.editor.doc();
+                match super::export::export_shown(self.board.shown(), doc, &self.cwd) {
                     Ok(text) => self.status.say(text),
                     Err(text) => self.status.error(text),
                 }
@@ -338,7 +338,7 @@ impl App {
             SelectNext | SelectPrevious | Select(_) | Nudge(..) | AddObstacle(_)
             | ToggleAddTool | Duplicate | Delete | AddSlot | CyclePreset | CycleShape
             | ToggleWaypoint | ToggleInspect | FieldUp | FieldDown | EditStart(_)
-            | EditInput(_) | EditBackspace | EditCommit | EditCancel | Undo | Redo
+            | EditInput(_) | EditBackspace | EditClear | EditCommit | EditCancel | Undo | Redo
             | DragStart(..) | DragTo(_) | DragEnd => self.update_editor(action),
         }
     }
@@ -349,6 +349,9 @@ impl App {
             Action::Quit => {
                 if self.editor.doc().is_modified() {
                     self.overlays.show(Overlay::Quit);
+                } else if self.board.any_running() {
+                    // A run would be lost without a word: ask.
+                    self.overlays.show(Overlay::QuitRunning);
                 } else {
                     self.shutdown();
                 }
@@ -488,6 +491,11 @@ impl App {
         self.shutdown();
     }
 
+    /// How many jobs are running (quitting cancels them).
+    pub fn running_jobs(&self) -> usize {
+        self.board.jobs().iter().filter(|j| j.is_running()).count()
+    }
+
     /// Cancels running jobs (they return their best at once) and stops.
     fn shutdown(&mut self) {
         self.board.cancel_all();
@@ -603,6 +611,10 @@ impl App {
                 }
                 self.shutdown();
             }
+            Some(Overlay::QuitRunning) => {
+                self.overlays.close();
+                self.shutdown();
+            }
             Some(Overlay::SaveAs { input, then }) => {
                 let input = input.trim();
                 if input.is_empty() {
@@ -670,10 +682,17 @@ impl App {
             name,
             path,
             errors,
+            new,
         } = loaded;
-        let doc = Document::new(m, path)
-            .with_source(text)
-            .with_label(entry.label());
+        let doc = match (&entry, path) {
+            (Entry::New(p), _) => Document::new_file(m, p.clone()),
+            (_, path) => Document::new(m, path),
+        }
+        .with_source(text);
+        let doc = match &entry {
+            Entry::Builtin(name) => doc.with_builtin(name),
+            Entry::File(_) | Entry::New(_) => doc.with_label(entry.label()),
+        };
         // The jobs were of the other mission: not "stale", gone.
         self.board.clear();
         self.editor.replace(doc);
@@ -682,12 +701,16 @@ impl App {
             // (the user was asked); its copy goes with them.
             r.discard();
             self.enable_recovery(match &entry {
-                Entry::File(p) => Origin::File(p.clone()),
+                Entry::File(p) | Entry::New(p) => Origin::File(p.clone()),
                 Entry::Builtin(name) => Origin::Builtin((*name).to_owned()),
             });
         }
         self.camera.fit_map();
-        if errors > 0 {
+        if new {
+            self.status.say(format!(
+                "new mission {name} (a box, a start, a goal): Ctrl-s creates the file"
+            ));
+        } else if errors > 0 {
             self.status
                 .error(format!("opened {name}: {errors} error(s) to fix"));
         } else {

@@ -11,7 +11,7 @@ use std::time::Instant;
 use crossbeam_channel::{Receiver, Sender, unbounded};
 
 use super::action::Action;
-use super::document::{Document, stem};
+use super::document::Document;
 use super::jobs::{self, Job, JobId, JobMsg, Kind, RecordSettings, Viewer};
 use super::status::StatusLine;
 use crate::pipeline::Level;
@@ -200,11 +200,15 @@ impl JobBoard {
             return;
         }
         let id = self.jobs.last().map_or(1, |j| j.id + 1);
-        let job = Job::new(id, pipeline, seed, doc.mission().clone(), Instant::now());
+        let mut job = Job::new(id, pipeline, seed, doc.mission().clone(), Instant::now());
+        // A new name rather than over an earlier recording (of this session
+        // or a file already there).
+        let taken: Vec<&Path> = self.jobs.iter().filter_map(|j| j.rrd.as_deref()).collect();
+        job.rrd = self
+            .record_rrd
+            .then(|| rrd_path(doc, cwd, pipeline.slug(), seed, &taken));
         let record = RecordSettings {
-            rrd: self
-                .record_rrd
-                .then(|| rrd_path(doc, cwd, pipeline.slug(), seed)),
+            rrd: job.rrd.clone(),
             viewer: self.viewer,
         };
         jobs::spawn_pipeline(
@@ -216,10 +220,14 @@ impl JobBoard {
             record,
             self.tx.clone(),
         );
+        let recording = job.rrd.as_ref().map_or_else(String::new, |p| {
+            let name = p.file_name().unwrap_or(p.as_os_str());
+            format!(", recording to {}", name.to_string_lossy())
+        });
         self.jobs.push(job);
         self.cursor = self.jobs.len() - 1;
         status.say(format!(
-            "job {id}: {} started with seed {seed} (x cancels)",
+            "job {id}: {} started with seed {seed}{recording} (x cancels)",
             pipeline.name()
         ));
     }
@@ -251,10 +259,19 @@ impl JobBoard {
                 } else {
                     "done"
                 };
-                let text = match &job.outcome {
+                let mut text = match &job.outcome {
                     Some(o) => format!("job {id} {verb}: {}", o.headline()),
                     None => format!("job {id} {verb}"),
                 };
+                // The recording is written before the run reports its end:
+                // the status names the file.
+                if let Some((path, bytes)) = &job.recorded {
+                    text.push_str(&format!(
+                        " · recorded {} ({:.1} MB)",
+                        path.display(),
+                        *bytes as f64 / 1e6
+                    ));
+                }
                 self.shown = Some(id);
                 shown = true;
                 status.say(text);
@@ -267,13 +284,21 @@ impl JobBoard {
     }
 }
 
-/// `<mission file stem>-<pipeline>-seed<N>.rrd` beside the mission file
-/// (in `cwd` for a mission without one).
-pub fn rrd_path(doc: &Document, cwd: &Path, pipeline: &str, seed: u64) -> PathBuf {
+/// `<mission stem>-<pipeline>-seed<N>.rrd` beside the mission file (in
+/// `cwd` for a mission without one), the stem as [`Document::stem`] gives
+/// it; `-2`, `-3`… before `.rrd` when that file exists or is `taken` by a
+/// run of this session, so no recording replaces another.
+pub fn rrd_path(doc: &Document, cwd: &Path, pipeline: &str, seed: u64, taken: &[&Path]) -> PathBuf {
     let dir = match doc.path() {
         Some(p) => p.parent().map(Path::to_path_buf).unwrap_or_default(),
         None => cwd.to_path_buf(),
     };
-    let stem = stem(doc.path(), &doc.mission().name);
-    dir.join(format!("{stem}-{pipeline}-seed{seed}.rrd"))
+    let base = format!("{}-{pipeline}-seed{seed}", doc.stem());
+    (1..)
+        .map(|k| match k {
+            1 => dir.join(format!("{base}.rrd")),
+            k => dir.join(format!("{base}-{k}.rrd")),
+        })
+        .find(|p| !p.exists() && !taken.contains(&p.as_path()))
+        .unwrap_or_else(|| dir.join(format!("{base}.rrd")))
 }

@@ -34,6 +34,8 @@ pub struct Document {
     changes: usize,
     /// What to call a document without a file ("(built-in) NAME").
     label: Option<String>,
+    /// The shipped mission it is a copy of, by file name, until it is saved.
+    builtin: Option<&'static str>,
 }
 
 impl Document {
@@ -51,7 +53,23 @@ impl Document {
             source: None,
             changes: 0,
             label: None,
+            builtin: None,
         }
+    }
+
+    /// A copy of the shipped mission `file_name` (no file of its own yet):
+    /// named after it in the status bar, recordings and exports.
+    pub fn with_builtin(mut self, file_name: &'static str) -> Self {
+        self.builtin = Some(file_name);
+        self.label = Some(format!("(built-in) {file_name}"));
+        self
+    }
+
+    /// What files made from this mission are named after: its file's stem,
+    /// else the shipped mission's (`bridge-inspection`), else its name's slug.
+    pub fn stem(&self) -> String {
+        let builtin = self.builtin.map(Path::new);
+        stem(self.path.as_deref().or(builtin), &self.mission.name)
     }
 
     /// Names a document that has no file yet (a built-in mission).

@@ -11,14 +11,13 @@
 
 use std::path::PathBuf;
 
-use nalgebra::{Point2, Vector2, Vector3};
+use nalgebra::{Point2, Vector2};
 
 use super::action::{Action, Pane};
 use super::document::Document;
 use super::fields::{self, Field, Item};
 use super::status::StatusLine;
 use crate::mission::{self, FleetTarget, Mission, MissionError, PathSegment, Preset, Severity};
-use crate::planner::iwp::min_pair_distance;
 use crate::planner::{Iwp, find_iwps};
 
 /// A line of text being typed into an inspector field.
@@ -240,6 +239,12 @@ impl Editor {
                     self.check_editing();
                 }
             }
+            EditClear => {
+                if let Some(e) = &mut self.editing {
+                    e.buffer.clear();
+                    self.check_editing();
+                }
+            }
             EditCommit => self.commit_edit(status),
             EditCancel => self.editing = None,
             Undo => self.step_history(true, status),
@@ -359,29 +364,76 @@ impl Editor {
         }
     }
 
+    /// One more UAV: a preset grows as itself (a diamond of 5 is a diamond
+    /// of 6), at a spacing valid for the mission; a custom shape gets one
+    /// behind its rearmost slot.
     fn add_slot(&mut self, status: &mut StatusLine) {
-        let slots = &self.mission().formation.slots;
-        let back = slots.iter().map(|s| s.x).fold(0.0, f64::min);
-        let spacing = self.preset_spacing();
-        self.edit(status, |m| {
-            m.formation
-                .slots
-                .push(Vector3::new(back - spacing, 0.0, 0.0))
-        });
-        self.select(Item::Slot(self.mission().formation.slots.len() - 1));
+        let n = self.mission().formation.slots.len() + 1;
+        let mut trial = self.mission().clone();
+        let said = match Preset::detect(&trial.formation.slots) {
+            Some((preset, _)) if n > 2 => match mission::reshape(&mut trial, preset, n, None) {
+                Ok(spacing) => format!(
+                    "formation: {} of {n}, {} m apart",
+                    preset.name(),
+                    fields::fmt_num(spacing)
+                ),
+                Err(e) => {
+                    status.error(e);
+                    return;
+                }
+            },
+            _ => {
+                let spacing = mission::spacing_of(&trial);
+                trial.formation.slots = mission::resize_custom(&trial.formation.slots, n, spacing);
+                format!("slot {n} added behind the others")
+            }
+        };
+        self.edit(status, |m| *m = trial);
+        self.select(Item::Slot(n - 1));
+        status.say(said);
     }
 
+    /// The next preset for this many UAVs that draws a new shape and fits
+    /// the mission (r_Q, shrink, d_com); those that do not fit are named.
     fn cycle_preset(&mut self, status: &mut StatusLine) {
-        self.preset = self.preset.next();
         let n = self.mission().formation.slots.len().max(1);
-        let spacing = self.preset_spacing();
-        let slots = self.preset.slots(n, spacing);
-        self.edit(status, |m| m.formation.slots = slots);
-        status.say(format!(
-            "formation: {} of {n}, {} m apart",
-            self.preset.name(),
-            fields::fmt_num(spacing)
-        ));
+        let scale = mission::smallest_scale(&self.mission().reconfiguration);
+        let formation = &self.mission().formation;
+        let (fit, misfits): (Vec<Preset>, Vec<Preset>) = Preset::distinct(n)
+            .into_iter()
+            .partition(|p| p.spacing_range(n, formation, scale).is_some());
+        let current = self.current_preset().unwrap_or(self.preset);
+        let after = Preset::ALL.iter().position(|p| *p == current).unwrap_or(0);
+        let next = (1..=Preset::ALL.len())
+            .map(|k| Preset::ALL[(after + k) % Preset::ALL.len()])
+            .find(|p| fit.contains(p));
+        let Some(next) = next else {
+            let mut trial = self.mission().clone();
+            let why = mission::reshape(&mut trial, current, n, None)
+                .err()
+                .unwrap_or_default();
+            status.error(format!("no preset of {n} fits this mission: {why}"));
+            return;
+        };
+        self.preset = next;
+        let mut trial = self.mission().clone();
+        match mission::reshape(&mut trial, next, n, None) {
+            Ok(spacing) => {
+                self.edit(status, |m| *m = trial);
+                let skipped = if misfits.is_empty() {
+                    String::new()
+                } else {
+                    let names: Vec<&str> = misfits.iter().map(|p| p.name()).collect();
+                    format!(" ({} of {n} would not fit d_com)", names.join(", "))
+                };
+                status.say(format!(
+                    "formation: {} of {n}, {} m apart{skipped}",
+                    next.name(),
+                    fields::fmt_num(spacing)
+                ));
+            }
+            Err(e) => status.error(e),
+        }
     }
 
     fn cycle_shape(&mut self, status: &mut StatusLine) {
@@ -457,23 +509,7 @@ impl Editor {
 
     /// The preset the slots are now (after any undo), if they are one.
     pub fn current_preset(&self) -> Option<Preset> {
-        let slots = &self.mission().formation.slots;
-        let spacing = self.preset_spacing();
-        Preset::ALL.into_iter().find(|p| {
-            let made = p.slots(slots.len().max(1), spacing);
-            made.len() == slots.len() && made.iter().zip(slots).all(|(a, b)| (a - b).norm() < 1e-9)
-        })
-    }
-
-    fn preset_spacing(&self) -> f64 {
-        let f = &self.mission().formation;
-        let d = min_pair_distance(&f.slots);
-        let floor = 2.0 * f.uav_radius + 1.0;
-        if d.is_finite() {
-            d.max(floor)
-        } else {
-            floor.max(2.0)
-        }
+        Preset::detect(&self.mission().formation.slots).map(|(p, _)| p)
     }
 
     fn nudge(&mut self, dx: f64, dy: f64, s: f64, status: &mut StatusLine) {
@@ -490,8 +526,8 @@ impl Editor {
                 // Formation frame on screen: forward is up, left is left.
                 self.edit(status, |m| {
                     if let Some(slot) = m.formation.slots.get_mut(i) {
-                        slot.x += dy * s;
-                        slot.y -= dx * s;
+                        slot.x = mission::round_mm(slot.x + dy * s);
+                        slot.y = mission::round_mm(slot.y - dx * s);
                     }
                 });
             }
@@ -588,9 +624,14 @@ impl Editor {
         let mut trial = self.mission().clone();
         let problem = match field.set(&mut trial, &self.selected, &editing.buffer) {
             Err(e) => Some((Severity::Error, e)),
+            // What the value would cause on this field, or on the array
+            // it is an element of (x max of an inverted x range).
             Ok(()) => crate::diagnose::diagnose(&trial)
                 .into_iter()
-                .filter(|d| fields::owner(&fields, &d.path) == Some(self.field))
+                .filter(|d| {
+                    fields::place(&self.selected, &trial, &fields, &d.path)
+                        .is_some_and(|(at, _)| at.covers(self.field))
+                })
                 .min_by_key(|d| d.severity)
                 .map(|d| (d.severity, d.message)),
         };
@@ -659,7 +700,10 @@ fn iwps_despite_choices(m: &Mission, diagnostics: &[mission::Diagnostic]) -> Vec
     find_iwps(&clean)
 }
 
+/// Moves a movable item to `p`, to the millimetre (steps of 0.1 m add up
+/// to 0.30000000000000004 otherwise, and files would say so).
 fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
+    let p = p.map(mission::round_mm);
     match item {
         Item::Obstacle(i) => {
             if let Some(o) = m.obstacles.get_mut(*i) {

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::document::stem;
+use super::document::Document;
 use super::jobs::{Job, Outcome};
 use crate::export::{self, ExportError, Format, Options, Planned};
 use crate::mission::Mission;
@@ -23,19 +23,15 @@ pub fn folder(mission_path: Option<&Path>, cwd: &Path, stem: &str) -> PathBuf {
     dir.join(format!("{stem}-export"))
 }
 
-/// Exports the result on the map (`shown`) beside the mission file at
-/// `mission_path` (in `cwd` without one): the status line on success, the
-/// reason on refusal or failure.
-pub fn export_shown(
-    shown: Option<&Job>,
-    mission_path: Option<&Path>,
-    cwd: &Path,
-) -> Result<String, String> {
+/// Exports the result on the map (`shown`) beside the document's file (in
+/// `cwd` without one), named after the document ([`Document::stem`]): the
+/// status line on success, the reason on refusal or failure.
+pub fn export_shown(shown: Option<&Job>, doc: &Document, cwd: &Path) -> Result<String, String> {
     let Some(job) = shown else {
         return Err("no result on the map to export: run a pipeline, or Enter on a job".into());
     };
-    let stem = stem(mission_path, &job.mission.name);
-    export_job(job, &folder(mission_path, cwd, &stem), &stem)
+    let stem = doc.stem();
+    export_job(job, &folder(doc.path(), cwd, &stem), &stem)
 }
 
 /// Exports `job`'s result (not forced): the status line on success, the

@@ -5,10 +5,9 @@
 //! field is in the mission (keys below the table's base path: a typed
 //! [`FieldPath`], the one the validator reports its diagnostics on), and
 //! how it is read and written as text. Typing a value, pasting one and a
-//! test all go through the same `set`; a validation message finds the
-//! field it names by comparing typed paths ([`owner`]: the field the
-//! message is on or inside, else the first element of the array it is
-//! about).
+//! test all go through the same `set`; a validation message is drawn where
+//! its path says ([`place`]: under the field at that path, after the group
+//! of fields that are that array's elements, or with the item at that path).
 //! The tables themselves are in `fields/table.rs`.
 
 use nalgebra::Point2;
@@ -174,6 +173,10 @@ struct Spec {
 /// The fields of one kind of item, below one base path.
 struct Table {
     base: &'static [Step],
+    /// Fields worked out from others (the formation's preset, UAVs and
+    /// spacing, all from its slots), shown first; each is at its keys'
+    /// path (they share keys without being an array's elements).
+    derived: &'static [Spec],
     fields: &'static [Spec],
 }
 
@@ -195,6 +198,9 @@ impl Table {
             };
         }
         let path = spec.keys.iter().fold(path, |p, key| p.key(key));
+        if self.derived.iter().any(|s| std::ptr::eq(s, spec)) {
+            return path;
+        }
         let mut siblings = self.fields.iter().filter(|s| s.keys == spec.keys);
         let element = siblings.clone().position(|s| std::ptr::eq(s, spec));
         match (siblings.nth(1), element) {
@@ -231,7 +237,7 @@ impl Field {
         self.spec.unit
     }
 
-    /// Where the field is in the mission; [`owner`] says which
+    /// Where the field is in the mission; [`place`] says which
     /// diagnostics are shown under it.
     pub fn path(&self) -> &FieldPath {
         &self.path
@@ -253,8 +259,9 @@ impl Field {
 pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
     let table = table::of(item);
     table
-        .fields
+        .derived
         .iter()
+        .chain(table.fields)
         .filter_map(|spec| {
             let value = (spec.get)(mission, item)?;
             let label = if spec.unit.is_empty() {
@@ -272,31 +279,92 @@ pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
         .collect()
 }
 
-/// Which of `fields` a message at `path` belongs under: the field whose path
-/// is the longest start of it (the field itself or something inside it),
-/// else the first element of the array the message is about (`bounds.x`:
-/// x min). None when no field shows it (it is listed below the fields).
-pub fn owner(fields: &[Field], path: &FieldPath) -> Option<usize> {
+/// Where the inspector draws a message among an item's fields.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Place {
+    /// Under this field.
+    Field(usize),
+    /// Under the fields `first..=last`, the elements of one array (x min
+    /// and x max of `bounds.x`): after the last of them.
+    Group(usize, usize),
+    /// Below the item's fields, with the item (`route.start` under Start).
+    Item,
+}
+
+impl Place {
+    /// Whether a message here concerns field `k` (while it is typed into).
+    pub fn covers(self, k: usize) -> bool {
+        match self {
+            Place::Field(f) => f == k,
+            Place::Group(a, b) => (a..=b).contains(&k),
+            Place::Item => false,
+        }
+    }
+
+    /// After which field the message is drawn (`None`: after them all).
+    pub fn after(self) -> Option<usize> {
+        match self {
+            Place::Field(k) | Place::Group(_, k) => Some(k),
+            Place::Item => None,
+        }
+    }
+}
+
+/// Where a message at `path` is drawn for `item` (its `fields`), and
+/// whether that place is at the message's own path. The place whose path
+/// is the message's: its field, the group of its array's elements, the item
+/// itself. Failing those (a message deeper than any field), the field it is
+/// inside (the longest start of its path), else the item it is inside,
+/// where it is listed with its path. `None`: it is another item's.
+pub fn place(
+    item: &Item,
+    m: &Mission,
+    fields: &[Field],
+    path: &FieldPath,
+) -> Option<(Place, bool)> {
+    if let Some(k) = fields.iter().position(|f| f.path() == path) {
+        return Some((Place::Field(k), true));
+    }
+    let elements: Vec<usize> = fields
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| {
+            let p = &f.path().0;
+            p.len() == path.0.len() + 1
+                && f.path().starts_with(path)
+                && matches!(p.last(), Some(PathSegment::Index(_)))
+        })
+        .map(|(k, _)| k)
+        .collect();
+    if let (Some(&a), Some(&b)) = (elements.first(), elements.last()) {
+        return Some((Place::Group(a, b), true));
+    }
+    let item_path = item.path(m);
+    if item_path.as_ref() == Some(path) {
+        return Some((Place::Item, true));
+    }
     let inside = fields
         .iter()
         .enumerate()
         .filter(|(_, f)| path.starts_with(f.path()))
         .max_by_key(|(k, f)| (f.path().0.len(), std::cmp::Reverse(*k)));
     if let Some((k, _)) = inside {
-        return Some(k);
+        return Some((Place::Field(k), false));
     }
-    fields.iter().position(|f| {
-        let element = &f.path().0;
-        element.len() == path.0.len() + 1
-            && f.path().starts_with(path)
-            && matches!(element.last(), Some(PathSegment::Index(_)))
-    })
+    item_path
+        .filter(|p| path.starts_with(p))
+        .map(|_| (Place::Item, false))
 }
 
 /// Metres, degrees, gains: any finite number.
 pub fn number(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
+        // `1e400` is a number, one too large for any field (Rust reads it
+        // as infinity); `inf` and `nan` are not numbers a field takes.
+        Ok(v) if v.is_infinite() && text.chars().any(|c| c.is_ascii_digit()) => Err(format!(
+            "'{text}' is too large: the largest number a field holds is about 1.8e308"
+        )),
         _ => Err(format!("'{text}' is not a number")),
     }
 }
@@ -420,13 +488,15 @@ mod tests {
         ];
         for item in items {
             for (k, f) in fields(&item, &m).into_iter().enumerate() {
-                let value = if f.label().contains("shape") {
-                    "shrink".to_string()
-                } else if f.value() == "yes" || f.value() == "no" {
-                    "yes".to_string()
-                } else {
-                    "7".to_string()
-                };
+                let value = match f.label() {
+                    l if l.contains("shape") => "shrink",
+                    "preset" => "diamond",
+                    "cost" => "paper",
+                    "encoding" => "angle",
+                    _ if f.value() == "yes" || f.value() == "no" => "yes",
+                    _ => "7",
+                }
+                .to_string();
                 f.set(&mut m, &item, &value).unwrap();
                 assert_eq!(
                     fields(&item, &m)[k].value(),
@@ -455,7 +525,8 @@ mod tests {
         let mut m = default_mission().mission;
         m.reconfiguration.waypoints.clear();
         let item = Item::Waypoint(["pier 5".into(), "light pole 4".into()]);
-        let shape = &fields(&item, &m)[1];
+        let shape = &fields(&item, &m)[2];
+        assert_eq!(shape.label(), "shape");
         assert!(shape.set(&mut m, &item, "round").is_err());
         assert!(
             m.reconfiguration.waypoints.is_empty(),
@@ -466,23 +537,30 @@ mod tests {
         assert_eq!(m.reconfiguration.waypoints[0].shape, ShapeChoice::Rotation);
         // Named the other way round, it is the same IWP.
         let item = Item::Waypoint(["light pole 4".into(), "pier 5".into()]);
-        fields(&item, &m)[0].set(&mut m, &item, "no").unwrap();
+        fields(&item, &m)[1].set(&mut m, &item, "no").unwrap();
         assert_eq!(m.reconfiguration.waypoints.len(), 1);
         assert!(!m.reconfiguration.waypoints[0].enabled);
     }
 
-    /// The message a field's owner would show, by the field's label.
+    /// The label of the field (or of the last field of the group) a
+    /// message holding `message` is drawn under for `item`; "item" when it
+    /// is drawn with the item.
     fn shown_under(item: &Item, m: &Mission, message: &str) -> Option<String> {
         let fields = fields(item, m);
         let d = crate::diagnose::diagnose(m)
             .into_iter()
             .find(|d| d.message.contains(message))?;
-        owner(&fields, &d.path).map(|k| fields[k].label().to_owned())
+        let (place, _) = place(item, m, &fields, &d.path)?;
+        Some(match place.after() {
+            Some(k) => fields[k].label().to_owned(),
+            None => "item".to_owned(),
+        })
     }
 
     /// A message on one element of an array is under that element's field;
-    /// one on the whole array under its first element; an IWP's own entry's
-    /// messages are under the IWP, and an IWP without an entry claims none.
+    /// one on the whole array after the group of its elements; an IWP's own
+    /// entry's messages are under the IWP, and an IWP without an entry
+    /// claims none.
     #[test]
     fn each_message_is_under_the_field_it_names() {
         let mut m = default_mission().mission;
@@ -497,23 +575,35 @@ mod tests {
             shown_under(&Item::Start, &m, "finite").as_deref(),
             Some("z (m)")
         );
-        m.route.start.z = 5.0;
-        m.bounds.x = [50.0, 10.0];
+        // Issue 24, item 6: the start's altitude out of the band is under z.
+        m.route.start.z = 50.0;
+        assert_eq!(
+            shown_under(&Item::Start, &m, "altitude band").as_deref(),
+            Some("z (m)")
+        );
+        m.route.start.z = 10.0;
+        // An inverted range is about both ends: after the pair.
+        m.bounds.x = [150.0, 100.0];
+        let bounds = fields(&Item::Bounds, &m);
         let d = crate::diagnose::diagnose(&m);
         let whole = d
             .iter()
             .find(|d| d.path.to_string() == "bounds.x")
             .expect("a message on bounds.x");
-        let bounds = fields(&Item::Bounds, &m);
         assert_eq!(
-            owner(&bounds, &whole.path).map(|k| bounds[k].label()),
-            Some("x min (m)")
+            place(&Item::Bounds, &m, &bounds, &whole.path),
+            Some((Place::Group(0, 1), true))
+        );
+        // Issue 24, item 6: 1e9 typed into x max is a message under x max.
+        m.bounds.x = [0.0, 1e9];
+        assert_eq!(
+            shown_under(&Item::Bounds, &m, "local plane").as_deref(),
+            Some("x max (m)")
         );
         m.bounds.x = [0.0, 138.0];
 
-        // An IWP entry naming a missing obstacle: its message is listed
-        // with the IWP (no field holds `between`), and the IWP without an
-        // entry does not claim it.
+        // An IWP entry naming a missing obstacle: its message is under the
+        // IWP's obstacles field, and the IWP without an entry claims none.
         let iwp = Item::Waypoint(["pier 5".into(), "light pole 4".into()]);
         m.reconfiguration.waypoints.clear();
         m.reconfiguration.waypoints.push(WaypointChoice {
@@ -528,11 +618,21 @@ mod tests {
             .iter()
             .find(|d| d.path.to_string() == "reconfiguration.waypoints[0].between")
             .expect("a message on the missing name");
-        assert!(owner(&fields(&iwp, &m), &between.path).is_none());
-        assert!(owner(&fields(&broken, &m), &between.path).is_none());
-        let listed = broken.path(&m).expect("the entry's path");
-        assert!(between.path.starts_with(&listed));
+        assert!(place(&iwp, &m, &fields(&iwp, &m), &between.path).is_none());
+        let broken_fields = fields(&broken, &m);
+        let (at, exact) = place(&broken, &m, &broken_fields, &between.path).unwrap();
+        assert!(exact);
+        assert_eq!(broken_fields[at.after().unwrap()].label(), "obstacles");
         assert!(iwp.path(&m).is_none());
+    }
+
+    /// Issue 24, item 6: a number too large for a double is not "not a number".
+    #[test]
+    fn a_number_too_large_says_so() {
+        assert!(number("1e400").unwrap_err().contains("too large"));
+        assert!(number("-1e400").unwrap_err().contains("too large"));
+        assert_eq!(number("inf").unwrap_err(), "'inf' is not a number");
+        assert_eq!(number("1e9"), Ok(1e9));
     }
 
     /// Issue 13: a field's path is the typed path the validator reports on.
@@ -571,7 +671,7 @@ mod tests {
             at(&iwp, &m, "shape").as_deref(),
             Some("reconfiguration.waypoints[0].shape")
         );
-        fields(&iwp, &m)[1].set(&mut m, &iwp, "shrink").unwrap();
+        fields(&iwp, &m)[2].set(&mut m, &iwp, "shrink").unwrap();
         assert_eq!(
             at(&iwp, &m, "shape").as_deref(),
             Some("reconfiguration.waypoints[0].shape")

@@ -91,7 +91,11 @@ pub fn app_with_flatlo_result(mission: Mission, seed: u64) -> App {
 /// it, by actions as a user would (focus, arrows, typing, Enter).
 pub fn type_into(app: &mut App, label: &str, text: &str) {
     let Some(k) = app.fields().iter().position(|f| f.label() == label) else {
-        panic!("no field {label}");
+        panic!(
+            "no field {label} among {:?} of {:?}",
+            app.fields(),
+            app.selected()
+        );
     };
     app.update(Action::FocusOn(Focus::Inspector));
     while app.editor().field() > k {

@@ -32,6 +32,7 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
             KeyCode::Enter | KeyCode::Tab => Some(Action::EditCommit),
             KeyCode::Esc => Some(Action::EditCancel),
             KeyCode::Backspace => Some(Action::EditBackspace),
+            KeyCode::Char('u') if ctrl => Some(Action::EditClear),
             KeyCode::Up => Some(Action::FieldUp),
             KeyCode::Down => Some(Action::FieldDown),
             KeyCode::Char(c) if !ctrl => Some(Action::EditInput(c)),
@@ -83,6 +84,11 @@ fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
             KeyCode::Esc => Some(Action::Dismiss),
             KeyCode::Backspace => Some(Action::PromptBackspace),
             KeyCode::Char(c) if !ctrl => Some(Action::PromptInput(c)),
+            _ => None,
+        },
+        Overlay::QuitRunning => match key.code {
+            KeyCode::Char('y') | KeyCode::Char('q') => Some(Action::Confirm),
+            KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
             _ => None,
         },
         Overlay::Recover(_) => match key.code {

@@ -130,6 +130,10 @@ pub struct Job {
     pub started: Instant,
     pub ended: Option<Instant>,
     pub cancel: CancelToken,
+    /// The `.rrd` the run records to, if it does.
+    pub rrd: Option<PathBuf>,
+    /// The recording written, and its size in bytes.
+    pub recorded: Option<(PathBuf, u64)>,
 }
 
 impl Job {
@@ -149,6 +153,8 @@ impl Job {
             started,
             ended: None,
             cancel: CancelToken::new(),
+            rrd: None,
+            recorded: None,
         }
     }
 
@@ -182,7 +188,8 @@ impl Job {
                 }
             }
             JobMsg::Log(_, Level::Warn, text) => self.last_warning = Some(text),
-            JobMsg::Log(_, Level::Info, _) | JobMsg::Recorded { .. } => {}
+            JobMsg::Recorded { path, bytes, .. } => self.recorded = Some((path, bytes)),
+            JobMsg::Log(_, Level::Info, _) => {}
             JobMsg::Done(_, result) => {
                 self.ended = Some(now);
                 match result {

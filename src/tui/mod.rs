@@ -57,14 +57,18 @@ pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), 
     let builtin = mission::BUILTIN[0].text;
     let Some(path) = path else {
         return Ok((
-            Document::new(mission::default_mission().mission, None).with_source(builtin),
+            Document::new(mission::default_mission().mission, None)
+                .with_source(builtin)
+                .with_builtin(mission::BUILTIN[0].file_name),
             None,
         ));
     };
     if !path.exists() {
-        let doc = Document::new_file(mission::default_mission().mission, path.to_path_buf())
-            .with_source(builtin);
-        let note = format!("{} does not exist yet: Ctrl-s creates it", path.display());
+        let doc = new_document(path)?;
+        let note = format!(
+            "{} is a new mission (a box, a start, a goal): Ctrl-s creates the file",
+            path.display()
+        );
         return Ok((doc, Some(note)));
     }
     let text = mission::read(path).map_err(|e| e.to_string())?;
@@ -100,6 +104,15 @@ pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), 
             Err(format!("{name} is not a valid mission:\n{text}"))
         }
     }
+}
+
+/// A new, unsaved mission to be written at `path`: the minimal template
+/// (`mission::template_text`), named after the file. A shipped mission is
+/// copied only on purpose (`skyform new --from`, the open dialog).
+pub fn new_document(path: &Path) -> Result<Document, String> {
+    let name = mission::name_for(path);
+    let m = mission::template(&name).map_err(|e| e.to_string())?;
+    Ok(Document::new_file(m, path.to_path_buf()).with_source(mission::template_text(&name)))
 }
 
 /// Runs the TUI on `path` (or the built-in mission) until the operator

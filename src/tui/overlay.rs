@@ -18,6 +18,8 @@ use crate::mission::{self, Mission};
 pub enum Entry {
     File(PathBuf),
     Builtin(&'static str),
+    /// A `.toml` path typed that does not exist: a new mission there.
+    New(PathBuf),
 }
 
 impl Entry {
@@ -25,6 +27,7 @@ impl Entry {
         match self {
             Entry::File(p) => p.display().to_string(),
             Entry::Builtin(name) => format!("(built-in) {name}"),
+            Entry::New(p) => format!("{} (new)", p.display()),
         }
     }
 }
@@ -44,6 +47,8 @@ pub enum Overlay {
     Help,
     /// Unsaved changes: save, discard or stay.
     Quit,
+    /// Jobs are running and would be cancelled: quit or stay.
+    QuitRunning,
     SaveAs {
         input: String,
         then: AfterSave,
@@ -220,7 +225,9 @@ pub fn open_matches(entries: &[Entry], input: &str, cwd: &Path) -> Vec<Entry> {
         .filter_map(|e| {
             let label = entry_label(e, cwd).to_lowercase();
             let file = match e {
-                Entry::File(p) => p.file_name().map(|n| n.to_string_lossy().to_lowercase()),
+                Entry::File(p) | Entry::New(p) => {
+                    p.file_name().map(|n| n.to_string_lossy().to_lowercase())
+                }
                 Entry::Builtin(n) => Some(n.to_lowercase()),
             };
             let rank = if label == wanted || matches!(e, Entry::File(p) if *p == typed) {
@@ -242,7 +249,11 @@ pub fn open_matches(entries: &[Entry], input: &str, cwd: &Path) -> Vec<Entry> {
     let listed = matches
         .iter()
         .any(|e| matches!(e, Entry::File(p) if *p == typed));
-    if matches.is_empty() || (!listed && typed.is_file()) {
+    let new = !typed.exists() && typed.extension().is_some_and(|e| e == "toml");
+    if new {
+        // A mission file that does not exist yet: Enter starts it there.
+        matches.insert(0, Entry::New(typed));
+    } else if matches.is_empty() || (!listed && typed.is_file()) {
         matches.insert(0, Entry::File(typed));
     }
     matches
@@ -252,6 +263,10 @@ pub fn open_matches(entries: &[Entry], input: &str, cwd: &Path) -> Vec<Entry> {
 pub fn entry_label(entry: &Entry, cwd: &Path) -> String {
     match entry {
         Entry::File(p) => p.strip_prefix(cwd).unwrap_or(p).display().to_string(),
+        Entry::New(p) => format!(
+            "{}  (new: Enter starts a new mission there)",
+            p.strip_prefix(cwd).unwrap_or(p).display()
+        ),
         other => other.label(),
     }
 }
@@ -264,18 +279,38 @@ pub struct Loaded {
     pub path: Option<PathBuf>,
     /// Validation errors (it opens; the inspector shows them).
     pub errors: usize,
+    /// Not on disk yet: a new mission to be written at `path`.
+    pub new: bool,
 }
 
 /// Reads and checks `entry`; the message names the file when it cannot be
 /// opened (missing, a folder, not a mission).
 pub fn load(entry: &Entry) -> Result<Loaded, String> {
     let (text, name, path) = match entry {
+        Entry::New(p) => {
+            if p.exists() {
+                return Err(format!("{} exists: open it instead", p.display()));
+            }
+            let name = mission::name_for(p);
+            let mission = mission::template(&name).map_err(|e| e.to_string())?;
+            return Ok(Loaded {
+                mission,
+                text: mission::template_text(&name),
+                name: p.display().to_string(),
+                path: Some(p.clone()),
+                errors: 0,
+                new: true,
+            });
+        }
         Entry::File(p) => {
             if p.is_dir() {
                 return Err(format!("cannot open {}: it is a folder", p.display()));
             }
             if !p.exists() {
-                return Err(format!("cannot open {}: no such file", p.display()));
+                return Err(format!(
+                    "cannot open {}: no such file (a name ending in .toml starts a new mission)",
+                    p.display()
+                ));
             }
             match mission::read(p) {
                 Ok(text) => (text, p.display().to_string(), Some(p.clone())),
@@ -295,6 +330,7 @@ pub fn load(entry: &Entry) -> Result<Loaded, String> {
             text,
             name,
             path,
+            new: false,
         }),
         None => {
             let first = checked

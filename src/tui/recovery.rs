@@ -70,8 +70,14 @@ pub struct Copy {
 }
 
 impl Copy {
-    /// "3 changes, 2 min ago" for the prompt.
+    /// "3 change(s), saved 2 min ago (2026-12-01 18:04)" for the prompt, in
+    /// the local time zone.
     pub fn describe(&self, now: SystemTime) -> String {
+        self.describe_in(now, &jiff::tz::TimeZone::system())
+    }
+
+    /// [`Copy::describe`] with the clock read in `zone`.
+    pub fn describe_in(&self, now: SystemTime, zone: &jiff::tz::TimeZone) -> String {
         let age = now.duration_since(self.saved_at).unwrap_or_default();
         let ago = match age.as_secs() {
             s if s < 60 => format!("{s} s ago"),
@@ -79,15 +85,10 @@ impl Copy {
             s if s < 86_400 => format!("{} h ago", s / 3600),
             s => format!("{} days ago", s / 86_400),
         };
-        let stamp = self
-            .saved_at
-            .duration_since(UNIX_EPOCH)
-            .map(|d| d.as_secs())
-            .unwrap_or(0);
-        format!(
-            "{} change(s), saved {ago} (unix time {stamp})",
-            self.changes
-        )
+        let when = jiff::Timestamp::try_from(self.saved_at)
+            .map(|t| format!(" ({})", t.to_zoned(zone.clone()).strftime("%Y-%m-%d %H:%M")))
+            .unwrap_or_default();
+        format!("{} change(s), saved {ago}{when}", self.changes)
     }
 }
 
@@ -222,4 +223,26 @@ pub fn read(path: &Path) -> Option<Copy> {
         saved_at: UNIX_EPOCH + Duration::from_secs(number("saved_at").unwrap_or(0)),
         changes: number("changes").unwrap_or(0) as usize,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 24, item 18: the prompt gives the copy's date and time as a
+    /// clock shows it, not a count of seconds since 1970.
+    #[test]
+    fn the_prompt_says_when_the_copy_was_saved_as_a_clock_does() {
+        let copy = Copy {
+            mission: crate::mission::default_mission().mission,
+            saved_at: UNIX_EPOCH + Duration::from_secs(1_796_148_257),
+            changes: 3,
+        };
+        let now = copy.saved_at + Duration::from_secs(150);
+        assert_eq!(
+            copy.describe_in(now, &jiff::tz::TimeZone::UTC),
+            "3 change(s), saved 2 min ago (2026-12-01 18:04)"
+        );
+        assert!(!copy.describe(now).contains("unix time"));
+    }
 }

@@ -8,7 +8,8 @@ use nalgebra::Vector3;
 use super::Step::{Index, Key};
 use super::{Item, Spec, Table, fmt_num, number, shape_name, waypoint_choice};
 use crate::mission::{
-    FleetTarget, GeoOrigin, Mission, Obstacle, ShapeChoice, Terrain, WaypointChoice,
+    CostKind, Encoding, FleetTarget, GeoOrigin, Mission, Obstacle, Preset, ShapeChoice, Terrain,
+    WaypointChoice, spacing_of,
 };
 use crate::terrain::Lookup;
 
@@ -32,17 +33,17 @@ pub(super) fn of(item: &Item) -> &'static Table {
 }
 
 #[rustfmt::skip]
-static MISSION: Table = Table { base: &[], fields: &[
+static MISSION: Table = Table { base: &[], derived: &[], fields: &[
     Spec { name: "name", unit: "", keys: &["name"], get: |m, _| text(&m.name), set: |m, _, t| put(&mut m.name, Ok(t.to_owned())) },
     Spec { name: "description", unit: "", keys: &["description"], get: |m, _| text(&m.description), set: |m, _, t| put(&mut m.description, Ok(t.to_owned())) },
     Spec { name: "seed", unit: "", keys: &["seed"], get: |m, _| text(m.seed), set: |m, _, t| put(&mut m.seed, seed(t)) },
-    Spec { name: "origin lat", unit: "°", keys: &["origin", "latitude"], get: |m, _| origin(m, |o| o.latitude), set: |m, _, t| set_origin(m, t, |o, v| o.latitude = v) },
-    Spec { name: "origin lon", unit: "°", keys: &["origin", "longitude"], get: |m, _| origin(m, |o| o.longitude), set: |m, _, t| set_origin(m, t, |o, v| o.longitude = v) },
-    Spec { name: "origin alt", unit: "m", keys: &["origin", "altitude"], get: |m, _| origin(m, |o| o.altitude), set: |m, _, t| set_origin(m, t, |o, v| o.altitude = v) },
+    Spec { name: "origin lat", unit: "°", keys: &["origin", "latitude"], get: |m, _| origin(m, |o| o.latitude), set: |m, _, t| set_origin(m, t, OriginPart::Latitude) },
+    Spec { name: "origin lon", unit: "°", keys: &["origin", "longitude"], get: |m, _| origin(m, |o| o.longitude), set: |m, _, t| set_origin(m, t, OriginPart::Longitude) },
+    Spec { name: "origin alt", unit: "m", keys: &["origin", "altitude"], get: |m, _| origin(m, |o| o.altitude), set: |m, _, t| set_origin(m, t, OriginPart::Altitude) },
 ]};
 
 #[rustfmt::skip]
-static BOUNDS: Table = Table { base: &[Key("bounds")], fields: &[
+static BOUNDS: Table = Table { base: &[Key("bounds")], derived: &[], fields: &[
     Spec { name: "x min", unit: "m", keys: &["x"], get: |m, _| num(m.bounds.x[0]), set: |m, _, t| put(&mut m.bounds.x[0], number(t)) },
     Spec { name: "x max", unit: "m", keys: &["x"], get: |m, _| num(m.bounds.x[1]), set: |m, _, t| put(&mut m.bounds.x[1], number(t)) },
     Spec { name: "y min", unit: "m", keys: &["y"], get: |m, _| num(m.bounds.y[0]), set: |m, _, t| put(&mut m.bounds.y[0], number(t)) },
@@ -52,14 +53,14 @@ static BOUNDS: Table = Table { base: &[Key("bounds")], fields: &[
 ]};
 
 #[rustfmt::skip]
-static START: Table = Table { base: &[Key("route"), Key("start")], fields: &[
+static START: Table = Table { base: &[Key("route"), Key("start")], derived: &[], fields: &[
     Spec { name: "x", unit: "m", keys: &[], get: |m, _| num(m.route.start.x), set: |m, _, t| put(&mut m.route.start.x, number(t)) },
     Spec { name: "y", unit: "m", keys: &[], get: |m, _| num(m.route.start.y), set: |m, _, t| put(&mut m.route.start.y, number(t)) },
     Spec { name: "z", unit: "m", keys: &[], get: |m, _| num(m.route.start.z), set: |m, _, t| put(&mut m.route.start.z, number(t)) },
 ]};
 
 #[rustfmt::skip]
-static GOAL: Table = Table { base: &[Key("route"), Key("goal")], fields: &[
+static GOAL: Table = Table { base: &[Key("route"), Key("goal")], derived: &[], fields: &[
     Spec { name: "x", unit: "m", keys: &[], get: |m, _| num(m.route.goal.x), set: |m, _, t| put(&mut m.route.goal.x, number(t)) },
     Spec { name: "y", unit: "m", keys: &[], get: |m, _| num(m.route.goal.y), set: |m, _, t| put(&mut m.route.goal.y, number(t)) },
     Spec { name: "z", unit: "m", keys: &[], get: |m, _| num(m.route.goal.z), set: |m, _, t| put(&mut m.route.goal.z, number(t)) },
@@ -69,7 +70,7 @@ static GOAL: Table = Table { base: &[Key("route"), Key("goal")], fields: &[
 /// (`Document::edit`), and a file that does not load is an error on
 /// `terrain.file`.
 #[rustfmt::skip]
-static TERRAIN: Table = Table { base: &[Key("terrain")], fields: &[
+static TERRAIN: Table = Table { base: &[Key("terrain")], derived: &[], fields: &[
     Spec { name: "file", unit: "", keys: &["file"], get: |m, _| text(&m.terrain.as_ref()?.file), set: |m, _, t| put(&mut terrain(m)?.file, geotiff(t)) },
     Spec { name: "origin x", unit: "m", keys: &["origin"], get: |m, _| num(m.terrain.as_ref()?.origin[0]), set: |m, _, t| put(&mut terrain(m)?.origin[0], number(t)) },
     Spec { name: "origin y", unit: "m", keys: &["origin"], get: |m, _| num(m.terrain.as_ref()?.origin[1]), set: |m, _, t| put(&mut terrain(m)?.origin[1], number(t)) },
@@ -79,7 +80,7 @@ static TERRAIN: Table = Table { base: &[Key("terrain")], fields: &[
 ]};
 
 #[rustfmt::skip]
-static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], fields: &[
+static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], derived: &[], fields: &[
     Spec { name: "name", unit: "", keys: &["name"], get: |m, i| text(&obstacle_at(m, i)?.name), set: rename_obstacle },
     Spec { name: "kind", unit: "", keys: &["kind"], get: |m, i| text(obstacle_at(m, i)?.kind.as_deref().unwrap_or("")), set: |m, i, t| put(&mut obstacle(m, i)?.kind, Ok((!t.is_empty()).then(|| t.to_owned()))) },
     Spec { name: "centre x", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.x), set: |m, i, t| put(&mut obstacle(m, i)?.center.x, number(t)) },
@@ -92,7 +93,11 @@ static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], fields: &[
 ]};
 
 #[rustfmt::skip]
-static FORMATION: Table = Table { base: &[], fields: &[
+static FORMATION: Table = Table { base: &[], derived: &[
+    Spec { name: "UAVs", unit: "", keys: &["formation", "slots"], get: |m, _| text(m.formation.slots.len()), set: |m, _, t| set_uav_count(m, t) },
+    Spec { name: "preset", unit: "", keys: &["formation", "slots"], get: |m, _| text(Preset::detect(&m.formation.slots).map_or("custom", |(p, _)| p.name())), set: |m, _, t| set_preset(m, t) },
+    Spec { name: "spacing", unit: "m", keys: &["formation", "slots"], get: |m, _| num(spacing_of(m)), set: |m, _, t| set_spacing(m, t) },
+], fields: &[
     Spec { name: "UAV radius r_Q", unit: "m", keys: &["formation", "uav_radius"], get: |m, _| num(m.formation.uav_radius), set: |m, _, t| put(&mut m.formation.uav_radius, number(t)) },
     Spec { name: "ground speed", unit: "m/s", keys: &["formation", "ground_speed"], get: |m, _| num(m.formation.ground_speed), set: |m, _, t| put(&mut m.formation.ground_speed, number(t)) },
     Spec { name: "comm range", unit: "m", keys: &["formation", "comm_range"], get: |m, _| num(m.formation.comm_range), set: |m, _, t| put(&mut m.formation.comm_range, number(t)) },
@@ -106,7 +111,7 @@ static FORMATION: Table = Table { base: &[], fields: &[
 ]};
 
 #[rustfmt::skip]
-static SLOT: Table = Table { base: &[Key("formation"), Key("slots"), Index], fields: &[
+static SLOT: Table = Table { base: &[Key("formation"), Key("slots"), Index], derived: &[], fields: &[
     Spec { name: "forward x", unit: "m", keys: &[], get: |m, i| num(slot_at(m, i)?.x), set: |m, i, t| put(&mut slot(m, i)?.x, number(t)) },
     Spec { name: "left y", unit: "m", keys: &[], get: |m, i| num(slot_at(m, i)?.y), set: |m, i, t| put(&mut slot(m, i)?.y, number(t)) },
     Spec { name: "up z", unit: "m", keys: &[], get: |m, i| num(slot_at(m, i)?.z), set: |m, i, t| put(&mut slot(m, i)?.z, number(t)) },
@@ -115,17 +120,21 @@ static SLOT: Table = Table { base: &[Key("formation"), Key("slots"), Index], fie
 /// An IWP's reconfiguration choice: the defaults until the first edit
 /// creates its entry.
 #[rustfmt::skip]
-static WAYPOINT: Table = Table { base: &[Key("reconfiguration"), Key("waypoints"), Index], fields: &[
+static WAYPOINT: Table = Table { base: &[Key("reconfiguration"), Key("waypoints"), Index], derived: &[], fields: &[
+    Spec { name: "obstacles", unit: "", keys: &["between"], get: |_, i| between(i), set: |_, _, _| Err("an IWP is named by its two obstacles: rename an obstacle, or Del deletes this choice".into()) },
     Spec { name: "enabled", unit: "", keys: &["enabled"], get: |m, i| yes(choice_at(m, i).is_none_or(|c| c.enabled)), set: |m, i, t| set_choice(m, i, yes_no(t), |c| &mut c.enabled) },
     Spec { name: "shape", unit: "", keys: &["shape"], get: |m, i| text(shape_name(choice_at(m, i).map_or(ShapeChoice::Auto, |c| c.shape))), set: |m, i, t| set_choice(m, i, shape(t), |c| &mut c.shape) },
     Spec { name: "scale (blank: default)", unit: "", keys: &["scale"], get: |m, i| text(choice_at(m, i).and_then(|c| c.scale).map(fmt_num).unwrap_or_default()), set: |m, i, t| set_choice(m, i, blank_or(number, t), |c| &mut c.scale) },
 ]};
 
 #[rustfmt::skip]
-static THETA_PSO: Table = Table { base: &[Key("theta_pso")], fields: &[
+static THETA_PSO: Table = Table { base: &[Key("theta_pso")], derived: &[], fields: &[
     Spec { name: "swarm size", unit: "", keys: &["swarm_size"], get: |m, _| text(m.theta_pso.swarm_size), set: |m, _, t| put(&mut m.theta_pso.swarm_size, count(t)) },
     Spec { name: "waypoints", unit: "", keys: &["waypoints"], get: |m, _| text(m.theta_pso.waypoints), set: |m, _, t| put(&mut m.theta_pso.waypoints, count(t)) },
     Spec { name: "iterations", unit: "", keys: &["iterations"], get: |m, _| text(m.theta_pso.iterations), set: |m, _, t| put(&mut m.theta_pso.iterations, count(t)) },
+    Spec { name: "restarts", unit: "", keys: &["restarts"], get: |m, _| text(m.theta_pso.restarts), set: |m, _, t| put(&mut m.theta_pso.restarts, count(t)) },
+    Spec { name: "seeded particles", unit: "", keys: &["seeded_particles"], get: |m, _| text(m.theta_pso.seeded_particles), set: |m, _, t| put(&mut m.theta_pso.seeded_particles, count(t)) },
+    Spec { name: "clearance margin", unit: "m", keys: &["clearance_margin"], get: |m, _| num(m.theta_pso.clearance_margin), set: |m, _, t| put(&mut m.theta_pso.clearance_margin, number(t)) },
     Spec { name: "inertia w", unit: "", keys: &["inertia"], get: |m, _| num(m.theta_pso.inertia), set: |m, _, t| put(&mut m.theta_pso.inertia, number(t)) },
     Spec { name: "cognitive c1", unit: "", keys: &["cognitive"], get: |m, _| num(m.theta_pso.cognitive), set: |m, _, t| put(&mut m.theta_pso.cognitive, number(t)) },
     Spec { name: "social c2", unit: "", keys: &["social"], get: |m, _| num(m.theta_pso.social), set: |m, _, t| put(&mut m.theta_pso.social, number(t)) },
@@ -134,12 +143,16 @@ static THETA_PSO: Table = Table { base: &[Key("theta_pso")], fields: &[
     Spec { name: "β2 obstacle", unit: "", keys: &["weight_obstacle"], get: |m, _| num(m.theta_pso.weight_obstacle), set: |m, _, t| put(&mut m.theta_pso.weight_obstacle, number(t)) },
     Spec { name: "β3 altitude", unit: "", keys: &["weight_altitude"], get: |m, _| num(m.theta_pso.weight_altitude), set: |m, _, t| put(&mut m.theta_pso.weight_altitude, number(t)) },
     Spec { name: "βR waypoints", unit: "", keys: &["weight_waypoints"], get: |m, _| num(m.theta_pso.weight_waypoints), set: |m, _, t| put(&mut m.theta_pso.weight_waypoints, number(t)) },
+    Spec { name: "J_B bounds weight", unit: "", keys: &["weight_bounds"], get: |m, _| num(m.theta_pso.weight_bounds), set: |m, _, t| put(&mut m.theta_pso.weight_bounds, number(t)) },
+    Spec { name: "J_T turning weight", unit: "", keys: &["weight_turning"], get: |m, _| num(m.theta_pso.weight_turning), set: |m, _, t| put(&mut m.theta_pso.weight_turning, number(t)) },
+    Spec { name: "ground penalty", unit: "", keys: &["ground_penalty"], get: |m, _| num(m.theta_pso.ground_penalty), set: |m, _, t| put(&mut m.theta_pso.ground_penalty, number(t)) },
+    Spec { name: "cost", unit: "", keys: &["cost"], get: |m, _| text(cost_name(m.theta_pso.cost)), set: |m, _, t| put(&mut m.theta_pso.cost, cost(t)) },
+    Spec { name: "encoding", unit: "", keys: &["encoding"], get: |m, _| text(encoding_name(m.theta_pso.encoding)), set: |m, _, t| put(&mut m.theta_pso.encoding, encoding(t)) },
 ]};
 
-/// FLATLO's squadron: what the operator sets per mission; the airframe
-/// constants stay in the file.
+/// FLATLO's squadron and its aircraft model: every `[flatlo]` key.
 #[rustfmt::skip]
-static SQUADRON: Table = Table { base: &[Key("flatlo")], fields: &[
+static SQUADRON: Table = Table { base: &[Key("flatlo")], derived: &[], fields: &[
     Spec { name: "aircraft N", unit: "", keys: &["aircraft"], get: |m, _| text(m.flatlo.aircraft), set: |m, _, t| put(&mut m.flatlo.aircraft, count(t)) },
     Spec { name: "spacing Δd", unit: "m", keys: &["spacing"], get: |m, _| num(m.flatlo.spacing), set: |m, _, t| put(&mut m.flatlo.spacing, number(t)) },
     Spec { name: "airspeed", unit: "m/s", keys: &["airspeed"], get: |m, _| num(m.flatlo.airspeed), set: |m, _, t| put(&mut m.flatlo.airspeed, number(t)) },
@@ -152,12 +165,26 @@ static SQUADRON: Table = Table { base: &[Key("flatlo")], fields: &[
     Spec { name: "final leg K2", unit: "m", keys: &["final_leg"], get: |m, _| num(m.flatlo.final_leg), set: |m, _, t| put(&mut m.flatlo.final_leg, number(t)) },
     Spec { name: "noise σ", unit: "", keys: &["noise"], get: |m, _| num(m.flatlo.noise), set: |m, _, t| put(&mut m.flatlo.noise, number(t)) },
     Spec { name: "min separation", unit: "m", keys: &["min_separation"], get: |m, _| num(m.flatlo.min_separation), set: |m, _, t| put(&mut m.flatlo.min_separation, number(t)) },
+    Spec { name: "sample period T", unit: "s", keys: &["sample_period"], get: |m, _| num(m.flatlo.sample_period), set: |m, _, t| put(&mut m.flatlo.sample_period, number(t)) },
+    Spec { name: "RK4 step", unit: "s", keys: &["sim_step"], get: |m, _| num(m.flatlo.sim_step), set: |m, _, t| put(&mut m.flatlo.sim_step, number(t)) },
+    Spec { name: "mass", unit: "kg", keys: &["mass"], get: |m, _| num(m.flatlo.mass), set: |m, _, t| put(&mut m.flatlo.mass, number(t)) },
+    Spec { name: "wing area", unit: "m²", keys: &["wing_area"], get: |m, _| num(m.flatlo.wing_area), set: |m, _, t| put(&mut m.flatlo.wing_area, number(t)) },
+    Spec { name: "air density", unit: "kg/m³", keys: &["air_density"], get: |m, _| num(m.flatlo.air_density), set: |m, _, t| put(&mut m.flatlo.air_density, number(t)) },
+    Spec { name: "drag C_D0", unit: "", keys: &["drag_cd0"], get: |m, _| num(m.flatlo.drag_cd0), set: |m, _, t| put(&mut m.flatlo.drag_cd0, number(t)) },
+    Spec { name: "drag k", unit: "", keys: &["drag_k"], get: |m, _| num(m.flatlo.drag_k), set: |m, _, t| put(&mut m.flatlo.drag_k, number(t)) },
+    Spec { name: "max thrust", unit: "N", keys: &["max_thrust"], get: |m, _| num(m.flatlo.max_thrust), set: |m, _, t| put(&mut m.flatlo.max_thrust, number(t)) },
+    Spec { name: "load factor min", unit: "", keys: &["load_factor"], get: |m, _| num(m.flatlo.load_factor[0]), set: |m, _, t| put(&mut m.flatlo.load_factor[0], number(t)) },
+    Spec { name: "load factor max", unit: "", keys: &["load_factor"], get: |m, _| num(m.flatlo.load_factor[1]), set: |m, _, t| put(&mut m.flatlo.load_factor[1], number(t)) },
+    Spec { name: "max bank", unit: "°", keys: &["max_bank_deg"], get: |m, _| num(m.flatlo.max_bank_deg), set: |m, _, t| put(&mut m.flatlo.max_bank_deg, number(t)) },
+    Spec { name: "PID kp", unit: "", keys: &["pid"], get: |m, _| num(m.flatlo.pid[0]), set: |m, _, t| put(&mut m.flatlo.pid[0], number(t)) },
+    Spec { name: "PID ki", unit: "", keys: &["pid"], get: |m, _| num(m.flatlo.pid[1]), set: |m, _, t| put(&mut m.flatlo.pid[1], number(t)) },
+    Spec { name: "PID kd", unit: "", keys: &["pid"], get: |m, _| num(m.flatlo.pid[2]), set: |m, _, t| put(&mut m.flatlo.pid[2], number(t)) },
 ]};
 
-/// The fleet's parameters (Table 1 and the scenario); gains and the
-/// airframe stay in the file.
+/// The fleet's parameters (Table 1, the scenario, the quadrotor); its
+/// matrices and lists are shown (edited in the file).
 #[rustfmt::skip]
-static FLEET: Table = Table { base: &[Key("fleet")], fields: &[
+static FLEET: Table = Table { base: &[Key("fleet")], derived: &[], fields: &[
     Spec { name: "agents n", unit: "", keys: &["agents"], get: |m, _| text(m.fleet.agents), set: |m, _, t| put(&mut m.fleet.agents, count(t)) },
     Spec { name: "ρ target weight", unit: "", keys: &["rho"], get: |m, _| num(m.fleet.rho), set: |m, _, t| put(&mut m.fleet.rho, number(t)) },
     Spec { name: "σ steepness", unit: "", keys: &["sigma"], get: |m, _| num(m.fleet.sigma), set: |m, _, t| put(&mut m.fleet.sigma, number(t)) },
@@ -170,10 +197,29 @@ static FLEET: Table = Table { base: &[Key("fleet")], fields: &[
     Spec { name: "altitude", unit: "m", keys: &["altitude"], get: |m, _| num(m.fleet.altitude), set: |m, _, t| put(&mut m.fleet.altitude, number(t)) },
     Spec { name: "duration", unit: "s", keys: &["duration"], get: |m, _| num(m.fleet.duration), set: |m, _, t| put(&mut m.fleet.duration, number(t)) },
     Spec { name: "tolerance", unit: "", keys: &["tolerance"], get: |m, _| num(m.fleet.tolerance), set: |m, _, t| put(&mut m.fleet.tolerance, number(t)) },
+    Spec { name: "PSO particles", unit: "", keys: &["swarm_size"], get: |m, _| text(m.fleet.swarm_size), set: |m, _, t| put(&mut m.fleet.swarm_size, count(t)) },
+    Spec { name: "PSO iterations", unit: "", keys: &["iterations"], get: |m, _| text(m.fleet.iterations), set: |m, _, t| put(&mut m.fleet.iterations, count(t)) },
+    Spec { name: "PSO inertia w", unit: "", keys: &["inertia"], get: |m, _| num(m.fleet.inertia), set: |m, _, t| put(&mut m.fleet.inertia, number(t)) },
+    Spec { name: "PSO cognitive c1", unit: "", keys: &["cognitive"], get: |m, _| num(m.fleet.cognitive), set: |m, _, t| put(&mut m.fleet.cognitive, number(t)) },
+    Spec { name: "PSO social c2", unit: "", keys: &["social"], get: |m, _| num(m.fleet.social), set: |m, _, t| put(&mut m.fleet.social, number(t)) },
+    Spec { name: "dynamics step", unit: "s", keys: &["sim_step"], get: |m, _| num(m.fleet.sim_step), set: |m, _, t| put(&mut m.fleet.sim_step, number(t)) },
+    Spec { name: "mass", unit: "kg", keys: &["mass"], get: |m, _| num(m.fleet.mass), set: |m, _, t| put(&mut m.fleet.mass, number(t)) },
+    Spec { name: "inertia J x", unit: "kg·m²", keys: &["inertia_diag"], get: |m, _| num(m.fleet.inertia_diag.x), set: |m, _, t| put(&mut m.fleet.inertia_diag.x, number(t)) },
+    Spec { name: "inertia J y", unit: "kg·m²", keys: &["inertia_diag"], get: |m, _| num(m.fleet.inertia_diag.y), set: |m, _, t| put(&mut m.fleet.inertia_diag.y, number(t)) },
+    Spec { name: "inertia J z", unit: "kg·m²", keys: &["inertia_diag"], get: |m, _| num(m.fleet.inertia_diag.z), set: |m, _, t| put(&mut m.fleet.inertia_diag.z, number(t)) },
+    Spec { name: "K_pos position", unit: "", keys: &["position_gains"], get: |m, _| num(m.fleet.position_gains[0]), set: |m, _, t| put(&mut m.fleet.position_gains[0], number(t)) },
+    Spec { name: "K_pos velocity", unit: "", keys: &["position_gains"], get: |m, _| num(m.fleet.position_gains[1]), set: |m, _, t| put(&mut m.fleet.position_gains[1], number(t)) },
+    Spec { name: "K_att attitude", unit: "", keys: &["attitude_gains"], get: |m, _| num(m.fleet.attitude_gains[0]), set: |m, _, t| put(&mut m.fleet.attitude_gains[0], number(t)) },
+    Spec { name: "K_att rate", unit: "", keys: &["attitude_gains"], get: |m, _| num(m.fleet.attitude_gains[1]), set: |m, _, t| put(&mut m.fleet.attitude_gains[1], number(t)) },
+    Spec { name: "max thrust", unit: "N", keys: &["max_thrust"], get: |m, _| num(m.fleet.max_thrust), set: |m, _, t| put(&mut m.fleet.max_thrust, number(t)) },
+    Spec { name: "max tilt", unit: "°", keys: &["max_tilt_deg"], get: |m, _| num(m.fleet.max_tilt_deg), set: |m, _, t| put(&mut m.fleet.max_tilt_deg, number(t)) },
+    Spec { name: "distances d^d", unit: "", keys: &["distances"], get: |m, _| text(listed(m.fleet.distances.len(), "rows", "a uniform polygon")), set: in_the_file },
+    Spec { name: "initial positions", unit: "", keys: &["initial_positions"], get: |m, _| text(listed(m.fleet.initial_positions.len(), "positions", "seeded random")), set: in_the_file },
+    Spec { name: "pushes", unit: "", keys: &["pushes"], get: |m, _| text(listed(m.fleet.pushes.len(), "pushes", "none")), set: in_the_file },
 ]};
 
 #[rustfmt::skip]
-static FLEET_TARGET: Table = Table { base: &[Key("fleet"), Key("targets"), Index], fields: &[
+static FLEET_TARGET: Table = Table { base: &[Key("fleet"), Key("targets"), Index], derived: &[], fields: &[
     Spec { name: "time", unit: "s", keys: &["time"], get: |m, i| num(target_at(m, i)?.time), set: |m, i, t| put(&mut target(m, i)?.time, number(t)) },
     Spec { name: "x", unit: "m", keys: &["position"], get: |m, i| num(target_at(m, i)?.position.x), set: |m, i, t| put(&mut target(m, i)?.position.x, number(t)) },
     Spec { name: "y", unit: "m", keys: &["position"], get: |m, i| num(target_at(m, i)?.position.y), set: |m, i, t| put(&mut target(m, i)?.position.y, number(t)) },
@@ -259,6 +305,119 @@ fn lookup_name(lookup: Lookup) -> &'static str {
     match lookup {
         Lookup::Nearest => "nearest",
         Lookup::Bilinear => "bilinear",
+    }
+}
+
+fn cost(text: &str) -> Result<CostKind, String> {
+    match text.trim().to_ascii_lowercase().as_str() {
+        "paper" => Ok(CostKind::Paper),
+        "spso" => Ok(CostKind::Spso),
+        other => Err(format!("'{other}' is not a cost: paper or spso")),
+    }
+}
+
+fn cost_name(cost: CostKind) -> &'static str {
+    match cost {
+        CostKind::Paper => "paper",
+        CostKind::Spso => "spso",
+    }
+}
+
+fn encoding(text: &str) -> Result<Encoding, String> {
+    match text.trim().to_ascii_lowercase().as_str() {
+        "angle" => Ok(Encoding::Angle),
+        "spherical" => Ok(Encoding::Spherical),
+        other => Err(format!("'{other}' is not an encoding: angle or spherical")),
+    }
+}
+
+fn encoding_name(encoding: Encoding) -> &'static str {
+    match encoding {
+        Encoding::Angle => "angle",
+        Encoding::Spherical => "spherical",
+    }
+}
+
+/// A list the file holds, as a count (or what its absence means).
+fn listed(n: usize, what: &str, none: &str) -> String {
+    if n == 0 {
+        format!("none: {none}")
+    } else {
+        format!("{n} {what} (edit them in the file)")
+    }
+}
+
+/// The write of a value shown but edited in the file.
+fn in_the_file(_: &mut Mission, _: &Item, _: &str) -> Result<(), String> {
+    Err("a list of the file: edit it there (the inspector shows its messages)".into())
+}
+
+/// The two obstacles an IWP choice names.
+fn between(item: &Item) -> Option<String> {
+    match item {
+        Item::Waypoint([a, b]) => Some(format!("{a} ↔ {b}")),
+        _ => None,
+    }
+}
+
+// The formation's shape, worked out from its slots.
+
+/// Most UAVs the designer makes a formation of (eq. 7 checks every pair).
+const MOST_UAVS: usize = 1000;
+
+/// A new number of UAVs: a preset stays that preset (at a spacing valid for
+/// the mission), a custom shape gains slots behind or loses its last ones.
+fn set_uav_count(m: &mut Mission, t: &str) -> Result<(), String> {
+    let n = count(t)?;
+    if n == 0 {
+        return Err("a formation needs at least one UAV".into());
+    }
+    if n > MOST_UAVS {
+        return Err(format!("at most {MOST_UAVS} UAVs"));
+    }
+    match Preset::detect(&m.formation.slots) {
+        Some((preset, _)) if m.formation.slots.len() > 1 => {
+            crate::mission::reshape(m, preset, n, None).map(|_| ())
+        }
+        _ => {
+            let spacing = spacing_of(m);
+            m.formation.slots = crate::mission::resize_custom(&m.formation.slots, n, spacing);
+            Ok(())
+        }
+    }
+}
+
+/// A preset by name, at a spacing valid for the mission.
+fn set_preset(m: &mut Mission, t: &str) -> Result<(), String> {
+    let names: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
+    let Some(preset) = Preset::named(t) else {
+        return Err(format!(
+            "'{t}' is not a preset: {} (a custom shape: move the slots)",
+            names.join(", ")
+        ));
+    };
+    let n = m.formation.slots.len().max(1);
+    crate::mission::reshape(m, preset, n, None).map(|_| ())
+}
+
+/// The distance between neighbours: a preset is made again at it, a custom
+/// shape scaled so its closest pair is that far apart.
+fn set_spacing(m: &mut Mission, t: &str) -> Result<(), String> {
+    let spacing = number(t)?;
+    if spacing <= 0.0 {
+        return Err(format!("the spacing must be positive, got {spacing} m"));
+    }
+    let n = m.formation.slots.len();
+    match Preset::detect(&m.formation.slots) {
+        Some((preset, _)) if n > 1 => {
+            crate::mission::reshape(m, preset, n, Some(spacing)).map(|_| ())
+        }
+        _ if n > 1 => {
+            let now = crate::mission::min_pair_distance(&m.formation.slots);
+            m.formation.slots = crate::mission::rescale(&m.formation.slots, spacing / now);
+            Ok(())
+        }
+        _ => Err("one UAV has no spacing: add UAVs first".into()),
     }
 }
 
@@ -379,19 +538,44 @@ fn origin(m: &Mission, get: fn(&GeoOrigin) -> f64) -> Option<String> {
     )
 }
 
-/// Sets one `[origin]` value (creating the section at 0°, 0°, 0 m); an empty
-/// text removes the section (exports then offer CSV in ENU only).
-fn set_origin(m: &mut Mission, text: &str, set: fn(&mut GeoOrigin, f64)) -> Result<(), String> {
-    if text.trim().is_empty() {
+/// One value of `[origin]`.
+#[derive(Clone, Copy, PartialEq)]
+enum OriginPart {
+    Latitude,
+    Longitude,
+    Altitude,
+}
+
+/// Sets one `[origin]` value (creating the section at 0°, 0°, 0 m). An
+/// empty text clears that value alone: the altitude goes back to 0 m; an
+/// origin cannot lack its latitude or longitude, so the message says how to
+/// remove the whole section (`none`; exports then write CSV in ENU only).
+fn set_origin(m: &mut Mission, text: &str, part: OriginPart) -> Result<(), String> {
+    let text = text.trim();
+    if text.eq_ignore_ascii_case("none") {
         m.origin = None;
         return Ok(());
     }
-    let v = number(text)?;
+    let value = match (text.is_empty(), part) {
+        (false, _) => number(text)?,
+        (true, OriginPart::Altitude) => 0.0,
+        (true, _) if m.origin.is_none() => return Ok(()),
+        (true, _) => {
+            return Err(
+                "an [origin] needs a latitude and a longitude; type none to remove the origin"
+                    .into(),
+            );
+        }
+    };
     let origin = m.origin.get_or_insert(GeoOrigin {
         latitude: 0.0,
         longitude: 0.0,
         altitude: 0.0,
     });
-    set(origin, v);
+    match part {
+        OriginPart::Latitude => origin.latitude = value,
+        OriginPart::Longitude => origin.longitude = value,
+        OriginPart::Altitude => origin.altitude = value,
+    }
     Ok(())
 }

@@ -9,7 +9,7 @@ use ratatui::widgets::{Block, BorderType, Borders, Paragraph, Wrap};
 
 use crate::mission::Severity;
 use crate::tui::app::{App, Focus};
-use crate::tui::fields::{self, Item};
+use crate::tui::fields::{self, Item, Place};
 
 fn severity_span(severity: Severity, text: String) -> Span<'static> {
     match severity {
@@ -27,11 +27,21 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
     let m = app.mission();
     let fields = app.fields();
     let diagnostics = app.doc().diagnostics();
-    // Which field shows each message, worked out once per frame.
-    let owners: Vec<Option<usize>> = diagnostics
+    // Where each message is drawn, worked out once per frame.
+    let places: Vec<Option<(Place, bool)>> = diagnostics
         .iter()
-        .map(|d| fields::owner(&fields, &d.path))
+        .map(|d| fields::place(app.selected(), m, &fields, &d.path))
         .collect();
+    // A message at its own place reads alone; one deeper than any field
+    // says where it is.
+    let message = |d: &crate::mission::Diagnostic, exact: bool| {
+        let text = if exact {
+            d.message.clone()
+        } else {
+            format!("{}: {}", d.path, d.message)
+        };
+        Line::from(severity_span(d.severity, text))
+    };
     let label_width = fields
         .iter()
         .map(|f| f.label().chars().count())
@@ -65,28 +75,24 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
             {
                 lines.push(Line::from(severity_span(severity, text)));
             }
-        } else {
-            // Each message once, under the field it belongs to.
-            for (d, _) in diagnostics
-                .iter()
-                .zip(&owners)
-                .filter(|(_, owner)| **owner == Some(k))
-            {
-                lines.push(Line::from(severity_span(d.severity, d.message.clone())));
+            continue;
+        }
+        // Each message once: under its field, or after its group's last field.
+        for (d, placed) in diagnostics.iter().zip(&places) {
+            match placed {
+                Some((Place::Field(at), exact)) if *at == k => lines.push(message(d, *exact)),
+                Some((Place::Group(_, last), exact)) if *last == k => {
+                    lines.push(message(d, *exact));
+                }
+                _ => {}
             }
         }
     }
-    // Messages about the item that no field shows (e.g. an obstacle outside the bounds).
-    if let Some(prefix) = app.selected().path(app.mission()) {
-        for (d, _) in diagnostics
-            .iter()
-            .zip(&owners)
-            .filter(|(d, owner)| owner.is_none() && d.path.starts_with(&prefix))
-        {
-            lines.push(Line::from(severity_span(
-                d.severity,
-                format!("{}: {}", d.path, d.message),
-            )));
+    // Messages on the item itself (the start's position) or deeper than
+    // any of its fields.
+    for (d, placed) in diagnostics.iter().zip(&places) {
+        if let Some((Place::Item, exact)) = placed {
+            lines.push(message(d, *exact));
         }
     }
     if *app.selected() == Item::Mission {
@@ -94,11 +100,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         let warnings = diagnostics.len() - errors;
         lines.push(Line::raw(""));
         lines.push(Line::from(vec![
-            Span::raw(format!(
-                "{} obstacles · {} UAVs · ",
-                m.obstacles.len(),
-                m.formation.slots.len()
-            )),
+            Span::raw(format!("{} obstacles · ", m.obstacles.len())),
             if errors == 0 {
                 Span::styled("valid", Style::default().green())
             } else {
@@ -110,6 +112,13 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
                 String::new()
             }),
         ]));
+        // Each pipeline flies its own vehicles: all three counts.
+        lines.push(Line::raw(format!(
+            "θ-PSO {} UAVs · FLATLO {} aircraft · fleet {} agents",
+            m.formation.slots.len(),
+            m.flatlo.aircraft,
+            m.fleet.agents
+        )));
         for d in diagnostics.iter().take(6) {
             lines.push(Line::from(severity_span(
                 d.severity,
@@ -119,7 +128,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
     }
     lines.push(Line::raw(""));
     let hint = if app.editor().editing().is_some() {
-        "Enter apply · Esc cancel"
+        "Enter apply · Esc cancel · Ctrl-u clear"
     } else {
         "↑↓ field · Enter/type to edit · n/p next/prev item"
     };

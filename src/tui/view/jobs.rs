@@ -8,7 +8,9 @@ use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Style};
 use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Axis, Block, BorderType, Borders, Chart, Dataset, GraphType, Paragraph};
+use ratatui::widgets::{
+    Axis, Block, BorderType, Borders, Chart, Dataset, GraphType, Paragraph, Wrap,
+};
 
 use crate::tui::action::Action;
 use crate::tui::app::{App, Focus};
@@ -156,40 +158,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         facts.push(Line::styled(format!("error: {e}"), Style::default().red()));
     }
     if let Some(o) = job.outcome.as_ref().and_then(|o| o.theta_pso()) {
-        let v = &o.verification;
-        facts.push(Line::raw(format!(
-            "J {:.2} · {:.1} m · {:.1} s · {} reconfiguration(s)",
-            o.cost.total,
-            o.path_length,
-            o.duration,
-            o.reconfigurations.len()
-        )));
-        facts.push(if v.feasible {
-            Line::styled("✓ all checks pass", Style::default().green())
-        } else {
-            Line::styled(
-                format!("✗ {} violation(s)", v.violation_count),
-                Style::default().red().bold(),
-            )
-        });
-        for c in v.checks.iter().filter(|c| !c.ok).take(2) {
-            facts.push(Line::styled(
-                format!(
-                    "✗ {} {} {} (worst {:.3})",
-                    c.name,
-                    c.relation,
-                    c.limit,
-                    c.worst.unwrap_or(f64::NAN)
-                ),
-                Style::default().red(),
-            ));
-        }
-        if app.is_stale(job) {
-            facts.push(Line::styled(
-                "stale: the mission changed since this run",
-                Style::default().yellow(),
-            ));
-        }
+        facts.extend(theta_pso_table(o, &job.state, app.is_stale(job)));
     } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.fleet()) {
         let lines = fleet_table(o, app.is_stale(job));
         frame.render_widget(Paragraph::new(lines), detail);
@@ -202,11 +171,112 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
     } else if let Some(w) = &job.last_warning {
         facts.push(Line::styled(w.clone(), Style::default().yellow()));
     }
-    let facts_height = (facts.len() as u16).min(detail.height / 2);
-    let [chart_area, facts_area] =
-        Layout::vertical([Constraint::Min(0), Constraint::Length(facts_height)]).areas(detail);
-    frame.render_widget(Paragraph::new(facts), facts_area);
+    // The verdict and the table first, from the top: the chart takes what
+    // they leave, when that is enough to read.
+    let needed = wrapped_rows(&facts, detail.width);
+    let chart_room = detail.height.saturating_sub(needed);
+    let chart_height = if chart_room >= 6 { chart_room } else { 0 };
+    let [facts_area, chart_area] = Layout::vertical([
+        Constraint::Length(detail.height - chart_height),
+        Constraint::Length(chart_height),
+    ])
+    .areas(detail);
+    frame.render_widget(Paragraph::new(facts).wrap(Wrap { trim: false }), facts_area);
     draw_chart(frame, job, chart_area);
+}
+
+/// Rows `lines` take once wrapped at `width` cells.
+fn wrapped_rows(lines: &[Line], width: u16) -> u16 {
+    let width = usize::from(width.max(1));
+    lines
+        .iter()
+        .map(|l| l.width().max(1).div_ceil(width) as u16)
+        .sum()
+}
+
+/// A table row with its padding collapsed, for a narrow panel.
+fn collapsed(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// θ-PSO's result as the CLI prints it: the verdict and its first failing
+/// check on top, the figures, the unusable IWPs grouped by reason, then the
+/// whole verification table (`outcome::summary::verification_rows`).
+fn theta_pso_table(
+    o: &crate::planner::ThetaPsoOutcome,
+    state: &JobState,
+    stale: bool,
+) -> Vec<Line<'static>> {
+    let v = &o.verification;
+    let rows = crate::outcome::summary::verification_rows(o);
+    let mut lines = Vec::new();
+    let verdict = match (state, v.feasible) {
+        (JobState::Cancelled, _) => Line::styled(
+            "cancelled: no verdict on the best path so far",
+            Style::default().yellow(),
+        ),
+        (_, true) => Line::styled(
+            format!("✓ FEASIBLE · all {} checks pass", rows.len()),
+            Style::default().green().bold(),
+        ),
+        (_, false) => Line::styled(
+            format!(
+                "✗ INFEASIBLE · {}",
+                v.first_failure().unwrap_or_else(|| "a check failed".into())
+            ),
+            Style::default().red().bold(),
+        ),
+    };
+    lines.push(verdict);
+    if stale {
+        lines.push(Line::styled(
+            "stale: the mission changed since this run",
+            Style::default().yellow(),
+        ));
+    }
+    lines.push(Line::raw(format!(
+        "J {:.2} · {:.1} m · {:.1} s · {} reconfiguration(s)",
+        o.cost.total,
+        o.path_length,
+        o.duration,
+        o.reconfigurations.len()
+    )));
+    let enabled = o.iwps.iter().filter(|i| i.enabled).count();
+    let groups = crate::outcome::iwp_groups::unusable_groups(&o.iwps, &o.centroid_path, 2);
+    let unusable: usize = groups.iter().map(|g| g.count).sum();
+    let mut iwps = format!("IWPs {} found, {enabled} enabled", o.iwps.len());
+    if unusable > 0 {
+        iwps.push_str(&format!(", {unusable} unusable (all in the IWP table, 2):"));
+    }
+    lines.push(Line::raw(iwps));
+    for g in &groups {
+        let named: Vec<String> = g
+            .nearest
+            .iter()
+            .map(|b| format!("{} ↔ {}", b[0], b[1]))
+            .collect();
+        let more = if g.count > g.nearest.len() {
+            ", …"
+        } else {
+            ""
+        };
+        lines.push(Line::styled(
+            format!("  {} {}: {}{more}", g.count, g.reason, named.join(", ")),
+            Style::default().yellow(),
+        ));
+    }
+    for row in rows {
+        let (mark, style) = if row.ok {
+            ("✓", Style::default().green())
+        } else {
+            ("✗", Style::default().red())
+        };
+        lines.push(Line::from(vec![
+            Span::styled(format!("{mark} "), style),
+            Span::raw(collapsed(&row.text)),
+        ]));
+    }
+    lines
 }
 
 /// The fleet's result: each target's formation time, the closest approaches,

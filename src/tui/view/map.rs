@@ -177,14 +177,12 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     let m = app.mission();
     let vp = *vp;
     let scale = vp.metres_per_column();
-    let mut title = vec![
-        Span::styled(" Map ", Style::default().bold()),
-        Span::raw(format!(
-            "· {:.1} m/cell · step {} m ",
-            scale,
-            crate::tui::fields::fmt_num(app.step_size())
-        )),
-    ];
+    let scale_span = Span::raw(format!(
+        "· {:.1} m/cell · step {} m ",
+        scale,
+        crate::tui::fields::fmt_num(app.step_size())
+    ));
+    let mut title = Vec::new();
     if let (Some(t), Some(end)) = (app.replay_time(), app.replay_end()) {
         title.push(Span::styled(
             format!(
@@ -201,6 +199,8 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
         ));
     }
     let result = result_of(app);
+    // The shown result's state, and its short form for a narrow map.
+    let mut short = None;
     match (&result, app.shown()) {
         (Some((o, stale)), Some(job)) => {
             let verdict = if o.feasible() {
@@ -209,16 +209,21 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
                 "INFEASIBLE"
             };
             let text = format!(" job {} seed {}: {verdict} ", job.id, job.seed);
-            title.push(if *stale {
-                Span::styled(
+            let (long, brief, style) = if *stale {
+                (
                     format!(" STALE{text}(mission edited) "),
+                    format!(" STALE job {} ", job.id),
                     Style::default().black().on_yellow(),
                 )
             } else if o.feasible() {
-                Span::styled(text, Style::default().green())
+                let brief = format!(" job {} ✓ ", job.id);
+                (text, brief, Style::default().green())
             } else {
-                Span::styled(text, Style::default().red().bold())
-            });
+                let brief = format!(" job {} INFEASIBLE ", job.id);
+                (text, brief, Style::default().red().bold())
+            };
+            title.push(Span::styled(long, style));
+            short = Some(Span::styled(brief, style));
         }
         (None, Some(job)) if job.is_running() => {
             title.push(Span::styled(
@@ -231,7 +236,10 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     if let Some(ground) = super::terrain::legend(m) {
         title.push(ground);
     }
-    let block = pane_block(TextLine::from(title), app.focus() == Focus::Map);
+    let block = pane_block(
+        map_title(title, scale_span, short, area.width),
+        app.focus() == Focus::Map,
+    );
     let dot = scale / 2.0;
     let canvas = Canvas::default()
         .block(block)
@@ -649,6 +657,33 @@ fn draw_formation_at_start(ctx: &mut Context, app: &App, m: &Mission, dot: f64) 
     }
 }
 
+/// The map's title: " Map ", the scale, then `state` (replay, add tool,
+/// the shown result). When that does not fit in `width` the state comes
+/// first, the result in its `short` form, and the scale last, where the cut
+/// falls: at 80 × 24 "STALE" was cut to "STAL".
+fn map_title<'a>(
+    state: Vec<Span<'a>>,
+    scale: Span<'a>,
+    short: Option<Span<'a>>,
+    width: u16,
+) -> TextLine<'a> {
+    let name = Span::styled(" Map ", Style::default().bold());
+    let full = name.width() + scale.width() + state.iter().map(Span::width).sum::<usize>();
+    if full + 2 <= usize::from(width) {
+        return TextLine::from([vec![name, scale], state].concat());
+    }
+    let mut spans = vec![name];
+    for span in state {
+        // The shown result's span is the one naming its job.
+        match &short {
+            Some(brief) if span.content.contains("job ") => spans.push(brief.clone()),
+            _ => spans.push(span),
+        }
+    }
+    spans.push(scale);
+    TextLine::from(spans)
+}
+
 /// Distance along the path vs altitude, with the altitude band and the
 /// obstacles the path passes.
 fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
@@ -705,29 +740,44 @@ fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
                     Span::styled("ground", Style::default().fg(Color::Yellow)),
                 );
             }
-            ctx.print(
-                0.0,
-                m.bounds.z[1],
-                Span::styled("z max", Style::default().fg(Color::DarkGray)),
-            );
-            ctx.print(
-                0.0,
-                m.bounds.z[0],
-                Span::styled("z min", Style::default().fg(Color::DarkGray)),
-            );
-            // Obstacles the formation passes within its safe radius.
+            // The altitude axis: the band's limits with their numbers.
+            for (z, name) in [(m.bounds.z[1], "z max"), (m.bounds.z[0], "z min")] {
+                ctx.print(
+                    0.0,
+                    z,
+                    Span::styled(
+                        format!("{name} {} m", crate::tui::fields::fmt_num(z)),
+                        Style::default().fg(Color::DarkGray),
+                    ),
+                );
+            }
+            // Obstacles the formation passes within its safe radius, and
+            // every inspected one (the mission's subject, however far the
+            // path stays from it), at its closest point along the path.
             let reach = m.formation.safe_radius();
             for o in &m.obstacles {
                 if let Some((s, d)) = closest_along(&centroid, &along, &o.center)
-                    && d < o.radius + reach
+                    && (o.inspect || d < o.radius + reach)
                 {
+                    let color = if o.inspect {
+                        Color::LightMagenta
+                    } else {
+                        Color::LightRed
+                    };
                     ctx.draw(&Rectangle {
                         x: s - o.radius,
                         y: 0.0,
                         width: 2.0 * o.radius,
                         height: o.height,
-                        color: Color::LightRed,
+                        color,
                     });
+                    if o.inspect {
+                        ctx.print(
+                            s,
+                            o.height,
+                            Span::styled(o.name.clone(), Style::default().fg(color)),
+                        );
+                    }
                 }
             }
             ctx.layer();
@@ -922,7 +972,11 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
         })
         .collect();
     let empty = app.iwps().is_empty();
+    // With errors elsewhere the IWPs are not looked for: "none" would say
+    // no gap needs one.
+    let errors = app.doc().diagnostics().iter().any(|d| d.is_error());
     let title = match (empty, narrow) {
+        (true, _) if errors => " IWPs (eq. 9): not found until the mission's errors are fixed ",
         (true, false) => " IWPs (eq. 9): none: no gap narrower than the formation ",
         (true, true) => " IWPs (eq. 9): none ",
         (false, false) => " IWPs (eq. 9) · s cycle shape · space on/off ",

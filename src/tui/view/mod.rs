@@ -140,7 +140,7 @@ fn draw_status(frame: &mut Frame, app: &App, area: Rect) {
         spans.push(Span::styled(status.text.clone(), style));
     }
     let hints = match (app.focus(), app.pane()) {
-        _ if app.editor().editing().is_some() => "Enter apply · Esc cancel",
+        _ if app.editor().editing().is_some() => "Enter apply · Esc cancel · Ctrl-u clear",
         (Focus::Map, Pane::Map) => "n/p select · arrows move · a add · r run · ? help",
         (Focus::Map, Pane::Formation) => "n/p select · arrows move · P preset · s shape · ? help",
         (Focus::Inspector, _) => "↑↓ field · Enter edit · Tab focus · ? help",
@@ -265,6 +265,27 @@ fn wrap_words(text: &str, room: usize) -> Vec<String> {
     lines
 }
 
+/// "1 job is running (θ-PSO s7): quitting cancels it." when one is.
+fn running_line(app: &App) -> Vec<Line<'static>> {
+    let running: Vec<String> = app
+        .jobs()
+        .iter()
+        .filter(|j| j.is_running())
+        .map(|j| format!("job {} {} s{}", j.id, j.pipeline.name(), j.seed))
+        .collect();
+    match running.len() {
+        0 => Vec::new(),
+        1 => vec![Line::raw(format!(
+            "{} is running: quitting cancels it.",
+            running[0]
+        ))],
+        n => vec![Line::raw(format!(
+            "{n} jobs are running ({}): quitting cancels them.",
+            running.join(", ")
+        ))],
+    }
+}
+
 fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
     match overlay {
         Overlay::Help => {
@@ -350,17 +371,30 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
             }
         }
         Overlay::Quit => {
-            let lines = vec![
-                Line::raw(format!("{} has unsaved changes.", app.doc().title())),
-                Line::raw(""),
-                hints(&[
-                    ("s", " save and quit   "),
-                    ("y", " quit without saving   "),
-                    ("Esc", " stay"),
-                ]),
-            ];
+            let mut lines = vec![Line::raw(format!(
+                "{} has unsaved changes.",
+                app.doc().title()
+            ))];
+            lines.extend(running_line(app));
+            lines.push(Line::raw(""));
+            lines.push(hints(&[
+                ("s", " save and quit   "),
+                ("y", " quit without saving   "),
+                ("Esc", " stay"),
+            ]));
+            let width = 70.min(area.width);
+            let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
             let body = Paragraph::new(lines).wrap(Wrap { trim: false });
-            popup(frame, area, (70, 5), ("Quit?", Color::Yellow), body);
+            popup(frame, area, size, ("Quit?", Color::Yellow), body);
+        }
+        Overlay::QuitRunning => {
+            let mut lines = running_line(app);
+            lines.push(Line::raw(""));
+            lines.push(hints(&[("y", " quit and cancel   "), ("Esc", " stay")]));
+            let width = 70.min(area.width);
+            let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
+            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+            popup(frame, area, size, ("Quit?", Color::Yellow), body);
         }
         Overlay::SaveAs { input, .. } => {
             let lines = vec![

@@ -1,0 +1,163 @@
+//! Unusable IWPs grouped for a reader: a 200-tree forest has dozens, each
+//! with the same few reasons. Grouped by reason (the names and widths of
+//! each taken out), counted, the few nearest the route named; the IWP
+//! table and the inspector list every one.
+
+use nalgebra::{Point2, Point3};
+
+use crate::geometry::segment_point_distance;
+use crate::planner::Iwp;
+
+/// Unusable IWPs that share a reason.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnusableGroup {
+    /// The reason without the names and figures of any one IWP.
+    pub reason: String,
+    pub count: usize,
+    /// The IWPs of the group nearest the route, nearest first (at most the
+    /// number asked for).
+    pub nearest: Vec<[String; 2]>,
+}
+
+/// An IWP of a group: its distance to the route and the obstacles it is
+/// between.
+type Member = (f64, [String; 2]);
+
+/// The enabled, unusable IWPs of `iwps` grouped by reason, the largest
+/// group first, each naming its `named` IWPs nearest `route` (x-y).
+pub fn unusable_groups(iwps: &[Iwp], route: &[Point3<f64>], named: usize) -> Vec<UnusableGroup> {
+    let mut groups: Vec<(String, Vec<Member>)> = Vec::new();
+    for iwp in iwps.iter().filter(|i| i.enabled) {
+        let Some(reason) = &iwp.unusable else {
+            continue;
+        };
+        let key = reason_kind(reason);
+        let entry = (distance_to(route, &iwp.position), iwp.between.clone());
+        match groups.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, members)) => members.push(entry),
+            None => groups.push((key, vec![entry])),
+        }
+    }
+    let mut out: Vec<UnusableGroup> = groups
+        .into_iter()
+        .map(|(reason, mut members)| {
+            members.sort_by(|a, b| a.0.total_cmp(&b.0));
+            UnusableGroup {
+                reason,
+                count: members.len(),
+                nearest: members.into_iter().take(named).map(|(_, b)| b).collect(),
+            }
+        })
+        .collect();
+    out.sort_by_key(|g| std::cmp::Reverse(g.count));
+    out
+}
+
+/// A reason with what is particular to one IWP taken out: the part before
+/// a colon, quoted names as `'…'`, numbers as `#`.
+fn reason_kind(reason: &str) -> String {
+    let head = reason.split(':').next().unwrap_or(reason);
+    let mut out = String::new();
+    let mut quoted = false;
+    let mut in_number = false;
+    for c in head.chars() {
+        if c == '\'' {
+            quoted = !quoted;
+            if quoted {
+                out.push_str("'…'");
+            }
+            continue;
+        }
+        if quoted {
+            continue;
+        }
+        let digit = c.is_ascii_digit() || (in_number && c == '.');
+        if digit {
+            if !in_number {
+                out.push('#');
+            }
+            in_number = true;
+            continue;
+        }
+        in_number = false;
+        out.push(c);
+    }
+    out.trim().to_owned()
+}
+
+/// The x-y distance from `p` to the polyline `route` (∞ without one).
+fn distance_to(route: &[Point3<f64>], p: &Point2<f64>) -> f64 {
+    match route {
+        [] => f64::INFINITY,
+        [only] => (only.xy() - p).norm(),
+        _ => route
+            .windows(2)
+            .map(|w| segment_point_distance(&w[0].xy(), &w[1].xy(), p))
+            .fold(f64::INFINITY, f64::min),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mission::ShapeChoice;
+    use crate::planner::Iwp;
+    use nalgebra::Vector2;
+
+    fn iwp(a: &str, b: &str, y: f64, reason: Option<&str>) -> Iwp {
+        Iwp {
+            between: [a.into(), b.into()],
+            obstacles: [0, 1],
+            position: Point2::new(50.0, y),
+            gap: 1.0,
+            normal: Vector2::x(),
+            enabled: true,
+            choice: ShapeChoice::Auto,
+            shape: None,
+            unusable: reason.map(str::to_owned),
+            hold: 0.0,
+            straight: 0.0,
+        }
+    }
+
+    /// Issue 23, item 4 (the designer half): forty unusable IWPs read as
+    /// two lines: a count by reason, the nearest named.
+    #[test]
+    fn unusable_iwps_are_counted_by_reason_and_the_nearest_named() {
+        let mut iwps = Vec::new();
+        for k in 0..30 {
+            let why = format!(
+                "no shape fits: the narrowest, a column, is 1.{k:02} m wide and the gap is 0.9 m"
+            );
+            iwps.push(iwp(
+                &format!("tree {k}"),
+                &format!("tree {}", k + 1),
+                k as f64,
+                Some(&why),
+            ));
+        }
+        for k in 0..10 {
+            let why =
+                format!("held through the gap, the alignment would pass within r_Q of 'post {k}'");
+            iwps.push(iwp(
+                &format!("post {k}"),
+                "wall",
+                40.0 + k as f64,
+                Some(&why),
+            ));
+        }
+        iwps.push(iwp("gate a", "gate b", 5.0, None));
+        let route = [Point3::new(0.0, 12.0, 10.0), Point3::new(100.0, 12.0, 10.0)];
+        let groups = unusable_groups(&iwps, &route, 3);
+        assert_eq!(groups.len(), 2, "{groups:?}");
+        assert_eq!(groups[0].reason, "no shape fits");
+        assert_eq!(groups[0].count, 30);
+        let nearest: Vec<&str> = groups[0].nearest.iter().map(|b| b[0].as_str()).collect();
+        assert_eq!(nearest, ["tree 12", "tree 11", "tree 13"]);
+        assert_eq!(
+            groups[1].reason,
+            "held through the gap, the alignment would pass within r_Q of '…'"
+        );
+        assert_eq!(groups[1].count, 10);
+    }
+}
