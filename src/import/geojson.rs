@@ -19,8 +19,12 @@ pub enum Problem {
 
 pub fn read(text: &str) -> Result<Survey, Problem> {
     let root: Value = serde_json::from_str(text).map_err(|e| {
+        let full = e.to_string();
+        let what = full
+            .rsplit_once(" at line ")
+            .map_or(full.as_str(), |(w, _)| w);
         Problem::Format(format!(
-            "not JSON (line {}, column {}): {e}",
+            "not JSON, so not GeoJSON (line {}, column {}: {what})",
             e.line(),
             e.column()
         ))

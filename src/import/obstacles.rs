@@ -151,6 +151,7 @@ pub fn make(
         let height = property(f, "height", &mut problems);
         let mut discs: Vec<Disc> = Vec::new();
         let mut outside_points = 0;
+        let mut no_area = false;
         for shape in &f.shapes {
             match shape {
                 Shape::Point(p) => {
@@ -186,6 +187,10 @@ pub fn make(
                         continue;
                     };
                     let whole = polygon.unsigned_area();
+                    if whole <= 1e-6 {
+                        no_area = true;
+                        continue;
+                    }
                     let inside = box_polygon.intersection(&polygon);
                     let area = inside.unsigned_area();
                     if area <= 1e-6 {
@@ -214,12 +219,12 @@ pub fn make(
             }
         }
         if discs.is_empty() {
-            made.skipped.push(format!(
-                "{}: outside the bounds x {:?}, y {:?} (or of no area)",
-                f.label(),
-                bounds.x,
-                bounds.y
-            ));
+            let why = if no_area {
+                "a polygon of no area".to_owned()
+            } else {
+                format!("outside the bounds x {:?}, y {:?}", bounds.x, bounds.y)
+            };
+            made.skipped.push(format!("{}: {why}", f.label()));
             continue;
         }
         if outside_points > 0 {
