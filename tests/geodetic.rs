@@ -310,3 +310,49 @@ fn with_terrain_a_position_gives_its_height_above_the_ground_not_an_altitude() {
         "{errs:?}"
     );
 }
+
+/// The inspector shows a position in both forms: the lat/lon fields read
+/// through `[origin]`, a typed latitude moves the item there (its longitude
+/// kept), and without an origin they are empty and refuse a value.
+#[test]
+fn the_inspector_shows_and_edits_positions_in_latitude_longitude() {
+    use skyform::tui::fields::Item as Selected;
+    use skyform::tui::fixtures::type_into;
+    use skyform::tui::{Action, App, Document};
+    let m = load(&shipped("bridge-inspection.toml"));
+    let frame = Frame::new(m.origin.as_ref().expect("the bridge has an origin"));
+    let mut app = App::new(Document::new(m.clone(), None), std::env::temp_dir());
+    app.update(Action::Select(Selected::Obstacle(2)));
+    let field = |app: &App, label: &str| -> String {
+        let fields = app.fields();
+        let f = fields.iter().find(|f| f.label() == label);
+        f.unwrap_or_else(|| panic!("no field {label} in {fields:?}"))
+            .value()
+            .to_owned()
+    };
+    let here = frame.ground_to_geodetic(&m.obstacles[2].center);
+    let lat: f64 = field(&app, "centre lat (°)").parse().unwrap();
+    let lon: f64 = field(&app, "centre lon (°)").parse().unwrap();
+    assert!((lat - here.latitude).abs() < 1e-8 && (lon - here.longitude).abs() < 1e-8);
+
+    // 0.0001° north is about 11.1 m.
+    let typed = format!("{:.8}", here.latitude + 1e-4);
+    type_into(&mut app, "centre lat (°)", &typed);
+    let moved = app.mission().obstacles[2].center;
+    let want = frame.ground_to_enu(typed.parse().unwrap(), here.longitude);
+    assert!((moved - want).norm() < 1e-6, "{moved} vs {want}");
+    assert!((moved.y - m.obstacles[2].center.y - 11.09).abs() < 0.05);
+    assert!((moved.x - m.obstacles[2].center.x).abs() < 1e-3);
+    app.update(Action::Undo);
+    assert_eq!(app.mission(), &m, "the latitude edit is one undo step");
+
+    let mut no_origin = m.clone();
+    no_origin.origin = None;
+    let mut app = App::new(Document::new(no_origin.clone(), None), std::env::temp_dir());
+    app.update(Action::Select(Selected::Obstacle(2)));
+    assert_eq!(field(&app, "centre lat (°)"), "");
+    type_into(&mut app, "centre lat (°)", "-33.9");
+    assert_eq!(app.mission(), &no_origin, "no origin: nothing moves");
+    let status = app.status().expect("the refusal on the status line");
+    assert!(status.text.contains("[origin]"), "{}", status.text);
+}
