@@ -476,3 +476,88 @@ fn into_a_mission_written_in_latitude_longitude_the_survey_comes_in_latitude_lon
         .mission;
     assert!((named(&m, "gum tree").center - Point2::new(100.0, 90.0)).norm() < 1e-3);
 }
+
+/// The designer's `I`: the survey's path typed into the prompt, Enter.
+fn import_in_designer(app: &mut skyform::tui::App, typed: &str) {
+    use skyform::tui::Action;
+    app.update(Action::Import);
+    for c in typed.chars() {
+        app.update(Action::PromptInput(c));
+    }
+    app.update(Action::Confirm);
+}
+
+#[test]
+fn the_designers_import_is_one_undo_step_and_a_re_import_adds_nothing() {
+    use skyform::tui::{Action, App, Document};
+    let dir = tempfile::tempdir().unwrap();
+    let site = dir.path().join("site.toml");
+    std::fs::copy(root().join("missions/bridge-site.toml"), &site).unwrap();
+    std::fs::copy(
+        root().join("missions/bridge-site.geojson"),
+        dir.path().join("survey.geojson"),
+    )
+    .unwrap();
+    let before = mission::load(&site).unwrap().mission;
+    let mut app = App::new(
+        Document::new(before.clone(), Some(site.clone())),
+        dir.path().to_path_buf(),
+    );
+
+    import_in_designer(&mut app, "survey.geojson");
+    let status = app.status().expect("a status line").clone();
+    assert!(!status.error, "{}", status.text);
+    assert!(
+        status.text.contains("imported survey.geojson"),
+        "{}",
+        status.text
+    );
+    let once = app.mission().clone();
+    // The CLI's import of the same file gives the same obstacles.
+    let cli = import_into(&before, &dir.path().join("survey.geojson")).mission;
+    assert_eq!(once.obstacles, cli.obstacles);
+    assert!(named(&once, "pier 5").radius > 0.0);
+    assert!(app.doc().is_modified());
+    assert_eq!(
+        std::fs::read_to_string(&site).unwrap(),
+        std::fs::read_to_string(root().join("missions/bridge-site.toml")).unwrap(),
+        "the designer's import writes nothing until a save"
+    );
+
+    import_in_designer(&mut app, "survey.geojson");
+    assert_eq!(app.mission(), &once, "a re-import duplicates nothing");
+    let again = app.status().expect("a status line");
+    assert!(again.text.contains("nothing to import"), "{}", again.text);
+
+    app.update(Action::Undo);
+    assert_eq!(
+        app.mission(),
+        &before,
+        "one undo takes the whole import back"
+    );
+    assert!(!app.doc().is_modified());
+    app.update(Action::Redo);
+    assert_eq!(app.mission(), &once);
+}
+
+#[test]
+fn a_bad_survey_in_the_designer_changes_nothing_and_says_why() {
+    use skyform::tui::{App, Document};
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("broken.geojson"), "{ not json").unwrap();
+    let m = bridge();
+    let mut app = App::new(Document::new(m.clone(), None), dir.path().to_path_buf());
+    import_in_designer(&mut app, "broken.geojson");
+    let status = app.status().expect("a status line");
+    assert!(status.error);
+    assert!(
+        status.text.starts_with("not imported:") && status.text.contains("broken.geojson"),
+        "{}",
+        status.text
+    );
+    assert_eq!(app.mission(), &m);
+    assert!(!app.doc().is_modified());
+    import_in_designer(&mut app, "missing.kml");
+    assert!(app.status().expect("a status line").error);
+    assert_eq!(app.mission(), &m);
+}
