@@ -452,7 +452,7 @@ fn far_from_site(f: &Feature, frame: &Frame, bounds: &Bounds) -> Option<String> 
             Shape::Polygon(r) => r.iter().flatten().copied().collect(),
         })
         .map(|[lon, lat]| (lon, lat, away(lon, lat)))
-        .find(|(_, _, d)| !(*d <= REGION))?;
+        .find(|(_, _, d)| d.is_nan() || *d > REGION)?;
     let (lon, lat, d) = first_far;
     let swapped = lat.abs() <= 180.0 && lon.abs() <= 90.0 && away(lat, lon) <= REGION;
     let hint = if swapped {

@@ -216,7 +216,7 @@ pub fn convert(root: &Spanned<DeTable<'_>>) -> Result<Conversions, Vec<Diagnosti
         }
         let values = enu(&frame, f);
         let distance = values[0].hypot(values[1]);
-        if !(distance <= REGION) {
+        if distance.is_nan() || distance > REGION {
             problems.push(Diagnostic::error(
                 f.path.clone(),
                 format!(
