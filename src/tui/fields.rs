@@ -424,6 +424,11 @@ mod tests {
                     "shrink".to_string()
                 } else if f.value() == "yes" || f.value() == "no" {
                     "yes".to_string()
+                } else if f.label().ends_with("lat (°)") || f.label().ends_with("lon (°)") {
+                    // A position nearby: 7° would be thousands of km off the site.
+                    let now: f64 = f.value().parse().unwrap();
+                    let typed = format!("{:.8}", now + 1e-4);
+                    typed.trim_end_matches('0').trim_end_matches('.').to_owned()
                 } else {
                     "7".to_string()
                 };
@@ -441,8 +446,8 @@ mod tests {
     #[test]
     fn bad_text_is_refused_with_what_was_expected() {
         let mut m = default_mission().mission;
-        let radius = &fields(&Item::Obstacle(0), &m)[4];
-        assert_eq!(radius.label(), "radius (m)");
+        let all = fields(&Item::Obstacle(0), &m);
+        let radius = all.iter().find(|f| f.label() == "radius (m)").unwrap();
         let before = m.clone();
         let err = radius.set(&mut m, &Item::Obstacle(0), "wide").unwrap_err();
         assert_eq!(err, "'wide' is not a number");
@@ -579,7 +584,8 @@ mod tests {
 
         // The validator's message on the radius is the radius field's.
         m.obstacles[3].radius = -1.0;
-        let radius = &fields(&obstacle, &m)[4];
+        let all = fields(&obstacle, &m);
+        let radius = all.iter().find(|f| f.label() == "radius (m)").unwrap();
         let found: Vec<_> = crate::diagnose::diagnose(&m)
             .into_iter()
             .filter(|d| d.path.starts_with(radius.path()))
