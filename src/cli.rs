@@ -14,6 +14,7 @@ use crate::record::{self, Recorder, Sinks};
 
 pub mod eval_cmd;
 pub mod export_cmd;
+pub mod import_cmd;
 pub mod sweep_cmd;
 
 /// Terminal mission designer for multi-UAV formations.
@@ -80,20 +81,41 @@ pub enum Command {
         record: RecordArgs,
     },
     /// Plan a mission and write one autopilot mission file per vehicle
-    /// (.plan, .waypoints, CSV), re-verified as it will be flown.
+    /// (.plan, .waypoints, CSV), re-verified as it will be flown, and/or a
+    /// KML of the whole plan.
     ///
-    /// Files: `<mission-stem>-<pipeline>-uav<N>.<ext>` in DIR. Each vehicle's
+    /// Files: `<mission-stem>-<pipeline>-uav<N>.<ext>` in DIR, and
+    /// `<mission-stem>-<pipeline>.kml` (the mission, each vehicle's planned
+    /// track in a folder of its own in its map colour, the verdict; altitudes
+    /// relative to the ground). Each vehicle's
     /// track becomes waypoints within the tolerance of where the plan has it
     /// at each instant, with a commanded speed per leg so that it reaches
     /// each waypoint on time. The plans are flown as an autopilot flies them
     /// (straight legs at the commanded speeds, all vehicles starting
     /// together) and checked with the pipeline's own verification; a flown
-    /// plan that breaks a constraint is refused unless --force. `plan` and
-    /// `wpl` need the mission's [origin]; `csv` works without it (ENU only).
+    /// plan that breaks a constraint is refused unless --force. `plan`, `wpl`
+    /// and `kml` need the mission's [origin]; `csv` works without it (ENU only).
     /// Prints the files, their waypoint counts, the largest deviation and
     /// timing error. Exit status: 0 written, 1 error, 2 refused, 130
     /// cancelled (Ctrl-C). See docs/export.md.
     Export(export_cmd::ExportArgs),
+    /// Bring a site survey's obstacles into a mission: GeoJSON (RFC 7946),
+    /// KML or KMZ.
+    ///
+    /// Points become cylinders, lines a row of cylinders, polygons a cover
+    /// of cylinders whose union contains them (the area it adds is said per
+    /// polygon); lines and polygons are clipped to the bounds. Radius and
+    /// height come from each feature's `radius` and `height` properties
+    /// (KML: ExtendedData), metres, else 1 m and 1 m above the altitude
+    /// band (a warning lists them); names from `name`, kinds from `kind` (KML:
+    /// the folder). Features outside the bounds or without a usable geometry
+    /// are listed. Obstacles are matched by name: importing the same file
+    /// again changes nothing. The mission is edited in place (comments and
+    /// layout kept) and saved atomically; nothing is written on an error.
+    /// Needs the mission's [origin]. Exit status: 0 imported (or nothing to
+    /// change), 1 error, 2 refused: the mission would then have validation
+    /// errors it does not have now (--force writes it anyway).
+    Import(import_cmd::ImportArgs),
     /// Print the cost of given paths under the mission's cost, one per line
     /// with 17 significant digits (`inf` where infinite): the parity hook
     /// with the SPSO benchmark's reference code (see docs/spso.md).
@@ -290,6 +312,7 @@ pub fn main() -> ExitCode {
             ExitCode::from(record_mission(&mission, &record.sinks()))
         }
         Command::Export(args) => ExitCode::from(export_cmd::export_command(&args)),
+        Command::Import(args) => ExitCode::from(import_cmd::import_command(&args)),
         Command::Eval(args) => ExitCode::from(eval_cmd::eval_command(&args)),
         Command::Sweep(args) => ExitCode::from(sweep_cmd::sweep_command(&args)),
     }

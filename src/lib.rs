@@ -12,6 +12,7 @@ pub mod export;
 pub mod flatlo;
 pub mod fleet;
 pub mod geometry;
+pub mod import;
 pub mod mission;
 pub mod ode;
 pub mod outcome;

@@ -271,10 +271,14 @@ fn shipped_missions_export_and_re_verify_as_flown() {
             r.max_deviation,
             done.tolerance
         );
-        assert_eq!(done.files.len(), 3 * p.tracks.len());
+        assert_eq!(
+            done.files.len(),
+            3 * p.tracks.len() + 1,
+            "three per vehicle, one KML"
+        );
         // Timing: speeds are written to 0.01 m/s and corrected leg by leg.
         assert!(r.max_timing_error < 0.5, "{}", r.max_timing_error);
-        for f in &done.files {
+        for f in done.files.iter().filter(|f| f.format.per_vehicle()) {
             let name = f.path.file_name().and_then(|n| n.to_str()).unwrap_or("");
             assert_eq!(
                 name,
@@ -290,8 +294,20 @@ fn shipped_missions_export_and_re_verify_as_flown() {
                 Format::Plan => check_plan_file(&m, &p, &f.path),
                 Format::Wpl => check_wpl_file(&f.path),
                 Format::Csv => check_csv_file(&p.tracks[f.vehicle], &f.path, true),
+                Format::Kml => {}
             }
         }
+        let kml: Vec<_> = done
+            .files
+            .iter()
+            .filter(|f| f.format == Format::Kml)
+            .collect();
+        assert_eq!(kml.len(), 1);
+        assert_eq!(
+            kml[0].path.file_name().and_then(|n| n.to_str()),
+            Some(format!("{}-{}.kml", s.stem, s.pipeline).as_str())
+        );
+        assert_eq!(kml[0].waypoints, p.tracks.len());
         // No temporary files left behind.
         let stray = std::fs::read_dir(dir.path())
             .unwrap_or_else(|e| panic!("{e}"))
@@ -729,6 +745,153 @@ fn pymavlink_and_mavsdk_read_every_exported_file_as_written() {
     }
 }
 
+/// The expectation of `tests/export_readers/check_kml.py` for an export's
+/// KML: the plan's samples (ENU, with their height above the ground), the
+/// obstacles and inspection bands, the colours and the verdict.
+fn kml_expectation(m: &Mission, p: &Planned, done: &Exported, dir: &Path) -> PathBuf {
+    let origin = m.origin.as_ref().unwrap_or_else(|| panic!("origin"));
+    let kml = done
+        .files
+        .iter()
+        .find(|f| f.format == Format::Kml)
+        .unwrap_or_else(|| panic!("no KML written"));
+    let vehicles: Vec<Value> = p
+        .tracks
+        .iter()
+        .map(|t| {
+            let samples: Vec<Value> = t
+                .samples
+                .iter()
+                .map(|s| {
+                    let q = s.position;
+                    json!([q.x, q.y, q.z, q.z - m.ground(q.x, q.y)])
+                })
+                .collect();
+            json!({
+                "folder": format!("UAV {}", t.vehicle + 1),
+                "color": export::kml::kml_color(skyform::tracks::vehicle_color(t.vehicle), 0xff),
+                "samples": samples,
+            })
+        })
+        .collect();
+    let obstacles: Vec<Value> = m
+        .obstacles
+        .iter()
+        .map(|o| json!({"name": o.name, "center": [o.center.x, o.center.y], "radius": o.radius, "height": o.height}))
+        .collect();
+    let bands: Vec<Value> = m
+        .obstacles
+        .iter()
+        .filter(|o| o.inspect)
+        .map(|o| {
+            let [d_min, d_max] = o.stand_off_band(&m.formation);
+            json!({"name": format!("{} band", o.name), "center": [o.center.x, o.center.y],
+                   "inner": o.radius + d_min, "outer": o.radius + d_max})
+        })
+        .collect();
+    let spec = json!({
+        "tolerance_m": 0.01,
+        "files": [{
+            "path": kml.path.display().to_string(),
+            "origin": {"latitude": origin.latitude, "longitude": origin.longitude, "altitude": origin.altitude},
+            "verdict": p.verdict,
+            "vehicles": vehicles,
+            "obstacles": obstacles,
+            "bands": bands,
+        }],
+    });
+    let path = dir.join("expect_kml.json");
+    std::fs::write(&path, serde_json::to_string(&spec).unwrap_or_default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    path
+}
+
+/// Issue 28: the KML export read back by fastkml (validating against the
+/// KML 2.2 schema), every position within 0.01 m of the plan through
+/// pymap3d's geodesy, one folder per vehicle in its colour, the verdict in
+/// the description; for every shipped mission and pipeline.
+#[test]
+fn fastkml_reads_every_kml_export_within_a_centimetre_of_the_plan() {
+    let Some(python) = reader_python() else {
+        return;
+    };
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_readers/check_kml.py");
+    for s in &SHIPPED {
+        let dir = tempdir();
+        let (m, p, done) = export_shipped(s, dir.path());
+        assert!(!p.verdict.is_empty());
+        let expect = kml_expectation(&m, &p, &done, dir.path());
+        let out = std::process::Command::new(&python)
+            .arg(&script)
+            .arg(&expect)
+            .output()
+            .unwrap_or_else(|e| panic!("cannot run check_kml.py: {e}"));
+        eprint!(
+            "check_kml.py on {} {}: {}",
+            s.stem,
+            s.pipeline,
+            text(&out.stdout)
+        );
+        assert!(
+            out.status.success(),
+            "check_kml.py on {} {}: {}{}",
+            s.stem,
+            s.pipeline,
+            text(&out.stdout),
+            text(&out.stderr)
+        );
+    }
+}
+
+/// The checker is not a rubber stamp: a track moved by 2 cm, or a file the
+/// schema refuses, fails it.
+#[test]
+fn the_kml_checker_refuses_a_track_two_centimetres_off_and_an_invalid_file() {
+    let Some(python) = reader_python() else {
+        return;
+    };
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/export_readers/check_kml.py");
+    let dir = tempdir();
+    let (m, mut p, done) = export_shipped(&SHIPPED[1], dir.path());
+    for t in &mut p.tracks {
+        for s in &mut t.samples {
+            s.position.x += 0.02;
+        }
+    }
+    let expect = kml_expectation(&m, &p, &done, dir.path());
+    let run = |expect: &Path| {
+        std::process::Command::new(&python)
+            .arg(&script)
+            .arg(expect)
+            .output()
+            .unwrap_or_else(|e| panic!("cannot run check_kml.py: {e}"))
+    };
+    let off = run(&expect);
+    assert_eq!(off.status.code(), Some(1), "{}", text(&off.stdout));
+    assert!(
+        text(&off.stderr).contains("off horizontally"),
+        "{}",
+        text(&off.stderr)
+    );
+    // A styleUrl after the geometry (as the kml crate's own field writes it)
+    // is outside the KML 2.2 schema.
+    let kml = done
+        .files
+        .iter()
+        .find(|f| f.format == Format::Kml)
+        .map(|f| f.path.clone());
+    let kml = kml.unwrap_or_else(|| panic!("no KML"));
+    let body = read(&kml).replacen("</LineString>", "</LineString><styleUrl>#x</styleUrl>", 1);
+    std::fs::write(&kml, body).unwrap_or_else(|e| panic!("{e}"));
+    let refused = run(&expect);
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(
+        text(&refused.stderr).contains("could not read"),
+        "{}",
+        text(&refused.stderr)
+    );
+}
+
 // ------------------------------------------------------------ designer
 
 #[test]
@@ -771,6 +934,7 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
     for ext in ["plan", "waypoints", "csv"] {
         assert!(folder.join(format!("bridge-theta-pso-uav1.{ext}")).exists());
     }
+    assert!(folder.join("bridge-theta-pso.kml").exists(), "and the KML");
 
     // The inspector edits [origin] (Mission item): its three fields.
     let fields = skyform::tui::fields::fields(&Item::Mission, app.mission());

@@ -53,7 +53,8 @@ fn inspector_with_a_validation_error() {
     let mut app = default_app();
     app.update(Action::Select(Item::Obstacle(2)));
     app.update(Action::FocusOn(Focus::Inspector));
-    for _ in 0..4 {
+    // name, kind, centre x, y, lat, lon: radius
+    for _ in 0..6 {
         app.update(Action::FieldDown);
     }
     app.update(Action::EditStart(Some('0')));

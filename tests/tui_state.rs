@@ -109,7 +109,8 @@ fn validation_follows_the_typing() {
     let mut app = app_in(dir.path());
     app.update(Action::Select(Item::Obstacle(0)));
     app.update(Action::FocusOn(Focus::Inspector));
-    for _ in 0..4 {
+    // name, kind, centre x, y, lat, lon: radius
+    for _ in 0..6 {
         app.update(Action::FieldDown);
     }
     assert_eq!(app.fields()[app.editor().field()].label(), "radius (m)");

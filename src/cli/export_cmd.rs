@@ -36,6 +36,8 @@ pub enum FormatArg {
     Wpl,
     /// Timed samples t,x,y,z,vx,vy,vz[,lat,lon,alt].
     Csv,
+    /// One KML of the mission and every vehicle's track (Google Earth).
+    Kml,
 }
 
 impl From<FormatArg> for Format {
@@ -44,6 +46,7 @@ impl From<FormatArg> for Format {
             FormatArg::Plan => Format::Plan,
             FormatArg::Wpl => Format::Wpl,
             FormatArg::Csv => Format::Csv,
+            FormatArg::Kml => Format::Kml,
         }
     }
 }
@@ -53,7 +56,7 @@ impl From<FormatArg> for Format {
 pub struct ExportArgs {
     /// Mission TOML file.
     pub mission: PathBuf,
-    /// File format; repeat for several (plan, wpl, csv).
+    /// File format; repeat for several (plan, wpl, csv, kml).
     #[arg(long, value_enum, required = true)]
     pub format: Vec<FormatArg>,
     /// Folder for the files (created if missing).
@@ -183,6 +186,11 @@ pub fn summary(done: &Exported) -> String {
         done.tolerance,
         done.tolerance_source
     );
+    let flown = done.files.iter().any(|f| f.format.per_vehicle());
+    if !flown {
+        // Only the KML: the plan itself, no waypoint plans to fly.
+        return out + &files_written(done);
+    }
     for p in &done.plans {
         out.push_str(&format!(
             "  UAV {}: {} waypoints\n",
@@ -229,18 +237,34 @@ pub fn summary(done: &Exported) -> String {
             i.band[1]
         ));
     }
+    out + &files_written(done)
+}
+
+/// One line per file written.
+fn files_written(done: &Exported) -> String {
+    let mut out = String::new();
     for f in &done.files {
-        out.push_str(&format!(
-            "wrote {} ({} waypoints, {} {})\n",
-            f.path.display(),
-            f.waypoints,
-            f.items,
-            if f.format == Format::Csv {
-                "samples"
-            } else {
-                "items"
-            }
-        ));
+        let line = match f.format {
+            Format::Kml => format!(
+                "wrote {} ({} tracks, {} placemarks, altitudes relative to the ground)\n",
+                f.path.display(),
+                f.waypoints,
+                f.items
+            ),
+            Format::Csv => format!(
+                "wrote {} ({} waypoints, {} samples)\n",
+                f.path.display(),
+                f.waypoints,
+                f.items
+            ),
+            Format::Plan | Format::Wpl => format!(
+                "wrote {} ({} waypoints, {} items)\n",
+                f.path.display(),
+                f.waypoints,
+                f.items
+            ),
+        };
+        out.push_str(&line);
     }
     out
 }

@@ -9,10 +9,13 @@
 //! commanded speeds, all vehicles starting together) and checked with the
 //! pipeline's own verification ([`reverify`]). Only then are the files
 //! written: QGroundControl `.plan` ([`plan`]), `QGC WPL 110` ([`wpl`]) or CSV
-//! ([`csv`]), atomically. `docs/export.md` describes the formats.
+//! ([`csv`]), atomically. A KML of the whole plan ([`kml`]: the mission, every
+//! vehicle's track, the verdict) is one more file, to look at over imagery.
+//! `docs/export.md` describes the formats.
 
 pub mod csv;
 pub mod geodesy;
+pub mod kml;
 pub mod plan;
 pub mod reverify;
 pub mod simplify;
@@ -44,16 +47,19 @@ pub enum Format {
     Wpl,
     /// Timed ENU (and WGS-84) samples of each track.
     Csv,
+    /// One KML of the mission and every vehicle's track (Google Earth).
+    Kml,
 }
 
 impl Format {
-    pub const ALL: [Format; 3] = [Format::Plan, Format::Wpl, Format::Csv];
+    pub const ALL: [Format; 4] = [Format::Plan, Format::Wpl, Format::Csv, Format::Kml];
 
     pub fn extension(self) -> &'static str {
         match self {
             Format::Plan => "plan",
             Format::Wpl => "waypoints",
             Format::Csv => "csv",
+            Format::Kml => "kml",
         }
     }
 
@@ -62,12 +68,19 @@ impl Format {
             Format::Plan => "plan",
             Format::Wpl => "wpl",
             Format::Csv => "csv",
+            Format::Kml => "kml",
         }
     }
 
     /// Needs the mission's `[origin]` (latitude and longitude).
     pub fn geodetic(self) -> bool {
         !matches!(self, Format::Csv)
+    }
+
+    /// One file per vehicle, from the re-verified waypoint plans (the KML
+    /// is one file of the planned tracks, to look at, not to fly).
+    pub fn per_vehicle(self) -> bool {
+        !matches!(self, Format::Kml)
     }
 }
 
@@ -101,6 +114,8 @@ pub struct Planned {
     pub margin_source: String,
     /// Fixed-wing loiter radius at the end, metres.
     pub loiter_radius: f64,
+    /// The run's verdict in one line (`Outcome::headline`), for the KML.
+    pub verdict: String,
 }
 
 impl Planned {
@@ -112,6 +127,11 @@ impl Planned {
             Outcome::Flatlo(o) => Planned::flatlo(mission, o),
             Outcome::Fleet(o) => Planned::fleet(mission, o),
         }
+    }
+
+    /// The headline of an outcome (what the designer and `skyform run` say).
+    fn headline(outcome: crate::outcome::Outcome) -> String {
+        outcome.headline()
     }
 
     /// θ-PSO: the UAVs' trajectories, held to r_Q, [2 r_Q, d_com], the band,
@@ -126,6 +146,9 @@ impl Planned {
             margin: mission.theta_pso.clearance_margin,
             margin_source: "theta_pso.clearance_margin".into(),
             loiter_radius: 0.0,
+            verdict: Planned::headline(crate::outcome::Outcome::ThetaPso(Box::new(
+                outcome.clone(),
+            ))),
         }
     }
 
@@ -153,6 +176,7 @@ impl Planned {
             margin: tracking,
             margin_source: "the simulated squadron's largest tracking error".into(),
             loiter_radius: p.turn_radius,
+            verdict: Planned::headline(crate::outcome::Outcome::Flatlo(Box::new(outcome.clone()))),
         }
     }
 
@@ -174,6 +198,7 @@ impl Planned {
             margin: p.tolerance * p.safety_distance / 2.0,
             margin_source: "fleet.tolerance × fleet.safety_distance / 2".into(),
             loiter_radius: 0.0,
+            verdict: Planned::headline(crate::outcome::Outcome::Fleet(Box::new(outcome.clone()))),
         }
     }
 
@@ -333,11 +358,11 @@ pub struct Options {
 pub struct Written {
     pub path: PathBuf,
     pub format: Format,
-    /// 0-based vehicle.
+    /// 0-based vehicle (0 for the KML, which holds them all).
     pub vehicle: usize,
-    /// Waypoints (NAV_WAYPOINT items) of the vehicle's plan.
+    /// Waypoints (NAV_WAYPOINT items) of the vehicle's plan (KML: tracks).
     pub waypoints: usize,
-    /// Lines or mission items written (CSV: samples).
+    /// Lines or mission items written (CSV: samples; KML: placemarks).
     pub items: usize,
 }
 
@@ -385,6 +410,11 @@ pub fn file_name(stem: &str, pipeline: Kind, vehicle: usize, format: Format) -> 
     )
 }
 
+/// File name of the KML of the whole plan: `<mission-stem>-<pipeline>.kml`.
+pub fn kml_file_name(stem: &str, pipeline: Kind) -> String {
+    format!("{stem}-{}.kml", pipeline.slug())
+}
+
 /// Reduces, re-verifies and (unless refused) writes one file per vehicle and
 /// format into `options.out_dir`, named after `stem` (the mission file's stem).
 pub fn export(
@@ -410,7 +440,9 @@ pub fn export(
     let fixed_wing = planned.pipeline.fixed_wing();
     let plans = reduce(&planned.tracks, tolerance, fixed_wing);
     let reverification = reverify::reverify(mission, &planned.limits, &planned.tracks, &plans);
-    let forced = !reverification.passed();
+    // The KML shows the plan itself: only the files to fly are refused.
+    let flown = options.formats.iter().any(|f| f.per_vehicle());
+    let forced = flown && !reverification.passed();
     if forced && !options.force {
         return Err(ExportError::Refused(Box::new(reverification)));
     }
@@ -421,6 +453,19 @@ pub fn export(
     })?;
     let mut files = Vec::new();
     for format in &options.formats {
+        if let (Format::Kml, Some(frame)) = (format, &frame) {
+            let path = options.out_dir.join(kml_file_name(stem, planned.pipeline));
+            let (text, items) = kml::render(mission, planned, frame);
+            write_atomic(&path, text.as_bytes())?;
+            files.push(Written {
+                path,
+                format: *format,
+                vehicle: 0,
+                waypoints: planned.tracks.len(),
+                items,
+            });
+            continue;
+        }
         for (plan, track) in plans.iter().zip(&planned.tracks) {
             let name = file_name(stem, planned.pipeline, plan.vehicle, *format);
             let path = options.out_dir.join(name);
@@ -430,7 +475,9 @@ pub fn export(
                     plan::render(mission, planned, plan, frame, tolerance)
                 }
                 (Format::Wpl, Some(frame)) => wpl::render(planned, plan, frame, tolerance),
-                (f, None) => return Err(ExportError::NoOrigin(f.name())),
+                (f @ (Format::Plan | Format::Wpl | Format::Kml), _) => {
+                    return Err(ExportError::NoOrigin(f.name()));
+                }
             };
             write_atomic(&path, text.as_bytes())?;
             files.push(Written {

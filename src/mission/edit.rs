@@ -8,6 +8,11 @@
 //! its default that the file did not write stays unwritten, so saving an
 //! unchanged mission gives back the same bytes. New items (an obstacle, a
 //! section the file did not have) are added in TOML's usual style.
+//!
+//! Positions keep the form the file wrote them in: one written as
+//! latitude/longitude is compared and written as latitude/longitude
+//! (`geodetic::write_forms`), and an element added to an array of them (a
+//! new obstacle) takes the form of the file's last one.
 
 use toml_edit::{ArrayOfTables, DocumentMut, Item, Table, TableLike};
 
@@ -18,9 +23,12 @@ use super::model::Mission;
 /// caller then writes the whole mission afresh.
 pub fn edit_in_place(mission: &Mission, original: &str) -> Option<String> {
     let mut doc: DocumentMut = original.parse().ok()?;
-    let before: Mission = toml::from_str(original).ok()?;
-    let old = tree(&before)?;
-    let new = tree(mission)?;
+    let source = super::source::SourceMap::new(original);
+    let (before, forms) = super::file::read_model(original, &source).ok()?;
+    let mut old = tree(&before)?;
+    let mut new = tree(mission)?;
+    super::geodetic::write_forms(&mut old, &before, &forms);
+    super::geodetic::write_forms(&mut new, mission, &forms);
     apply(doc.as_table_mut(), &old, &new);
     Some(doc.to_string())
 }
@@ -42,6 +50,13 @@ fn apply(table: &mut dyn TableLike, old: &toml::Table, new: &toml::Table) {
             continue;
         }
         match value {
+            // A new latitude/longitude position: inline, as a position is written.
+            toml::Value::Table(sub)
+                if super::geodetic::is_position(sub)
+                    && table.get(key).and_then(Item::as_table_like).is_none() =>
+            {
+                set_value(table, key, to_edit_value(value));
+            }
             toml::Value::Table(sub) => {
                 let old_sub = match before {
                     Some(toml::Value::Table(t)) => t,

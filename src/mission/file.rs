@@ -4,9 +4,11 @@ use std::fs;
 use std::io::{self, Write};
 use std::path::Path;
 
+use serde::Deserialize;
 use toml::de::DeTable;
 
 use super::diagnostic::{Diagnostic, Report};
+use super::geodetic::{self, Forms};
 use super::model::Mission;
 use super::source::SourceMap;
 use super::validate::validate;
@@ -52,8 +54,8 @@ pub fn check_str(text: &str, file: Option<&str>) -> Checked {
             report: Report::new(diagnostics),
         };
     }
-    match toml::from_str::<Mission>(text) {
-        Ok(mut mission) => {
+    match read_model(text, &source) {
+        Ok((mut mission, _)) => {
             // A terrain file is relative to the mission file (or to the
             // current directory for a mission without one).
             let base = file
@@ -68,11 +70,27 @@ pub fn check_str(text: &str, file: Option<&str>) -> Checked {
                 report,
             }
         }
-        Err(e) => Checked {
+        Err(diagnostics) => Checked {
             mission: None,
-            report: Report::new(vec![locate(locate_toml_error(&e, &source))]),
+            report: Report::new(diagnostics.into_iter().map(locate).collect()),
         },
     }
+}
+
+/// The typed mission of a file's text, its latitude/longitude positions
+/// converted to ENU (`geodetic.rs`), not validated; and the forms the file
+/// wrote its positions in (a save writes them back so). Fails on the first
+/// type error, or on every position that cannot be converted.
+pub(super) fn read_model(
+    text: &str,
+    source: &SourceMap<'_>,
+) -> Result<(Mission, Forms), Vec<Diagnostic>> {
+    let root = DeTable::parse(text).map_err(|e| vec![locate_toml_error(&e, source)])?;
+    let conversions = geodetic::convert(&root)?;
+    let root = geodetic::apply(root, &conversions);
+    let mission = Mission::deserialize(toml::de::Deserializer::from(root))
+        .map_err(|e| vec![locate_toml_error(&e, source)])?;
+    Ok((mission, conversions.forms))
 }
 
 /// A toml error as a diagnostic on the field under its span.

@@ -5,6 +5,8 @@ mod builtin;
 mod diagnostic;
 mod edit;
 mod file;
+pub mod geodesy;
+pub mod geodetic;
 mod model;
 mod presets;
 mod source;

@@ -123,6 +123,8 @@ pub enum Action {
     DragTo(Point2<f64>),
     DragEnd,
 
+    /// Ask for a site survey (GeoJSON, KML, KMZ) to bring its obstacles in.
+    Import,
     /// Export the shown job's result, one file per vehicle and format,
     /// beside the mission (re-verified as flown; refused if it breaks a constraint).
     Export,

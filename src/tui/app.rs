@@ -315,7 +315,7 @@ impl App {
             | ToggleSideView => self.update_screen(action),
             ToggleHelp | ScrollHelp(_) | PromptInput(_) | PromptClear | PromptBackspace
             | PickerMove(_) => self.overlays.update(action, &self.cwd),
-            Save | SaveAs | Open | Confirm => self.update_files(action),
+            Save | SaveAs | Open | Confirm | Import => self.update_files(action),
             ChangeStep(_) | Zoom(..) | Pan(..) | Fit => self.update_camera(action),
             Scrub(_) | TogglePlay => self.update_replay(action),
             Run | RunFlatlo | RunFleet | RunNewSeed | Cancel | JobUp | JobDown
@@ -479,6 +479,9 @@ impl App {
                 });
             }
             Action::Open => self.overlays.open_dialog(&self.cwd),
+            Action::Import => self.overlays.show(Overlay::Import {
+                input: String::new(),
+            }),
             Action::Confirm => self.confirm(),
             _ => {}
         }
@@ -658,6 +661,10 @@ impl App {
                 }
             }
             Some(Overlay::Discard(entry)) => self.open(entry),
+            Some(Overlay::Import { input }) => {
+                self.overlays.close();
+                super::import::import(&mut self.editor, &self.cwd, &input, &mut self.status);
+            }
             Some(Overlay::Help) | None => {}
         }
     }

@@ -489,14 +489,19 @@ mod tests {
         for item in items {
             for (k, f) in fields(&item, &m).into_iter().enumerate() {
                 let value = match f.label() {
-                    l if l.contains("shape") => "shrink",
-                    "preset" => "diamond",
-                    "cost" => "paper",
-                    "encoding" => "angle",
-                    _ if f.value() == "yes" || f.value() == "no" => "yes",
-                    _ => "7",
-                }
-                .to_string();
+                    l if l.contains("shape") => "shrink".to_string(),
+                    "preset" => "diamond".to_string(),
+                    "cost" => "paper".to_string(),
+                    "encoding" => "angle".to_string(),
+                    _ if f.value() == "yes" || f.value() == "no" => "yes".to_string(),
+                    l if l.ends_with("lat (°)") || l.ends_with("lon (°)") => {
+                        // A position nearby: 7° would be thousands of km off the site.
+                        let now: f64 = f.value().parse().unwrap();
+                        let typed = format!("{:.8}", now + 1e-4);
+                        typed.trim_end_matches('0').trim_end_matches('.').to_owned()
+                    }
+                    _ => "7".to_string(),
+                };
                 f.set(&mut m, &item, &value).unwrap();
                 assert_eq!(
                     fields(&item, &m)[k].value(),
@@ -511,8 +516,8 @@ mod tests {
     #[test]
     fn bad_text_is_refused_with_what_was_expected() {
         let mut m = default_mission().mission;
-        let radius = &fields(&Item::Obstacle(0), &m)[4];
-        assert_eq!(radius.label(), "radius (m)");
+        let all = fields(&Item::Obstacle(0), &m);
+        let radius = all.iter().find(|f| f.label() == "radius (m)").unwrap();
         let before = m.clone();
         let err = radius.set(&mut m, &Item::Obstacle(0), "wide").unwrap_err();
         assert_eq!(err, "'wide' is not a number");
@@ -679,7 +684,8 @@ mod tests {
 
         // The validator's message on the radius is the radius field's.
         m.obstacles[3].radius = -1.0;
-        let radius = &fields(&obstacle, &m)[4];
+        let all = fields(&obstacle, &m);
+        let radius = all.iter().find(|f| f.label() == "radius (m)").unwrap();
         let found: Vec<_> = crate::diagnose::diagnose(&m)
             .into_iter()
             .filter(|d| d.path.starts_with(radius.path()))

@@ -78,7 +78,7 @@ fn overlay_key(overlay: &Overlay, key: KeyEvent, ctrl: bool) -> Option<Action> {
             KeyCode::Esc | KeyCode::Char('n') => Some(Action::Dismiss),
             _ => None,
         },
-        Overlay::SaveAs { .. } => match key.code {
+        Overlay::SaveAs { .. } | Overlay::Import { .. } => match key.code {
             KeyCode::Char('u') if ctrl => Some(Action::PromptClear),
             KeyCode::Enter => Some(Action::Confirm),
             KeyCode::Esc => Some(Action::Dismiss),

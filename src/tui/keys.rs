@@ -170,6 +170,12 @@ pub static KEYS: &[KeyRow] = &[
         bindings: &[bind(Key::Char('o'), When::Always, Action::Open)],
     },
     KeyRow {
+        group: "General",
+        keys: "I",
+        help: "import obstacles from a site survey (GeoJSON, KML, KMZ): one undo step",
+        bindings: &[bind(Key::Char('I'), When::Always, Action::Import)],
+    },
+    KeyRow {
         group: "Select & move",
         keys: "n  p",
         help: "next / previous item (map: mission, bounds, start, goal, obstacles, θ-PSO; formation: slots, IWPs)",
@@ -425,7 +431,7 @@ pub static KEYS: &[KeyRow] = &[
     KeyRow {
         group: "Run",
         keys: "X",
-        help: "export the shown result per vehicle (.plan, .waypoints, CSV) to <mission>-export/",
+        help: "export the shown result per vehicle (.plan, .waypoints, CSV) and a .kml to <mission>-export/",
         bindings: &[bind(Key::Char('X'), When::Always, Action::Export)],
     },
 ];

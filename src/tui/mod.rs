@@ -20,6 +20,7 @@ pub mod export;
 pub mod fields;
 #[doc(hidden)]
 pub mod fixtures;
+mod import;
 pub mod input;
 pub mod jobs;
 pub mod keys;

@@ -78,6 +78,10 @@ pub enum Overlay {
     },
     /// An earlier session left unsaved changes: restore them?
     Recover(Box<recovery::Copy>),
+    /// The survey file to import obstacles from (typed path).
+    Import {
+        input: String,
+    },
 }
 
 /// The window shown, if any, and where the help overlay is scrolled to.
@@ -157,7 +161,7 @@ impl Overlays {
     /// dialog filters its list by it.
     fn edit_prompt(&mut self, cwd: &Path, change: impl FnOnce(&mut String)) {
         match &mut self.shown {
-            Some(Overlay::SaveAs { input, .. }) => change(input),
+            Some(Overlay::SaveAs { input, .. }) | Some(Overlay::Import { input }) => change(input),
             Some(Overlay::Open {
                 entries,
                 input,

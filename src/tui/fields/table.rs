@@ -3,10 +3,11 @@
 //! values as text. The tables keep one field a line (`rustfmt::skip`) so
 //! they read as tables: name, unit, keys, read, write.
 
-use nalgebra::Vector3;
+use nalgebra::{Point2, Vector3};
 
 use super::Step::{Index, Key};
 use super::{Item, Spec, Table, fmt_num, number, shape_name, waypoint_choice};
+use crate::mission::geodesy::Frame;
 use crate::mission::{
     CostKind, Encoding, FleetTarget, GeoOrigin, Mission, Obstacle, Preset, ShapeChoice, Terrain,
     WaypointChoice, spacing_of,
@@ -57,6 +58,8 @@ static START: Table = Table { base: &[Key("route"), Key("start")], derived: &[],
     Spec { name: "x", unit: "m", keys: &[], get: |m, _| num(m.route.start.x), set: |m, _, t| put(&mut m.route.start.x, number(t)) },
     Spec { name: "y", unit: "m", keys: &[], get: |m, _| num(m.route.start.y), set: |m, _, t| put(&mut m.route.start.y, number(t)) },
     Spec { name: "z", unit: "m", keys: &[], get: |m, _| num(m.route.start.z), set: |m, _, t| put(&mut m.route.start.z, number(t)) },
+    Spec { name: "lat", unit: "°", keys: &["latitude"], get: |m, i| geo(m, i, LAT), set: |m, i, t| set_geo(m, i, t, LAT) },
+    Spec { name: "lon", unit: "°", keys: &["longitude"], get: |m, i| geo(m, i, LON), set: |m, i, t| set_geo(m, i, t, LON) },
 ]};
 
 #[rustfmt::skip]
@@ -64,6 +67,8 @@ static GOAL: Table = Table { base: &[Key("route"), Key("goal")], derived: &[], f
     Spec { name: "x", unit: "m", keys: &[], get: |m, _| num(m.route.goal.x), set: |m, _, t| put(&mut m.route.goal.x, number(t)) },
     Spec { name: "y", unit: "m", keys: &[], get: |m, _| num(m.route.goal.y), set: |m, _, t| put(&mut m.route.goal.y, number(t)) },
     Spec { name: "z", unit: "m", keys: &[], get: |m, _| num(m.route.goal.z), set: |m, _, t| put(&mut m.route.goal.z, number(t)) },
+    Spec { name: "lat", unit: "°", keys: &["latitude"], get: |m, i| geo(m, i, LAT), set: |m, i, t| set_geo(m, i, t, LAT) },
+    Spec { name: "lon", unit: "°", keys: &["longitude"], get: |m, i| geo(m, i, LON), set: |m, i, t| set_geo(m, i, t, LON) },
 ]};
 
 /// The `[terrain]` keys; the map is read again when they change
@@ -85,6 +90,8 @@ static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], derived: &[],
     Spec { name: "kind", unit: "", keys: &["kind"], get: |m, i| text(obstacle_at(m, i)?.kind.as_deref().unwrap_or("")), set: |m, i, t| put(&mut obstacle(m, i)?.kind, Ok((!t.is_empty()).then(|| t.to_owned()))) },
     Spec { name: "centre x", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.x), set: |m, i, t| put(&mut obstacle(m, i)?.center.x, number(t)) },
     Spec { name: "centre y", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.y), set: |m, i, t| put(&mut obstacle(m, i)?.center.y, number(t)) },
+    Spec { name: "centre lat", unit: "°", keys: &["center", "latitude"], get: |m, i| geo(m, i, LAT), set: |m, i, t| set_geo(m, i, t, LAT) },
+    Spec { name: "centre lon", unit: "°", keys: &["center", "longitude"], get: |m, i| geo(m, i, LON), set: |m, i, t| set_geo(m, i, t, LON) },
     Spec { name: "radius", unit: "m", keys: &["radius"], get: |m, i| num(obstacle_at(m, i)?.radius), set: |m, i, t| put(&mut obstacle(m, i)?.radius, number(t)) },
     Spec { name: "height", unit: "m", keys: &["height"], get: |m, i| num(obstacle_at(m, i)?.height), set: |m, i, t| put(&mut obstacle(m, i)?.height, number(t)) },
     Spec { name: "inspect (eq. 8)", unit: "", keys: &["inspect"], get: |m, i| yes(obstacle_at(m, i)?.inspect), set: |m, i, t| put(&mut obstacle(m, i)?.inspect, yes_no(t)) },
@@ -223,9 +230,76 @@ static FLEET_TARGET: Table = Table { base: &[Key("fleet"), Key("targets"), Index
     Spec { name: "time", unit: "s", keys: &["time"], get: |m, i| num(target_at(m, i)?.time), set: |m, i, t| put(&mut target(m, i)?.time, number(t)) },
     Spec { name: "x", unit: "m", keys: &["position"], get: |m, i| num(target_at(m, i)?.position.x), set: |m, i, t| put(&mut target(m, i)?.position.x, number(t)) },
     Spec { name: "y", unit: "m", keys: &["position"], get: |m, i| num(target_at(m, i)?.position.y), set: |m, i, t| put(&mut target(m, i)?.position.y, number(t)) },
+    Spec { name: "lat", unit: "°", keys: &["position", "latitude"], get: |m, i| geo(m, i, LAT), set: |m, i, t| set_geo(m, i, t, LAT) },
+    Spec { name: "lon", unit: "°", keys: &["position", "longitude"], get: |m, i| geo(m, i, LON), set: |m, i, t| set_geo(m, i, t, LON) },
 ]};
 
 // Reading and writing the values as text.
+
+const LAT: bool = true;
+const LON: bool = false;
+
+/// Degrees to 8 decimals (about a millimetre), as typed.
+fn degrees(v: f64) -> String {
+    let s = format!("{v:.8}");
+    s.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+/// Where a positioned item is on the ground plane (x, y), metres ENU.
+fn ground_xy(m: &Mission, item: &Item) -> Option<Point2<f64>> {
+    match item {
+        Item::Start => Some(m.route.start.xy()),
+        Item::Goal => Some(m.route.goal.xy()),
+        Item::Obstacle(_) => obstacle_at(m, item).map(|o| o.center),
+        Item::FleetTarget(_) => target_at(m, item).map(|t| t.position),
+        _ => None,
+    }
+}
+
+/// The item's latitude or longitude through `[origin]` (the geodesy of the
+/// files and exports); empty for a mission without an origin.
+fn geo(m: &Mission, item: &Item, lat: bool) -> Option<String> {
+    let p = ground_xy(m, item)?;
+    Some(m.origin.as_ref().map_or_else(String::new, |o| {
+        let g = Frame::new(o).ground_to_geodetic(&p);
+        degrees(if lat { g.latitude } else { g.longitude })
+    }))
+}
+
+/// Moves the item to a typed latitude or longitude (the other and its
+/// height kept). The value shown, applied again, moves nothing.
+fn set_geo(m: &mut Mission, item: &Item, text: &str, lat: bool) -> Result<(), String> {
+    let Some(origin) = m.origin.clone() else {
+        return Err(
+            "a latitude/longitude needs the mission's [origin] (Mission: origin lat, lon)".into(),
+        );
+    };
+    let frame = Frame::new(&origin);
+    let here = ground_xy(m, item).ok_or("the item is gone")?;
+    let g = frame.ground_to_geodetic(&here);
+    if text == degrees(if lat { g.latitude } else { g.longitude }) {
+        return Ok(());
+    }
+    let v = number(text)?;
+    let limit = if lat { 90.0 } else { 180.0 };
+    if v.abs() > limit {
+        return Err(format!("must be within ±{limit}°, got {v}"));
+    }
+    let (la, lo) = if lat {
+        (v, g.longitude)
+    } else {
+        (g.latitude, v)
+    };
+    let p = frame.ground_to_enu(la, lo);
+    match item {
+        Item::Start => (m.route.start.x, m.route.start.y) = (p.x, p.y),
+        Item::Goal => (m.route.goal.x, m.route.goal.y) = (p.x, p.y),
+        Item::Obstacle(_) => obstacle(m, item)?.center = p,
+        Item::FleetTarget(_) => target(m, item)?.position = p,
+        _ => return Err("this item has no position".into()),
+    }
+    Ok(())
+}
 
 /// Writes a parsed value (or passes its error on).
 fn put<T>(place: &mut T, value: Result<T, String>) -> Result<(), String> {

@@ -413,6 +413,26 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
                 Paragraph::new(lines),
             );
         }
+        Overlay::Import { input } => {
+            let lines = vec![
+                Line::raw(format!(
+                    "Survey: GeoJSON, KML or KMZ (relative to {}):",
+                    app.cwd().display()
+                )),
+                Line::from(Span::styled(
+                    format!("{input}▏"),
+                    Style::default().white().on_blue(),
+                )),
+                hints(&[("Enter", " import (one undo step)   "), ("Esc", " cancel")]),
+            ];
+            popup(
+                frame,
+                area,
+                (72, 5),
+                ("Import obstacles", Color::Cyan),
+                Paragraph::new(lines),
+            );
+        }
         Overlay::SaveInvalid { errors, .. } => {
             let mut lines = vec![Line::raw(format!(
                 "The mission has {} error(s):",

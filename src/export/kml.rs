@@ -1,0 +1,376 @@
+//! The plan as KML, to look at over the imagery a site is checked with
+//! (Google Earth, QGIS, …): written with the `kml` crate.
+//!
+//! One Document: its description carries the run's verdict; a folder
+//! "Mission" with the bounds, the start and goal, every obstacle as an
+//! extruded circle as tall as the obstacle, and each inspected obstacle's
+//! stand-off band (eq. 8) as a ring on the ground; then one folder per
+//! vehicle with its planned track, in the vehicle's colour on the map.
+//! Every altitude is `relativeToGround`: metres above the ground under the
+//! point (the mission's z above its ground), which is how the plan's
+//! heights are meant and how Google Earth draws them over its terrain.
+//! Positions go through the mission's geodesy (`mission::geodesy`), to
+//! 1e-9° (0.1 mm) and 1 mm.
+
+use std::collections::HashMap;
+
+use kml::types::{
+    AltitudeMode, Coord, Element, Folder, Geometry, LineString, LineStyle, LinearRing, Placemark,
+    Point, PolyStyle, Polygon, Style,
+};
+use kml::{Kml, KmlDocument, KmlVersion, KmlWriter};
+use nalgebra::{Point2, Point3};
+
+use super::{Frame, Planned};
+use crate::mission::{Mission, Obstacle};
+use crate::tracks::vehicle_color;
+
+/// Points on each circle (an obstacle, a band's edge).
+const CIRCLE_POINTS: usize = 48;
+
+/// The folder of vehicle `i` (0-based), as readers find it.
+pub fn vehicle_folder(i: usize) -> String {
+    format!("UAV {}", i + 1)
+}
+
+/// KML's `aabbggrr` colour of an RGB colour with alpha `a`.
+pub fn kml_color([r, g, b]: [u8; 3], a: u8) -> String {
+    format!("{a:02x}{b:02x}{g:02x}{r:02x}")
+}
+
+/// The KML text of the plan, and its number of placemarks.
+pub fn render(mission: &Mission, planned: &Planned, frame: &Frame) -> (String, usize) {
+    let mut placemarks = 0;
+    let mut elements = vec![
+        text(
+            "name",
+            &format!("{} — {}", mission.name, planned.pipeline.slug()),
+        ),
+        text("open", "1"),
+        text("description", &description(mission, planned)),
+    ];
+    elements.extend(styles(planned));
+    let mission_folder = mission_folder(mission, frame, &mut placemarks);
+    elements.push(mission_folder);
+    for track in &planned.tracks {
+        let mut coords: Vec<Coord<f64>> = track
+            .samples
+            .iter()
+            .map(|s| {
+                coord(
+                    frame,
+                    &s.position,
+                    s.position.z - ground(mission, &s.position),
+                )
+            })
+            .collect();
+        // A vehicle holding still: one vertex (readers drop repeats anyway).
+        coords.dedup();
+        let line = LineString {
+            coords,
+            altitude_mode: AltitudeMode::RelativeToGround,
+            ..LineString::default()
+        };
+        let name = vehicle_folder(track.vehicle);
+        let placemark = Placemark {
+            name: Some(format!("{name} track")),
+            description: Some(format!(
+                "{} samples over {:.1} s, seed {}; altitudes relative to the ground",
+                track.samples.len(),
+                track.duration(),
+                planned.seed
+            )),
+            geometry: Some(Geometry::LineString(line)),
+            children: vec![style_url(&format!("uav{}", track.vehicle + 1))],
+            ..Placemark::default()
+        };
+        placemarks += 1;
+        elements.push(Kml::Folder(Folder {
+            name: Some(name),
+            elements: vec![Kml::Placemark(placemark)],
+            ..Folder::default()
+        }));
+    }
+    let root = Kml::KmlDocument(KmlDocument {
+        version: KmlVersion::V22,
+        attrs: HashMap::from([(
+            "xmlns".to_owned(),
+            "http://www.opengis.net/kml/2.2".to_owned(),
+        )]),
+        elements: vec![Kml::Document {
+            attrs: HashMap::new(),
+            elements,
+        }],
+    });
+    let mut body = Vec::new();
+    let written = KmlWriter::<_, f64>::new(quick_xml::Writer::new_with_indent(&mut body, b' ', 2))
+        .write(&root);
+    let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    if written.is_ok() {
+        out.push_str(&String::from_utf8_lossy(&body));
+    }
+    out.push('\n');
+    (out, placemarks)
+}
+
+/// The verdict, what the altitudes mean, and the run.
+fn description(mission: &Mission, planned: &Planned) -> String {
+    let mut out = format!(
+        "{} plan, seed {}: {}\n\nAltitudes are relativeToGround: metres above the ground \
+         under each point (the mission's z above its ground).",
+        planned.pipeline.slug(),
+        planned.seed,
+        planned.verdict
+    );
+    if !mission.description.is_empty() {
+        out.push_str("\n\n");
+        out.push_str(&mission.description);
+    }
+    out
+}
+
+/// One style per vehicle (its colour on the map), obstacles, inspected
+/// obstacles, the bands and the bounds.
+fn styles(planned: &Planned) -> Vec<Kml<f64>> {
+    let style = |id: String, line: (String, f64), poly: Option<String>| {
+        Kml::Style(Style {
+            id: Some(id),
+            line: Some(LineStyle {
+                color: line.0,
+                width: line.1,
+                ..LineStyle::default()
+            }),
+            poly: poly.map(|color| PolyStyle {
+                color,
+                ..PolyStyle::default()
+            }),
+            ..Style::default()
+        })
+    };
+    let mut out: Vec<Kml<f64>> = planned
+        .tracks
+        .iter()
+        .map(|t| {
+            let rgb = vehicle_color(t.vehicle);
+            style(
+                format!("uav{}", t.vehicle + 1),
+                (kml_color(rgb, 0xff), 3.0),
+                None,
+            )
+        })
+        .collect();
+    out.push(style(
+        "obstacle".into(),
+        (kml_color([200, 200, 200], 0xff), 1.0),
+        Some(kml_color([150, 150, 150], 0xb0)),
+    ));
+    out.push(style(
+        "inspected".into(),
+        (kml_color([255, 170, 40], 0xff), 2.0),
+        Some(kml_color([255, 170, 40], 0xb0)),
+    ));
+    out.push(style(
+        "band".into(),
+        (kml_color([255, 170, 40], 0xff), 1.0),
+        Some(kml_color([255, 170, 40], 0x50)),
+    ));
+    out.push(style(
+        "bounds".into(),
+        (kml_color([255, 255, 255], 0xff), 2.0),
+        None,
+    ));
+    out
+}
+
+/// The bounds, start and goal, obstacles and inspection bands.
+fn mission_folder(mission: &Mission, frame: &Frame, placemarks: &mut usize) -> Kml<f64> {
+    let b = &mission.bounds;
+    let corners = [
+        (b.x[0], b.y[0]),
+        (b.x[1], b.y[0]),
+        (b.x[1], b.y[1]),
+        (b.x[0], b.y[1]),
+        (b.x[0], b.y[0]),
+    ];
+    let ring: Vec<Coord<f64>> = corners
+        .iter()
+        .map(|(x, y)| coord(frame, &Point3::new(*x, *y, 0.0), 0.0))
+        .collect();
+    let mut elements = vec![placemark(
+        "bounds",
+        format!(
+            "x {:?}, y {:?} m about [origin]; altitude band z {:?} m",
+            b.x, b.y, b.z
+        ),
+        Geometry::LineString(LineString {
+            coords: ring,
+            tessellate: true,
+            altitude_mode: AltitudeMode::ClampToGround,
+            ..LineString::default()
+        }),
+        "bounds",
+    )];
+    for (name, p) in [("start", mission.route.start), ("goal", mission.route.goal)] {
+        let at = coord(frame, &p, p.z - ground(mission, &p));
+        elements.push(placemark(
+            name,
+            format!(
+                "formation centroid at {:.1} m above the ground",
+                at.z.unwrap_or(0.0)
+            ),
+            Geometry::Point(Point {
+                coord: at,
+                altitude_mode: AltitudeMode::RelativeToGround,
+                ..Point::default()
+            }),
+            "bounds",
+        ));
+    }
+    let obstacles: Vec<Kml<f64>> = mission
+        .obstacles
+        .iter()
+        .map(|o| obstacle(o, frame))
+        .collect();
+    let bands: Vec<Kml<f64>> = mission
+        .obstacles
+        .iter()
+        .filter(|o| o.inspect)
+        .map(|o| band(mission, o, frame))
+        .collect();
+    *placemarks += elements.len() + obstacles.len() + bands.len();
+    elements.push(folder("Obstacles", obstacles));
+    if !bands.is_empty() {
+        elements.push(folder("Inspection bands", bands));
+    }
+    folder("Mission", elements)
+}
+
+/// An obstacle: its circle at its height, extruded to the ground.
+fn obstacle(o: &Obstacle, frame: &Frame) -> Kml<f64> {
+    let ring = circle(frame, &o.center, o.radius, o.height);
+    let mut text = format!(
+        "radius {} m, height {} m above the ground",
+        o.radius, o.height
+    );
+    if let Some(kind) = &o.kind {
+        text = format!("{kind}: {text}");
+    }
+    if o.inspect {
+        text.push_str("; inspected (eq. 8)");
+    }
+    placemark(
+        &o.name,
+        text,
+        polygon(ring, Vec::new(), AltitudeMode::RelativeToGround, true),
+        if o.inspect { "inspected" } else { "obstacle" },
+    )
+}
+
+/// An inspected obstacle's stand-off band [d_min, d_max] from its surface,
+/// as a ring on the ground.
+fn band(mission: &Mission, o: &Obstacle, frame: &Frame) -> Kml<f64> {
+    let [d_min, d_max] = o.stand_off_band(&mission.formation);
+    let outer = circle(frame, &o.center, o.radius + d_max, 0.0);
+    let inner = circle(frame, &o.center, o.radius + d_min.max(1e-3), 0.0);
+    placemark(
+        &format!("{} band", o.name),
+        format!(
+            "eq. 8: the facing UAV stays {d_min}-{d_max} m from the surface over {} m of path, \
+             within the altitude band z {:?} m",
+            mission.formation.inspection_pass, mission.bounds.z
+        ),
+        polygon(outer, vec![inner], AltitudeMode::ClampToGround, false),
+        "band",
+    )
+}
+
+fn placemark(name: &str, description: String, geometry: Geometry<f64>, style: &str) -> Kml<f64> {
+    Kml::Placemark(Placemark {
+        name: Some(name.to_owned()),
+        description: Some(description),
+        geometry: Some(geometry),
+        children: vec![style_url(style)],
+        ..Placemark::default()
+    })
+}
+
+/// `<styleUrl>#id</styleUrl>`, as a child: the `kml` crate writes its own
+/// `style_url` after the geometry, where the KML 2.2 schema does not allow
+/// it (fastkml's validating reader refuses it); children come before.
+fn style_url(id: &str) -> Element {
+    Element {
+        name: "styleUrl".into(),
+        content: Some(format!("#{id}")),
+        ..Element::default()
+    }
+}
+
+fn folder(name: &str, elements: Vec<Kml<f64>>) -> Kml<f64> {
+    Kml::Folder(Folder {
+        name: Some(name.to_owned()),
+        elements,
+        ..Folder::default()
+    })
+}
+
+fn polygon(
+    outer: Vec<Coord<f64>>,
+    holes: Vec<Vec<Coord<f64>>>,
+    mode: AltitudeMode,
+    extrude: bool,
+) -> Geometry<f64> {
+    let ring = |coords| LinearRing {
+        coords,
+        altitude_mode: mode,
+        ..LinearRing::default()
+    };
+    Geometry::Polygon(Polygon {
+        outer: ring(outer),
+        inner: holes.into_iter().map(ring).collect(),
+        extrude,
+        altitude_mode: mode,
+        ..Polygon::default()
+    })
+}
+
+/// A closed ring of [`CIRCLE_POINTS`] points about `center` at `altitude`
+/// above the ground, counter-clockwise.
+fn circle(frame: &Frame, center: &Point2<f64>, radius: f64, altitude: f64) -> Vec<Coord<f64>> {
+    (0..=CIRCLE_POINTS)
+        .map(|k| {
+            let a = (k % CIRCLE_POINTS) as f64 * std::f64::consts::TAU / CIRCLE_POINTS as f64;
+            let p = Point3::new(
+                center.x + radius * a.cos(),
+                center.y + radius * a.sin(),
+                0.0,
+            );
+            coord(frame, &p, altitude)
+        })
+        .collect()
+}
+
+/// Longitude and latitude of an ENU point (to 1e-9°) and an altitude above
+/// the ground (to 1 mm).
+fn coord(frame: &Frame, p: &Point3<f64>, altitude: f64) -> Coord<f64> {
+    let g = frame.to_geodetic(p);
+    // Through the decimal text, so the file shows the short form.
+    let round = |v: f64, digits: usize| format!("{v:.digits$}").parse().unwrap_or(v);
+    Coord {
+        x: round(g.longitude, 9),
+        y: round(g.latitude, 9),
+        z: Some(round(altitude, 3)),
+    }
+}
+
+/// The mission's ground under a point (0 without terrain).
+fn ground(mission: &Mission, p: &Point3<f64>) -> f64 {
+    mission.ground(p.x, p.y)
+}
+
+fn text(name: &str, content: &str) -> Kml<f64> {
+    Kml::Element(Element {
+        name: name.to_owned(),
+        content: Some(content.to_owned()),
+        ..Element::default()
+    })
+}

@@ -1,0 +1,300 @@
+//! A site survey into a mission: obstacles from GeoJSON (RFC 7946) and
+//! KML/KMZ files.
+//!
+//! A file is read into a [`Survey`] of features in WGS-84 (`geojson.rs`,
+//! `kml.rs`: the georust readers, then the checks a survey must pass:
+//! closed rings, coordinates in range, near the mission's origin). Each
+//! feature becomes cylinders in the mission's ENU frame (`obstacles.rs`):
+//! a point one cylinder, a line a row of them, a polygon a cover whose union
+//! contains it (`cover.rs`), clipped to the bounds, with what the cover adds
+//! stated. They join the mission by name (`merge.rs`): importing the same
+//! file again changes nothing, an updated survey updates its obstacles.
+//! Reading the file is the only I/O; the CLI and the designer write.
+
+pub mod cover;
+mod geojson;
+mod kml;
+mod merge;
+mod obstacles;
+
+use std::path::Path;
+
+use serde_json::{Map, Value};
+
+use crate::mission::Mission;
+
+pub use merge::{Change, Changes};
+pub use obstacles::{DEFAULT_LINE_RADIUS, DEFAULT_POINT_RADIUS, HEIGHT_ABOVE_BAND, Note};
+
+/// A shape of a feature, in degrees `[longitude, latitude]` (the order both
+/// GeoJSON and KML write).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape {
+    Point([f64; 2]),
+    Line(Vec<[f64; 2]>),
+    /// The outer ring, then the holes; each ring closed as written.
+    Polygon(Vec<Vec<[f64; 2]>>),
+}
+
+/// One feature of a survey: a GeoJSON Feature, a KML Placemark.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Feature {
+    /// 1-based, in the order of the file.
+    pub number: usize,
+    pub name: Option<String>,
+    /// Its properties (GeoJSON) or extended data (KML, as text).
+    pub properties: Map<String, Value>,
+    /// The KML folder it is in, the kind when it gives none.
+    pub folder: Option<String>,
+    pub shapes: Vec<Shape>,
+    /// Why it has no usable geometry, when it has none.
+    pub unusable: Option<String>,
+}
+
+impl Feature {
+    /// `feature 4 'pier 5'`, as messages name it.
+    pub fn label(&self) -> String {
+        match &self.name {
+            Some(name) => format!("feature {} '{name}'", self.number),
+            None => format!("feature {}", self.number),
+        }
+    }
+
+    /// A property by name, any case.
+    pub fn property(&self, key: &str) -> Option<&Value> {
+        self.properties
+            .iter()
+            .find(|(k, _)| k.eq_ignore_ascii_case(key))
+            .map(|(_, v)| v)
+    }
+}
+
+/// The features of one file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Survey {
+    /// "GeoJSON", "KML" or "KMZ".
+    pub format: &'static str,
+    pub features: Vec<Feature>,
+}
+
+/// Why nothing was imported (and nothing written).
+#[derive(Debug, thiserror::Error)]
+pub enum ImportError {
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Format { path: String, message: String },
+    #[error("{path}: {} problem(s), nothing imported:\n  {}", problems.len(), problems.join("\n  "))]
+    Features { path: String, problems: Vec<String> },
+    #[error(
+        "the mission has no [origin]: a survey's latitudes and longitudes are placed through \
+         it; add the WGS-84 latitude, longitude and altitude of the ENU origin"
+    )]
+    NoOrigin,
+}
+
+/// What an import gives: the mission with the survey in it, and what
+/// changed and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Imported {
+    pub mission: Mission,
+    pub format: &'static str,
+    pub features: usize,
+    pub changes: Changes,
+    /// Per polygon and line: the cylinders made and what they add.
+    pub notes: Vec<Note>,
+    /// Features listed, not imported: outside the bounds, no usable geometry.
+    pub skipped: Vec<String>,
+    /// Defaults assumed (no radius, no height), grouped.
+    pub warnings: Vec<String>,
+}
+
+/// Reads a survey file: GeoJSON (`.geojson`, `.json`), KML (`.kml`) or KMZ
+/// (`.kmz`, or any zip), by its name and, failing that, its first bytes.
+pub fn read_survey(path: &Path) -> Result<Survey, ImportError> {
+    let bytes = std::fs::read(path).map_err(|source| ImportError::Read {
+        path: path.display().to_string(),
+        source,
+    })?;
+    parse_survey(&bytes, &path.display().to_string())
+}
+
+/// [`read_survey`] on bytes already read; `name` names the file.
+pub fn parse_survey(bytes: &[u8], name: &str) -> Result<Survey, ImportError> {
+    let format_error = |message: String| ImportError::Format {
+        path: name.to_owned(),
+        message,
+    };
+    let lower = name.to_ascii_lowercase();
+    let survey = if bytes.starts_with(b"PK\x03\x04") || lower.ends_with(".kmz") {
+        kml::read_kmz(bytes).map_err(format_error)?
+    } else if lower.ends_with(".kml") || looks_like_xml(bytes) {
+        let text =
+            std::str::from_utf8(bytes).map_err(|e| format_error(format!("not UTF-8 text: {e}")))?;
+        kml::read_kml(text, "KML").map_err(format_error)?
+    } else {
+        let text =
+            std::str::from_utf8(bytes).map_err(|e| format_error(format!("not UTF-8 text: {e}")))?;
+        geojson::read(text).map_err(|e| match e {
+            geojson::Problem::Format(message) => format_error(message),
+            geojson::Problem::Features(problems) => ImportError::Features {
+                path: name.to_owned(),
+                problems,
+            },
+        })?
+    };
+    let problems: Vec<String> = survey.features.iter().flat_map(check_feature).collect();
+    if !problems.is_empty() {
+        return Err(ImportError::Features {
+            path: name.to_owned(),
+            problems,
+        });
+    }
+    Ok(survey)
+}
+
+fn looks_like_xml(bytes: &[u8]) -> bool {
+    let start = bytes
+        .iter()
+        .position(|b| !b.is_ascii_whitespace())
+        .unwrap_or(0);
+    bytes[start..].starts_with(b"<") || bytes.starts_with(b"\xEF\xBB\xBF<")
+}
+
+/// What a feature's geometry must be, whatever the format: coordinates in
+/// range, rings closed and long enough (RFC 7946 3.1.6; KML's LinearRing).
+fn check_feature(f: &Feature) -> Vec<String> {
+    let mut problems = Vec::new();
+    let check_position = |p: &[f64; 2], problems: &mut Vec<String>| {
+        let [lon, lat] = *p;
+        if !(lon.is_finite() && lat.is_finite()) {
+            problems.push(format!(
+                "{}: coordinate ({lon}, {lat}) is not a number",
+                f.label()
+            ));
+        } else if lat.abs() > 90.0 || lon.abs() > 180.0 {
+            let swapped = if lat.abs() > 90.0 && lon.abs() <= 90.0 && lat.abs() <= 180.0 {
+                " (latitude and longitude swapped? longitude comes first)"
+            } else {
+                ""
+            };
+            problems.push(format!(
+                "{}: coordinate ({lon}, {lat}) is out of range: longitude must be within ±180°, \
+                 latitude within ±90°{swapped}",
+                f.label()
+            ));
+        }
+    };
+    for shape in &f.shapes {
+        match shape {
+            Shape::Point(p) => check_position(p, &mut problems),
+            Shape::Line(points) => points.iter().for_each(|p| check_position(p, &mut problems)),
+            Shape::Polygon(rings) => {
+                for (k, ring) in rings.iter().enumerate() {
+                    ring.iter().for_each(|p| check_position(p, &mut problems));
+                    let which = if k == 0 {
+                        "its outer ring".to_owned()
+                    } else {
+                        format!("hole {k}")
+                    };
+                    match (ring.first(), ring.last()) {
+                        _ if ring.len() < 4 => problems.push(format!(
+                            "{}: {which} has {} positions; a closed ring needs at least 4 \
+                             (the first repeated at the end)",
+                            f.label(),
+                            ring.len()
+                        )),
+                        (Some(a), Some(b)) if a != b => problems.push(format!(
+                            "{}: {which} does not close: it starts at ({}, {}) and ends at \
+                             ({}, {}); the last position must repeat the first",
+                            f.label(),
+                            a[0],
+                            a[1],
+                            b[0],
+                            b[1]
+                        )),
+                        _ => {}
+                    }
+                }
+            }
+        }
+    }
+    problems
+}
+
+/// Puts the survey's features into `mission` as obstacles (see the module
+/// comment); `stem` names the unnamed ones (`<stem> <number>`). Fails,
+/// listing every feature concerned, when a feature lies far from the
+/// mission's site (latitude and longitude swapped, another site) or its
+/// properties are not numbers.
+pub fn import(mission: &Mission, survey: &Survey, stem: &str) -> Result<Imported, ImportError> {
+    let origin = mission.origin.as_ref().ok_or(ImportError::NoOrigin)?;
+    let made = obstacles::make(mission, origin, survey, stem).map_err(|problems| {
+        ImportError::Features {
+            path: stem.to_owned(),
+            problems,
+        }
+    })?;
+    let (merged, changes) = merge::merge(mission, &made.features);
+    Ok(Imported {
+        mission: merged,
+        format: survey.format,
+        features: survey.features.len(),
+        changes,
+        notes: made.notes,
+        skipped: made.skipped,
+        warnings: made.warnings,
+    })
+}
+
+/// The stem of a survey file's name, for unnamed features.
+pub fn stem(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "survey".to_owned())
+}
+
+impl Imported {
+    /// What the import did, in lines for a person: the changes, each
+    /// polygon's and line's cylinders, what was skipped, then warnings.
+    pub fn report(&self) -> String {
+        let mut out = String::new();
+        let c = &self.changes;
+        out.push_str(&format!(
+            "{} {} feature(s): {} obstacle(s) added, {} updated, {} removed, {} unchanged\n",
+            self.format,
+            self.features,
+            c.added().count(),
+            c.updated().count(),
+            c.removed().count(),
+            c.unchanged
+        ));
+        let added: Vec<&str> = c
+            .added()
+            .filter_map(|a| match a {
+                Change::Added(name) => Some(name.as_str()),
+                _ => None,
+            })
+            .collect();
+        if !added.is_empty() {
+            out.push_str(&format!("  added {}\n", merge::runs(&added)));
+        }
+        for change in c.list.iter().filter(|c| !matches!(c, Change::Added(_))) {
+            out.push_str(&format!("  {change}\n"));
+        }
+        for note in &self.notes {
+            out.push_str(&format!("  {note}\n"));
+        }
+        for s in &self.skipped {
+            out.push_str(&format!("  skipped {s}\n"));
+        }
+        for w in &self.warnings {
+            out.push_str(&format!("warning: {w}\n"));
+        }
+        out
+    }
+}
