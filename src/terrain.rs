@@ -222,7 +222,9 @@ impl HeightMap {
     pub fn ground_clamped(&self, lookup: Lookup, x: f64, y: f64) -> f64 {
         let [x0, x1] = self.x_extent();
         let [y0, y1] = self.y_extent();
-        let (x, y) = (x.clamp(x0, x1), y.clamp(y0, y1));
+        // max/min rather than clamp: a map placed at NaN (an invalid
+        // mission, reported elsewhere) must not panic here.
+        let (x, y) = (x.max(x0).min(x1), y.max(y0).min(y1));
         self.ground(lookup, x, y)
             .unwrap_or_else(|| f64::from(self.heights[0]))
     }

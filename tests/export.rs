@@ -456,7 +456,7 @@ fn the_files_agree_with_each_other_and_with_the_geodesy() {
 fn a_coarse_tolerance_that_cuts_an_obstacle_is_refused_naming_it() {
     let dir = tempdir();
     let (m, p) = planned("missions/bridge-inspection.toml", "theta-pso");
-    let err = export::export(&m, "bridge", &p, &options(dir.path(), Some(2.0), false));
+    let err = export::export(&m, "bridge", &p, &options(dir.path(), Some(3.0), false));
     let Err(ExportError::Refused(r)) = err else {
         panic!("expected a refusal, got {err:?}");
     };
@@ -488,7 +488,7 @@ fn the_binary_refuses_with_exit_2_and_writes_with_force() {
         "--out",
         &out,
         "--tolerance",
-        "2",
+        "3",
     ];
     let refused = skyform(&args);
     let stderr = text(&refused.stderr);

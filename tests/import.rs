@@ -412,7 +412,7 @@ fn an_import_that_would_break_the_mission_is_refused_unless_forced() {
     let g = frame.ground_to_geodetic(&m.route.start.xy());
     let survey = dir.path().join("on-start.geojson");
     let body = format!(
-        r#"{{"type": "Feature", "properties": {{"name": "skip bin", "radius": 1.0, "height": 12.0}},
+        r#"{{"type": "Feature", "properties": {{"name": "skip bin", "radius": 3.0, "height": 12.0}},
              "geometry": {{"type": "Point", "coordinates": [{}, {}]}}}}"#,
         g.longitude, g.latitude
     );
@@ -438,9 +438,7 @@ fn an_import_that_would_break_the_mission_is_refused_unless_forced() {
     let stderr = text(&refused.stderr);
     assert_eq!(refused.status.code(), Some(2), "{stderr}");
     assert!(
-        stderr.contains(
-            "route.start: start is within the formation's safe radius of obstacle 'skip bin'"
-        ),
+        stderr.contains("route.start: the formation does not fit at the start in any heading"),
         "{stderr}"
     );
     assert!(stderr.contains("nothing written"), "{stderr}");

@@ -398,7 +398,8 @@ fn a_new_mission_built_with_keys_only_saves_what_was_typed() {
             &format!("{DOWN}{DOWN}{DOWN}{y}\r"),
             &format!("centre y (m) = {y}"),
         );
-        step(&mut s, &format!("{DOWN}2\r"), "radius (m) = 2");
+        // Past the centre's latitude and longitude (empty without an origin).
+        step(&mut s, &format!("{DOWN}{DOWN}{DOWN}2\r"), "radius (m) = 2");
         step(&mut s, &format!("{DOWN}60\r"), "height (m) = 60");
         step(
             &mut s,

@@ -111,11 +111,11 @@ fn jobs_panel_with_a_finished_result() {
         "{screen}"
     );
     assert!(
-        screen.contains("✓ obstacle clearance worst 0.682 ≥ 0.5"),
+        screen.contains("✓ obstacle clearance worst 0.751 ≥ 0.5"),
         "{screen}"
     );
     assert!(
-        screen.contains("✓ inspection of 'pier 1' 13.8 m ≥ 6 m"),
+        screen.contains("✓ inspection of 'pier 1' 13.5 m ≥ 6 m"),
         "{screen}"
     );
     insta::assert_snapshot!(screen);
@@ -503,7 +503,7 @@ fn the_jobs_panel_puts_the_verdict_and_the_first_failure_on_top_at_80_by_24() {
     assert!(panel[1].starts_with("✗ INFEASIBLE · "), "{screen}");
     let detail = panel[1..].join(" ");
     assert!(
-        detail.starts_with("✗ INFEASIBLE · obstacle clearance worst 0.310 ≥ 0.5 (UAV 1 at t ="),
+        detail.starts_with("✗ INFEASIBLE · obstacle clearance worst 0.310 ≥ 0.5 (UAV 2 at t ="),
         "{screen}"
     );
 }

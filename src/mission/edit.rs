@@ -52,7 +52,8 @@ fn apply(table: &mut dyn TableLike, old: &toml::Table, new: &toml::Table) {
         match value {
             // A new latitude/longitude position: inline, as a position is written.
             toml::Value::Table(sub)
-                if super::geodetic::is_position(sub)
+                if key != "origin"
+                    && super::geodetic::is_position(sub)
                     && table.get(key).and_then(Item::as_table_like).is_none() =>
             {
                 set_value(table, key, to_edit_value(value));

@@ -342,7 +342,19 @@ impl Checker {
     /// warning when only some headings do (the plan must leave that way).
     fn formation_fits(&mut self, path: FieldPath, what: &str, p: &Point3<f64>, mission: &Mission) {
         let f = &mission.formation;
-        if f.slots.is_empty() || !f.uav_radius.is_finite() {
+        // Non-finite numbers have errors of their own; the fit means nothing then.
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let b = &mission.bounds;
+        if f.slots.is_empty()
+            || !f.uav_radius.is_finite()
+            || !finite(p.coords.as_slice())
+            || !f.slots.iter().all(|s| finite(s.as_slice()))
+            || !finite(&[b.x[0], b.x[1], b.y[0], b.y[1], b.z[0], b.z[1]])
+            || !mission
+                .obstacles
+                .iter()
+                .all(|o| finite(&[o.center.x, o.center.y, o.radius, o.height]))
+        {
             return;
         }
         // Every UAV within `reach` of the centroid: clear of everything by

@@ -435,7 +435,7 @@ pub fn unusable_by_reason(iwps: &[Iwp]) -> Vec<(String, usize)> {
             None => counts.push((key, 1)),
         }
     }
-    counts.sort_by(|a, b| b.1.cmp(&a.1));
+    counts.sort_by_key(|c| std::cmp::Reverse(c.1));
     counts
 }
 

@@ -55,7 +55,7 @@ pub fn repair(mission: &Mission, problem: &Problem, position: &[f64]) -> Option<
             return Some(particle);
         }
         // Where it fails: the first violation, or where the objective says.
-        let Some(at) = verification
+        let at = verification
             .violations
             .first()
             .map(|v| v.location.position)
@@ -65,10 +65,7 @@ pub fn repair(mission: &Mission, problem: &Problem, position: &[f64]) -> Option<
                     .iter()
                     .find(|c| !c.ok)
                     .and_then(|c| c.at.as_ref().map(|a| a.position))
-            })
-        else {
-            return None;
-        };
+            })?;
         // The free waypoints nearest the violation, nearest first.
         let mut order: Vec<usize> = (0..waypoints.len()).collect();
         order.sort_by(|&a, &b| {

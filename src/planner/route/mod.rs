@@ -49,6 +49,8 @@ use crate::mission::Mission;
 const PASS_ANGLES: usize = 16;
 /// Cells the grid has at most (per layer and stage).
 const MAX_CELLS: f64 = 160_000.0;
+/// Search states (cell × layer × stage) at most: about 16 bytes each.
+const MAX_STATES: f64 = 2_000_000.0;
 /// Extra spacing the squeezed shape keeps beyond 2 r_Q between two UAVs.
 const SQUEEZE_SPACING_MARGIN: f64 = 0.05;
 
@@ -230,7 +232,13 @@ pub fn find(
     let need = shape.need();
     let b = &mission.bounds;
     let area = (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]);
-    let cell = (area / MAX_CELLS).sqrt().clamp(0.2, 2.0);
+    // The search holds a state per cell, layer and stage: the grid shares
+    // MAX_STATES among the stages (a stop per pass and requested crossing),
+    // never finer than 0.2 m. A large site gets coarse cells rather than
+    // gigabytes (the refusal then speaks for that resolution).
+    let stops = builder.inspections().len() + builder.crossing_iwps().len();
+    let cells = (MAX_STATES / (LAYERS * (stops + 1)) as f64).min(MAX_CELLS);
+    let cell = (area / cells).sqrt().max(0.2);
     let obstacles = blocking(mission);
     let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| *d).collect();
     let field = Field::new([b.x, b.y], &discs, cell, need[0] + 2.0 * cell);
@@ -263,13 +271,13 @@ pub fn find(
     // wherever it is itself clear.
     for end in [start, goal] {
         let around = shape.reach + cell;
-        for i in 0..field.len() {
+        for (i, bits) in open.iter_mut().enumerate() {
             let p = field.center(i);
             if (p - end).norm() <= around
                 && field.clearance(i) >= shape.r_q + margin
                 && b.contains_xy(&p)
             {
-                open[i] |= bit(0) | bit(1) | bit(2);
+                *bits |= bit(0) | bit(1) | bit(2);
             }
         }
     }
