@@ -17,6 +17,7 @@ fn check_passes_on_the_shipped_missions() {
         "missions/flatlo-squadron.toml",
         "missions/fleet-triangle.toml",
         "missions/narrow-passage.toml",
+        "missions/two-span-viaduct.toml",
     ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
     // Issue 24, item 18: and without a warning (the fleet's route stood

@@ -643,6 +643,35 @@ fn narrow_passage() -> Mission {
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// Issue 23: the shipped two-passage mission (a V of five, two rows of piers
+/// with one narrow passage each, an inspected tower between) plans feasibly
+/// on seeds 0-19, reconfiguring at both passages.
+#[test]
+fn the_two_span_viaduct_is_planned_through_both_passages_for_20_seeds() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("missions/two-span-viaduct.toml");
+    let m = mission::load(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    assert_eq!(m.formation.slots.len(), 5);
+    let outcomes: Vec<_> = (0..20u64)
+        .into_par_iter()
+        .map(|seed| run(&m, seed))
+        .collect();
+    for (seed, o) in outcomes.iter().enumerate() {
+        assert!(
+            o.feasible(),
+            "seed {seed}: {:?}",
+            o.verification.first_failure()
+        );
+        let mut crossed: Vec<usize> = o.reconfigurations.iter().filter_map(|r| r.iwp).collect();
+        crossed.sort_unstable();
+        crossed.dedup();
+        assert_eq!(crossed.len(), 2, "seed {seed}: both passages, {crossed:?}");
+        assert!(o.bypassed.is_empty(), "seed {seed}");
+    }
+}
+
 /// The shipped θ-PSO missions plan feasibly on seeds 0-19 with the paper's
 /// swarm: what a user tries first must work whatever the seed.
 #[test]
