@@ -26,7 +26,7 @@ fn check_passes_on_the_shipped_missions() {
         text(&out.stdout)
             .matches(": ok (0 error(s), 0 warning(s))")
             .count(),
-        4,
+        5,
         "{}",
         text(&out.stdout)
     );
