@@ -86,7 +86,7 @@ fn reason_kind(reason: &str) -> String {
 }
 
 /// The x-y distance from `p` to the polyline `route` (∞ without one).
-fn distance_to(route: &[Point3<f64>], p: &Point2<f64>) -> f64 {
+pub(crate) fn distance_to(route: &[Point3<f64>], p: &Point2<f64>) -> f64 {
     match route {
         [] => f64::INFINITY,
         [only] => (only.xy() - p).norm(),

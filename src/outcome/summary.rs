@@ -190,12 +190,8 @@ fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
         return;
     }
     // The few nearest the path: those a user most likely meant the plan to take.
-    let distance = |i: &crate::planner::Iwp| {
-        o.centroid_path
-            .windows(2)
-            .map(|w| crate::geometry::segment_point_distance(&w[0].xy(), &w[1].xy(), &i.position))
-            .fold(f64::INFINITY, f64::min)
-    };
+    let distance =
+        |i: &crate::planner::Iwp| super::iwp_groups::distance_to(&o.centroid_path, &i.position);
     let mut nearest: Vec<(f64, &crate::planner::Iwp)> =
         unusable.iter().map(|i| (distance(i), *i)).collect();
     nearest.sort_by(|a, b| a.0.total_cmp(&b.0));
