@@ -7,12 +7,22 @@
 //! `paper_run_one_core` plans the shipped bridge (with its two inspection
 //! passes); `paper_run_no_inspection` the same bridge without them, the
 //! mission the earlier releases measured.
+//!
+//! Issue 23: `route_refusal/*` is the time to refuse a mission with no
+//! corridor (target < 50 ms: the route stage says so before any swarm), and
+//! `sites/twelve_uavs_two_passages` one full run (all cores, as `skyform run`)
+//! of the first generated site of `tests/sites` with a 4 × 3 grid and two
+//! walls whose gaps both need a reconfiguration.
+
+#[path = "../tests/sites/mod.rs"]
+mod sites;
 
 use std::f64::consts::FRAC_PI_4;
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use skyform::mission::{self, Mission};
+use nalgebra::{Point2, Point3};
+use skyform::mission::{self, Mission, Obstacle};
 use skyform::pipeline::{CancelToken, Silent};
 use skyform::planner::{PlanOptions, Problem, plan};
 
@@ -95,5 +105,100 @@ fn budget_check(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, cost_evaluation, full_run, budget_check);
+fn post(name: String, x: f64, y: f64, radius: f64) -> Obstacle {
+    Obstacle {
+        name,
+        center: Point2::new(x, y),
+        radius,
+        height: 30.0,
+        kind: None,
+        inspect: false,
+        stand_off: None,
+    }
+}
+
+/// The two missions of the route stage's refusal tests (`tests/theta_pso.rs`):
+/// a wall across a 100 m field whose one gap (0.6 m) is narrower than one
+/// UAV, and a start ringed by 24 poles.
+fn no_corridor() -> [(&'static str, Mission); 2] {
+    let text = "name = \"field\"\n[bounds]\nx = [0.0, 100.0]\ny = [0.0, 100.0]\nz = [5.0, 15.0]\n\
+                [route]\nstart = [10.0, 50.0, 10.0]\ngoal = [90.0, 50.0, 10.0]\n";
+    let field = match mission::parse_str(text, "field.toml") {
+        Ok(l) => l.mission,
+        Err(e) => panic!("{e}"),
+    };
+    let mut wall = field.clone();
+    for side in [1.0, -1.0] {
+        let mut y = 50.0 + side * 1.3;
+        while (0.0..=100.0).contains(&y) {
+            wall.obstacles
+                .push(post(format!("post {side} {y:.1}"), 50.0, y, 1.0));
+            y += side * 1.8;
+        }
+    }
+    let mut ring = field;
+    ring.route.start = Point3::new(20.0, 50.0, 10.0);
+    ring.obstacles = (0..24)
+        .map(|i| {
+            let a = i as f64 * std::f64::consts::TAU / 24.0;
+            post(
+                format!("ring {i}"),
+                20.0 + 6.0 * a.cos(),
+                50.0 + 6.0 * a.sin(),
+                0.7,
+            )
+        })
+        .collect();
+    [("wall_without_gap", wall), ("walled_in_start", ring)]
+}
+
+fn route_refusal(c: &mut Criterion) {
+    for (name, m) in no_corridor() {
+        c.bench_function(&format!("route_refusal/{name}"), |b| {
+            b.iter(|| {
+                let refused = plan(
+                    black_box(&m),
+                    1,
+                    PlanOptions::default(),
+                    &mut Silent,
+                    &CancelToken::new(),
+                );
+                assert!(refused.is_err(), "{name} must be refused");
+            })
+        });
+    }
+}
+
+fn twelve_uavs_two_passages(c: &mut Criterion) {
+    let Some(site) = (0..1_000)
+        .map(sites::generated)
+        .find(|s| s.uavs == 12 && s.walls == 2 && s.narrow == 2)
+    else {
+        panic!("no 12-UAV site with two narrow passages in the first 1,000");
+    };
+    let mut group = c.benchmark_group("sites");
+    group.sample_size(10);
+    group.bench_function("twelve_uavs_two_passages", |b| {
+        b.iter(|| {
+            plan(
+                black_box(&site.mission),
+                0,
+                PlanOptions::default(),
+                &mut Silent,
+                &CancelToken::new(),
+            )
+            .map(|o| o.feasible())
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    cost_evaluation,
+    full_run,
+    budget_check,
+    route_refusal,
+    twelve_uavs_two_passages
+);
 criterion_main!(benches);

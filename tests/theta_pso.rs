@@ -863,6 +863,82 @@ fn a_walled_in_start_is_refused_by_the_route_stage_naming_the_ring() {
     );
 }
 
+/// A field walled from the south bound to the north at x = 50 m by posts of
+/// radius 1 m, 1.8 m apart (they overlap), but for one gap of `gap` metres
+/// between the two posts either side of y = 50 m; the field is `scale`
+/// times the 100 m square of `open_field`.
+fn wall_across(gap: f64, scale: f64) -> Mission {
+    let mut m = open_field();
+    let size = 100.0 * scale;
+    m.bounds.x = [0.0, size];
+    m.bounds.y = [0.0, size];
+    m.route.start = Point3::new(10.0, size / 2.0, 10.0);
+    m.route.goal = Point3::new(size - 10.0, size / 2.0, 10.0);
+    m.obstacles.clear();
+    for (side, name) in [(1.0, "north"), (-1.0, "south")] {
+        let mut y = size / 2.0 + side * (gap / 2.0 + 1.0);
+        let mut k = 0;
+        while (0.0..=size).contains(&y) {
+            m.obstacles
+                .push(pole(&format!("{name} post {k}"), size / 2.0, y, 1.0));
+            y += side * 1.8;
+            k += 1;
+        }
+    }
+    m
+}
+
+fn refusal(m: &Mission) -> String {
+    let refused = plan(
+        m,
+        1,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    );
+    match refused {
+        Err(PipelineError::NoRoute(why)) => why,
+        other => panic!("expected the route stage to refuse: {other:?}"),
+    }
+}
+
+#[test]
+fn a_wall_without_a_gap_any_shape_fits_is_refused_naming_the_wall() {
+    // 0.6 m between the posts either side of the middle: narrower than one
+    // UAV (2 r_Q = 1 m), so no shape, the column included, goes through.
+    let why = refusal(&wall_across(0.6, 1.0));
+    assert!(
+        why.contains("close the way between the south and north bounds"),
+        "{why}"
+    );
+    assert!(
+        why.contains("'north post 0' | 'south post 0', is 0.60 m: narrower than one UAV"),
+        "{why}"
+    );
+    // From one end of the wall to the other, by name.
+    assert!(
+        why.contains("obstacles from 'north post 27' to 'south post 27'")
+            || why.contains("obstacles from 'south post 27' to 'north post 27'"),
+        "{why}"
+    );
+    // A 100 m site is searched finely: no word on the resolution.
+    assert!(!why.contains("cells"), "{why}");
+}
+
+#[test]
+fn a_large_site_refusal_says_how_finely_it_was_searched() {
+    // 2 km square: 4 km² over 160,000 cells is a 5 m grid.
+    let why = refusal(&wall_across(0.6, 20.0));
+    assert!(
+        why.contains("close the way between the south and north bounds"),
+        "{why}"
+    );
+    assert!(
+        why.contains("this large site was searched at 5.00 m cells, not the finest 0.20 m"),
+        "{why}"
+    );
+}
+
 #[test]
 fn cancelling_returns_promptly_with_the_best_so_far() {
     let m = mission::default_mission().mission;

@@ -11,9 +11,9 @@
 
 use nalgebra::Point2;
 
-use super::Stop;
 use super::field::{Disc, Field};
 use super::search::Reached;
+use super::{FINEST_CELL, Stop};
 use crate::mission::Mission;
 use crate::planner::iwp::Iwp;
 use crate::planner::path::PathBuilder;
@@ -188,9 +188,26 @@ pub fn explain(
     });
     super::Blocked {
         reason: format!(
-            "no corridor from start to goal{stuck}: {span} close the way {place}{gap_text}"
+            "no corridor from start to goal{stuck}: {span} close the way {place}{gap_text}{}",
+            resolution_note(field.cell())
         ),
         obstacles: members.iter().map(|&i| obstacles[i].0).collect(),
+    }
+}
+
+/// What a coarse search cannot see. The grid is as fine as 0.2 m, but a
+/// large site is searched at coarser cells (its states are capped; named
+/// from 0.3 m on): a way
+/// that fits by less than about one cell may then not be found, and the
+/// crew should know the refusal is only that sure.
+fn resolution_note(cell: f64) -> String {
+    if cell > 1.5 * FINEST_CELL {
+        format!(
+            " (this large site was searched at {cell:.2} m cells, not the finest {FINEST_CELL:.2} m: \
+             a way that fits by less than about {cell:.2} m may not be found)"
+        )
+    } else {
+        String::new()
     }
 }
 

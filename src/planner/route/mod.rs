@@ -49,6 +49,8 @@ use crate::mission::Mission;
 const PASS_ANGLES: usize = 16;
 /// Cells the grid has at most (per layer and stage).
 const MAX_CELLS: f64 = 160_000.0;
+/// The finest grid, metres: the search is complete up to this cell size.
+pub(crate) const FINEST_CELL: f64 = 0.2;
 /// Search states (cell × layer × stage) at most: about 16 bytes each.
 const MAX_STATES: f64 = 2_000_000.0;
 /// Extra spacing the squeezed shape keeps beyond 2 r_Q between two UAVs.
@@ -99,6 +101,9 @@ pub struct SqueezeMap {
     shapes: Vec<FormationShape>,
     /// The mission's index and the centre of each of the field's discs.
     obstacle_of: Vec<(usize, Point2<f64>)>,
+    /// Per cell, how many cells away the nearest region cell is (Chebyshev,
+    /// capped at 255): a sample this far out lets the next few be skipped.
+    free: Vec<u8>,
 }
 
 impl SqueezeMap {
@@ -106,6 +111,21 @@ impl SqueezeMap {
     pub fn at(&self, p: Point2<f64>) -> Option<(u16, FormationShape)> {
         let r = self.region[self.field.index_of(p)];
         (r > 0).then(|| (r, self.shapes[r as usize - 1]))
+    }
+
+    /// The region at `p` as [`Self::at`], and outside them the distance
+    /// within which no point is in one (0 inside).
+    pub fn at_with_room(&self, p: Point2<f64>) -> (Option<(u16, FormationShape)>, f64) {
+        let i = self.field.index_of(p);
+        let r = self.region[i];
+        if r > 0 {
+            (Some((r, self.shapes[r as usize - 1])), 0.0)
+        } else {
+            // Within d − 1 cells (in x and in y) of this cell's point every
+            // cell is d − 1 or fewer steps away, so none is a region's.
+            let d = f64::from(self.free[i]);
+            (None, (d - 1.0).max(0.0) * self.field.cell())
+        }
     }
 
     /// Side of the grid's cells, metres: the resolution to sample paths at.
@@ -238,7 +258,7 @@ pub fn find(
     // gigabytes (the refusal then speaks for that resolution).
     let stops = builder.inspections().len() + builder.crossing_iwps().len();
     let cells = (MAX_STATES / (LAYERS * (stops + 1)) as f64).min(MAX_CELLS);
-    let cell = (area / cells).sqrt().max(0.2);
+    let cell = (area / cells).sqrt().max(FINEST_CELL);
     let obstacles = blocking(mission);
     let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| *d).collect();
     let field = Field::new([b.x, b.y], &discs, cell, need[0] + 2.0 * cell);
@@ -350,7 +370,11 @@ pub fn find(
             .max(field.cell()),
     };
     let (s, g) = (field.index_of(start), field.index_of(goal));
-    let steps = match search::search(&graph, s, g) {
+    let found = match search::unreachable(&graph, s, g) {
+        Some(reached) => Err(reached),
+        None => search::search(&graph, s, g),
+    };
+    let steps = match found {
         Ok(steps) => steps,
         Err(reached) => {
             return Err(blocked::explain(
@@ -600,12 +624,36 @@ fn squeeze_map(
             }
         }
     }
-    (!shapes.is_empty()).then(|| SqueezeMap {
+    if shapes.is_empty() {
+        return None;
+    }
+    let free = chebyshev_distance(field, &region);
+    Some(SqueezeMap {
         field: field.clone(),
         region,
         shapes,
         obstacle_of: Vec::new(),
+        free,
     })
+}
+
+/// Per cell, the Chebyshev distance in cells to the nearest cell with a
+/// region (0 on one), capped at 255: two passes of the 8-neighbour chamfer,
+/// exact for this metric.
+fn chebyshev_distance(field: &Field, region: &[u16]) -> Vec<u8> {
+    let mut d: Vec<u8> = region
+        .iter()
+        .map(|&r| if r > 0 { 0 } else { 255 })
+        .collect();
+    let mut relax = |i: usize| {
+        d[i] = field
+            .neighbourhood(i)
+            .map(|j| d[j].saturating_add(1))
+            .fold(d[i], u8::min);
+    };
+    (0..field.len()).for_each(&mut relax);
+    (0..field.len()).rev().for_each(&mut relax);
+    d
 }
 
 /// Labels the connected narrow cells round `seed` with `label`.
@@ -625,5 +673,57 @@ fn flood(
                 stack.push(j);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The room `at_with_room` reports is never wrong: within it of the
+    /// sampled point no point is in a region, so the path builder may skip
+    /// those samples and find the same squeezed stretches.
+    #[test]
+    fn the_room_round_a_sample_holds_no_squeezed_region() {
+        let field = Field::new([[0.0, 40.0], [0.0, 30.0]], &[], 0.25, 5.0);
+        let mut region = vec![0u16; field.len()];
+        // Two regions: a block and a single cell.
+        for (i, r) in region.iter_mut().enumerate() {
+            let c = field.center(i);
+            if (10.0..12.0).contains(&c.x) && (5.0..20.0).contains(&c.y) {
+                *r = 1;
+            }
+        }
+        let lone = field.index_of(Point2::new(30.0, 25.0));
+        region[lone] = 2;
+        let free = chebyshev_distance(&field, &region);
+        let map = SqueezeMap {
+            field,
+            region,
+            shapes: vec![FormationShape::Shrink { scale: 0.5 }; 2],
+            obstacle_of: Vec::new(),
+            free,
+        };
+        let mut checked = 0;
+        for ix in 0..80 {
+            for iy in 0..60 {
+                let p = Point2::new(ix as f64 * 0.5 + 0.13, iy as f64 * 0.5 + 0.07);
+                let (hit, room) = map.at_with_room(p);
+                assert_eq!(hit.is_some(), map.at(p).is_some());
+                if room <= 0.0 {
+                    continue;
+                }
+                for k in 0..16 {
+                    let a = k as f64 * std::f64::consts::TAU / 16.0;
+                    let q = p + nalgebra::Vector2::new(a.cos(), a.sin()) * (room * 0.999);
+                    assert!(map.at(q).is_none(), "{q:?} within {room} m of {p:?}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 10_000, "{checked}");
+        // Next to the block the room is small; far from both, large.
+        assert!(map.at_with_room(Point2::new(12.6, 10.0)).1 < 1.0);
+        assert!(map.at_with_room(Point2::new(25.0, 5.0)).1 > 5.0);
     }
 }

@@ -66,6 +66,41 @@ pub struct Reached {
     pub stage: Vec<Option<usize>>,
 }
 
+/// The cells reached from `start` when `goal` is not among them, in a
+/// relaxation of the search's graph: a cell open in any layer is open to
+/// all, every jump may be taken at any stage. No plain flood (a few
+/// milliseconds) reaching the goal means no route at all, and the refusal
+/// needs no search; when it does reach, the search decides.
+pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reached> {
+    let field = graph.field;
+    let mut seen = vec![false; field.len()];
+    let mut queue = std::collections::VecDeque::from([start]);
+    seen[start] = true;
+    let mut jumps: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
+    for jump in graph.jumps {
+        jumps.entry(jump.from).or_default().push(jump.to);
+    }
+    while let Some(cell) = queue.pop_front() {
+        if cell == goal {
+            return None;
+        }
+        let next = field
+            .steps(cell)
+            .map(|(j, _)| j)
+            .filter(|&j| graph.open[j] != 0 || j == goal)
+            .chain(jumps.get(&cell).into_iter().flatten().copied());
+        for j in next.collect::<Vec<_>>() {
+            if !seen[j] {
+                seen[j] = true;
+                queue.push_back(j);
+            }
+        }
+    }
+    // Past every stop: the goal itself is what cannot be reached.
+    let stage = seen.iter().map(|&s| s.then_some(graph.stages)).collect();
+    Some(Reached { stage })
+}
+
 /// The cheapest route from `start` to `goal` through every stage, or the
 /// cells reached when there is none.
 pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>, Reached> {
@@ -78,7 +113,36 @@ pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>,
     let mut parent = vec![u32::MAX; states];
     let mut via = vec![u32::MAX; states];
     let goal_point = field.center(goal);
-    let heuristic = |cell: usize| (field.center(cell) - goal_point).norm();
+    // A lower bound of what is left from each stage: at the last, the
+    // straight line to the goal; before it, the way to one of the stage's
+    // stop edges (an inspection pass, a requested crossing), the edge, and
+    // the bound from where it ends. Without it the search floods the site
+    // on its way to an inspection off the straight line.
+    let mut targets: Vec<Vec<(Point2<f64>, f64)>> = vec![Vec::new(); graph.stages + 1];
+    targets[graph.stages].push((goal_point, 0.0));
+    for stage in (0..graph.stages).rev() {
+        let after = &targets[stage + 1];
+        let bound = |p: Point2<f64>| {
+            after
+                .iter()
+                .map(|(q, c)| (p - q).norm() + c)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let list: Vec<(Point2<f64>, f64)> = graph
+            .jumps
+            .iter()
+            .filter(|j| j.pass_at == Some(stage))
+            .map(|j| (field.center(j.from), j.length + bound(field.center(j.to))))
+            .collect();
+        targets[stage] = list;
+    }
+    let heuristic = |cell: usize, stage: usize| {
+        let p = field.center(cell);
+        targets[stage]
+            .iter()
+            .map(|(q, c)| (p - q).norm() + c)
+            .fold(f64::INFINITY, f64::min)
+    };
     let mut index: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
     for (j, jump) in graph.jumps.iter().enumerate() {
         index.entry(jump.from).or_default().push(j);
@@ -88,17 +152,21 @@ pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>,
     let first = state(start, 0, 0);
     cost[first] = 0.0;
     open.push(Entry {
-        estimate: heuristic(start),
+        estimate: heuristic(start, 0),
+        reached: 0.0,
         state: first,
     });
     let mut done = None;
-    while let Some(Entry { state: s, estimate }) = open.pop() {
+    while let Some(Entry {
+        state: s, reached, ..
+    }) = open.pop()
+    {
         let cell = s % cells;
         let layer = (s / cells) % layers;
         let stage = s / (cells * layers);
         let g = cost[s];
-        if estimate > g + heuristic(cell) + 1e-9 {
-            continue; // stale entry
+        if reached > g {
+            continue; // stale entry: a cheaper way here was found since
         }
         if cell == goal && stage == graph.stages {
             done = Some(s);
@@ -110,7 +178,8 @@ pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>,
                 parent[to] = s as u32;
                 via[to] = through;
                 open.push(Entry {
-                    estimate: g_to + heuristic(to % cells),
+                    estimate: g_to + heuristic(to % cells, to / (cells * layers)),
+                    reached: g_to,
                     state: to,
                 });
             }
@@ -202,9 +271,12 @@ pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>,
     Ok(steps)
 }
 
+/// A state on the open list: its estimate of the whole route through it,
+/// and the cost it was reached at.
 #[derive(Debug, PartialEq)]
 struct Entry {
     estimate: f64,
+    reached: f64,
     state: usize,
 }
 
@@ -212,9 +284,12 @@ impl Eq for Entry {}
 
 impl Ord for Entry {
     fn cmp(&self, other: &Self) -> Ordering {
+        // The smallest estimate first; among equal ones the deepest (on a
+        // grid many routes tie, and finishing one beats widening all).
         other
             .estimate
             .total_cmp(&self.estimate)
+            .then(self.reached.total_cmp(&other.reached))
             .then(other.state.cmp(&self.state))
     }
 }

@@ -1,0 +1,67 @@
+//! The CI's share of the generated sites of `tests/sites` (issue 23): one to
+//! three walls with one gap each, walls as close as 15 m, clutter, start and
+//! goal near the bounds, 3 to 12 UAVs in nine shapes, half the sites
+//! inspecting one or two towers; the paper's swarm. A plan exists on every
+//! site by construction, so every run must be feasible.
+//!
+//! The full measurement (hundreds of runs, rates per dimension) is
+//! `cargo run --release --no-default-features --example theta_pso_sites`.
+
+mod sites;
+
+use std::collections::BTreeSet;
+
+use rayon::prelude::*;
+use skyform::pipeline::{CancelToken, Silent};
+use skyform::planner::{PlanOptions, plan};
+
+/// Sites 400-423 (a range the planner was never tuned on), one seed each.
+const SHARE: std::ops::Range<u64> = 400..424;
+
+#[test]
+fn every_site_of_the_share_is_planned_feasible() {
+    let runs: Vec<(sites::Site, Result<bool, String>, String)> = SHARE
+        .into_par_iter()
+        .map(|i| {
+            let site = sites::generated(i);
+            let seed = i % 3;
+            let result = plan(
+                &site.mission,
+                seed,
+                PlanOptions { parallel: false },
+                &mut Silent,
+                &CancelToken::new(),
+            );
+            let (feasible, why) = match result {
+                Ok(o) => (
+                    Ok(o.feasible()),
+                    o.verification.first_failure().unwrap_or_default(),
+                ),
+                Err(e) => (Err(e.to_string()), String::new()),
+            };
+            (site, feasible, why)
+        })
+        .collect();
+
+    // The share covers the family's dimensions, so a pass means something.
+    let walls: BTreeSet<usize> = runs.iter().map(|r| r.0.walls).collect();
+    let shapes: BTreeSet<&str> = runs.iter().map(|r| r.0.shape).collect();
+    let inspected: BTreeSet<usize> = runs.iter().map(|r| r.0.inspected).collect();
+    let largest = runs.iter().map(|r| r.0.uavs).max().unwrap_or(0);
+    let close_walls = runs.iter().filter(|r| r.0.closest_walls < 22.0).count();
+    assert_eq!(walls, BTreeSet::from([1, 2, 3]), "walls covered");
+    assert!(shapes.len() >= 5, "shapes covered: {shapes:?}");
+    assert_eq!(inspected, BTreeSet::from([0, 1, 2]), "inspections covered");
+    assert!(largest >= 9, "largest formation {largest}");
+    assert!(close_walls >= 2, "walls closer than 22 m: {close_walls}");
+
+    let failures: Vec<String> = runs
+        .iter()
+        .filter(|(_, feasible, _)| !matches!(feasible, Ok(true)))
+        .map(|(site, feasible, why)| match feasible {
+            Err(e) => format!("{}: refused: {e}", site.mission.name),
+            _ => format!("{}: infeasible: {why}", site.mission.name),
+        })
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
