@@ -85,11 +85,10 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
             return None;
         }
         let next = field
-            .steps(cell)
-            .map(|(j, _)| j)
+            .neighbourhood(cell)
             .filter(|&j| graph.open[j] != 0 || j == goal)
             .chain(jumps.get(&cell).into_iter().flatten().copied());
-        for j in next.collect::<Vec<_>>() {
+        for j in next {
             if !seen[j] {
                 seen[j] = true;
                 queue.push_back(j);
