@@ -7,30 +7,27 @@
 //! fleet, decide in parallel, each with its own random stream, and only then
 //! move. So the result does not depend on the number of threads.
 //!
-//! Just over 700 lines: the scenario, what each agent observes, the run's
-//! predicted size (`budget`) and the round loop share this module's sample
-//! and outcome types; the per-agent pieces already live in `agent.rs`,
-//! `cost.rs` and `quadrotor.rs`.
+//! Here: the scenario, the run's predicted size (`budget`) and the outcome
+//! types; the round loop with its named stages (observe, decide, fly,
+//! record) is `simulation.rs`, the per-agent pieces `agent.rs`, `cost.rs`
+//! and `quadrotor.rs`.
 
 pub mod agent;
 pub mod cost;
 pub mod quadrotor;
+pub mod simulation;
 
 use std::collections::HashMap;
 
-use nalgebra::{Point2, Point3, Vector2};
+use nalgebra::{Point2, Point3};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
-use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::mission::{Diagnostic, FieldPath, FleetParams, Mission};
-use crate::ode::rk4_step;
-use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError};
+use crate::mission::{Diagnostic, FieldPath, Mission};
+use crate::pipeline::{CancelToken, Completion, Event, Observer, PipelineError};
 
-use agent::Planner;
-use cost::{Detected, Neighbour, Observation};
-use quadrotor::{Body, State};
+use simulation::Simulation;
 
 /// Samples kept per simulated second (positions, distances).
 const SAMPLE_RATE: f64 = 20.0;
@@ -108,7 +105,7 @@ pub const MAX_SERIES_AGENTS: usize = 12;
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FleetOutcome {
-    pub pipeline: &'static str,
+    pub pipeline: crate::pipeline::Kind,
     pub mission: String,
     pub seed: u64,
     pub completion: Completion,
@@ -297,52 +294,6 @@ pub fn neighbourhoods(positions: &[Point2<f64>], radius: f64) -> Vec<Vec<usize>>
         .collect()
 }
 
-/// What agent i observes of the fleet snapshot: its neighbours within l and
-/// the obstacles within d_obs, nothing else.
-fn observe(
-    i: usize,
-    positions: &[Point2<f64>],
-    near: &[usize],
-    target: Point2<f64>,
-    desired: &[Vec<f64>],
-    obstacles: &[Detected],
-    p: &FleetParams,
-) -> Observation {
-    let me = positions[i];
-    Observation {
-        position: me,
-        target,
-        target_distance: p.target_distance,
-        // Eq. 2: Ξ_i, the agents within l (the round's lists reach a little
-        // further, for the safety check).
-        neighbours: near
-            .iter()
-            .filter(|&&j| (positions[j] - me).norm() <= p.neighbourhood)
-            .map(|&j| Neighbour {
-                position: positions[j],
-                desired: desired[i][j],
-            })
-            .collect(),
-        obstacles: obstacles
-            .iter()
-            .filter(|o| (o.center - me).norm() - o.radius <= p.detection_range)
-            .copied()
-            .collect(),
-        rho: p.rho,
-        safety: p.safety_distance,
-        sigma: p.sigma,
-        keep_apart: p.safety_distance + p.step_max,
-        keep_clear: p.safety_distance + p.step_max / 2.0,
-    }
-}
-
-/// One quadrotor in flight.
-struct Flight {
-    planner: Planner,
-    state: State,
-    reference: Point3<f64>,
-}
-
 /// The fleet's predicted size against `pipeline::limits`: agents, cost
 /// evaluations (agents × re-plans × particles × iterations), dynamics steps
 /// (agents × duration / sim_step) and kept samples (agents × duration × 20 Hz).
@@ -432,280 +383,11 @@ pub fn plan(
 ) -> Result<FleetOutcome, PipelineError> {
     crate::pipeline::require_valid(mission)?;
     crate::pipeline::require_within_budget(budget(mission))?;
-    let p = &mission.fleet;
-    let n = p.agents;
     observer.on_event(Event::Stage("scenario"));
-    let sc = scenario(mission, seed);
-    let obstacles: Vec<Detected> = mission
-        .obstacles
-        .iter()
-        .filter(|o| o.height > p.altitude)
-        .map(|o| Detected {
-            center: o.center,
-            radius: o.radius,
-        })
-        .collect();
-    let body = Body::from_params(p);
-    let mut flights: Vec<Flight> = sc
-        .starts
-        .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            let start = Point3::new(s.x, s.y, p.altitude);
-            Flight {
-                planner: Planner::new(i, seed, p),
-                state: quadrotor::hover_at(start),
-                reference: start,
-            }
-        })
-        .collect();
-
+    let mut simulation = Simulation::new(mission, seed);
     observer.on_event(Event::Stage("flight"));
-    let dt = p.sim_step;
-    let steps = (p.duration / dt).round() as usize;
-    let replan_every = ((p.replan_period / dt).round() as usize).max(1);
-    let record_every = ((1.0 / (SAMPLE_RATE * dt)).round() as usize).max(1);
-    let report_every = ((1.0 / dt).round() as usize).max(1);
-    let series = n <= MAX_SERIES_AGENTS;
-
-    let mut times = Vec::with_capacity(steps / record_every + 1);
-    let mut samples: Vec<Vec<AgentSample>> = vec![Vec::with_capacity(steps / record_every + 1); n];
-    let mut distances: Vec<DistanceSeries> = Vec::new();
-    if series {
-        for a in 0..n {
-            for b in a + 1..n {
-                distances.push(DistanceSeries {
-                    a,
-                    b,
-                    desired: sc.desired[a][b],
-                    values: Vec::new(),
-                });
-            }
-        }
-    }
-    let mut closest_agents: Option<Closest> = None;
-    let mut closest_obstacle: Option<Closest> = None;
-    // Per target: the last sampled time the formation was outside tolerance.
-    let mut outside: Vec<Option<f64>> = vec![None; sc.targets.len()];
-    let mut inside_at_end: Vec<bool> = vec![false; sc.targets.len()];
-    let mut pushes: Vec<&crate::mission::FleetPush> = p.pushes.iter().collect();
-    pushes.sort_by(|a, b| a.time.total_cmp(&b.time));
-    let mut next_push = 0;
-    let mut completion = Completion::Finished;
-    let mut round: u64 = 0;
-    let mut near: Vec<Vec<usize>> = vec![Vec::new(); n];
-    // Each reference is at most √2·h_max from its agent, so two agents close
-    // in on each other by well under 2·√2·h_max + 1 m in one τ.
-    let watch_radius = p
-        .neighbourhood
-        .max(p.safety_distance + 2.0 * std::f64::consts::SQRT_2 * p.step_max + 1.0);
-
-    for k in 0..=steps {
-        let t = k as f64 * dt;
-        let active = sc
-            .targets
-            .iter()
-            .rposition(|(time, _)| *time <= t)
-            .unwrap_or(0);
-        let target = sc.targets[active].1;
-        let positions: Vec<Point2<f64>> = flights
-            .iter()
-            .map(|f| quadrotor::position(&f.state).xy())
-            .collect();
-        // Neighbour lists are built at every scheduled round, reaching beyond
-        // c by what two agents can close within τ: in between, the same lists
-        // serve the "closer than c" check and the closest-approach record.
-        // Eq. 2's Ξ_i (within l) is taken from them in `observe`.
-        let scheduled = k % replan_every == 0;
-        if scheduled {
-            near = neighbourhoods(&positions, watch_radius);
-        }
-
-        // Record (and check) on the sample grid.
-        if k % record_every == 0 {
-            times.push(t);
-            for (i, f) in flights.iter().enumerate() {
-                samples[i].push(AgentSample {
-                    t,
-                    position: quadrotor::position(&f.state),
-                    reference: f.reference,
-                });
-                for &j in near[i].iter().filter(|&&j| j > i) {
-                    let d = (positions[j] - positions[i]).norm();
-                    if closest_agents.as_ref().is_none_or(|c| d < c.distance) {
-                        closest_agents = Some(Closest {
-                            a: i,
-                            b: Other::Agent(j),
-                            distance: d,
-                            time: t,
-                        });
-                    }
-                }
-                // Obstacles the fleet flies over are not in its way (as in `observe`).
-                for o in mission.obstacles.iter().filter(|o| o.height > p.altitude) {
-                    let d = (o.center - positions[i]).norm() - o.radius;
-                    if closest_obstacle.as_ref().is_none_or(|c| d < c.distance) {
-                        closest_obstacle = Some(Closest {
-                            a: i,
-                            b: Other::Obstacle(o.name.clone()),
-                            distance: d,
-                            time: t,
-                        });
-                    }
-                }
-            }
-            if series {
-                for s in &mut distances {
-                    s.values.push((positions[s.a] - positions[s.b]).norm());
-                }
-            }
-            let within =
-                |d: f64, want: f64| (d - want).abs() <= p.tolerance * want.max(p.safety_distance);
-            let formed = positions
-                .iter()
-                .all(|q| within((q - target).norm(), p.target_distance))
-                && (0..n).all(|i| {
-                    near[i]
-                        .iter()
-                        .all(|&j| within((positions[j] - positions[i]).norm(), sc.desired[i][j]))
-                });
-            if formed {
-                inside_at_end[active] = true;
-            } else {
-                inside_at_end[active] = false;
-                outside[active] = Some(t);
-            }
-        }
-
-        // Disturbances (4.2): an impulse changes the velocity at once.
-        while next_push < pushes.len() && pushes[next_push].time <= t {
-            let push = pushes[next_push];
-            if let Some(f) = flights.get_mut(push.agent) {
-                f.state[3] += push.impulse.x / p.mass;
-                f.state[4] += push.impulse.y / p.mass;
-            }
-            next_push += 1;
-        }
-
-        // Who decides now: everyone every τ; an agent with a neighbour closer than c at once.
-        let due: Vec<bool> = (0..n)
-            .map(|i| {
-                scheduled
-                    || near[i]
-                        .iter()
-                        .any(|&j| (positions[j] - positions[i]).norm() < p.safety_distance)
-            })
-            .collect();
-        // Before the first target appears the agents hold their starts.
-        let started = t >= sc.targets[0].0;
-        if started && due.iter().any(|&d| d) {
-            let snapshot = &positions;
-            let desired = &sc.desired;
-            let obstacles = &obstacles;
-            let near = &near;
-            flights
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(8)
-                .for_each(|(i, f)| {
-                    if due[i] {
-                        let view = observe(i, snapshot, &near[i], target, desired, obstacles, p);
-                        let h: Vector2<f64> = f.planner.decide(&view, round);
-                        // Eq. 8: Y_id(t + τ) = Y_i(t) + h, in the flight plane.
-                        f.reference =
-                            Point3::new(snapshot[i].x + h.x, snapshot[i].y + h.y, p.altitude);
-                    }
-                });
-            round += 1;
-        }
-
-        if k == steps {
-            break;
-        }
-        // Fly one step (eq. 10 under eqs. 11-13), each agent on its own.
-        flights.par_iter_mut().with_min_len(8).for_each(|f| {
-            let u = body.control(&f.state, &f.reference);
-            f.state = rk4_step(|_, x| body.derivative(x, &u), t, &f.state, dt);
-            quadrotor::renormalize(&mut f.state);
-        });
-
-        if k % report_every == 0 {
-            observer.on_event(Event::Progress(0.98 * k as f64 / steps.max(1) as f64));
-            if cancel.is_cancelled() {
-                completion = Completion::Cancelled;
-                let text = format!("cancelled at t = {t:.1} s of {:.1} s", p.duration);
-                observer.on_event(Event::Log(Level::Warn, &text));
-                break;
-            }
-        }
-    }
-
-    let end = times.last().copied().unwrap_or(0.0);
-    let targets = sc
-        .targets
-        .iter()
-        .enumerate()
-        .map(|(k, &(time, position))| {
-            let window_end = sc.targets.get(k + 1).map_or(end, |next| next.0);
-            let converged_after = (inside_at_end[k] && time <= end).then(|| {
-                let since = outside[k].map_or(time, |last| last + record_every as f64 * dt);
-                (since - time).max(0.0)
-            });
-            let _ = window_end;
-            TargetOutcome {
-                time,
-                position,
-                converged_after,
-            }
-        })
-        .collect();
-    for (k, t) in sc.targets.iter().enumerate() {
-        let text = match (inside_at_end.get(k), outside.get(k)) {
-            (Some(true), _) => format!(
-                "target {} at ({:.2}, {:.2}): formation reached",
-                k + 1,
-                t.1.x,
-                t.1.y
-            ),
-            _ => format!(
-                "target {} at ({:.2}, {:.2}): formation not reached",
-                k + 1,
-                t.1.x,
-                t.1.y
-            ),
-        };
-        observer.on_event(Event::Log(Level::Info, &text));
-    }
-    // A cancelled run stays at the share it got through.
-    if completion == Completion::Finished {
-        observer.on_event(Event::Progress(1.0));
-    }
-    let agents = flights
-        .into_iter()
-        .zip(samples)
-        .enumerate()
-        .map(|(i, (f, samples))| AgentOutcome {
-            index: i,
-            start: sc.starts[i],
-            samples,
-            decisions: f.planner.decisions,
-            evaluations: f.planner.evaluations,
-        })
-        .collect();
-    Ok(FleetOutcome {
-        pipeline: "fleet",
-        mission: mission.name.clone(),
-        seed,
-        completion,
-        duration: end,
-        times,
-        agents,
-        targets,
-        distances,
-        safety_distance: p.safety_distance,
-        closest_agents,
-        closest_obstacle,
-    })
+    let completion = simulation.run(observer, cancel);
+    Ok(simulation.finish(completion, observer))
 }
 
 #[cfg(test)]
