@@ -4,6 +4,7 @@
 //! pipelines turn it into outcomes, and views (CLI, TUI, Rerun) show them.
 //! See `docs/architecture.md`.
 
+pub mod atomic;
 #[cfg(feature = "rerun")]
 pub mod cli;
 pub mod detour;
@@ -20,6 +21,7 @@ pub mod pipeline;
 pub mod planner;
 #[cfg(feature = "rerun")]
 pub mod record;
+pub mod run;
 pub mod spso;
 pub mod swarm;
 pub mod terrain;

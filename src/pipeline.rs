@@ -9,11 +9,15 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use nalgebra::Point3;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The planning pipelines: what `outcome::run` runs, what a track came
-/// from, what the CLI's `--pipeline` and the designer's run keys name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+/// from, what the CLI's `--pipeline` and the designer's run keys name. Its
+/// value on the command line and in the JSON is the `slug`.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
 pub enum Kind {
     ThetaPso,
     Flatlo,
@@ -21,8 +25,6 @@ pub enum Kind {
 }
 
 impl Kind {
-    pub const ALL: [Kind; 3] = [Kind::ThetaPso, Kind::Flatlo, Kind::Fleet];
-
     /// For people: `θ-PSO`, `FLATLO`, `fleet`.
     pub fn name(self) -> &'static str {
         match self {
@@ -44,15 +46,6 @@ impl Kind {
     /// The vehicles it plans fly with fixed wings (FLATLO's aircraft).
     pub fn fixed_wing(self) -> bool {
         matches!(self, Kind::Flatlo)
-    }
-
-    /// What its vehicles are called in messages.
-    pub fn vehicle(self) -> &'static str {
-        match self {
-            Kind::ThetaPso => "UAV",
-            Kind::Flatlo => "aircraft",
-            Kind::Fleet => "agent",
-        }
     }
 }
 

@@ -919,7 +919,7 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
         status.text
     );
 
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipeline::Kind::ThetaPso));
     assert!(app.wait_for_jobs(std::time::Duration::from_secs(120)));
     app.update(Action::ShowJob);
     app.update(Action::Export);

@@ -89,7 +89,7 @@ pub fn import_command(args: &ImportArgs) -> u8 {
         println!("dry run: nothing written");
         return exit::OK;
     }
-    if let Err(e) = mission::write_atomically(&args.into, new_text.as_bytes()) {
+    if let Err(e) = crate::atomic::write(&args.into, new_text.as_bytes()) {
         eprintln!("error: cannot save {name}: {e}; it is unchanged");
         return exit::ERROR;
     }

@@ -500,11 +500,11 @@ pub fn export(
     })
 }
 
-/// Writes atomically (`mission::write_atomically`: a synced temporary file
+/// Writes atomically (`atomic::write`: a synced temporary file
 /// renamed over `path`, so a reader never sees half a file), with the
 /// permissions of any file the user creates.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
-    crate::mission::write_atomically(path, bytes).map_err(|source| ExportError::Io {
+    crate::atomic::write(path, bytes).map_err(|source| ExportError::Io {
         path: path.to_owned(),
         source,
     })

@@ -237,7 +237,7 @@ pub struct FlatloVerification {
 /// Everything a FLATLO run produces.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FlatloOutcome {
-    pub pipeline: &'static str,
+    pub pipeline: crate::pipeline::Kind,
     pub mission: String,
     pub seed: u64,
     pub completion: Completion,
@@ -529,7 +529,7 @@ pub fn plan(
         observer.on_event(Event::Progress(1.0));
     }
     Ok(FlatloOutcome {
-        pipeline: "flatlo",
+        pipeline: crate::pipeline::Kind::Flatlo,
         mission: mission.name.clone(),
         seed,
         completion,

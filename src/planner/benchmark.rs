@@ -119,7 +119,7 @@ pub fn plan(
         .map(|i| nalgebra::Point3::new(run.nodes[i], run.nodes[n + i], run.nodes[2 * n + i]))
         .collect();
     Ok(ThetaPsoOutcome {
-        pipeline: "theta-pso",
+        pipeline: crate::pipeline::Kind::ThetaPso,
         mission: mission.name.clone(),
         seed,
         completion,

@@ -50,7 +50,7 @@ impl Default for PlanOptions {
 /// Everything a θ-PSO run produces.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThetaPsoOutcome {
-    pub pipeline: &'static str,
+    pub pipeline: crate::pipeline::Kind,
     pub mission: String,
     pub seed: u64,
     pub completion: Completion,
@@ -592,7 +592,7 @@ pub fn plan(
         .collect();
     let reference_length = reference.map(|r| r.length);
     Ok(ThetaPsoOutcome {
-        pipeline: "theta-pso",
+        pipeline: crate::pipeline::Kind::ThetaPso,
         mission: mission.name.clone(),
         seed,
         completion,

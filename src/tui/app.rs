@@ -318,7 +318,7 @@ impl App {
             Save | SaveAs | Open | Confirm | Import => self.update_files(action),
             ChangeStep(_) | Zoom(..) | Pan(..) | Fit => self.update_camera(action),
             Scrub(_) | TogglePlay => self.update_replay(action),
-            Run | RunFlatlo | RunFleet | RunNewSeed | Cancel | JobUp | JobDown
+            Run(_) | RunNewSeed | Cancel | JobUp | JobDown
             | ToggleRecording | CycleViewer => {
                 self.board
                     .update(action, self.editor.doc(), &self.cwd, &mut self.status)

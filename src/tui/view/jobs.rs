@@ -12,6 +12,7 @@ use ratatui::widgets::{
     Axis, Block, BorderType, Borders, Chart, Dataset, GraphType, Paragraph, Wrap,
 };
 
+use crate::outcome::Outcome;
 use crate::tui::action::Action;
 use crate::tui::app::{App, Focus};
 use crate::tui::jobs::{Job, JobState};
@@ -30,20 +31,24 @@ fn bar(progress: f64, width: usize) -> String {
 }
 
 fn state_span(job: &Job) -> Span<'static> {
-    // A θ-PSO plan is feasible or not; a flown run passes or fails.
-    let plan = job.pipeline == crate::pipeline::Kind::ThetaPso;
     match &job.state {
         JobState::Running => Span::styled(job.stage.clone(), Style::default().cyan()),
         JobState::Cancelled => Span::styled("cancelled", Style::default().yellow()),
         JobState::Failed(_) => Span::styled("FAILED", Style::default().red().bold()),
-        JobState::Done { passed: true } => Span::styled(
-            if plan { "feasible" } else { "pass" },
-            Style::default().green(),
-        ),
-        JobState::Done { passed: false } => Span::styled(
-            if plan { "INFEASIBLE" } else { "FAIL" },
-            Style::default().red().bold(),
-        ),
+        JobState::Done => {
+            let passed = job.outcome.as_ref().is_some_and(Outcome::ok);
+            let word = job
+                .outcome
+                .as_ref()
+                .and_then(Outcome::verdict_word)
+                .unwrap_or("FAIL");
+            let style = if passed {
+                Style::default().green()
+            } else {
+                Style::default().red().bold()
+            };
+            Span::styled(word, style)
+        }
     }
 }
 
@@ -84,9 +89,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
             row.bindings.iter().any(|b| {
                 matches!(
                     b.action,
-                    Action::Run
-                        | Action::RunFlatlo
-                        | Action::RunFleet
+                    Action::Run(_)
                         | Action::RunNewSeed
                         | Action::ToggleRecording
                         | Action::CycleViewer
