@@ -132,7 +132,11 @@ mod tests {
         fs::write(abandoned.temporary_path(), b"half").unwrap();
         drop(abandoned);
         assert_eq!(fs::read(&target).unwrap(), b"old");
-        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary left");
+        assert_eq!(
+            fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary left"
+        );
 
         let pending = create(&target).unwrap();
         fs::write(pending.temporary_path(), b"new").unwrap();

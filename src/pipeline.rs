@@ -14,9 +14,7 @@ use serde::{Deserialize, Serialize};
 /// The planning pipelines: what `outcome::run` runs, what a track came
 /// from, what the CLI's `--pipeline` and the designer's run keys name. Its
 /// value on the command line and in the JSON is the `slug`.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum Kind {
     ThetaPso,

@@ -185,7 +185,10 @@ impl<'m> Simulation<'m> {
             if k % self.clock.report_every == 0 {
                 observer.on_event(Event::Progress(0.98 * k as f64 / steps.max(1) as f64));
                 if cancel.is_cancelled() {
-                    let text = format!("cancelled at t = {:.1} s of {:.1} s", now.t, self.p.duration);
+                    let text = format!(
+                        "cancelled at t = {:.1} s of {:.1} s",
+                        now.t, self.p.duration
+                    );
                     observer.on_event(Event::Log(Level::Warn, &text));
                     return Completion::Cancelled;
                 }
@@ -202,7 +205,10 @@ impl<'m> Simulation<'m> {
     fn snapshot(&mut self, k: usize) -> Snapshot {
         let t = k as f64 * self.clock.dt;
         let targets = &self.scenario.targets;
-        let active = targets.iter().rposition(|(time, _)| *time <= t).unwrap_or(0);
+        let active = targets
+            .iter()
+            .rposition(|(time, _)| *time <= t)
+            .unwrap_or(0);
         let positions: Vec<Point2<f64>> = self
             .flights
             .iter()
@@ -244,7 +250,12 @@ impl<'m> Simulation<'m> {
                 }
             }
             // Obstacles the fleet flies over are not in its way (as in `observe`).
-            for o in self.mission.obstacles.iter().filter(|o| o.height > p.altitude) {
+            for o in self
+                .mission
+                .obstacles
+                .iter()
+                .filter(|o| o.height > p.altitude)
+            {
                 let d = (o.center - positions[i]).norm() - o.radius;
                 if log.closest_obstacle.as_ref().is_none_or(|c| d < c.distance) {
                     log.closest_obstacle = Some(Closest {
@@ -405,7 +416,12 @@ impl<'m> Simulation<'m> {
             } else {
                 "formation not reached"
             };
-            let text = format!("target {} at ({:.2}, {:.2}): {reached}", k + 1, t.1.x, t.1.y);
+            let text = format!(
+                "target {} at ({:.2}, {:.2}): {reached}",
+                k + 1,
+                t.1.x,
+                t.1.y
+            );
             observer.on_event(Event::Log(Level::Info, &text));
         }
         // A cancelled run stays at the share it got through.

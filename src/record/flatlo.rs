@@ -126,4 +126,3 @@ pub fn log_outcome(
     stream.reset_time();
     Ok(())
 }
-

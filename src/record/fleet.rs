@@ -9,10 +9,7 @@ use crate::pipeline::Kind;
 
 /// A fleet outcome: agents with trails and their references on `sim_time`,
 /// detection ranges, targets, the inter-agent distances (Fig. 13) as series.
-pub fn log_outcome(
-    stream: &RecordingStream,
-    o: &FleetOutcome,
-) -> rerun::RecordingStreamResult<()> {
+pub fn log_outcome(stream: &RecordingStream, o: &FleetOutcome) -> rerun::RecordingStreamResult<()> {
     let events = paths::events(Kind::Fleet);
     stream.send_property(
         paths::root(Kind::Fleet),
@@ -116,4 +113,3 @@ pub fn log_outcome(
     stream.reset_time();
     Ok(())
 }
-

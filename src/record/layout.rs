@@ -17,29 +17,29 @@ pub fn layout(kind: Kind) -> rerun::blueprint::Blueprint {
         // The clearance plays with the flight on `sim_time`, the timeline
         // the viewer opens on; the cost is on `iteration`, in the tab behind.
         Kind::ThetaPso => vec![
-                Tabs::new([
-                    TimeSeriesView::new("clearance to obstacles, m")
-                        .with_origin(origin(paths::theta_pso::CLEARANCE))
-                        .into(),
-                    TimeSeriesView::new("θ-PSO cost (timeline: iteration)")
-                        .with_origin(origin(paths::theta_pso::COST))
-                        .into(),
-                ])
-                .into(),
-            ],
+            Tabs::new([
+                TimeSeriesView::new("clearance to obstacles, m")
+                    .with_origin(origin(paths::theta_pso::CLEARANCE))
+                    .into(),
+                TimeSeriesView::new("θ-PSO cost (timeline: iteration)")
+                    .with_origin(origin(paths::theta_pso::COST))
+                    .into(),
+            ])
+            .into(),
+        ],
         Kind::Flatlo => vec![
-                TimeSeriesView::new("airspeed, m/s")
-                    .with_origin(origin(paths::flatlo::AIRSPEED))
-                    .into(),
-                TimeSeriesView::new("load factor")
-                    .with_origin(origin(paths::flatlo::LOAD_FACTOR))
-                    .into(),
-            ],
+            TimeSeriesView::new("airspeed, m/s")
+                .with_origin(origin(paths::flatlo::AIRSPEED))
+                .into(),
+            TimeSeriesView::new("load factor")
+                .with_origin(origin(paths::flatlo::LOAD_FACTOR))
+                .into(),
+        ],
         Kind::Fleet => vec![
-                TimeSeriesView::new("inter-agent distances, m (Fig. 13)")
-                    .with_origin(origin(paths::fleet::DISTANCES))
-                    .into(),
-            ],
+            TimeSeriesView::new("inter-agent distances, m (Fig. 13)")
+                .with_origin(origin(paths::fleet::DISTANCES))
+                .into(),
+        ],
     };
     let mut column = series;
     column.push(
@@ -69,4 +69,3 @@ pub fn layout(kind: Kind) -> rerun::blueprint::Blueprint {
     )
     .with_time_panel(TimePanel::new().with_timeline("sim_time"))
 }
-

@@ -129,8 +129,7 @@ impl Recorder {
             };
             check_rrd_path(path).map_err(error)?;
             let pending = crate::atomic::create(path).map_err(|e| error(e.to_string()))?;
-            let sink =
-                FileSink::new(pending.temporary_path()).map_err(|e| error(e.to_string()))?;
+            let sink = FileSink::new(pending.temporary_path()).map_err(|e| error(e.to_string()))?;
             boxes.push(Box::new(sink));
             file = Some(pending);
         }
@@ -276,7 +275,6 @@ pub(crate) fn f32x3(p: &Point3<f64>) -> [f32; 3] {
     [p.x as f32, p.y as f32, p.z as f32]
 }
 
-
 /// Vehicle `n`'s colour, the same as on the designer's map.
 fn uav_color(n: usize) -> rerun::Color {
     let [r, g, b] = crate::tracks::vehicle_color(n);
@@ -317,7 +315,6 @@ fn log_series(
             .columns_of_unit_batches()?,
     )
 }
-
 
 /// Why streaming to a viewer would not work now, if it would not: nothing
 /// listens at the default port (`connect`), or no `rerun` on PATH

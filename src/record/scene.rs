@@ -152,4 +152,3 @@ fn log_terrain(
         })),
     )
 }
-

@@ -44,7 +44,6 @@ pub fn flush_iterations(
     }
 }
 
-
 /// Each UAV's clearance over `sim_time`: the distance from its sphere of
 /// radius r_Q to the nearest obstacle (terrain-raised), 0 = touching. The
 /// plot beside the scene on the timeline the flight plays on.
@@ -81,7 +80,6 @@ fn log_clearances(
     }
     Ok(())
 }
-
 
 /// A θ-PSO outcome: planned paths, UAVs moving on `sim_time`, events, violations.
 pub fn log_outcome(
@@ -244,4 +242,3 @@ pub fn log_outcome(
     stream.reset_time();
     Ok(())
 }
-

@@ -318,11 +318,9 @@ impl App {
             Save | SaveAs | Open | Confirm | Import => self.update_files(action),
             ChangeStep(_) | Zoom(..) | Pan(..) | Fit => self.update_camera(action),
             Scrub(_) | TogglePlay => self.update_replay(action),
-            Run(_) | RunNewSeed | Cancel | JobUp | JobDown
-            | ToggleRecording | CycleViewer => {
-                self.board
-                    .update(action, self.editor.doc(), &self.cwd, &mut self.status)
-            }
+            Run(_) | RunNewSeed | Cancel | JobUp | JobDown | ToggleRecording | CycleViewer => self
+                .board
+                .update(action, self.editor.doc(), &self.cwd, &mut self.status),
             ShowJob => {
                 if self.board.show_selected() {
                     self.pane = Pane::Map;

@@ -367,13 +367,21 @@ pub static KEYS: &[KeyRow] = &[
         group: "Run",
         keys: "r",
         help: "run θ-PSO with the mission's seed",
-        bindings: &[bind(Key::Char('r'), When::Always, Action::Run(Kind::ThetaPso))],
+        bindings: &[bind(
+            Key::Char('r'),
+            When::Always,
+            Action::Run(Kind::ThetaPso),
+        )],
     },
     KeyRow {
         group: "Run",
         keys: "F",
         help: "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
-        bindings: &[bind(Key::Char('F'), When::Always, Action::Run(Kind::Flatlo))],
+        bindings: &[bind(
+            Key::Char('F'),
+            When::Always,
+            Action::Run(Kind::Flatlo),
+        )],
     },
     KeyRow {
         group: "Run",
