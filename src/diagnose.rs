@@ -23,9 +23,12 @@ pub fn diagnose(mission: &Mission) -> Vec<Diagnostic> {
 /// What the pipelines say of a mission that follows the rules: their budgets
 /// first (a run too large to start), then θ-PSO's IWPs and inspections.
 fn pipeline_findings(mission: &Mission) -> Vec<Diagnostic> {
-    let mut out = crate::planner::budget(mission);
-    out.extend(crate::flatlo::budget(mission));
-    out.extend(crate::fleet::budget(mission));
+    use clap::ValueEnum as _;
+    // Every registered pipeline's predicted size, in the order of `Kind`.
+    let mut out: Vec<Diagnostic> = crate::pipeline::Kind::value_variants()
+        .iter()
+        .flat_map(|&kind| crate::outcome::budget(kind, mission))
+        .collect();
     out.extend(crate::planner::diagnostics(mission));
     out
 }

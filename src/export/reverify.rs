@@ -202,6 +202,8 @@ pub fn deviation(plan: &VehiclePlan, track: &Track) -> f64 {
 
 /// Flies `plans` and checks them against `limits` and the mission's band and
 /// bounds; measures deviation from `tracks` and timing errors.
+///
+/// Long (~125 lines): the checks of the flown plans one after another, each a short block, in the order the report lists them.
 pub fn reverify(
     mission: &Mission,
     limits: &Limits,

@@ -403,6 +403,8 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
 /// Plans and simulates the mission's squadron with `seed` (the noise). Fails
 /// only on an invalid mission; a squadron that comes too close is a failed
 /// verification, not an error.
+///
+/// Long (~140 lines): references, simulation and verification in order, the paper's three stages.
 pub fn plan(
     mission: &Mission,
     seed: u64,

@@ -51,6 +51,16 @@ pub fn figure_name(kind: Kind) -> &'static str {
     }
 }
 
+/// What `kind` predicts of a run on `mission` against the documented
+/// limits (`pipelines::limits`), before one starts.
+pub fn budget(kind: Kind, mission: &Mission) -> Vec<crate::mission::Diagnostic> {
+    match kind {
+        Kind::ThetaPso => planner::budget(mission),
+        Kind::Flatlo => flatlo::budget(mission),
+        Kind::Fleet => fleet::budget(mission),
+    }
+}
+
 /// Runs `kind` on `mission` with `seed`. `options` only matters to θ-PSO.
 pub fn run(
     kind: Kind,

@@ -410,6 +410,8 @@ fn log_iwps(observer: &mut dyn Observer, iwps: &[Iwp]) {
 /// too, the swarm runs again with new random streams of the same seed, up to
 /// `theta_pso.restarts` times; when every run fails, the corridor itself is
 /// tried. The first feasible plan is kept, else the one of lowest cost.
+///
+/// Long (~200 lines) because it is Fig. 3 in order: route, swarm, repair, restarts, corridor, each step a few lines that read the one before.
 pub fn plan(
     mission: &Mission,
     seed: u64,

@@ -17,7 +17,7 @@ pub fn log_outcome(
     let events = paths::events(Kind::Flatlo);
     let min_separation = o.verification.as_ref().map_or(0.0, |v| v.min_separation);
     stream.send_property(
-        paths::root(Kind::Flatlo),
+        &paths::root(Kind::Flatlo),
         &rerun::TextDocument::from_markdown(format!(
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\naircraft: {}\n\
              arrival: {:.1} s\nduration: {:.1} s\nclosest: {}\nspacing error: {}\n\

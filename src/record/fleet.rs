@@ -12,7 +12,7 @@ use crate::pipeline::Kind;
 pub fn log_outcome(stream: &RecordingStream, o: &FleetOutcome) -> rerun::RecordingStreamResult<()> {
     let events = paths::events(Kind::Fleet);
     stream.send_property(
-        paths::root(Kind::Fleet),
+        &paths::root(Kind::Fleet),
         &rerun::TextDocument::from_markdown(format!(
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\nagents: {}\n\
              kept apart: {}\nconverged: {}\nskyform: {}",

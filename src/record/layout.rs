@@ -44,7 +44,7 @@ pub fn layout(kind: Kind) -> rerun::blueprint::Blueprint {
     let mut column = series;
     column.push(
         TextLogView::new("events")
-            .with_origin(origin(paths::root(kind)))
+            .with_origin(origin(&paths::root(kind)))
             .into(),
     );
     column.push(

@@ -14,13 +14,10 @@ pub const IWPS: &str = "world/iwps";
 /// The mission file as a text document.
 pub const MISSION: &str = "mission";
 
-/// The root of a pipeline's entities (and the name of its recording property).
-pub fn root(kind: Kind) -> &'static str {
-    match kind {
-        Kind::ThetaPso => "theta_pso",
-        Kind::Flatlo => "flatlo",
-        Kind::Fleet => "fleet",
-    }
+/// The root of a pipeline's entities (and the name of its recording
+/// property): its slug as an entity name, `theta_pso`, `flatlo`, `fleet`.
+pub fn root(kind: Kind) -> String {
+    kind.slug().replace('-', "_")
 }
 
 /// Where a pipeline's log lines (its `Event::Log`s) go: under its own root,
@@ -112,6 +109,7 @@ mod tests {
             assert!(events(kind).starts_with(&format!("{}/", root(kind))));
         }
         assert_eq!(log(Kind::Flatlo), "flatlo/log");
+        assert_eq!(root(Kind::ThetaPso), "theta_pso");
         assert_eq!(theta_pso::pass("pier 1/a"), "theta_pso/plan/pass_pier_1_a");
         assert_eq!(fleet::distance(0, 2), "fleet/distances/1_3");
     }

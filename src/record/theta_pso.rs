@@ -92,7 +92,7 @@ pub fn log_outcome(
     }
     let events = paths::events(Kind::ThetaPso);
     stream.send_property(
-        paths::root(Kind::ThetaPso),
+        &paths::root(Kind::ThetaPso),
         &rerun::TextDocument::from_markdown(format!(
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\niterations: {}\n\
              feasible: {}\ncost J: {:.4}\nlength: {:.2} m\nduration: {:.2} s\nskyform: {}",
@@ -114,6 +114,19 @@ pub fn log_outcome(
             .with_colors([rerun::Color::from_rgb(255, 255, 255)])
             .with_labels(["centroid"]),
     )?;
+    log_trajectories(stream, o)?;
+    log_reconfigurations(stream, o, &events)?;
+    log_passes(stream, o, &events)?;
+    log_violations(stream, o, &events)?;
+    stream.reset_time();
+    Ok(())
+}
+
+/// Each UAV's planned path (static), and the UAV with its velocity on `sim_time`.
+fn log_trajectories(
+    stream: &RecordingStream,
+    o: &ThetaPsoOutcome,
+) -> rerun::RecordingStreamResult<()> {
     for t in &o.trajectories {
         let color = uav_color(t.uav);
         let entity = at::plan(t.uav);
@@ -160,6 +173,15 @@ pub fn log_outcome(
                 .columns_of_unit_batches()?,
         )?;
     }
+    Ok(())
+}
+
+/// t1..t4 of each reconfiguration, as events on `sim_time`.
+fn log_reconfigurations(
+    stream: &RecordingStream,
+    o: &ThetaPsoOutcome,
+    events: &str,
+) -> rerun::RecordingStreamResult<()> {
     for r in &o.reconfigurations {
         for (label, t) in [
             ("t1: transformation starts", r.t1),
@@ -169,7 +191,7 @@ pub fn log_outcome(
         ] {
             stream.set_duration_secs("sim_time", t);
             stream.log(
-                events.as_str(),
+                events,
                 &rerun::TextLog::new(format!(
                     "{} between '{}' and '{}': {label}",
                     r.shape.name(),
@@ -180,7 +202,15 @@ pub fn log_outcome(
             )?;
         }
     }
-    // Inspection passes (eq. 8): the centroid's stretch, and when each begins and ends.
+    Ok(())
+}
+
+/// Inspection passes (eq. 8): the centroid's stretch, and when each begins and ends.
+fn log_passes(
+    stream: &RecordingStream,
+    o: &ThetaPsoOutcome,
+    events: &str,
+) -> rerun::RecordingStreamResult<()> {
     let speed = o.path_length / o.duration.max(1e-9);
     let walker = crate::planner::path::ArcWalker::new(&o.centroid_path);
     for (pass, result) in o.passes.iter().zip(&o.verification.inspections) {
@@ -208,7 +238,7 @@ pub fn log_outcome(
                 },
             );
             stream.log(
-                events.as_str(),
+                events,
                 &rerun::TextLog::new(format!("{label}: '{}' ({achieved})", pass.obstacle))
                     .with_level(if result.ok {
                         rerun::TextLogLevel::INFO
@@ -218,6 +248,15 @@ pub fn log_outcome(
             )?;
         }
     }
+    Ok(())
+}
+
+/// Each violation found by verification: a red point and a warning event.
+fn log_violations(
+    stream: &RecordingStream,
+    o: &ThetaPsoOutcome,
+    events: &str,
+) -> rerun::RecordingStreamResult<()> {
     for v in &o.verification.violations {
         stream.set_duration_secs("sim_time", v.location.time);
         let other = v.location.other.as_deref().unwrap_or("");
@@ -229,7 +268,7 @@ pub fn log_outcome(
                 .with_labels([format!("{} {:.2} {other}", v.check, v.value)]),
         )?;
         stream.log(
-            events.as_str(),
+            events,
             &rerun::TextLog::new(format!(
                 "violation: UAV {} {} = {:.3} {other}",
                 v.location.uav + 1,
@@ -239,6 +278,5 @@ pub fn log_outcome(
             .with_level(rerun::TextLogLevel::WARN),
         )?;
     }
-    stream.reset_time();
     Ok(())
 }

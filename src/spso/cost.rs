@@ -172,6 +172,7 @@ impl Model {
         self.evaluate(xyz, f64::INFINITY)
     }
 
+    /// Long (~200 lines) on purpose: the SPSO reference's cost loop in its own order, term by term, so a parity check reads it line by line.
     fn evaluate(&self, xyz: &[f64], bound: f64) -> Terms {
         let n = self.nodes;
         let points = n + 2;

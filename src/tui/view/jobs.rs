@@ -52,6 +52,7 @@ fn state_span(job: &Job) -> Span<'static> {
     }
 }
 
+/// Long (~135 lines): the jobs panel's parts top to bottom (title, list, progress, the shown result's table, the convergence chart).
 pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
     let focused = app.focus() == Focus::Jobs;
     let border = if focused {

@@ -277,6 +277,7 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     }
 }
 
+/// Long (~150 lines): the map's layers in drawing order (terrain, bounds, obstacles, IWPs, plans, vehicles), each a short block.
 fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     let b = &m.bounds;
     ctx.draw(&Rectangle {
@@ -686,6 +687,8 @@ fn map_title<'a>(
 
 /// Distance along the path vs altitude, with the altitude band and the
 /// obstacles the path passes.
+///
+/// Long (~130 lines): the side view's layers in drawing order (band, obstacles, path, vehicles).
 fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
     let m = app.mission();
     let result = result_of(app);
@@ -868,6 +871,8 @@ pub fn formation_split(app: &App, area: Rect) -> [Rect; 2] {
 
 /// The formation editor: slots in the formation frame (drawn through `vp`,
 /// the viewport `Drawn` reports), and the IWPs' shapes.
+///
+/// Long (~135 lines): the formation's slots, their labels and the heading, in drawing order.
 pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     let m = app.mission();
     let [top, bottom] = formation_split(app, area);
