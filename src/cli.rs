@@ -7,8 +7,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::mission::{self, Checked, Report};
-use crate::pipeline::{CancelToken, Completion, Event, Kind, Level, Observer};
-use crate::planner::PlanOptions;
+use crate::pipelines::theta_pso::PlanOptions;
+use crate::pipelines::{CancelToken, Completion, Event, Kind, Level, Observer};
 use crate::record::{self, Recorder, Sinks};
 use crate::run::Run;
 
@@ -359,7 +359,7 @@ fn new_mission(file: &std::path::Path, from: Option<&str>, no_open: bool) -> u8 
         eprintln!("error: cannot create {}: {e}", dir.display());
         return exit::ERROR;
     }
-    if let Err(e) = crate::atomic::write(file, text.as_bytes()) {
+    if let Err(e) = crate::base::atomic::write(file, text.as_bytes()) {
         eprintln!("error: cannot write {}: {e}", file.display());
         return exit::ERROR;
     }
@@ -393,7 +393,7 @@ fn copied_mission(from: &str) -> Result<(String, String), String> {
         };
         (b.text.to_owned(), format!("the shipped {}", b.file_name))
     };
-    if crate::diagnose::check_text(&text, Some(&source))
+    if crate::outcome::diagnose::check_text(&text, Some(&source))
         .mission
         .is_none()
     {
@@ -430,7 +430,7 @@ fn record_mission(path: &std::path::Path, sinks: &Sinks) -> u8 {
 
 /// Loads a mission for a command: its warnings and errors go to stderr.
 fn load_reporting(path: &std::path::Path) -> Option<mission::Mission> {
-    match crate::diagnose::load(path) {
+    match crate::outcome::diagnose::load(path) {
         Ok(loaded) => {
             eprint!("{}", loaded.warnings);
             Some(loaded.mission)
@@ -589,7 +589,7 @@ fn run_pipeline(
         Ok(o) => o,
         // No plan exists within the planner's model: not an error of the
         // program or the file, the answer (with the place that closes the way).
-        Err(crate::pipeline::PipelineError::NoRoute(reason)) => {
+        Err(crate::pipelines::PipelineError::NoRoute(reason)) => {
             if progress.terminal {
                 eprintln!();
             }
@@ -623,7 +623,7 @@ fn run_pipeline(
         };
         if json_to_stdout {
             println!("{text}");
-        } else if let Err(e) = crate::atomic::write(target, text.as_bytes()) {
+        } else if let Err(e) = crate::base::atomic::write(target, text.as_bytes()) {
             eprintln!("error: cannot write {}: {e}", target.display());
             return exit::ERROR;
         }
@@ -647,7 +647,8 @@ fn check(files: &[PathBuf], strict: bool, json: bool) -> u8 {
         let name = path.display().to_string();
         let report = match mission::read(path) {
             Ok(text) => {
-                let Checked { report, .. } = crate::diagnose::check_text(&text, Some(&name));
+                let Checked { report, .. } =
+                    crate::outcome::diagnose::check_text(&text, Some(&name));
                 report
             }
             Err(e) => Report::new(vec![

@@ -7,8 +7,8 @@
 
 use crate::mission::Mission;
 use crate::outcome::{self, Outcome};
-use crate::pipeline::{CancelToken, Kind, Observer, PipelineError, Tee};
-use crate::planner::PlanOptions;
+use crate::pipelines::theta_pso::PlanOptions;
+use crate::pipelines::{CancelToken, Kind, Observer, PipelineError, Tee};
 
 #[cfg(feature = "rerun")]
 pub use crate::record::{Finished, Recorder};
@@ -112,7 +112,7 @@ impl Recorder {
 
 #[cfg(not(feature = "rerun"))]
 impl Observer for Recorder {
-    fn on_event(&mut self, _: crate::pipeline::Event<'_>) {
+    fn on_event(&mut self, _: crate::pipelines::Event<'_>) {
         match *self {}
     }
 }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use super::{StderrProgress, cancel_on_ctrl_c, exit, load_reporting};
 use crate::export::{self, ExportError, Exported, Format, Options, Planned};
 use crate::mission::Mission;
-use crate::pipeline::{Completion, Kind};
+use crate::pipelines::{Completion, Kind};
 use crate::run::Run;
 
 /// A format on the command line.

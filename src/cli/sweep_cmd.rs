@@ -10,8 +10,8 @@ use rayon::prelude::*;
 use super::{exit, load_reporting};
 use crate::mission::{CostKind, Encoding, Mission};
 use crate::outcome::{self, Verdict};
-use crate::pipeline::{CancelToken, Kind, Silent};
-use crate::planner::PlanOptions;
+use crate::pipelines::theta_pso::PlanOptions;
+use crate::pipelines::{CancelToken, Kind, Silent};
 use crate::run::Run;
 
 /// An encoding on the command line.
@@ -247,7 +247,7 @@ pub fn csv(rows: &[SeedRow], figure: &str, words: Words) -> String {
             r.seed,
             r.completed,
             r.passed,
-            crate::spso::g17(r.figure),
+            crate::pipelines::theta_pso::spso::g17(r.figure),
             r.evaluations,
             r.wall.as_secs_f64(),
             r.cpu.as_secs_f64(),
@@ -387,7 +387,7 @@ pub fn sweep_command(args: &SweepArgs) -> u8 {
                     "[{}{}] {k}/{total} seeds  last: seed {seed} {} {:.1} s",
                     "█".repeat(filled),
                     "·".repeat(width - filled),
-                    crate::spso::g17(row.figure),
+                    crate::pipelines::theta_pso::spso::g17(row.figure),
                     row.wall.as_secs_f64()
                 );
                 if terminal {
@@ -417,7 +417,7 @@ pub fn sweep_command(args: &SweepArgs) -> u8 {
     print!("{}", table(&summary, figure, words));
     let _ = std::io::stdout().flush();
     if let Some(path) = &args.csv
-        && let Err(e) = crate::atomic::write(path, csv(&rows, figure, words).as_bytes())
+        && let Err(e) = crate::base::atomic::write(path, csv(&rows, figure, words).as_bytes())
     {
         eprintln!("error: cannot write {}: {e}", path.display());
         return exit::ERROR;

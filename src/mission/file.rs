@@ -154,7 +154,7 @@ pub fn to_toml_string(mission: &Mission) -> Result<String, MissionError> {
 /// either the old file or the new one, never half of one.
 pub fn save(mission: &Mission, path: &Path) -> Result<(), MissionError> {
     let text = to_toml_string(mission)?;
-    crate::atomic::write(path, text.as_bytes()).map_err(|source| MissionError::Write {
+    crate::base::atomic::write(path, text.as_bytes()).map_err(|source| MissionError::Write {
         path: path.display().to_string(),
         source,
     })
@@ -174,7 +174,7 @@ pub fn save_edited(
         Some(text) => text,
         None => to_toml_string(mission)?,
     };
-    crate::atomic::write(path, text.as_bytes()).map_err(|source| MissionError::Write {
+    crate::base::atomic::write(path, text.as_bytes()).map_err(|source| MissionError::Write {
         path: path.display().to_string(),
         source,
     })?;

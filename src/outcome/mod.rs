@@ -10,17 +10,19 @@
 //!
 //! Adding a pipeline: see "Adding a pipeline" in `docs/architecture.md`.
 
+pub mod diagnose;
 pub mod iwp_groups;
 pub mod summary;
+pub mod tracks;
 
 use serde::Serialize;
 
-use crate::flatlo::{self, FlatloOutcome};
-use crate::fleet::{self, FleetOutcome};
 use crate::mission::Mission;
-use crate::pipeline::{CancelToken, Completion, Kind, Observer, PipelineError};
-use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
-use crate::tracks::{self, Track};
+use crate::pipelines::flatlo::{self, FlatloOutcome};
+use crate::pipelines::fleet::{self, FleetOutcome};
+use crate::pipelines::theta_pso::{self, PlanOptions, ThetaPsoOutcome};
+use crate::pipelines::{CancelToken, Completion, Kind, Observer, PipelineError};
+use tracks::Track;
 
 /// A finished (or cancelled) run's result.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -55,7 +57,7 @@ pub fn figure_name(kind: Kind) -> &'static str {
 /// limits (`pipelines::limits`), before one starts.
 pub fn budget(kind: Kind, mission: &Mission) -> Vec<crate::mission::Diagnostic> {
     match kind {
-        Kind::ThetaPso => planner::budget(mission),
+        Kind::ThetaPso => theta_pso::budget(mission),
         Kind::Flatlo => flatlo::budget(mission),
         Kind::Fleet => fleet::budget(mission),
     }
@@ -71,7 +73,7 @@ pub fn run(
     cancel: &CancelToken,
 ) -> Result<Outcome, PipelineError> {
     Ok(match kind {
-        Kind::ThetaPso => Outcome::ThetaPso(Box::new(planner::plan(
+        Kind::ThetaPso => Outcome::ThetaPso(Box::new(theta_pso::plan(
             mission, seed, options, observer, cancel,
         )?)),
         Kind::Flatlo => Outcome::Flatlo(Box::new(flatlo::plan(mission, seed, observer, cancel)?)),

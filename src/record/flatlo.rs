@@ -4,8 +4,8 @@ use rerun::RecordingStream;
 
 use super::paths::{self, flatlo::aircraft};
 use super::{f32x3, log_moving_point, log_series, uav_color};
-use crate::flatlo::FlatloOutcome;
-use crate::pipeline::Kind;
+use crate::pipelines::Kind;
+use crate::pipelines::flatlo::FlatloOutcome;
 
 /// A FLATLO outcome: references and flown paths per aircraft, the aircraft
 /// on `sim_time`, their airspeed, γ, χ and controls as series, the closest
@@ -17,7 +17,7 @@ pub fn log_outcome(
     let events = paths::events(Kind::Flatlo);
     let min_separation = o.verification.as_ref().map_or(0.0, |v| v.min_separation);
     stream.send_property(
-        &paths::root(Kind::Flatlo),
+        paths::root(Kind::Flatlo),
         &rerun::TextDocument::from_markdown(format!(
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\naircraft: {}\n\
              arrival: {:.1} s\nduration: {:.1} s\nclosest: {}\nspacing error: {}\n\
@@ -76,7 +76,7 @@ pub fn log_outcome(
             .with_labels([format!("aircraft {}", a.index + 1)]);
         let positions = a.flown.iter().map(|s| f32x3(&s.position)).collect();
         log_moving_point(stream, &entity, &times, style, positions)?;
-        type Series = fn(&crate::flatlo::FlownSample) -> f64;
+        type Series = fn(&crate::pipelines::flatlo::FlownSample) -> f64;
         let series: [(&str, Series); 6] = [
             ("airspeed", |s| s.airspeed),
             ("gamma_deg", |s| s.gamma.to_degrees()),

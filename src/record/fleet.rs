@@ -4,15 +4,15 @@ use rerun::RecordingStream;
 
 use super::paths::{self, fleet as at};
 use super::{f32x3, log_moving_point, log_series, uav_color};
-use crate::fleet::FleetOutcome;
-use crate::pipeline::Kind;
+use crate::pipelines::Kind;
+use crate::pipelines::fleet::FleetOutcome;
 
 /// A fleet outcome: agents with trails and their references on `sim_time`,
 /// detection ranges, targets, the inter-agent distances (Fig. 13) as series.
 pub fn log_outcome(stream: &RecordingStream, o: &FleetOutcome) -> rerun::RecordingStreamResult<()> {
     let events = paths::events(Kind::Fleet);
     stream.send_property(
-        &paths::root(Kind::Fleet),
+        paths::root(Kind::Fleet),
         &rerun::TextDocument::from_markdown(format!(
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\nagents: {}\n\
              kept apart: {}\nconverged: {}\nskyform: {}",

@@ -1,7 +1,7 @@
 //! The viewer layout of each pipeline's recording.
 
 use super::paths::{self, origin};
-use crate::pipeline::Kind;
+use crate::pipelines::Kind;
 
 /// The viewer layout: the 3D scene large on the left; on the right the
 /// pipeline's series (θ-PSO cost terms; FLATLO airspeeds and load factors;

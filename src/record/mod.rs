@@ -30,7 +30,7 @@ use rerun::{RecordingStream, RecordingStreamBuilder};
 
 use crate::mission::Mission;
 use crate::outcome::Outcome;
-use crate::pipeline::{CostTerms, Event, Kind, Level, Observer};
+use crate::pipelines::{CostTerms, Event, Kind, Level, Observer};
 
 mod flatlo;
 mod fleet;
@@ -95,7 +95,7 @@ pub struct Recorder {
     dropped: usize,
     /// The `.rrd` being written: it replaces its destination (atomically,
     /// keeping that file's mode) when the recording is finished.
-    file: Option<crate::atomic::Pending>,
+    file: Option<crate::base::atomic::Pending>,
 }
 
 /// What a finished recording left behind.
@@ -128,7 +128,7 @@ impl Recorder {
                 message,
             };
             check_rrd_path(path).map_err(error)?;
-            let pending = crate::atomic::create(path).map_err(|e| error(e.to_string()))?;
+            let pending = crate::base::atomic::create(path).map_err(|e| error(e.to_string()))?;
             let sink = FileSink::new(pending.temporary_path()).map_err(|e| error(e.to_string()))?;
             boxes.push(Box::new(sink));
             file = Some(pending);
@@ -277,7 +277,7 @@ pub(crate) fn f32x3(p: &Point3<f64>) -> [f32; 3] {
 
 /// Vehicle `n`'s colour, the same as on the designer's map.
 fn uav_color(n: usize) -> rerun::Color {
-    let [r, g, b] = crate::tracks::vehicle_color(n);
+    let [r, g, b] = crate::outcome::tracks::vehicle_color(n);
     rerun::Color::from_rgb(r, g, b)
 }
 

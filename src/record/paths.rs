@@ -2,7 +2,7 @@
 //! documents and the viewer layout (`layout.rs`) shows. The scene is under
 //! `world/`, the mission file at `mission`, each pipeline under its own root.
 
-use crate::pipeline::Kind;
+use crate::pipelines::Kind;
 
 pub const WORLD: &str = "world";
 pub const BOUNDS: &str = "world/bounds";

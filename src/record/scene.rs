@@ -5,7 +5,7 @@ use rerun::RecordingStream;
 
 use super::{f32x3, paths};
 use crate::mission::{Mission, to_toml_string};
-use crate::planner::find_iwps;
+use crate::pipelines::theta_pso::find_iwps;
 
 /// The mission as static data.
 pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamResult<()> {
@@ -132,10 +132,10 @@ pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStrea
 /// by height (`terrain::height_colour`: the hues of the designer's map, brighter).
 fn log_terrain(
     stream: &RecordingStream,
-    map: &crate::terrain::HeightMap,
-    lookup: crate::terrain::Lookup,
+    map: &crate::base::terrain::HeightMap,
+    lookup: crate::base::terrain::Lookup,
 ) -> rerun::RecordingStreamResult<()> {
-    let grid = crate::terrain::Grid::of(map, lookup, 200);
+    let grid = crate::base::terrain::Grid::of(map, lookup, 200);
     let [low, high] = map.range;
     let span = f64::from(high - low).max(1e-9);
     stream.log_static(
@@ -147,7 +147,7 @@ fn log_terrain(
         )
         .with_triangle_indices(grid.triangles())
         .with_vertex_colors(grid.points.iter().map(|p| {
-            let [r, g, b] = crate::terrain::height_colour((p[2] - f64::from(low)) / span);
+            let [r, g, b] = crate::base::terrain::height_colour((p[2] - f64::from(low)) / span);
             rerun::Color::from_rgb(r, g, b)
         })),
     )

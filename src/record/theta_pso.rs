@@ -8,8 +8,8 @@ use rerun::RecordingStream;
 use super::paths::{self, theta_pso as at};
 use super::{f32x3, log_moving_point, log_series, uav_color};
 use crate::mission::Mission;
-use crate::pipeline::{CostTerms, Kind};
-use crate::planner::ThetaPsoOutcome;
+use crate::pipelines::theta_pso::ThetaPsoOutcome;
+use crate::pipelines::{CostTerms, Kind};
 
 /// Picks one term out of the cost breakdown.
 type CostTerm = fn(&CostTerms) -> f64;
@@ -92,7 +92,7 @@ pub fn log_outcome(
     }
     let events = paths::events(Kind::ThetaPso);
     stream.send_property(
-        &paths::root(Kind::ThetaPso),
+        paths::root(Kind::ThetaPso),
         &rerun::TextDocument::from_markdown(format!(
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\niterations: {}\n\
              feasible: {}\ncost J: {:.4}\nlength: {:.2} m\nduration: {:.2} s\nskyform: {}",
@@ -212,7 +212,7 @@ fn log_passes(
     events: &str,
 ) -> rerun::RecordingStreamResult<()> {
     let speed = o.path_length / o.duration.max(1e-9);
-    let walker = crate::planner::path::ArcWalker::new(&o.centroid_path);
+    let walker = crate::pipelines::theta_pso::path::ArcWalker::new(&o.centroid_path);
     for (pass, result) in o.passes.iter().zip(&o.verification.inspections) {
         let [t0, t1] = pass.time;
         let steps = 20;

@@ -6,7 +6,7 @@
 use nalgebra::Point2;
 
 use super::fields::Item;
-use crate::pipeline::Kind;
+use crate::pipelines::Kind;
 
 /// Which panel takes the keys that are not global.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -34,7 +34,7 @@ use super::replay::Replay;
 pub use super::status::Status;
 use super::status::StatusLine;
 use crate::mission::{Mission, Preset};
-use crate::planner::Iwp;
+use crate::pipelines::theta_pso::Iwp;
 
 /// The whole TUI state.
 pub struct App {

@@ -14,7 +14,7 @@ use super::action::Action;
 use super::document::Document;
 use super::jobs::{self, Job, JobId, JobMsg, Kind, RecordSettings, Viewer};
 use super::status::StatusLine;
-use crate::pipeline::Level;
+use crate::pipelines::Level;
 
 pub struct JobBoard {
     jobs: Vec<Job>,

@@ -16,8 +16,8 @@ use nalgebra::Point3;
 
 use crate::mission::Mission;
 pub use crate::outcome::Outcome;
-pub use crate::pipeline::Kind;
-use crate::pipeline::{CancelToken, Completion, Event, Level, Observer};
+pub use crate::pipelines::Kind;
+use crate::pipelines::{CancelToken, Completion, Event, Level, Observer};
 use crate::run::{Recorder, Run};
 
 pub type JobId = usize;
@@ -86,7 +86,7 @@ pub enum JobMsg {
 pub enum JobError {
     /// The pipeline refused the mission (invalid, over its budget).
     #[error("{0}")]
-    Pipeline(#[from] crate::pipeline::PipelineError),
+    Pipeline(#[from] crate::pipelines::PipelineError),
     /// The pipeline panicked; the designer lives on.
     #[error("the pipeline panicked: {0}")]
     Panicked(String),

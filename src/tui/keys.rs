@@ -9,7 +9,7 @@
 use ratatui::crossterm::event::KeyCode;
 
 use super::action::{Action, Focus, Pane};
-use crate::pipeline::Kind;
+use crate::pipelines::Kind;
 
 /// A key press as the table states it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

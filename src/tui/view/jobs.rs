@@ -207,7 +207,7 @@ fn collapsed(text: &str) -> String {
 /// check on top, the figures, the unusable IWPs grouped by reason, then the
 /// whole verification table (`outcome::summary::verification_rows`).
 fn theta_pso_table(
-    o: &crate::planner::ThetaPsoOutcome,
+    o: &crate::pipelines::theta_pso::ThetaPsoOutcome,
     state: &JobState,
     stale: bool,
 ) -> Vec<Line<'static>> {
@@ -285,7 +285,7 @@ fn theta_pso_table(
 
 /// The fleet's result: each target's formation time, the closest approaches,
 /// the final inter-agent distances, the PSO effort.
-fn fleet_table(o: &crate::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>> {
+fn fleet_table(o: &crate::pipelines::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>> {
     let safe = o.kept_apart() && o.obstacles_clear();
     let mut lines = vec![Line::from(vec![
         Span::raw(format!(
@@ -357,7 +357,7 @@ fn fleet_table(o: &crate::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>
 }
 
 /// FLATLO's verification: every pair's closest approach, the final line, the verdict.
-fn flatlo_table(o: &crate::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'static>> {
+fn flatlo_table(o: &crate::pipelines::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'static>> {
     let verdict = match &o.verification {
         Some(v) if v.passed => Span::styled("✓ separation kept", Style::default().green()),
         Some(_) => Span::styled("✗ SEPARATION LOST", Style::default().red().bold()),

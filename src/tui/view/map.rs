@@ -15,11 +15,11 @@ use ratatui::text::{Line as TextLine, Span};
 use ratatui::widgets::canvas::{Canvas, Context, Line, Painter, Rectangle, Shape};
 use ratatui::widgets::{Block, BorderType, Borders, Cell, Row, Table};
 
-use crate::flatlo::FlatloOutcome;
-use crate::fleet::FleetOutcome;
-use crate::geometry::segment_projection;
+use crate::base::geometry::segment_projection;
 use crate::mission::{Mission, Preset, ShapeChoice};
-use crate::planner::ThetaPsoOutcome;
+use crate::pipelines::flatlo::FlatloOutcome;
+use crate::pipelines::fleet::FleetOutcome;
+use crate::pipelines::theta_pso::ThetaPsoOutcome;
 use crate::tui::app::{App, Focus};
 use crate::tui::fields::{Item, shape_name};
 use crate::tui::jobs::Outcome;
@@ -28,7 +28,7 @@ pub use super::viewport::Viewport;
 
 /// UAV `i`'s colour (0-based), the same as in the Rerun recording.
 pub fn uav_color(i: usize) -> Color {
-    let [r, g, b] = crate::tracks::vehicle_color(i);
+    let [r, g, b] = crate::outcome::tracks::vehicle_color(i);
     Color::Rgb(r, g, b)
 }
 

@@ -13,7 +13,7 @@
 
 use std::sync::Arc;
 
-use crate::terrain::HeightMap;
+use crate::base::terrain::HeightMap;
 
 /// (180/π)·atan2(y, x): Octave 7.3's `atan2d`, the product 180/π first.
 const DEG: f64 = 180.0 / std::f64::consts::PI;

@@ -15,9 +15,9 @@ use super::{
     AgentOutcome, AgentSample, Closest, DistanceSeries, FleetOutcome, MAX_SERIES_AGENTS, Other,
     SAMPLE_RATE, Scenario, TargetOutcome, neighbourhoods, scenario,
 };
+use crate::base::ode::rk4_step;
 use crate::mission::{FleetParams, FleetPush, Mission};
-use crate::ode::rk4_step;
-use crate::pipeline::{CancelToken, Completion, Event, Level, Observer};
+use crate::pipelines::{CancelToken, Completion, Event, Level, Observer};
 
 /// One quadrotor in flight.
 struct Flight {
@@ -166,7 +166,7 @@ impl<'m> Simulation<'m> {
         let steps = self.clock.steps;
         for k in 0..=steps {
             let now = self.snapshot(k);
-            if k % self.clock.record_every == 0 {
+            if k.is_multiple_of(self.clock.record_every) {
                 self.record(&now);
             }
             self.disturb(now.t);
@@ -182,7 +182,7 @@ impl<'m> Simulation<'m> {
                 break;
             }
             self.fly(now.t);
-            if k % self.clock.report_every == 0 {
+            if k.is_multiple_of(self.clock.report_every) {
                 observer.on_event(Event::Progress(0.98 * k as f64 / steps.max(1) as f64));
                 if cancel.is_cancelled() {
                     let text = format!(
@@ -214,7 +214,7 @@ impl<'m> Simulation<'m> {
             .iter()
             .map(|f| quadrotor::position(&f.state).xy())
             .collect();
-        let scheduled = k % self.clock.replan_every == 0;
+        let scheduled = k.is_multiple_of(self.clock.replan_every);
         if scheduled {
             self.near = neighbourhoods(&positions, self.watch_radius);
         }
@@ -441,7 +441,7 @@ impl<'m> Simulation<'m> {
             })
             .collect();
         FleetOutcome {
-            pipeline: crate::pipeline::Kind::Fleet,
+            pipeline: crate::pipelines::Kind::Fleet,
             mission: mission.name.clone(),
             seed,
             completion,

@@ -24,7 +24,7 @@
 use nalgebra::{Point2, Vector2, Vector3};
 use serde::Serialize;
 
-use crate::geometry::segment_point_distance;
+use crate::base::geometry::segment_point_distance;
 use crate::mission::{Formation, Mission, ShapeChoice};
 
 /// An intermediate waypoint between two obstacles.

@@ -15,8 +15,8 @@ use super::Stop;
 use super::field::{Disc, Field};
 use super::search::Reached;
 use crate::mission::Mission;
-use crate::planner::iwp::Iwp;
-use crate::planner::path::PathBuilder;
+use crate::pipelines::theta_pso::iwp::Iwp;
+use crate::pipelines::theta_pso::path::PathBuilder;
 
 /// The sides of the bounds, in the order `side_of` numbers them.
 const SIDES: [&str; 4] = ["west", "east", "south", "north"];

@@ -22,7 +22,7 @@ use rand::rngs::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
 use super::{Decoder, Model};
-use crate::detour::{self, Disc};
+use crate::base::detour::{self, Disc};
 
 /// `count` starting particles for `decoder`'s encoding, or none when no
 /// route reaches the goal.

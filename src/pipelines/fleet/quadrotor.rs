@@ -147,7 +147,7 @@ pub fn renormalize(x: &mut State) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ode::rk4_step;
+    use crate::base::ode::rk4_step;
 
     fn body() -> Body {
         Body::from_params(&FleetParams::default())

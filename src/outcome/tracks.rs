@@ -11,9 +11,9 @@
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
-use crate::flatlo::FlatloOutcome;
-use crate::fleet::FleetOutcome;
-use crate::planner::ThetaPsoOutcome;
+use crate::pipelines::flatlo::FlatloOutcome;
+use crate::pipelines::fleet::FleetOutcome;
+use crate::pipelines::theta_pso::ThetaPsoOutcome;
 
 /// One colour per vehicle (RGB), in vehicle order, cycling: the designer's
 /// map and the Rerun recording draw UAV n in the same colour. Chosen to
@@ -35,7 +35,7 @@ pub fn vehicle_color(i: usize) -> [u8; 3] {
 
 /// One instant of a track (seconds, metres ENU, m/s): the same sample as a
 /// θ-PSO trajectory's, so those tracks are the trajectories themselves.
-pub use crate::planner::Sample as TrackSample;
+pub use crate::pipelines::theta_pso::Sample as TrackSample;
 
 /// One vehicle's timed track.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -14,8 +14,8 @@ use std::ops::ControlFlow;
 
 use nalgebra::Point3;
 
+use crate::base::swarm::{self, SwarmResult};
 use crate::mission::{Encoding, Mission};
-use crate::swarm::{self, SwarmResult};
 pub use encoding::Decoder;
 
 /// The benchmark's model of `mission`: start, goal, the free nodes, the

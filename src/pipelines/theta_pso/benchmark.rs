@@ -1,6 +1,6 @@
 //! θ-PSO against the SPSO benchmark's cost (`theta_pso.cost = "spso"`): the
 //! swarm searches the benchmark's n free nodes with the mission's encoding
-//! (`crate::spso`), and the best path is flown, sampled and verified like
+//! (`crate::pipelines::theta_pso::spso`), and the best path is flown, sampled and verified like
 //! any θ-PSO plan (trajectories, the band above the ground, clearances), so
 //! the CLI, the designer and the recording show it as they show any plan.
 //!
@@ -11,8 +11,8 @@ use std::ops::ControlFlow;
 
 use super::{ThetaPsoOutcome, path, trajectory, verify};
 use crate::mission::Mission;
-use crate::pipeline::{CancelToken, Completion, CostTerms, Event, Level, Observer, PipelineError};
-use crate::spso::{self, Decoder};
+use crate::pipelines::theta_pso::spso::{self, Decoder};
+use crate::pipelines::{CancelToken, Completion, CostTerms, Event, Level, Observer, PipelineError};
 
 /// The benchmark's terms as `CostTerms`.
 pub fn cost_terms(t: &spso::Terms) -> CostTerms {
@@ -34,8 +34,8 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<ThetaPsoOutcome, PipelineError> {
-    crate::pipeline::require_valid(mission)?;
-    crate::pipeline::require_within_budget(super::budget(mission))?;
+    crate::pipelines::require_valid(mission)?;
+    crate::pipelines::require_within_budget(super::budget(mission))?;
     let model = spso::model(mission).map_err(PipelineError::InvalidMission)?;
     let decoder = Decoder::new(mission, mission.theta_pso.encoding);
     let p = &mission.theta_pso;
@@ -99,13 +99,13 @@ pub fn plan(
         .sum();
     let samples =
         (length / speed / trajectory::SAMPLE_PERIOD + 1.0) * mission.formation.slots.len() as f64;
-    if crate::pipeline::exceeds(samples, crate::pipeline::limits::TRAJECTORY_SAMPLES) {
+    if crate::pipelines::exceeds(samples, crate::pipelines::limits::TRAJECTORY_SAMPLES) {
         return Err(PipelineError::OverBudget(format!(
             "formation.ground_speed: the planned path ({length:.1} m at {} m/s) needs {} \
              trajectory samples (limit {})",
-            crate::pipeline::figure(speed),
-            crate::pipeline::figure(samples),
-            crate::pipeline::figure(crate::pipeline::limits::TRAJECTORY_SAMPLES)
+            crate::pipelines::figure(speed),
+            crate::pipelines::figure(samples),
+            crate::pipelines::figure(crate::pipelines::limits::TRAJECTORY_SAMPLES)
         )));
     }
     let span = path::heading_span(mission);
@@ -119,7 +119,7 @@ pub fn plan(
         .map(|i| nalgebra::Point3::new(run.nodes[i], run.nodes[n + i], run.nodes[2 * n + i]))
         .collect();
     Ok(ThetaPsoOutcome {
-        pipeline: crate::pipeline::Kind::ThetaPso,
+        pipeline: crate::pipelines::Kind::ThetaPso,
         mission: mission.name.clone(),
         seed,
         completion,

@@ -85,7 +85,8 @@ pub fn shortest_route(
     }
     let visible = |a: &Point2<f64>, b: &Point2<f64>| {
         discs.iter().all(|d| {
-            crate::geometry::segment_point_distance(a, b, &d.center) >= d.radius * inner - 1e-9
+            crate::base::geometry::segment_point_distance(a, b, &d.center)
+                >= d.radius * inner - 1e-9
         })
     };
 

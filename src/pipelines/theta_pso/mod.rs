@@ -14,6 +14,7 @@ pub mod reference;
 pub mod repair;
 pub mod route;
 pub mod seeding;
+pub mod spso;
 pub mod trajectory;
 pub mod verify;
 
@@ -23,9 +24,9 @@ use std::ops::ControlFlow;
 use nalgebra::Point3;
 use serde::Serialize;
 
+use crate::base::swarm::{self, SearchSpace, SwarmConfig};
 use crate::mission::{Diagnostic, FieldPath, Mission};
-use crate::pipeline::{CancelToken, Completion, CostTerms, Event, Level, Observer, PipelineError};
-use crate::swarm::{self, SearchSpace, SwarmConfig};
+use crate::pipelines::{CancelToken, Completion, CostTerms, Event, Level, Observer, PipelineError};
 
 pub use cost::CostModel;
 pub use inspection::PassGeometry;
@@ -50,7 +51,7 @@ impl Default for PlanOptions {
 /// Everything a θ-PSO run produces.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThetaPsoOutcome {
-    pub pipeline: crate::pipeline::Kind,
+    pub pipeline: crate::pipelines::Kind,
     pub mission: String,
     pub seed: u64,
     pub completion: Completion,
@@ -221,7 +222,7 @@ pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
 /// speed, every 0.1 s, for every UAV; `plan` checks the real figure again
 /// before it samples the planned path.
 pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
-    use crate::pipeline::{figure, limits};
+    use crate::pipelines::{figure, limits};
     let p = &mission.theta_pso;
     let at = |key: &str| FieldPath::root().key("theta_pso").key(key);
     let mut out = Vec::new();
@@ -256,7 +257,7 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
         ));
     }
     let evaluations = p.swarm_size as f64 * p.iterations as f64 * (1.0 + p.restarts as f64);
-    if crate::pipeline::exceeds(evaluations, limits::THETA_PSO_EVALUATIONS) {
+    if crate::pipelines::exceeds(evaluations, limits::THETA_PSO_EVALUATIONS) {
         // Name the largest factor: that is the field the user most likely mistyped.
         let key = if p.restarts as f64 >= p.swarm_size.max(p.iterations) as f64 {
             "restarts"
@@ -281,7 +282,7 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
     let speed = mission.formation.ground_speed;
     let duration = distance / speed;
     let samples = trajectory_samples(duration, mission.formation.slots.len());
-    if crate::pipeline::exceeds(samples, limits::TRAJECTORY_SAMPLES) {
+    if crate::pipelines::exceeds(samples, limits::TRAJECTORY_SAMPLES) {
         out.push(Diagnostic::error(
             FieldPath::root().key("formation").key("ground_speed"),
             format!(
@@ -342,14 +343,14 @@ impl Attempt {
         let cost = problem.cost.terms(&path);
         // The budget checked the straight distance; the planned path is longer.
         let samples = trajectory_samples(cost.length / speed, mission.formation.slots.len());
-        if crate::pipeline::exceeds(samples, crate::pipeline::limits::TRAJECTORY_SAMPLES) {
+        if crate::pipelines::exceeds(samples, crate::pipelines::limits::TRAJECTORY_SAMPLES) {
             return Err(PipelineError::OverBudget(format!(
                 "formation.ground_speed: the planned path ({:.1} m at {} m/s) needs {} \
                  trajectory samples (limit {})",
                 cost.length,
-                crate::pipeline::figure(speed),
-                crate::pipeline::figure(samples),
-                crate::pipeline::figure(crate::pipeline::limits::TRAJECTORY_SAMPLES)
+                crate::pipelines::figure(speed),
+                crate::pipelines::figure(samples),
+                crate::pipelines::figure(crate::pipelines::limits::TRAJECTORY_SAMPLES)
             )));
         }
         let names: Vec<String> = mission.obstacles.iter().map(|o| o.name.clone()).collect();
@@ -422,8 +423,8 @@ pub fn plan(
     if mission.theta_pso.cost == crate::mission::CostKind::Spso {
         return benchmark::plan(mission, seed, observer, cancel);
     }
-    crate::pipeline::require_valid(mission)?;
-    crate::pipeline::require_within_budget(budget(mission))?;
+    crate::pipelines::require_valid(mission)?;
+    crate::pipelines::require_within_budget(budget(mission))?;
     let errors: Vec<String> = diagnostics(mission)
         .into_iter()
         .filter(|d| d.is_error())
@@ -594,7 +595,7 @@ pub fn plan(
         .collect();
     let reference_length = reference.map(|r| r.length);
     Ok(ThetaPsoOutcome {
-        pipeline: crate::pipeline::Kind::ThetaPso,
+        pipeline: crate::pipelines::Kind::ThetaPso,
         mission: mission.name.clone(),
         seed,
         completion,

@@ -24,7 +24,7 @@
 use nalgebra::{Point2, Vector2, Vector3};
 
 use super::iwp::Iwp;
-use crate::detour::{Disc, Route, shortest_route};
+use crate::base::detour::{Disc, Route, shortest_route};
 use crate::mission::Mission;
 
 /// ρ: how close the centroid of a formation with UAVs at `offsets`

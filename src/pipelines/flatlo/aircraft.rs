@@ -187,7 +187,7 @@ impl Autopilot {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ode::rk4_step;
+    use crate::base::ode::rk4_step;
 
     fn airframe() -> Airframe {
         Airframe::from_params(&FlatloParams::default())

@@ -5,6 +5,10 @@
 //! iterations. It never touches a terminal, a file or Rerun: the CLI, the TUI,
 //! the recorder, the tests and the benchmarks are all observers.
 
+pub mod flatlo;
+pub mod fleet;
+pub mod theta_pso;
+
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 

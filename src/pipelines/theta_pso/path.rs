@@ -21,8 +21,8 @@ use nalgebra::{Point2, Point3, Vector2, Vector3};
 
 use super::inspection::PassGeometry;
 use super::iwp::{Iwp, Shape, lateral_half_width, vertical_half_height};
+pub use crate::base::swarm::{decode_angle, encode_angle};
 use crate::mission::Mission;
-pub use crate::swarm::{decode_angle, encode_angle};
 
 /// Why the formation changes shape over a zone.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -285,7 +285,7 @@ pub struct PathBuilder {
     inspections: Vec<Inspection>,
     /// With terrain, the path is planned above the ground and lifted onto it
     /// at its vertices.
-    ground: Option<crate::terrain::Ground>,
+    ground: Option<crate::base::terrain::Ground>,
     /// The nominal slots and r_Q (to choose the narrower of two shapes).
     slots: Vec<Vector3<f64>>,
     uav_radius: f64,

@@ -25,11 +25,11 @@ pub fn diagnose(mission: &Mission) -> Vec<Diagnostic> {
 fn pipeline_findings(mission: &Mission) -> Vec<Diagnostic> {
     use clap::ValueEnum as _;
     // Every registered pipeline's predicted size, in the order of `Kind`.
-    let mut out: Vec<Diagnostic> = crate::pipeline::Kind::value_variants()
+    let mut out: Vec<Diagnostic> = crate::pipelines::Kind::value_variants()
         .iter()
         .flat_map(|&kind| crate::outcome::budget(kind, mission))
         .collect();
-    out.extend(crate::planner::diagnostics(mission));
+    out.extend(crate::pipelines::theta_pso::diagnostics(mission));
     out
 }
 

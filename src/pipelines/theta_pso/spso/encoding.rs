@@ -6,8 +6,8 @@
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
+use crate::base::swarm::{SearchSpace, SequentialConfig};
 use crate::mission::{Encoding, Mission};
-use crate::swarm::{SearchSpace, SequentialConfig};
 
 /// (−1)^k / (2k + 1)!, k = 0..10: the Taylor coefficients of sine to θ²¹.
 const SINE_TAYLOR: [f64; 11] = [
@@ -244,7 +244,8 @@ impl Decoder {
             Encoding::Angle => {
                 for (c, b) in self.bounds.iter().enumerate() {
                     for i in 0..n {
-                        out[c * n + i] = crate::swarm::encode_angle(nodes[c * n + i], b[0], b[1]);
+                        out[c * n + i] =
+                            crate::base::swarm::encode_angle(nodes[c * n + i], b[0], b[1]);
                     }
                 }
             }

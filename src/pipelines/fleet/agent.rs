@@ -6,8 +6,8 @@ use std::ops::ControlFlow;
 use nalgebra::Vector2;
 
 use super::cost::Observation;
+use crate::base::swarm::{self, SearchSpace, SwarmConfig};
 use crate::mission::FleetParams;
-use crate::swarm::{self, SearchSpace, SwarmConfig};
 
 /// The planner of agent `index`: deterministic from (seed, index, round).
 #[derive(Debug, Clone)]

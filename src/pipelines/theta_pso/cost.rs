@@ -37,9 +37,9 @@ use nalgebra::{Point2, Point3, Vector3};
 use super::iwp::{Iwp, Shape, column_place};
 use super::motion::Motion;
 use super::path::{CentroidPath, heading_span};
-use crate::geometry::Cylinder;
+use crate::base::geometry::Cylinder;
 use crate::mission::{Bounds, Mission, ThetaPsoParams};
-use crate::pipeline::CostTerms;
+use crate::pipelines::CostTerms;
 
 /// How far a UAV's path may stray from the chord of a piece where the heading
 /// turns, metres: a fifth of the default clearance margin.
@@ -77,7 +77,7 @@ pub struct CostModel {
     band: [f64; 2],
     bounds: Bounds,
     /// With terrain, the band is above the ground under each UAV.
-    ground: Option<crate::terrain::Ground>,
+    ground: Option<crate::base::terrain::Ground>,
     /// Cosine of the largest heading turn over one piece: the turn at which a
     /// UAV `reach` from the centroid strays `CHORD_TOLERANCE` from the chord.
     max_turn_cos: f64,
@@ -730,7 +730,7 @@ pub fn violation_along(p: &Point3<f64>, q: &Point3<f64>, c: &Cylinder, safe: f64
     let (a, b) = (p.xy(), q.xy());
     let ab = b - a;
     let length = ab.norm();
-    let (t, _) = crate::geometry::segment_projection(&a, &b, &c.center);
+    let (t, _) = crate::base::geometry::segment_projection(&a, &b, &c.center);
     let h = c.axis_distance(&(p + (q - p) * t));
     if h >= safe {
         return 0.0;

@@ -25,7 +25,7 @@ use rand::{RngExt, SeedableRng};
 use serde::Serialize;
 
 use crate::mission::{Diagnostic, FieldPath, Mission};
-use crate::pipeline::{CancelToken, Completion, Event, Observer, PipelineError};
+use crate::pipelines::{CancelToken, Completion, Event, Observer, PipelineError};
 
 use simulation::Simulation;
 
@@ -105,7 +105,7 @@ pub const MAX_SERIES_AGENTS: usize = 12;
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FleetOutcome {
-    pub pipeline: crate::pipeline::Kind,
+    pub pipeline: crate::pipelines::Kind,
     pub mission: String,
     pub seed: u64,
     pub completion: Completion,
@@ -298,7 +298,7 @@ pub fn neighbourhoods(positions: &[Point2<f64>], radius: f64) -> Vec<Vec<usize>>
 /// evaluations (agents × re-plans × particles × iterations), dynamics steps
 /// (agents × duration / sim_step) and kept samples (agents × duration × 20 Hz).
 pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
-    use crate::pipeline::{figure, limits};
+    use crate::pipelines::{figure, limits};
     let p = &mission.fleet;
     let at = |key: &str| FieldPath::root().key("fleet").key(key);
     let mut out = Vec::new();
@@ -316,7 +316,7 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
     }
     let replans = (p.duration / p.replan_period).ceil();
     let evaluations = n * replans * p.swarm_size as f64 * p.iterations as f64;
-    if crate::pipeline::exceeds(evaluations, limits::FLEET_EVALUATIONS) {
+    if crate::pipelines::exceeds(evaluations, limits::FLEET_EVALUATIONS) {
         let key = if p.replan_period < 1e-3 {
             "replan_period"
         } else if p.swarm_size >= p.iterations {
@@ -339,7 +339,7 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
         ));
     }
     let steps = n * (p.duration / p.sim_step).ceil();
-    if crate::pipeline::exceeds(steps, limits::FLEET_STEPS) {
+    if crate::pipelines::exceeds(steps, limits::FLEET_STEPS) {
         let key = if p.sim_step < 1e-4 {
             "sim_step"
         } else {
@@ -358,7 +358,7 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
         ));
     }
     let samples = n * p.duration * SAMPLE_RATE;
-    if crate::pipeline::exceeds(samples, limits::FLEET_SAMPLES) {
+    if crate::pipelines::exceeds(samples, limits::FLEET_SAMPLES) {
         out.push(Diagnostic::error(
             at("duration"),
             format!(
@@ -381,8 +381,8 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<FleetOutcome, PipelineError> {
-    crate::pipeline::require_valid(mission)?;
-    crate::pipeline::require_within_budget(budget(mission))?;
+    crate::pipelines::require_valid(mission)?;
+    crate::pipelines::require_within_budget(budget(mission))?;
     observer.on_event(Event::Stage("scenario"));
     let mut simulation = Simulation::new(mission, seed);
     observer.on_event(Event::Stage("flight"));

@@ -17,9 +17,9 @@ use rand_distr::StandardNormal;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::base::ode::rk4_step;
 use crate::mission::{Diagnostic, FieldPath, FlatloParams, Mission};
-use crate::ode::rk4_step;
-use crate::pipeline::{CancelToken, Completion, Event, Level, Observer, PipelineError};
+use crate::pipelines::{CancelToken, Completion, Event, Level, Observer, PipelineError};
 
 use aircraft::{Airframe, Autopilot, Controls, State, Target};
 use algorithm::Side;
@@ -237,7 +237,7 @@ pub struct FlatloVerification {
 /// Everything a FLATLO run produces.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FlatloOutcome {
-    pub pipeline: crate::pipeline::Kind,
+    pub pipeline: crate::pipelines::Kind,
     pub mission: String,
     pub seed: u64,
     pub completion: Completion,
@@ -347,7 +347,7 @@ impl Flight {
 /// scans (aircraft × duration / sample_period). The duration comes from
 /// Algorithm 1's references (cheap: no simulation), so the figure is exact.
 pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
-    use crate::pipeline::{figure, limits};
+    use crate::pipelines::{figure, limits};
     let p = &mission.flatlo;
     let at = |key: &str| FieldPath::root().key("flatlo").key(key);
     if p.aircraft > limits::FLATLO_AIRCRAFT {
@@ -364,7 +364,7 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
     let duration = references(p).duration;
     let n = p.aircraft as f64;
     let steps = n * (duration / p.sim_step).ceil();
-    if crate::pipeline::exceeds(steps, limits::FLATLO_STEPS) {
+    if crate::pipelines::exceeds(steps, limits::FLATLO_STEPS) {
         // The step is the usual typo; a long flight comes from the squadron.
         let key = if p.sim_step < 1e-3 {
             "sim_step"
@@ -384,7 +384,7 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
         ));
     }
     let samples = n * (duration / p.sample_period).ceil();
-    if crate::pipeline::exceeds(samples, limits::FLATLO_SAMPLES) {
+    if crate::pipelines::exceeds(samples, limits::FLATLO_SAMPLES) {
         out.push(Diagnostic::error(
             at("sample_period"),
             format!(
@@ -411,8 +411,8 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<FlatloOutcome, PipelineError> {
-    crate::pipeline::require_valid(mission)?;
-    crate::pipeline::require_within_budget(budget(mission))?;
+    crate::pipelines::require_valid(mission)?;
+    crate::pipelines::require_within_budget(budget(mission))?;
     let p = &mission.flatlo;
     let n = p.aircraft;
 
@@ -531,7 +531,7 @@ pub fn plan(
         observer.on_event(Event::Progress(1.0));
     }
     Ok(FlatloOutcome {
-        pipeline: crate::pipeline::Kind::Flatlo,
+        pipeline: crate::pipelines::Kind::Flatlo,
         mission: mission.name.clone(),
         seed,
         completion,
