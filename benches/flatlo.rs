@@ -6,9 +6,9 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use skyform::flatlo;
 use skyform::mission::{self, Mission};
-use skyform::pipeline::{CancelToken, Silent};
+use skyform::pipelines::flatlo;
+use skyform::pipelines::{CancelToken, Silent};
 
 fn paper() -> Mission {
     let text = include_str!("../missions/flatlo-squadron.toml");

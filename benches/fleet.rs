@@ -8,9 +8,9 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Point2;
-use skyform::fleet::{self, agent::Planner, cost};
 use skyform::mission::{self, FleetParams, Mission};
-use skyform::pipeline::{CancelToken, Silent};
+use skyform::pipelines::fleet::{self, agent::Planner, cost};
+use skyform::pipelines::{CancelToken, Silent};
 
 /// `n` agents in a square room sized for them, one target, a regular polygon
 /// whose sides are the paper's 1.732 m.

@@ -92,7 +92,7 @@ fn import_200(c: &mut Criterion) {
         b.iter(|| {
             let imported = once();
             let saved = mission::edit_in_place(&imported.mission, &text).expect("a mission");
-            skyform::diagnose::check_text(&saved, Some("site.toml"))
+            skyform::outcome::diagnose::check_text(&saved, Some("site.toml"))
                 .report
                 .error_count()
         })

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use skyform::mission::{Encoding, Mission};
-use skyform::spso::{self, Decoder};
+use skyform::pipelines::theta_pso::spso::{self, Decoder};
 
 fn mission() -> Mission {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("missions/spso-benchmark.toml");

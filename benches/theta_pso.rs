@@ -23,8 +23,8 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::{Point2, Point3};
 use skyform::mission::{self, Mission, Obstacle};
-use skyform::pipeline::{CancelToken, Silent};
-use skyform::planner::{PlanOptions, Problem, plan};
+use skyform::pipelines::theta_pso::{PlanOptions, Problem, plan};
+use skyform::pipelines::{CancelToken, Silent};
 
 fn bridge_without_inspections() -> Mission {
     let mut m = mission::default_mission().mission;
@@ -94,14 +94,14 @@ fn budget_check(c: &mut Criterion) {
         c.bench_function(&format!("budget_check/{name}"), |b| {
             b.iter(|| {
                 let m = black_box(m);
-                skyform::planner::budget(m).len()
-                    + skyform::flatlo::budget(m).len()
-                    + skyform::fleet::budget(m).len()
+                skyform::pipelines::theta_pso::budget(m).len()
+                    + skyform::pipelines::flatlo::budget(m).len()
+                    + skyform::pipelines::fleet::budget(m).len()
             })
         });
     }
     c.bench_function("diagnose/bridge", |b| {
-        b.iter(|| skyform::diagnose::diagnose(black_box(&bridge)).len())
+        b.iter(|| skyform::outcome::diagnose::diagnose(black_box(&bridge)).len())
     });
 }
 

@@ -11,7 +11,7 @@
 use std::time::Instant;
 
 use skyform::mission;
-use skyform::pipeline::{CancelToken, Silent};
+use skyform::pipelines::{CancelToken, Silent};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -26,7 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(radius) = args.get(2) {
         m.flatlo.turn_radius = radius.parse()?;
     }
-    let refused = skyform::flatlo::budget(&m);
+    let refused = skyform::pipelines::flatlo::budget(&m);
     if !refused.is_empty() {
         for d in refused {
             eprintln!("refused: {d}");
@@ -34,7 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Ok(());
     }
     let started = Instant::now();
-    let out = skyform::flatlo::plan(&m, m.seed, &mut Silent, &CancelToken::new())?;
+    let out = skyform::pipelines::flatlo::plan(&m, m.seed, &mut Silent, &CancelToken::new())?;
     let kept: usize = out.aircraft.iter().map(|a| a.flown.len()).sum();
     println!(
         "{} aircraft, Δd {} m, r {} m: {:.0} s simulated in {:.2} s wall; stride {}, {} samples kept; closest {}; {}",

@@ -17,8 +17,8 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use skyform::pipeline::{CancelToken, Silent};
-use skyform::planner::{PlanOptions, plan};
+use skyform::pipelines::theta_pso::{PlanOptions, plan};
+use skyform::pipelines::{CancelToken, Silent};
 
 struct Run {
     site: u64,
@@ -31,7 +31,7 @@ struct Run {
 
 /// One site and seed in detail: its IWPs, the seeding route, the result.
 fn detail(m: &skyform::mission::Mission, seed: u64) {
-    use skyform::planner::{Problem, seeding};
+    use skyform::pipelines::theta_pso::{Problem, seeding};
     println!(
         "{} — {} obstacles, bounds x {:?} y {:?}",
         m.name,
@@ -63,7 +63,7 @@ fn detail(m: &skyform::mission::Mission, seed: u64) {
         );
     }
     let t = Instant::now();
-    let corridor = match skyform::planner::route::find(
+    let corridor = match skyform::pipelines::theta_pso::route::find(
         m,
         &problem.builder,
         &problem.iwps,
@@ -111,11 +111,13 @@ fn detail(m: &skyform::mission::Mission, seed: u64) {
         println!("  no seeding route");
     }
     let t0 = Instant::now();
-    let mut stages = |event: skyform::pipeline::Event<'_>| match event {
-        skyform::pipeline::Event::Stage(s) => {
+    let mut stages = |event: skyform::pipelines::Event<'_>| match event {
+        skyform::pipelines::Event::Stage(s) => {
             println!("    {:>7.3} s  stage {s}", t0.elapsed().as_secs_f64())
         }
-        skyform::pipeline::Event::Log(_, l) if !l.contains("unusable") && !l.starts_with("IWP") => {
+        skyform::pipelines::Event::Log(_, l)
+            if !l.contains("unusable") && !l.starts_with("IWP") =>
+        {
             println!("    {:>7.3} s  {l}", t0.elapsed().as_secs_f64())
         }
         _ => {}

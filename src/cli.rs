@@ -7,10 +7,10 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::mission::{self, Checked, Report};
-use crate::outcome;
-use crate::pipeline::{CancelToken, Completion, Event, Kind, Level, Observer, Tee};
-use crate::planner::PlanOptions;
+use crate::pipelines::theta_pso::PlanOptions;
+use crate::pipelines::{CancelToken, Completion, Event, Kind, Level, Observer};
 use crate::record::{self, Recorder, Sinks};
+use crate::run::Run;
 
 pub mod eval_cmd;
 pub mod export_cmd;
@@ -359,7 +359,7 @@ fn new_mission(file: &std::path::Path, from: Option<&str>, no_open: bool) -> u8 
         eprintln!("error: cannot create {}: {e}", dir.display());
         return exit::ERROR;
     }
-    if let Err(e) = mission::write_atomically(file, text.as_bytes()) {
+    if let Err(e) = crate::base::atomic::write(file, text.as_bytes()) {
         eprintln!("error: cannot write {}: {e}", file.display());
         return exit::ERROR;
     }
@@ -393,7 +393,7 @@ fn copied_mission(from: &str) -> Result<(String, String), String> {
         };
         (b.text.to_owned(), format!("the shipped {}", b.file_name))
     };
-    if crate::diagnose::check_text(&text, Some(&source))
+    if crate::outcome::diagnose::check_text(&text, Some(&source))
         .mission
         .is_none()
     {
@@ -430,7 +430,7 @@ fn record_mission(path: &std::path::Path, sinks: &Sinks) -> u8 {
 
 /// Loads a mission for a command: its warnings and errors go to stderr.
 fn load_reporting(path: &std::path::Path) -> Option<mission::Mission> {
-    match crate::diagnose::load(path) {
+    match crate::outcome::diagnose::load(path) {
         Ok(loaded) => {
             eprint!("{}", loaded.warnings);
             Some(loaded.mission)
@@ -447,6 +447,9 @@ fn report_recording(finished: Option<&record::Finished>) {
     let Some(f) = finished else { return };
     if let Some((path, size)) = &f.file {
         eprintln!("recording: wrote {} ({size} bytes)", path.display());
+    }
+    if let Some(e) = &f.error {
+        eprintln!("error: recording: {e}");
     }
     if f.dropped > 0 {
         eprintln!(
@@ -559,15 +562,16 @@ fn run_pipeline(
     options: PlanOptions,
     verbose: bool,
 ) -> u8 {
-    let plan = |m: &mission::Mission, seed, observer: &mut dyn Observer, cancel: &CancelToken| {
-        outcome::run(kind, m, seed, options, observer, cancel)
-    };
     let Some(mission) = load_reporting(path) else {
         return exit::ERROR;
     };
-    let seed = seed.unwrap_or(mission.seed);
+    let run = Run {
+        kind,
+        seed: seed.unwrap_or(mission.seed),
+        options,
+    };
     let mut warnings = Vec::new();
-    let mut recorder = match Recorder::start(&mission.name, sinks, &mut warnings) {
+    let recorder = match Recorder::start(&mission.name, Some(kind), sinks, &mut warnings) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");
@@ -579,19 +583,13 @@ fn run_pipeline(
     }
     let cancel = cancel_on_ctrl_c();
     let mut progress = StderrProgress::new();
-    let result = match recorder.as_mut() {
-        Some(r) => {
-            r.log_mission(&mission);
-            plan(&mission, seed, &mut Tee(&mut progress, r), &cancel)
-        }
-        None => plan(&mission, seed, &mut progress, &cancel),
-    };
-    let outcome = match result {
+    let ran = run.carry_out(&mission, recorder, &mut progress, &cancel);
+    let finished = ran.recorded;
+    let outcome = match ran.result {
         Ok(o) => o,
         // No plan exists within the planner's model: not an error of the
         // program or the file, the answer (with the place that closes the way).
-        Err(crate::pipeline::PipelineError::NoRoute(reason)) => {
-            let finished = recorder.map(Recorder::finish);
+        Err(crate::pipelines::PipelineError::NoRoute(reason)) => {
             if progress.terminal {
                 eprintln!();
             }
@@ -604,12 +602,6 @@ fn run_pipeline(
             return exit::ERROR;
         }
     };
-    if let Some(r) = recorder.as_mut() {
-        r.log_outcome(&outcome);
-    }
-    // Every clone of the stream is dropped here, so the file is complete
-    // (with its footer) before anything else is printed or the process ends.
-    let finished = recorder.map(Recorder::finish);
     if progress.terminal {
         eprintln!();
     }
@@ -631,7 +623,7 @@ fn run_pipeline(
         };
         if json_to_stdout {
             println!("{text}");
-        } else if let Err(e) = mission::write_atomically(target, text.as_bytes()) {
+        } else if let Err(e) = crate::base::atomic::write(target, text.as_bytes()) {
             eprintln!("error: cannot write {}: {e}", target.display());
             return exit::ERROR;
         }
@@ -655,7 +647,8 @@ fn check(files: &[PathBuf], strict: bool, json: bool) -> u8 {
         let name = path.display().to_string();
         let report = match mission::read(path) {
             Ok(text) => {
-                let Checked { report, .. } = crate::diagnose::check_text(&text, Some(&name));
+                let Checked { report, .. } =
+                    crate::outcome::diagnose::check_text(&text, Some(&name));
                 report
             }
             Err(e) => Report::new(vec![

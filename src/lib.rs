@@ -4,24 +4,17 @@
 //! pipelines turn it into outcomes, and views (CLI, TUI, Rerun) show them.
 //! See `docs/architecture.md`.
 
+// Layers, from the ground up (docs/architecture.md): what every layer may
+// use, what a user writes, the pipelines, what a run gives, the front ends.
+pub mod base;
 #[cfg(feature = "rerun")]
 pub mod cli;
-pub mod detour;
-pub mod diagnose;
 pub mod export;
-pub mod flatlo;
-pub mod fleet;
-pub mod geometry;
 pub mod import;
 pub mod mission;
-pub mod ode;
 pub mod outcome;
-pub mod pipeline;
-pub mod planner;
+pub mod pipelines;
 #[cfg(feature = "rerun")]
 pub mod record;
-pub mod spso;
-pub mod swarm;
-pub mod terrain;
-pub mod tracks;
+pub mod run;
 pub mod tui;

@@ -10,10 +10,10 @@ use skyform::export::{
     self, ExportError, Exported, Format, Frame, Geodetic, Options, Planned, simplify,
 };
 use skyform::mission::{self, GeoOrigin, Mission};
-use skyform::pipeline::{CancelToken, Silent};
-use skyform::planner::{self, PlanOptions};
-use skyform::tracks::{Track, TrackSample};
-use skyform::{flatlo, fleet};
+use skyform::outcome::tracks::{Track, TrackSample};
+use skyform::pipelines::theta_pso::{self, PlanOptions};
+use skyform::pipelines::{CancelToken, Silent};
+use skyform::pipelines::{flatlo, fleet};
 
 mod common;
 use common::skyform;
@@ -52,7 +52,7 @@ fn planned(path: &str, pipeline: &str) -> (Mission, Planned) {
     let cancel = CancelToken::new();
     let p = match pipeline {
         "theta-pso" => {
-            let o = planner::plan(&m, m.seed, PlanOptions::default(), &mut Silent, &cancel)
+            let o = theta_pso::plan(&m, m.seed, PlanOptions::default(), &mut Silent, &cancel)
                 .unwrap_or_else(|e| panic!("{e}"));
             Planned::theta_pso(&m, &o)
         }
@@ -549,7 +549,7 @@ fn without_an_origin_csv_works_in_enu_and_geodetic_formats_say_to_add_it() {
         let m = mission::load(&path)
             .unwrap_or_else(|e| panic!("{e}"))
             .mission;
-        let o = planner::plan(
+        let o = theta_pso::plan(
             &m,
             m.seed,
             PlanOptions::default(),
@@ -769,7 +769,7 @@ fn kml_expectation(m: &Mission, p: &Planned, done: &Exported, dir: &Path) -> Pat
                 .collect();
             json!({
                 "folder": format!("UAV {}", t.vehicle + 1),
-                "color": export::kml::kml_color(skyform::tracks::vehicle_color(t.vehicle), 0xff),
+                "color": export::kml::kml_color(skyform::outcome::tracks::vehicle_color(t.vehicle), 0xff),
                 "samples": samples,
             })
         })
@@ -919,7 +919,7 @@ fn the_designer_exports_the_shown_result_beside_the_mission_and_edits_the_origin
         status.text
     );
 
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     assert!(app.wait_for_jobs(std::time::Duration::from_secs(120)));
     app.update(Action::ShowJob);
     app.update(Action::Export);

@@ -20,8 +20,8 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use skyform::mission::BUILTIN;
-use skyform::pipeline::{CancelToken, Silent};
-use skyform::planner::PlanOptions;
+use skyform::pipelines::theta_pso::PlanOptions;
+use skyform::pipelines::{CancelToken, Silent};
 
 /// A run is cancelled after this long (the largest runs the budget allows
 /// take minutes; the test needs bounded time, not their result).
@@ -153,7 +153,8 @@ fn sweep(stride: usize) -> Tally {
                 let Ok(text) = toml::to_string(&changed) else {
                     continue;
                 };
-                let checked = catch_unwind(|| skyform::diagnose::check_text(&text, Some("x.toml")));
+                let checked =
+                    catch_unwind(|| skyform::outcome::diagnose::check_text(&text, Some("x.toml")));
                 let checked = match checked {
                     Ok(c) => c,
                     Err(_) => {
@@ -175,15 +176,21 @@ fn sweep(stride: usize) -> Tally {
                     (
                         "theta-pso",
                         Box::new(|c| {
-                            skyform::planner::plan(&m, 1, PlanOptions::default(), &mut Silent, c)
-                                .map(drop)
-                                .map_err(|e| e.to_string())
+                            skyform::pipelines::theta_pso::plan(
+                                &m,
+                                1,
+                                PlanOptions::default(),
+                                &mut Silent,
+                                c,
+                            )
+                            .map(drop)
+                            .map_err(|e| e.to_string())
                         }),
                     ),
                     (
                         "flatlo",
                         Box::new(|c| {
-                            skyform::flatlo::plan(&m, 1, &mut Silent, c)
+                            skyform::pipelines::flatlo::plan(&m, 1, &mut Silent, c)
                                 .map(drop)
                                 .map_err(|e| e.to_string())
                         }),
@@ -191,7 +198,7 @@ fn sweep(stride: usize) -> Tally {
                     (
                         "fleet",
                         Box::new(|c| {
-                            skyform::fleet::plan(&m, 1, &mut Silent, c)
+                            skyform::pipelines::fleet::plan(&m, 1, &mut Silent, c)
                                 .map(drop)
                                 .map_err(|e| e.to_string())
                         }),

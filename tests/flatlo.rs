@@ -2,9 +2,9 @@
 //! references, and the simulated squadron of Section 3.
 
 use nalgebra::Point3;
-use skyform::flatlo::{self, algorithm, line_spacing};
 use skyform::mission::{self, FlatloParams, Mission};
-use skyform::pipeline::{CancelToken, Completion, Silent};
+use skyform::pipelines::flatlo::{self, algorithm, line_spacing};
+use skyform::pipelines::{CancelToken, Completion, Silent};
 
 fn paper_mission() -> Mission {
     mission::load(std::path::Path::new(concat!(

@@ -1,9 +1,9 @@
 //! The distributed fleet against its paper's experiments (Section 4).
 
 use nalgebra::{Point2, Vector2};
-use skyform::fleet::{self, FleetOutcome};
 use skyform::mission::{self, FleetPush, FleetTarget, Mission, Obstacle};
-use skyform::pipeline::{CancelToken, Silent};
+use skyform::pipelines::fleet::{self, FleetOutcome};
+use skyform::pipelines::{CancelToken, Silent};
 
 fn triangle_mission() -> Mission {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/fleet-triangle.toml");

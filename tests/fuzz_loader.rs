@@ -186,7 +186,7 @@ fn generated() -> impl Strategy<Value = String> {
 }
 
 fn check(text: &str) -> Result<(), TestCaseError> {
-    let checked = skyform::diagnose::check_text(text, Some("fuzz.toml"));
+    let checked = skyform::outcome::diagnose::check_text(text, Some("fuzz.toml"));
     prop_assert!(checked.mission.is_some() || checked.report.has_errors());
     // Every error names where it is.
     for d in checked.report.errors() {

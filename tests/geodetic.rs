@@ -7,8 +7,8 @@ use std::path::Path;
 use nalgebra::{Point2, Point3};
 use skyform::mission::geodesy::Frame;
 use skyform::mission::{Mission, check_str, edit_in_place};
-use skyform::pipeline::{CancelToken, Silent};
-use skyform::planner::{self, PlanOptions};
+use skyform::pipelines::theta_pso::{self, PlanOptions};
+use skyform::pipelines::{CancelToken, Silent};
 use toml_edit::{DocumentMut, InlineTable, Item, Value};
 
 fn shipped(name: &str) -> String {
@@ -113,7 +113,7 @@ fn a_latitude_longitude_mission_plans_the_same_as_its_enu_twin() {
     let (enu, geo) = (load(&text), load(&geodetic_twin(&text)));
     let cancel = CancelToken::new();
     let plan = |m: &Mission| {
-        planner::plan(m, m.seed, PlanOptions::default(), &mut Silent, &cancel)
+        theta_pso::plan(m, m.seed, PlanOptions::default(), &mut Silent, &cancel)
             .unwrap_or_else(|e| panic!("{e}"))
     };
     let (a, b) = (plan(&enu), plan(&geo));

@@ -90,7 +90,7 @@ fn leaf_mut<'a>(value: &'a mut toml::Value, at: &[Step]) -> &'a mut toml::Value 
 /// when it is not a mission at all (the designer refuses to open those).
 fn opened(text: &str, file: &Path) -> Option<Mission> {
     let name = file.display().to_string();
-    skyform::diagnose::check_text(text, Some(&name)).mission
+    skyform::outcome::diagnose::check_text(text, Some(&name)).mission
 }
 
 /// Every generated mission: the shipped ones, each numeric leaf at each
@@ -313,7 +313,7 @@ fn every_message_is_under_the_field_whose_path_it_names() {
 fn the_generated_missions_reach_the_dangling_choice_and_the_unusable_shape() {
     let all: Vec<Diagnostic> = generated()
         .into_iter()
-        .flat_map(|(_, m, _)| skyform::diagnose::diagnose(&m))
+        .flat_map(|(_, m, _)| skyform::outcome::diagnose::diagnose(&m))
         .collect();
     let said = |path: &str, words: &str| {
         all.iter()

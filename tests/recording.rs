@@ -397,3 +397,27 @@ fn a_fleet_recording_holds_agents_references_and_the_distance_series() {
     assert!(paths.contains(&"/fleet/distances/safety_c".to_owned()));
     assert!(paths.contains(&"/fleet/events".to_owned()));
 }
+
+/// Each pipeline's log lines land under its own path, where its layout's
+/// event panel shows them, and nothing lands under another pipeline's.
+#[test]
+fn each_pipelines_log_lines_land_under_its_own_path() {
+    let runs = [
+        ("theta-pso", "theta_pso", "missions/bridge-inspection.toml"),
+        ("flatlo", "flatlo", "missions/flatlo-squadron.toml"),
+        ("fleet", "fleet", "missions/fleet-triangle.toml"),
+    ];
+    for (pipeline, own, mission) in runs {
+        let (_, chunks) = run_recorded(pipeline, mission, &[]);
+        let paths = entity_paths(&chunks);
+        let log = format!("/{own}/log");
+        assert!(paths.contains(&log), "{pipeline}: no {log} in {paths:?}");
+        for (_, other, _) in runs.iter().filter(|(_, o, _)| *o != own) {
+            let prefix = format!("/{other}/");
+            assert!(
+                !paths.iter().any(|p| p.starts_with(&prefix)),
+                "{pipeline} logged under {prefix}: {paths:?}"
+            );
+        }
+    }
+}

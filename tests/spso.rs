@@ -17,8 +17,8 @@ mod common;
 
 use std::sync::Arc;
 
-use skyform::spso::{Model, Threat};
-use skyform::terrain::HeightMap;
+use skyform::base::terrain::HeightMap;
+use skyform::pipelines::theta_pso::spso::{Model, Threat};
 
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spso");
 
@@ -299,20 +299,26 @@ fn the_shipped_benchmark_beats_the_reference_means() {
         Err(e) => panic!("{e}"),
     };
     assert_eq!(m.theta_pso.seeded_particles, 10);
-    let Ok(model) = skyform::spso::model(&m) else {
+    let Ok(model) = skyform::pipelines::theta_pso::spso::model(&m) else {
         panic!("no terrain");
     };
     for (encoding, reference) in [
         (skyform::mission::Encoding::Spherical, 4795.0_f64),
         (skyform::mission::Encoding::Angle, 6593.0),
     ] {
-        let decoder = skyform::spso::Decoder::new(&m, encoding);
+        let decoder = skyform::pipelines::theta_pso::spso::Decoder::new(&m, encoding);
         for seed in 1..=2 {
-            let starts = skyform::spso::seeding::particles(&model, &decoder, 10, seed);
-            let run =
-                skyform::spso::optimise(&model, &decoder, 500, 200, seed, &starts, |_, _, _| {
-                    std::ops::ControlFlow::Continue(())
-                });
+            let starts =
+                skyform::pipelines::theta_pso::spso::seeding::particles(&model, &decoder, 10, seed);
+            let run = skyform::pipelines::theta_pso::spso::optimise(
+                &model,
+                &decoder,
+                500,
+                200,
+                seed,
+                &starts,
+                |_, _, _| std::ops::ControlFlow::Continue(()),
+            );
             assert_eq!(run.swarm.evaluations, 100_500, "the same budget");
             assert!(
                 run.terms.total < reference.min(4795.0),
@@ -335,7 +341,7 @@ fn cost_throughput() {
     let m = skyform::mission::load(&path)
         .unwrap_or_else(|e| panic!("{e}"))
         .mission;
-    let model = skyform::spso::model(&m).expect("terrain");
+    let model = skyform::pipelines::theta_pso::spso::model(&m).expect("terrain");
     let text = fixture("paths.csv");
     let rows: Vec<Vec<f64>> = text
         .lines()
@@ -360,11 +366,17 @@ fn cost_throughput() {
         skyform::mission::Encoding::Angle,
         skyform::mission::Encoding::Spherical,
     ] {
-        let decoder = skyform::spso::Decoder::new(&m, encoding);
+        let decoder = skyform::pipelines::theta_pso::spso::Decoder::new(&m, encoding);
         let start = Instant::now();
-        let run = skyform::spso::optimise(&model, &decoder, 500, 200, 1, &[], |_, _, _| {
-            std::ops::ControlFlow::Continue(())
-        });
+        let run = skyform::pipelines::theta_pso::spso::optimise(
+            &model,
+            &decoder,
+            500,
+            200,
+            1,
+            &[],
+            |_, _, _| std::ops::ControlFlow::Continue(()),
+        );
         let t = start.elapsed().as_secs_f64();
         println!(
             "full run {encoding:?} 500 × 200: {:.3} s, {} evaluations, {:.0} per second, J = {}",

@@ -4,7 +4,9 @@
 
 use nalgebra::Point3;
 use skyform::mission;
-use skyform::planner::{CostModel, path::CentroidPath, path::heading_span, trajectory, verify};
+use skyform::pipelines::theta_pso::{
+    CostModel, path::CentroidPath, path::heading_span, trajectory, verify,
+};
 
 /// Writes a 101 × 21 float map (1 m pixels from (0, 0), rows northward):
 /// flat at 0, or with a 20 m hill over x ∈ [40, 60].

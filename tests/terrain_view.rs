@@ -108,7 +108,7 @@ fn the_map_shades_each_cell_by_the_ground_under_it() {
 /// and undo brings the map back.
 #[test]
 fn the_inspector_edits_the_terrain_and_reloads_its_map() {
-    use skyform::terrain::Lookup;
+    use skyform::base::terrain::Lookup;
     use skyform::tui::fields::Item;
     let mut app = benchmark_app();
     app.update(Action::Select(Item::Terrain));

@@ -6,13 +6,13 @@ use std::f64::consts::FRAC_PI_2;
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use rayon::prelude::*;
 use skyform::mission::{self, Mission, Obstacle, ShapeChoice};
-use skyform::pipeline::{CancelToken, Completion, Event, PipelineError, Silent};
-use skyform::planner::iwp::{lateral_half_width, resolve_shape};
-use skyform::planner::path::{ArcWalker, decode_angle};
-use skyform::planner::path::{Zone, ZoneCause};
-use skyform::planner::{
+use skyform::pipelines::theta_pso::iwp::{lateral_half_width, resolve_shape};
+use skyform::pipelines::theta_pso::path::{ArcWalker, decode_angle};
+use skyform::pipelines::theta_pso::path::{Zone, ZoneCause};
+use skyform::pipelines::theta_pso::{
     CentroidPath, CostModel, Iwp, PlanOptions, Shape, ThetaPsoOutcome, find_iwps, plan,
 };
+use skyform::pipelines::{CancelToken, Completion, Event, PipelineError, Silent};
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs()))
@@ -115,7 +115,7 @@ fn terms_with(
     m: &Mission,
     obstacles: Vec<Obstacle>,
     path: &CentroidPath,
-) -> skyform::pipeline::CostTerms {
+) -> skyform::pipelines::CostTerms {
     let mut m = m.clone();
     m.obstacles = obstacles;
     CostModel::new(&m, &[]).terms(path)
@@ -490,7 +490,7 @@ fn a_shape_that_cannot_pass_makes_the_iwp_unusable_with_the_reason() {
     // On a mission: `check` and the planner both say so, naming the IWP.
     let mut m = mission::default_mission().mission;
     m.reconfiguration.waypoints[0].shape = ShapeChoice::Rotation;
-    let found = skyform::planner::diagnostics(&m);
+    let found = skyform::pipelines::theta_pso::diagnostics(&m);
     assert!(
         found.iter().any(|d| !d.is_error()
             && d.path.to_string() == "reconfiguration.waypoints[0].shape"
@@ -1019,7 +1019,7 @@ fn the_observer_sees_every_iteration_with_a_non_increasing_best() {
 
 /// One UAV (a single slot) flying at 3 m/s round a 2 m cylinder at (50, 60),
 /// `d` metres from its surface, through `arc` metres of path.
-fn pass_at(d: f64, arc: f64) -> (Mission, Vec<skyform::planner::Trajectory>) {
+fn pass_at(d: f64, arc: f64) -> (Mission, Vec<skyform::pipelines::theta_pso::Trajectory>) {
     let mut m = open_field();
     m.formation.slots = vec![Vector3::zeros()];
     let mut o = pole("pier", 50.0, 60.0, 2.0);
@@ -1032,7 +1032,7 @@ fn pass_at(d: f64, arc: f64) -> (Mission, Vec<skyform::planner::Trajectory>) {
         .map(|k| {
             let t = k as f64 * 0.1;
             let angle = -std::f64::consts::FRAC_PI_2 + t * speed / radius;
-            skyform::planner::Sample {
+            skyform::pipelines::theta_pso::Sample {
                 t,
                 position: Point3::new(
                     50.0 + radius * angle.cos(),
@@ -1043,13 +1043,16 @@ fn pass_at(d: f64, arc: f64) -> (Mission, Vec<skyform::planner::Trajectory>) {
             }
         })
         .collect();
-    (m, vec![skyform::planner::Trajectory { uav: 0, samples }])
+    (
+        m,
+        vec![skyform::pipelines::theta_pso::Trajectory { uav: 0, samples }],
+    )
 }
 
 #[test]
 fn eq8_a_pass_inside_the_band_long_enough_is_an_inspection() {
     let (m, flown) = pass_at(3.0, 9.0);
-    let r = &skyform::planner::verify::verify_inspections(&m, &flown)[0];
+    let r = &skyform::pipelines::theta_pso::verify::verify_inspections(&m, &flown)[0];
     assert!(r.ok, "{r:?}");
     assert!(close(r.achieved, 9.0), "{r:?}");
     let [lo, hi] = r.distance.unwrap_or([f64::NAN; 2]);
@@ -1057,7 +1060,7 @@ fn eq8_a_pass_inside_the_band_long_enough_is_an_inspection() {
     assert_eq!(r.band, [1.0, 5.0]);
     // The same distance over too short a pass breaks eq. 8's pass length.
     let (m, flown) = pass_at(3.0, 3.0);
-    let short = &skyform::planner::verify::verify_inspections(&m, &flown)[0];
+    let short = &skyform::pipelines::theta_pso::verify::verify_inspections(&m, &flown)[0];
     assert!(!short.ok && close(short.achieved, 3.0), "{short:?}");
 }
 
@@ -1065,7 +1068,7 @@ fn eq8_a_pass_inside_the_band_long_enough_is_an_inspection() {
 fn eq8_a_pass_below_or_above_the_band_is_no_inspection() {
     for d in [0.8, 5.5] {
         let (m, flown) = pass_at(d, 9.0);
-        let r = &skyform::planner::verify::verify_inspections(&m, &flown)[0];
+        let r = &skyform::pipelines::theta_pso::verify::verify_inspections(&m, &flown)[0];
         assert!(
             !r.ok && r.achieved == 0.0 && r.distance.is_none(),
             "d = {d}: {r:?}"
@@ -1074,13 +1077,13 @@ fn eq8_a_pass_below_or_above_the_band_is_no_inspection() {
     // An obstacle's own band overrides the formation's.
     let (mut m, flown) = pass_at(5.5, 9.0);
     m.obstacles[0].stand_off = Some([4.0, 6.0]);
-    assert!(skyform::planner::verify::verify_inspections(&m, &flown)[0].ok);
+    assert!(skyform::pipelines::theta_pso::verify::verify_inspections(&m, &flown)[0].ok);
 }
 
 #[test]
 fn eq8_pass_geometry_centres_the_facing_uav_in_the_band() {
     let f = open_field().formation;
-    let g = skyform::planner::PassGeometry::new(&f.slots, 2.5, [1.0, 5.0], 6.0)
+    let g = skyform::pipelines::theta_pso::PassGeometry::new(&f.slots, 2.5, [1.0, 5.0], 6.0)
         .unwrap_or_else(|e| panic!("{e}"));
     for range in [g.range_left, g.range_right] {
         assert!(range[0] >= 1.0 && range[1] <= 5.0, "{range:?}");
@@ -1089,6 +1092,6 @@ fn eq8_pass_geometry_centres_the_facing_uav_in_the_band() {
     // UAV 1 (2 m left of the centroid) faces an obstacle on the left.
     assert!(g.radius_left > g.radius_right);
     // Too long a pass for a narrow band: refused with the reason.
-    let long = skyform::planner::PassGeometry::new(&f.slots, 2.5, [1.0, 1.5], 30.0);
+    let long = skyform::pipelines::theta_pso::PassGeometry::new(&f.slots, 2.5, [1.0, 1.5], 30.0);
     assert!(long.is_err_and(|e| e.contains("shorten formation.inspection_pass")));
 }

@@ -17,8 +17,8 @@ use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use skyform::mission::{self, Mission, Obstacle};
-use skyform::pipeline::{CancelToken, Silent};
-use skyform::planner::{PlanOptions, ThetaPsoOutcome, find_iwps, plan};
+use skyform::pipelines::theta_pso::{PlanOptions, ThetaPsoOutcome, find_iwps, plan};
+use skyform::pipelines::{CancelToken, Silent};
 
 /// A formation of the family, by index.
 fn formation(index: u64) -> (&'static str, Vec<Vector3<f64>>) {

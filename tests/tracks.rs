@@ -4,8 +4,8 @@
 use nalgebra::Point3;
 use skyform::mission::{self, BUILTIN, Mission};
 use skyform::outcome::{self, Outcome, Verdict};
-use skyform::pipeline::{CancelToken, Kind, Silent};
-use skyform::planner::PlanOptions;
+use skyform::pipelines::theta_pso::PlanOptions;
+use skyform::pipelines::{CancelToken, Kind, Silent};
 
 fn shipped(name: &str) -> Mission {
     let b = BUILTIN.iter().find(|b| b.file_name == name).unwrap();
@@ -88,11 +88,11 @@ fn flatlo_tracks_end_on_the_longitudinal_line() {
         .iter()
         .map(|t| t.samples.last().unwrap().position)
         .collect();
-    let line = skyform::flatlo::algorithm::line_direction(
+    let line = skyform::pipelines::flatlo::algorithm::line_direction(
         m.flatlo.heading_deg.to_radians(),
         m.flatlo.climb_deg.to_radians(),
     );
-    let (spacing, spread) = skyform::flatlo::line_spacing(&ends, &line);
+    let (spacing, spread) = skyform::pipelines::flatlo::line_spacing(&ends, &line);
     for s in &spacing {
         assert!(
             (s.spacing - m.flatlo.spacing).abs() < 0.01 * m.flatlo.spacing,

@@ -465,8 +465,8 @@ fn the_jobs_panel_groups_unusable_iwps_and_names_the_nearest_at_80_by_24() {
 /// 80 × 24 terminal shows it without scrolling.
 #[test]
 fn the_jobs_panel_puts_the_verdict_and_the_first_failure_on_top_at_80_by_24() {
-    use skyform::pipeline::{CancelToken, Silent};
-    use skyform::planner::{PlanOptions, plan};
+    use skyform::pipelines::theta_pso::{PlanOptions, plan};
+    use skyform::pipelines::{CancelToken, Silent};
     use skyform::tui::jobs::Outcome;
 
     let mut mission = default_mission().mission;

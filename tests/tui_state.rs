@@ -152,16 +152,17 @@ fn an_edit_after_a_run_marks_the_result_stale_and_undo_makes_it_fresh() {
 fn a_run_in_the_background_gives_the_same_result_as_the_pipeline() {
     let dir = tempfile::tempdir().unwrap();
     let mut app = app_in(dir.path());
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     assert_eq!(app.jobs().len(), 1);
     assert!(app.wait_for_jobs(Duration::from_secs(60)));
     let job = &app.jobs()[0];
-    assert_eq!(job.state, JobState::Done { passed: true });
-    let direct = skyform::planner::plan(
+    assert_eq!(job.state, JobState::Done);
+    assert!(job.outcome.as_ref().is_some_and(|o| o.ok()));
+    let direct = skyform::pipelines::theta_pso::plan(
         app.mission(),
         app.mission().seed,
         Default::default(),
-        &mut skyform::pipeline::Silent,
+        &mut skyform::pipelines::Silent,
         &Default::default(),
     )
     .unwrap();
@@ -183,7 +184,7 @@ fn cancel_keeps_the_best_so_far() {
     app.update(Action::Select(Item::ThetaPso));
     // Long, but inside the budget (100 × 40,000 × 4 runs = 1.6e7 evaluations).
     type_into(&mut app, "iterations", "40000");
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     // Let it get going, then cancel.
     while app.jobs()[0].convergence.len() < 3 {
         let msg = app
@@ -207,7 +208,7 @@ fn an_invalid_mission_is_not_run() {
     let mut app = app_in(dir.path());
     app.update(Action::Select(Item::Obstacle(0)));
     type_into(&mut app, "radius (m)", "0");
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     assert!(app.jobs().is_empty());
     let status = app.status().cloned().unwrap();
     assert!(status.error);
@@ -226,7 +227,7 @@ fn a_run_over_its_budget_is_not_started() {
     let mut app = app_in(dir.path());
     app.update(Action::Select(Item::Formation));
     type_into(&mut app, "ground speed (m/s)", "0.000001");
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     assert!(app.jobs().is_empty());
     let status = app.status().cloned().unwrap();
     assert!(status.error);
@@ -240,7 +241,7 @@ fn a_run_over_its_budget_is_not_started() {
     type_into(&mut app, "ground speed (m/s)", "3");
     app.update(Action::Select(Item::ThetaPso));
     type_into(&mut app, "swarm size", "100000000");
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     assert!(app.jobs().is_empty());
     let status = app.status().cloned().unwrap();
     assert!(
@@ -592,9 +593,9 @@ fn a_fleet_run_replays_on_the_map() {
     let mut m = mission::load(std::path::Path::new(path)).unwrap().mission;
     m.fleet.duration = 6.0;
     let mut app = App::new(Document::new(m, None), std::env::temp_dir());
-    app.update(Action::RunFleet);
+    app.update(Action::Run(skyform::pipelines::Kind::Fleet));
     assert!(app.wait_for_jobs(Duration::from_secs(60)));
-    assert_eq!(app.jobs()[0].pipeline, skyform::pipeline::Kind::Fleet);
+    assert_eq!(app.jobs()[0].pipeline, skyform::pipelines::Kind::Fleet);
     assert_eq!(app.replay_end(), Some(6.0));
     assert_eq!(app.replay_time(), Some(6.0), "the end until scrubbed");
     app.update(Action::Scrub(-2.5));
@@ -952,7 +953,7 @@ fn quitting_without_saving_leaves_no_recovery_copy() {
 fn an_iwp_choice_error_alone_keeps_the_iwps_on_the_map() {
     let dir = tempfile::tempdir().unwrap();
     let mut m = default_mission().mission;
-    let n = skyform::planner::find_iwps(&m).len();
+    let n = skyform::pipelines::theta_pso::find_iwps(&m).len();
     assert!(n > 0);
     m.reconfiguration.waypoints[0].scale = Some(7.0); // not in (0, 1]
     let app = App::new(
@@ -1351,7 +1352,7 @@ fn quitting_with_a_job_running_says_so_and_asks() {
     m.theta_pso.iterations = 20_000;
     mission::save(&m, &path).unwrap();
     let mut app = App::new(Document::new(m, Some(path)), dir.path().to_path_buf());
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     assert!(app.jobs()[0].is_running());
     app.update(Action::Quit);
     assert!(!app.should_quit(), "a running job is not dropped silently");
@@ -1391,7 +1392,7 @@ fn recordings_never_overwrite_and_the_status_names_the_file() {
     app.update(Action::ToggleRecording);
     let first = dir.path().join("bridge-inspection-theta-pso-seed7.rrd");
     let second = dir.path().join("bridge-inspection-theta-pso-seed7-2.rrd");
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     assert!(
         app.status()
             .unwrap()
@@ -1407,7 +1408,7 @@ fn recordings_never_overwrite_and_the_status_names_the_file() {
         "{status}"
     );
     let size = std::fs::metadata(&first).unwrap().len();
-    app.update(Action::Run);
+    app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     assert!(app.wait_for_jobs(Duration::from_secs(120)));
     let status = app.status().unwrap().text.clone();
     assert!(

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use super::{exit, load_reporting};
 use crate::mission::{CostKind, Mission};
-use crate::planner::{CostModel, path::CentroidPath};
-use crate::spso;
+use crate::pipelines::theta_pso::spso;
+use crate::pipelines::theta_pso::{CostModel, path::CentroidPath};
 
 /// The arguments of `skyform eval` (its help is on `Command::Eval`).
 #[derive(Debug, clap::Args)]

@@ -5,27 +5,8 @@ use std::path::{Path, PathBuf};
 use super::{StderrProgress, cancel_on_ctrl_c, exit, load_reporting};
 use crate::export::{self, ExportError, Exported, Format, Options, Planned};
 use crate::mission::Mission;
-use crate::outcome;
-use crate::pipeline::{Completion, Kind};
-use crate::planner::PlanOptions;
-
-/// A pipeline on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum PipelineArg {
-    ThetaPso,
-    Flatlo,
-    Fleet,
-}
-
-impl From<PipelineArg> for Kind {
-    fn from(p: PipelineArg) -> Self {
-        match p {
-            PipelineArg::ThetaPso => Kind::ThetaPso,
-            PipelineArg::Flatlo => Kind::Flatlo,
-            PipelineArg::Fleet => Kind::Fleet,
-        }
-    }
-}
+use crate::pipelines::{Completion, Kind};
+use crate::run::Run;
 
 /// A format on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -64,7 +45,7 @@ pub struct ExportArgs {
     pub out: PathBuf,
     /// The pipeline that plans the mission.
     #[arg(long, value_enum, default_value = "theta-pso")]
-    pub pipeline: PipelineArg,
+    pub pipeline: Kind,
     /// Seed of the pipeline (default: the mission's `seed`).
     #[arg(long)]
     pub seed: Option<u64>,
@@ -82,14 +63,9 @@ pub struct ExportArgs {
 pub fn planned(mission: &Mission, pipeline: Kind, seed: u64) -> Result<Planned, u8> {
     let cancel = cancel_on_ctrl_c();
     let mut progress = StderrProgress::new();
-    let result = outcome::run(
-        pipeline,
-        mission,
-        seed,
-        PlanOptions::default(),
-        &mut progress,
-        &cancel,
-    );
+    let result = Run::new(pipeline, seed)
+        .carry_out(mission, None, &mut progress, &cancel)
+        .result;
     if progress.terminal {
         eprintln!();
     }
@@ -132,7 +108,7 @@ pub fn export_command(args: &ExportArgs) -> u8 {
         eprintln!("error: {}", ExportError::NoOrigin(f.name()));
         return exit::ERROR;
     }
-    let pipeline = Kind::from(args.pipeline);
+    let pipeline = args.pipeline;
     let seed = args.seed.unwrap_or(mission.seed);
     let planned = match planned(&mission, pipeline, seed) {
         Ok(p) => p,

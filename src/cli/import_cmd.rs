@@ -35,7 +35,7 @@ pub fn import_command(args: &ImportArgs) -> u8 {
             return exit::ERROR;
         }
     };
-    let checked = crate::diagnose::check_text(&text, Some(&name));
+    let checked = crate::outcome::diagnose::check_text(&text, Some(&name));
     let Some(before) = checked.mission else {
         eprint!("{}", checked.report);
         eprintln!("error: {name} is not a mission file skyform can read: nothing imported");
@@ -89,7 +89,7 @@ pub fn import_command(args: &ImportArgs) -> u8 {
         println!("dry run: nothing written");
         return exit::OK;
     }
-    if let Err(e) = mission::write_atomically(&args.into, new_text.as_bytes()) {
+    if let Err(e) = crate::base::atomic::write(&args.into, new_text.as_bytes()) {
         eprintln!("error: cannot save {name}: {e}; it is unchanged");
         return exit::ERROR;
     }
@@ -105,7 +105,7 @@ fn errors_added(before: &[Diagnostic], text: &str, name: &str) -> Vec<Diagnostic
         .filter(|d| d.is_error())
         .map(|d| (d.path.to_string(), d.message.clone()))
         .collect();
-    crate::diagnose::check_text(text, Some(name))
+    crate::outcome::diagnose::check_text(text, Some(name))
         .report
         .errors()
         .filter(|d| !known.contains(&(d.path.to_string(), d.message.clone())))

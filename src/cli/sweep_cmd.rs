@@ -7,12 +7,12 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-use super::export_cmd::PipelineArg;
 use super::{exit, load_reporting};
 use crate::mission::{CostKind, Encoding, Mission};
-use crate::pipeline::{CancelToken, Silent};
-use crate::planner::{self, PlanOptions};
-use crate::{flatlo, fleet};
+use crate::outcome::{self, Verdict};
+use crate::pipelines::theta_pso::PlanOptions;
+use crate::pipelines::{CancelToken, Kind, Silent};
+use crate::run::Run;
 
 /// An encoding on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -31,7 +31,7 @@ pub struct SweepArgs {
     pub seeds: (u64, u64),
     /// The pipeline.
     #[arg(long, value_enum, default_value = "theta-pso")]
-    pub pipeline: PipelineArg,
+    pub pipeline: Kind,
     /// Runs at once (default: one per CPU).
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
@@ -111,7 +111,7 @@ fn process_cpu() -> Option<Duration> {
 }
 
 /// Runs `pipeline` on `mission` for `seed` (one thread).
-pub fn run_seed(mission: &Mission, pipeline: PipelineArg, seed: u64) -> SeedRow {
+pub fn run_seed(mission: &Mission, kind: Kind, seed: u64) -> SeedRow {
     let cancel = CancelToken::new();
     let start = Instant::now();
     let cpu0 = thread_cpu();
@@ -125,41 +125,19 @@ pub fn run_seed(mission: &Mission, pipeline: PipelineArg, seed: u64) -> SeedRow 
         cpu: Duration::ZERO,
         error: None,
     };
-    match pipeline {
-        PipelineArg::ThetaPso => {
-            match planner::plan(
-                mission,
-                seed,
-                PlanOptions { parallel: false },
-                &mut Silent,
-                &cancel,
-            ) {
-                Ok(o) => {
-                    row.completed = o.cost.total.is_finite();
-                    row.passed = o.feasible();
-                    row.figure = o.cost.total;
-                    row.evaluations = o.evaluations;
-                }
-                Err(e) => row.error = Some(e.to_string()),
-            }
+    let run = Run {
+        kind,
+        seed,
+        options: PlanOptions { parallel: false },
+    };
+    match run.carry_out(mission, None, &mut Silent, &cancel).result {
+        Ok(o) => {
+            row.completed = o.judged();
+            row.passed = o.verdict() == Verdict::Passed;
+            row.figure = o.figure();
+            row.evaluations = o.evaluations();
         }
-        PipelineArg::Flatlo => match flatlo::plan(mission, seed, &mut Silent, &cancel) {
-            Ok(o) => {
-                row.completed = o.verification.is_some();
-                row.passed = o.passed();
-                row.figure = o.closest.as_ref().map_or(f64::NAN, |c| c.min_distance);
-            }
-            Err(e) => row.error = Some(e.to_string()),
-        },
-        PipelineArg::Fleet => match fleet::plan(mission, seed, &mut Silent, &cancel) {
-            Ok(o) => {
-                row.completed = o.completion == crate::pipeline::Completion::Finished;
-                row.passed = o.converged() && o.kept_apart() && o.obstacles_clear();
-                row.figure = o.closest_agents.as_ref().map_or(f64::NAN, |c| c.distance);
-                row.evaluations = o.agents.iter().map(|a| a.evaluations).sum();
-            }
-            Err(e) => row.error = Some(e.to_string()),
-        },
+        Err(e) => row.error = Some(e.to_string()),
     }
     row.wall = start.elapsed();
     row.cpu = match (cpu0, thread_cpu()) {
@@ -236,13 +214,14 @@ pub struct Words {
 }
 
 impl Words {
-    pub fn of(pipeline: PipelineArg) -> Words {
+    pub fn of(pipeline: Kind) -> Words {
         match pipeline {
-            PipelineArg::ThetaPso => Words {
+            Kind::ThetaPso => Words {
                 completed: "J finite",
                 verdict: "feasible",
             },
-            PipelineArg::Flatlo | PipelineArg::Fleet => Words {
+            // A flown run (FLATLO, the fleet) passes or fails.
+            _ => Words {
                 completed: "finished",
                 verdict: "passed",
             },
@@ -268,7 +247,7 @@ pub fn csv(rows: &[SeedRow], figure: &str, words: Words) -> String {
             r.seed,
             r.completed,
             r.passed,
-            crate::spso::g17(r.figure),
+            crate::pipelines::theta_pso::spso::g17(r.figure),
             r.evaluations,
             r.wall.as_secs_f64(),
             r.cpu.as_secs_f64(),
@@ -379,24 +358,18 @@ pub fn sweep_command(args: &SweepArgs) -> u8 {
         }
     };
     let what = match args.pipeline {
-        PipelineArg::ThetaPso if mission.theta_pso.cost == CostKind::Spso => format!(
+        Kind::ThetaPso if mission.theta_pso.cost == CostKind::Spso => format!(
             "θ-PSO, SPSO cost, {:?} encoding, {} × {}",
             mission.theta_pso.encoding, mission.theta_pso.swarm_size, mission.theta_pso.iterations
         ),
-        PipelineArg::ThetaPso => "θ-PSO".to_owned(),
-        PipelineArg::Flatlo => "FLATLO".to_owned(),
-        PipelineArg::Fleet => "fleet".to_owned(),
+        kind => kind.name().to_owned(),
     };
     eprintln!(
         "sweep: {} · {what} · seeds {a}..{b} ({} runs) · {jobs} jobs",
         mission.name,
         seeds.len()
     );
-    let figure = match args.pipeline {
-        PipelineArg::ThetaPso => "best J",
-        PipelineArg::Flatlo => "closest pair (m)",
-        PipelineArg::Fleet => "closest agents (m)",
-    };
+    let figure = outcome::figure_name(args.pipeline);
     let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let done = AtomicUsize::new(0);
     let total = seeds.len();
@@ -414,7 +387,7 @@ pub fn sweep_command(args: &SweepArgs) -> u8 {
                     "[{}{}] {k}/{total} seeds  last: seed {seed} {} {:.1} s",
                     "█".repeat(filled),
                     "·".repeat(width - filled),
-                    crate::spso::g17(row.figure),
+                    crate::pipelines::theta_pso::spso::g17(row.figure),
                     row.wall.as_secs_f64()
                 );
                 if terminal {
@@ -444,7 +417,7 @@ pub fn sweep_command(args: &SweepArgs) -> u8 {
     print!("{}", table(&summary, figure, words));
     let _ = std::io::stdout().flush();
     if let Some(path) = &args.csv
-        && let Err(e) = crate::mission::write_atomically(path, csv(&rows, figure, words).as_bytes())
+        && let Err(e) = crate::base::atomic::write(path, csv(&rows, figure, words).as_bytes())
     {
         eprintln!("error: cannot write {}: {e}", path.display());
         return exit::ERROR;
@@ -476,11 +449,11 @@ mod tests {
             cpu: Duration::from_secs(1),
             evaluations: 0,
         };
-        let text = table(&summary, "best J", Words::of(PipelineArg::ThetaPso));
+        let text = table(&summary, "best J", Words::of(Kind::ThetaPso));
         let feasible: Vec<&str> = text.lines().filter(|l| l.contains("feasible")).collect();
         assert_eq!(feasible, ["feasible              9 of 10"], "{text}");
         assert!(text.contains("J finite              10 of 10"), "{text}");
-        let text = table(&summary, "closest pair (m)", Words::of(PipelineArg::Flatlo));
+        let text = table(&summary, "closest pair (m)", Words::of(Kind::Flatlo));
         assert!(text.contains("passed                9 of 10"), "{text}");
         assert!(!text.contains("feasible"), "{text}");
         let row = SeedRow {
@@ -493,7 +466,7 @@ mod tests {
             cpu: Duration::ZERO,
             error: None,
         };
-        let csv = csv(&[row], "best J", Words::of(PipelineArg::ThetaPso));
+        let csv = csv(&[row], "best J", Words::of(Kind::ThetaPso));
         assert!(csv.starts_with("seed,j_finite,feasible,best J,"), "{csv}");
         assert!(csv.contains("\n4,true,false,"), "{csv}");
     }

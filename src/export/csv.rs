@@ -5,7 +5,7 @@
 use std::fmt::Write;
 
 use super::Frame;
-use crate::tracks::Track;
+use crate::outcome::tracks::Track;
 
 /// The CSV text of one track, and its number of samples.
 pub fn render(track: &Track, frame: Option<&Frame>) -> (String, usize) {

@@ -23,7 +23,7 @@ use nalgebra::{Point2, Point3};
 
 use super::{Frame, Planned};
 use crate::mission::{Mission, Obstacle};
-use crate::tracks::vehicle_color;
+use crate::outcome::tracks::vehicle_color;
 
 /// Points on each circle (an obstacle, a band's edge).
 const CIRCLE_POINTS: usize = 48;

@@ -1,7 +1,7 @@
 //! From plan to flight: one mission file per vehicle that autopilots load,
 //! re-verified as they will be flown.
 //!
-//! Each vehicle's timed track ([`crate::tracks`]) is reduced to waypoints
+//! Each vehicle's timed track ([`crate::outcome::tracks`]) is reduced to waypoints
 //! ([`simplify`]: every sample within the tolerance of where the straight leg
 //! puts the vehicle at the same instant) with a commanded speed per leg, so
 //! that each vehicle reaches each waypoint when the plan says. The reduced
@@ -26,13 +26,13 @@ use std::path::{Path, PathBuf};
 use nalgebra::Point3;
 use serde::Serialize;
 
-use crate::flatlo::FlatloOutcome;
-use crate::fleet::FleetOutcome;
 use crate::mission::Mission;
-use crate::pipeline::Kind;
-use crate::planner::ThetaPsoOutcome;
-use crate::planner::verify::Limits;
-use crate::tracks::{self, Track};
+use crate::outcome::tracks::{self, Track};
+use crate::pipelines::Kind;
+use crate::pipelines::flatlo::FlatloOutcome;
+use crate::pipelines::fleet::FleetOutcome;
+use crate::pipelines::theta_pso::ThetaPsoOutcome;
+use crate::pipelines::theta_pso::verify::Limits;
 
 pub use geodesy::{Frame, Geodetic};
 pub use reverify::Reverification;
@@ -500,11 +500,11 @@ pub fn export(
     })
 }
 
-/// Writes atomically (`mission::write_atomically`: a synced temporary file
+/// Writes atomically (`atomic::write`: a synced temporary file
 /// renamed over `path`, so a reader never sees half a file), with the
 /// permissions of any file the user creates.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
-    crate::mission::write_atomically(path, bytes).map_err(|source| ExportError::Io {
+    crate::base::atomic::write(path, bytes).map_err(|source| ExportError::Io {
         path: path.to_owned(),
         source,
     })

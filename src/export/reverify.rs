@@ -4,7 +4,7 @@
 //! others, waits out each waypoint's hold, and flies each leg in a straight
 //! line at the leg's commanded speed (as written: rounded). The flights are
 //! sampled at the planned tracks' instants and handed to the pipeline's own
-//! verification ([`crate::planner::verify::verify_within`]) with the
+//! verification ([`crate::pipelines::theta_pso::verify::verify_within`]) with the
 //! pipeline's limits. Also measured: the largest distance between where a
 //! vehicle flies and where its track has it at the same instant (the
 //! deviation), and the largest difference between when a vehicle reaches a
@@ -18,9 +18,9 @@ use serde::Serialize;
 
 use super::VehiclePlan;
 use crate::mission::Mission;
-use crate::planner::verify::{Limits, Verification, verify_within};
-use crate::planner::{Sample, Trajectory};
-use crate::tracks::{Track, TrackSample};
+use crate::outcome::tracks::{Track, TrackSample};
+use crate::pipelines::theta_pso::verify::{Limits, Verification, verify_within};
+use crate::pipelines::theta_pso::{Sample, Trajectory};
 
 /// A broken constraint of the flown plans, located.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -202,6 +202,8 @@ pub fn deviation(plan: &VehiclePlan, track: &Track) -> f64 {
 
 /// Flies `plans` and checks them against `limits` and the mission's band and
 /// bounds; measures deviation from `tracks` and timing errors.
+///
+/// Long (~125 lines): the checks of the flown plans one after another, each a short block, in the order the report lists them.
 pub fn reverify(
     mission: &Mission,
     limits: &Limits,

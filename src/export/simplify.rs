@@ -13,7 +13,7 @@
 
 use nalgebra::Point3;
 
-use crate::tracks::TrackSample;
+use crate::outcome::tracks::TrackSample;
 
 /// Where the straight leg a → b is at time t, flown at constant speed.
 pub fn on_leg(a: &TrackSample, b: &TrackSample, t: f64) -> Point3<f64> {

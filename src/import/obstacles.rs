@@ -123,6 +123,8 @@ pub struct Made {
 }
 
 /// The obstacles of every feature of `survey`, or every problem found.
+///
+/// Long (~160 lines): one match over the survey's feature kinds (point, line, polygon), each placing and clipping in a few lines.
 pub fn make(
     mission: &Mission,
     origin: &GeoOrigin,

@@ -1,7 +1,7 @@
 //! Reading, checking and atomically saving mission files.
 
 use std::fs;
-use std::io::{self, Write};
+use std::io;
 use std::path::Path;
 
 use serde::Deserialize;
@@ -154,7 +154,7 @@ pub fn to_toml_string(mission: &Mission) -> Result<String, MissionError> {
 /// either the old file or the new one, never half of one.
 pub fn save(mission: &Mission, path: &Path) -> Result<(), MissionError> {
     let text = to_toml_string(mission)?;
-    write_atomically(path, text.as_bytes()).map_err(|source| MissionError::Write {
+    crate::base::atomic::write(path, text.as_bytes()).map_err(|source| MissionError::Write {
         path: path.display().to_string(),
         source,
     })
@@ -174,73 +174,9 @@ pub fn save_edited(
         Some(text) => text,
         None => to_toml_string(mission)?,
     };
-    write_atomically(path, text.as_bytes()).map_err(|source| MissionError::Write {
+    crate::base::atomic::write(path, text.as_bytes()).map_err(|source| MissionError::Write {
         path: path.display().to_string(),
         source,
     })?;
     Ok(text)
-}
-
-/// Writes `bytes` to `path` through a synced temporary file and a rename.
-///
-/// The result has the permissions a plain `File::create` would give a new
-/// file (0666 less the umask: 0644 under the usual umask 022), or the mode
-/// of the file it replaces: a ground station running as another user, or a
-/// shared folder, reads an export as it reads any file the user writes.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".skyform-save-").suffix(".tmp");
-    // Created with the mode `File::create` asks for, so the kernel applies
-    // the umask as it does for any new file (tempfile's own default is 0600).
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(fs::Permissions::from_mode(0o666));
-    }
-    let mut tmp = builder.tempfile_in(dir)?;
-    tmp.write_all(bytes)?;
-    // Replacing a file keeps its mode (a private mission stays private).
-    if let Ok(meta) = fs::metadata(path) {
-        tmp.as_file().set_permissions(meta.permissions())?;
-    }
-    tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    // Make the rename itself durable. Not every platform lets a directory be
-    // opened and synced; the data is already safe, so that failure is ignored.
-    if let Ok(d) = fs::File::open(dir) {
-        let _ = d.sync_all();
-    }
-    Ok(())
-}
-
-#[cfg(all(test, unix))]
-mod tests {
-    use super::*;
-    use std::os::unix::fs::PermissionsExt;
-
-    fn mode(path: &Path) -> u32 {
-        fs::metadata(path).unwrap().permissions().mode() & 0o777
-    }
-
-    /// Issue 24, item 9: a new file gets what `File::create` gives (the
-    /// umask applied), a replaced one keeps its mode.
-    #[test]
-    fn atomic_writes_create_files_as_file_create_does_and_keep_a_replaced_mode() {
-        let dir = tempfile::tempdir().unwrap();
-        let plain = dir.path().join("plain.txt");
-        fs::File::create(&plain).unwrap();
-        let atomic = dir.path().join("atomic.txt");
-        write_atomically(&atomic, b"one").unwrap();
-        assert_eq!(mode(&atomic), mode(&plain));
-        assert_ne!(mode(&atomic), 0o600, "not tempfile's private default");
-
-        fs::set_permissions(&atomic, fs::Permissions::from_mode(0o640)).unwrap();
-        write_atomically(&atomic, b"two").unwrap();
-        assert_eq!(mode(&atomic), 0o640);
-        assert_eq!(fs::read(&atomic).unwrap(), b"two");
-    }
 }

@@ -18,7 +18,7 @@ pub use diagnostic::{Diagnostic, Report, Severity};
 pub use edit::edit_in_place;
 pub use file::{
     Checked, Loaded, MissionError, check_str, load, parse_str, read, save, save_edited,
-    to_toml_string, write_atomically,
+    to_toml_string,
 };
 pub use model::*;
 pub use presets::{

@@ -58,10 +58,10 @@ pub struct Terrain {
     pub pixel_size: [f64; 2],
     /// How the ground between pixel centres is read.
     #[serde(default, skip_serializing_if = "is_default")]
-    pub lookup: crate::terrain::Lookup,
+    pub lookup: crate::base::terrain::Lookup,
     /// The map as loaded when the mission was read (or why it could not be).
     #[serde(skip)]
-    pub map: crate::terrain::Loaded,
+    pub map: crate::base::terrain::Loaded,
 }
 
 fn is_default<T: Default + PartialEq>(v: &T) -> bool {
@@ -70,7 +70,7 @@ fn is_default<T: Default + PartialEq>(v: &T) -> bool {
 
 impl Mission {
     /// The loaded height map, if the mission has one that loaded.
-    pub fn height_map(&self) -> Option<&std::sync::Arc<crate::terrain::HeightMap>> {
+    pub fn height_map(&self) -> Option<&std::sync::Arc<crate::base::terrain::HeightMap>> {
         self.terrain
             .as_ref()
             .and_then(|t| t.map.0.as_ref())
@@ -87,9 +87,9 @@ impl Mission {
     }
 
     /// The loaded map with the mission's lookup.
-    pub fn ground_model(&self) -> Option<crate::terrain::Ground> {
+    pub fn ground_model(&self) -> Option<crate::base::terrain::Ground> {
         let t = self.terrain.as_ref()?;
-        Some(crate::terrain::Ground {
+        Some(crate::base::terrain::Ground {
             map: self.height_map()?.clone(),
             lookup: t.lookup,
         })
@@ -97,7 +97,7 @@ impl Mission {
 
     /// Obstacle `o` as a cylinder in the ENU frame: with terrain, standing on
     /// the ground under its centre (its height is above that ground).
-    pub fn cylinder(&self, o: &Obstacle) -> crate::geometry::Cylinder {
+    pub fn cylinder(&self, o: &Obstacle) -> crate::base::geometry::Cylinder {
         let mut c = o.cylinder();
         if self.terrain.is_some() {
             c.height += self.ground(o.center.x, o.center.y);
@@ -109,7 +109,7 @@ impl Mission {
     /// keeping the reason when it fails (validation reports it, located).
     pub fn load_terrain(&mut self, base: &std::path::Path) {
         if let Some(t) = self.terrain.as_mut() {
-            t.map = crate::terrain::Loaded(Some(crate::terrain::load_cached(
+            t.map = crate::base::terrain::Loaded(Some(crate::base::terrain::load_cached(
                 base,
                 &t.file,
                 t.origin,
@@ -665,8 +665,8 @@ impl Obstacle {
         self.stand_off.unwrap_or(formation.surface_distance)
     }
 
-    pub fn cylinder(&self) -> crate::geometry::Cylinder {
-        crate::geometry::Cylinder {
+    pub fn cylinder(&self) -> crate::base::geometry::Cylinder {
+        crate::base::geometry::Cylinder {
             center: self.center,
             radius: self.radius,
             height: self.height,
@@ -677,7 +677,7 @@ impl Obstacle {
 impl Formation {
     /// r_F = max_n ‖ΔT_n‖: distance of the farthest UAV from the centroid (eq. 6).
     pub fn radius(&self) -> f64 {
-        crate::geometry::farthest_offset(&self.slots)
+        crate::base::geometry::farthest_offset(&self.slots)
     }
 
     /// Safe radius of the whole formation around its centroid, r_F + r_Q.

@@ -59,7 +59,7 @@ mod tests {
         assert!(m.obstacles.is_empty());
         assert!(m.reconfiguration.waypoints.is_empty());
         assert_eq!(m.formation, crate::mission::Formation::default());
-        assert!(crate::diagnose::diagnose(&m).is_empty());
+        assert!(crate::outcome::diagnose::diagnose(&m).is_empty());
         for word in ["bridge", "pier", "Sydney", "triangle", "eq."] {
             assert!(!text.contains(word), "{word} in\n{text}");
         }

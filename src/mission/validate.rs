@@ -755,6 +755,7 @@ impl Checker {
         }
     }
 
+    /// Long (~130 lines): one rule per key of `[fleet]`, in the order of the section.
     fn fleet(&mut self, path: &FieldPath, p: &FleetParams, mission: &Mission) {
         let bounds = &mission.bounds;
         let obstacles = &mission.obstacles;

@@ -5,8 +5,8 @@
 
 use nalgebra::{Point2, Point3};
 
-use crate::geometry::segment_point_distance;
-use crate::planner::Iwp;
+use crate::base::geometry::segment_point_distance;
+use crate::pipelines::theta_pso::Iwp;
 
 /// Unusable IWPs that share a reason.
 #[derive(Debug, Clone, PartialEq)]
@@ -101,7 +101,7 @@ pub(crate) fn distance_to(route: &[Point3<f64>], p: &Point2<f64>) -> f64 {
 mod tests {
     use super::*;
     use crate::mission::ShapeChoice;
-    use crate::planner::Iwp;
+    use crate::pipelines::theta_pso::Iwp;
     use nalgebra::Vector2;
 
     fn iwp(a: &str, b: &str, y: f64, reason: Option<&str>) -> Iwp {

@@ -8,21 +8,21 @@
 //! cost terms, FLATLO's pair table, the fleet's distance series) is reached
 //! through `theta_pso()`, `flatlo()`, `fleet()`.
 //!
-//! Adding a pipeline: its module (a `plan` function and an outcome type), a
-//! `Kind` variant and an `Outcome` variant with their arms here, its
-//! recorder layout (`record.rs`) and its export limits (`export::Planned`).
+//! Adding a pipeline: see "Adding a pipeline" in `docs/architecture.md`.
 
+pub mod diagnose;
 pub mod iwp_groups;
 pub mod summary;
+pub mod tracks;
 
 use serde::Serialize;
 
-use crate::flatlo::{self, FlatloOutcome};
-use crate::fleet::{self, FleetOutcome};
 use crate::mission::Mission;
-use crate::pipeline::{CancelToken, Completion, Kind, Observer, PipelineError};
-use crate::planner::{self, PlanOptions, ThetaPsoOutcome};
-use crate::tracks::{self, Track};
+use crate::pipelines::flatlo::{self, FlatloOutcome};
+use crate::pipelines::fleet::{self, FleetOutcome};
+use crate::pipelines::theta_pso::{self, PlanOptions, ThetaPsoOutcome};
+use crate::pipelines::{CancelToken, Completion, Kind, Observer, PipelineError};
+use tracks::Track;
 
 /// A finished (or cancelled) run's result.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -44,6 +44,25 @@ pub enum Verdict {
     Cancelled,
 }
 
+/// What [`Outcome::figure`] is for `kind`, as a sweep's table heads it.
+pub fn figure_name(kind: Kind) -> &'static str {
+    match kind {
+        Kind::ThetaPso => "best J",
+        Kind::Flatlo => "closest pair (m)",
+        Kind::Fleet => "closest agents (m)",
+    }
+}
+
+/// What `kind` predicts of a run on `mission` against the documented
+/// limits (`pipelines::limits`), before one starts.
+pub fn budget(kind: Kind, mission: &Mission) -> Vec<crate::mission::Diagnostic> {
+    match kind {
+        Kind::ThetaPso => theta_pso::budget(mission),
+        Kind::Flatlo => flatlo::budget(mission),
+        Kind::Fleet => fleet::budget(mission),
+    }
+}
+
 /// Runs `kind` on `mission` with `seed`. `options` only matters to θ-PSO.
 pub fn run(
     kind: Kind,
@@ -54,7 +73,7 @@ pub fn run(
     cancel: &CancelToken,
 ) -> Result<Outcome, PipelineError> {
     Ok(match kind {
-        Kind::ThetaPso => Outcome::ThetaPso(Box::new(planner::plan(
+        Kind::ThetaPso => Outcome::ThetaPso(Box::new(theta_pso::plan(
             mission, seed, options, observer, cancel,
         )?)),
         Kind::Flatlo => Outcome::Flatlo(Box::new(flatlo::plan(mission, seed, observer, cancel)?)),
@@ -193,6 +212,47 @@ impl Outcome {
         match self {
             Outcome::ThetaPso(o) => &o.convergence,
             _ => &[],
+        }
+    }
+
+    /// The run gave a result to judge: θ-PSO a finite J, FLATLO a verified
+    /// flight, the fleet a finished one.
+    pub fn judged(&self) -> bool {
+        match self {
+            Outcome::ThetaPso(o) => o.cost.total.is_finite(),
+            Outcome::Flatlo(o) => o.verification.is_some(),
+            Outcome::Fleet(o) => o.completion == Completion::Finished,
+        }
+    }
+
+    /// The one figure a sweep tabulates (named by [`figure_name`]): θ-PSO's
+    /// best J, FLATLO's closest pair, the fleet's closest two agents (m);
+    /// NaN when there is none.
+    pub fn figure(&self) -> f64 {
+        match self {
+            Outcome::ThetaPso(o) => o.cost.total,
+            Outcome::Flatlo(o) => o.closest.as_ref().map_or(f64::NAN, |c| c.min_distance),
+            Outcome::Fleet(o) => o.closest_agents.as_ref().map_or(f64::NAN, |c| c.distance),
+        }
+    }
+
+    /// Cost evaluations: θ-PSO's swarm, every agent's PSO; 0 for FLATLO.
+    pub fn evaluations(&self) -> usize {
+        match self {
+            Outcome::ThetaPso(o) => o.evaluations,
+            Outcome::Flatlo(_) => 0,
+            Outcome::Fleet(o) => o.agents.iter().map(|a| a.evaluations).sum(),
+        }
+    }
+
+    /// The verdict in one word for the job list: a θ-PSO plan is feasible or
+    /// not, a flown run passes or fails; `None` for a partial run.
+    pub fn verdict_word(&self) -> Option<&'static str> {
+        let plan = self.kind() == Kind::ThetaPso;
+        match self.verdict() {
+            Verdict::Passed => Some(if plan { "feasible" } else { "pass" }),
+            Verdict::Failed(_) => Some(if plan { "INFEASIBLE" } else { "FAIL" }),
+            Verdict::Cancelled => None,
         }
     }
 

@@ -2,9 +2,9 @@
 //! are numbered from 1 here as everywhere a person reads them (UAV 1,
 //! aircraft 1, agent 1); the JSON keeps the 0-based indices.
 
-use crate::flatlo::FlatloOutcome;
-use crate::fleet::FleetOutcome;
-use crate::planner::ThetaPsoOutcome;
+use crate::pipelines::flatlo::FlatloOutcome;
+use crate::pipelines::fleet::FleetOutcome;
+use crate::pipelines::theta_pso::ThetaPsoOutcome;
 
 /// How many unusable IWPs the summary names (the nearest the route).
 const NAMED_UNUSABLE: usize = 3;
@@ -49,9 +49,11 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
         o.waypoints.len()
     );
     let source = match o.source {
-        crate::planner::PlanSource::Swarm => "the swarm's best",
-        crate::planner::PlanSource::Repaired => "the swarm's best, moved clear by the repair step",
-        crate::planner::PlanSource::Corridor => {
+        crate::pipelines::theta_pso::PlanSource::Swarm => "the swarm's best",
+        crate::pipelines::theta_pso::PlanSource::Repaired => {
+            "the swarm's best, moved clear by the repair step"
+        }
+        crate::pipelines::theta_pso::PlanSource::Corridor => {
             "the route stage's corridor (every run of the swarm failed)"
         }
     };
@@ -149,7 +151,7 @@ pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
 fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
     use std::fmt::Write as _;
     let enabled = o.iwps.iter().filter(|i| i.enabled).count();
-    let unusable: Vec<&crate::planner::Iwp> = o
+    let unusable: Vec<&crate::pipelines::theta_pso::Iwp> = o
         .iwps
         .iter()
         .filter(|i| i.enabled && i.unusable.is_some())
@@ -183,16 +185,17 @@ fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
         }
         return;
     }
-    for (reason, count) in crate::planner::iwp::unusable_by_reason(&o.iwps) {
+    for (reason, count) in crate::pipelines::theta_pso::iwp::unusable_by_reason(&o.iwps) {
         let _ = writeln!(s, "  IWP          {count} unusable: {reason}");
     }
     if unusable.is_empty() {
         return;
     }
     // The few nearest the path: those a user most likely meant the plan to take.
-    let distance =
-        |i: &crate::planner::Iwp| super::iwp_groups::distance_to(&o.centroid_path, &i.position);
-    let mut nearest: Vec<(f64, &crate::planner::Iwp)> =
+    let distance = |i: &crate::pipelines::theta_pso::Iwp| {
+        super::iwp_groups::distance_to(&o.centroid_path, &i.position)
+    };
+    let mut nearest: Vec<(f64, &crate::pipelines::theta_pso::Iwp)> =
         unusable.iter().map(|i| (distance(i), *i)).collect();
     nearest.sort_by(|a, b| a.0.total_cmp(&b.0));
     for (d, i) in nearest.iter().take(NAMED_UNUSABLE) {

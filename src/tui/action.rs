@@ -6,6 +6,7 @@
 use nalgebra::Point2;
 
 use super::fields::Item;
+use crate::pipelines::Kind;
 
 /// Which panel takes the keys that are not global.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -86,12 +87,8 @@ pub enum Action {
     Undo,
     Redo,
 
-    /// Run θ-PSO with the mission's seed.
-    Run,
-    /// Run FLATLO (the squadron transition) with the mission's seed.
-    RunFlatlo,
-    /// Run the distributed fleet with the mission's seed.
-    RunFleet,
+    /// Run a pipeline with the mission's seed.
+    Run(Kind),
     /// Move the fleet replay by this many seconds (and pause it).
     Scrub(f64),
     /// Play or pause the fleet replay.

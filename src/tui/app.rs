@@ -34,7 +34,7 @@ use super::replay::Replay;
 pub use super::status::Status;
 use super::status::StatusLine;
 use crate::mission::{Mission, Preset};
-use crate::planner::Iwp;
+use crate::pipelines::theta_pso::Iwp;
 
 /// The whole TUI state.
 pub struct App {
@@ -318,11 +318,9 @@ impl App {
             Save | SaveAs | Open | Confirm | Import => self.update_files(action),
             ChangeStep(_) | Zoom(..) | Pan(..) | Fit => self.update_camera(action),
             Scrub(_) | TogglePlay => self.update_replay(action),
-            Run | RunFlatlo | RunFleet | RunNewSeed | Cancel | JobUp | JobDown
-            | ToggleRecording | CycleViewer => {
-                self.board
-                    .update(action, self.editor.doc(), &self.cwd, &mut self.status)
-            }
+            Run(_) | RunNewSeed | Cancel | JobUp | JobDown | ToggleRecording | CycleViewer => self
+                .board
+                .update(action, self.editor.doc(), &self.cwd, &mut self.status),
             ShowJob => {
                 if self.board.show_selected() {
                     self.pane = Pane::Map;

@@ -14,7 +14,7 @@ use super::action::Action;
 use super::document::Document;
 use super::jobs::{self, Job, JobId, JobMsg, Kind, RecordSettings, Viewer};
 use super::status::StatusLine;
-use crate::pipeline::Level;
+use crate::pipelines::Level;
 
 pub struct JobBoard {
     jobs: Vec<Job>,
@@ -123,9 +123,7 @@ impl JobBoard {
         use Action::*;
         let seed = doc.mission().seed;
         match action {
-            Run => self.run(Kind::ThetaPso, seed, doc, cwd, status),
-            RunFlatlo => self.run(Kind::Flatlo, seed, doc, cwd, status),
-            RunFleet => self.run(Kind::Fleet, seed, doc, cwd, status),
+            Run(kind) => self.run(kind, seed, doc, cwd, status),
             RunNewSeed => {
                 let seed = self
                     .jobs

@@ -40,7 +40,7 @@ pub struct Document {
 
 impl Document {
     pub fn new(mission: Mission, path: Option<PathBuf>) -> Self {
-        let diagnostics = crate::diagnose::diagnose(&mission);
+        let diagnostics = crate::outcome::diagnose::diagnose(&mission);
         Document {
             saved: mission.clone(),
             never_saved: false,
@@ -168,7 +168,7 @@ impl Document {
             return self.edit(change);
         }
         change(&mut self.mission);
-        self.diagnostics = crate::diagnose::diagnose(&self.mission);
+        self.diagnostics = crate::outcome::diagnose::diagnose(&self.mission);
     }
 
     pub fn end_gesture(&mut self) {
@@ -195,7 +195,7 @@ impl Document {
             Some(previous) => {
                 self.redo
                     .push(std::mem::replace(&mut self.mission, previous));
-                self.diagnostics = crate::diagnose::diagnose(&self.mission);
+                self.diagnostics = crate::outcome::diagnose::diagnose(&self.mission);
                 true
             }
             None => false,
@@ -208,7 +208,7 @@ impl Document {
         match self.redo.pop() {
             Some(next) => {
                 self.undo.push(std::mem::replace(&mut self.mission, next));
-                self.diagnostics = crate::diagnose::diagnose(&self.mission);
+                self.diagnostics = crate::outcome::diagnose::diagnose(&self.mission);
                 true
             }
             None => false,
@@ -266,7 +266,7 @@ impl Document {
 
     fn changed(&mut self) {
         self.changes += 1;
-        self.diagnostics = crate::diagnose::diagnose(&self.mission);
+        self.diagnostics = crate::outcome::diagnose::diagnose(&self.mission);
     }
 }
 

@@ -18,7 +18,7 @@ use super::document::Document;
 use super::fields::{self, Field, Item};
 use super::status::StatusLine;
 use crate::mission::{self, FleetTarget, Mission, MissionError, PathSegment, Preset, Severity};
-use crate::planner::{Iwp, find_iwps};
+use crate::pipelines::theta_pso::{Iwp, find_iwps};
 
 /// A line of text being typed into an inspector field.
 #[derive(Debug, Clone, PartialEq)]
@@ -330,7 +330,7 @@ impl Editor {
                     },
                     None => FleetTarget {
                         time: 0.0,
-                        position: crate::fleet::default_target(self.mission()),
+                        position: crate::pipelines::fleet::default_target(self.mission()),
                     },
                 };
                 self.edit(status, |m| m.fleet.targets.push(next));
@@ -626,7 +626,7 @@ impl Editor {
             Err(e) => Some((Severity::Error, e)),
             // What the value would cause on this field, or on the array
             // it is an element of (x max of an inverted x range).
-            Ok(()) => crate::diagnose::diagnose(&trial)
+            Ok(()) => crate::outcome::diagnose::diagnose(&trial)
                 .into_iter()
                 .filter(|d| {
                     fields::place(&self.selected, &trial, &fields, &d.path)

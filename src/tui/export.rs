@@ -7,7 +7,7 @@ use super::document::Document;
 use super::jobs::{Job, Outcome};
 use crate::export::{self, ExportError, Format, Options, Planned};
 use crate::mission::Mission;
-use crate::pipeline::Completion;
+use crate::pipelines::Completion;
 
 /// What the export needs of a finished job's outcome.
 pub fn planned(mission: &Mission, outcome: &Outcome) -> Planned {

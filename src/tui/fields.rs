@@ -13,7 +13,7 @@
 use nalgebra::Point2;
 
 use crate::mission::{FieldPath, Mission, Obstacle, PathSegment, ShapeChoice, WaypointChoice};
-use crate::planner::Iwp;
+use crate::pipelines::theta_pso::Iwp;
 
 mod table;
 
@@ -552,7 +552,7 @@ mod tests {
     /// is drawn with the item.
     fn shown_under(item: &Item, m: &Mission, message: &str) -> Option<String> {
         let fields = fields(item, m);
-        let d = crate::diagnose::diagnose(m)
+        let d = crate::outcome::diagnose::diagnose(m)
             .into_iter()
             .find(|d| d.message.contains(message))?;
         let (place, _) = place(item, m, &fields, &d.path)?;
@@ -590,7 +590,7 @@ mod tests {
         // An inverted range is about both ends: after the pair.
         m.bounds.x = [150.0, 100.0];
         let bounds = fields(&Item::Bounds, &m);
-        let d = crate::diagnose::diagnose(&m);
+        let d = crate::outcome::diagnose::diagnose(&m);
         let whole = d
             .iter()
             .find(|d| d.path.to_string() == "bounds.x")
@@ -618,7 +618,7 @@ mod tests {
             scale: None,
         });
         let broken = Item::Waypoint(["pier 5".into(), "nowhere".into()]);
-        let d = crate::diagnose::diagnose(&m);
+        let d = crate::outcome::diagnose::diagnose(&m);
         let between = d
             .iter()
             .find(|d| d.path.to_string() == "reconfiguration.waypoints[0].between")
@@ -686,7 +686,7 @@ mod tests {
         m.obstacles[3].radius = -1.0;
         let all = fields(&obstacle, &m);
         let radius = all.iter().find(|f| f.label() == "radius (m)").unwrap();
-        let found: Vec<_> = crate::diagnose::diagnose(&m)
+        let found: Vec<_> = crate::outcome::diagnose::diagnose(&m)
             .into_iter()
             .filter(|d| d.path.starts_with(radius.path()))
             .collect();

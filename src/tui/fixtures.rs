@@ -9,10 +9,10 @@ use super::action::{Action, Focus};
 use super::app::App;
 use super::document::Document;
 use super::jobs::{Job, JobError, JobMsg, Kind, Outcome};
-use crate::flatlo;
 use crate::mission::{self, Mission, Obstacle};
-use crate::pipeline::{CancelToken, Silent};
-use crate::planner::{PlanOptions, plan};
+use crate::pipelines::flatlo;
+use crate::pipelines::theta_pso::{PlanOptions, plan};
+use crate::pipelines::{CancelToken, Silent};
 
 /// A 400 m × 400 m field with `n` small posts on a jittered grid, clear of
 /// the start and goal corners: a stress case for drawing.

@@ -16,10 +16,9 @@ use nalgebra::Point3;
 
 use crate::mission::Mission;
 pub use crate::outcome::Outcome;
-use crate::outcome::{self, Verdict};
-pub use crate::pipeline::Kind;
-use crate::pipeline::{CancelToken, Completion, Event, Level, Observer};
-use crate::planner::PlanOptions;
+pub use crate::pipelines::Kind;
+use crate::pipelines::{CancelToken, Completion, Event, Level, Observer};
+use crate::run::{Recorder, Run};
 
 pub type JobId = usize;
 
@@ -87,7 +86,7 @@ pub enum JobMsg {
 pub enum JobError {
     /// The pipeline refused the mission (invalid, over its budget).
     #[error("{0}")]
-    Pipeline(#[from] crate::pipeline::PipelineError),
+    Pipeline(#[from] crate::pipelines::PipelineError),
     /// The pipeline panicked; the designer lives on.
     #[error("the pipeline panicked: {0}")]
     Panicked(String),
@@ -102,10 +101,8 @@ pub enum JobState {
     /// Cancelled; an outcome (the best so far) may still be there.
     Cancelled,
     Failed(JobError),
-    /// Finished; `passed` is the outcome's verdict.
-    Done {
-        passed: bool,
-    },
+    /// Finished; the job's outcome holds the verdict.
+    Done,
 }
 
 /// One launched pipeline, as the UI knows it.
@@ -200,9 +197,7 @@ impl Job {
                         }
                         self.state = match outcome.completion() {
                             Completion::Cancelled => JobState::Cancelled,
-                            Completion::Finished => JobState::Done {
-                                passed: outcome.verdict() == Verdict::Passed,
-                            },
+                            Completion::Finished => JobState::Done,
                         };
                         if !outcome.convergence().is_empty() {
                             self.convergence = outcome.convergence().to_vec();
@@ -291,24 +286,8 @@ where
     }
 }
 
-/// The pipeline itself, on the worker thread.
-fn plan(
-    pipeline: Kind,
-    mission: &Mission,
-    seed: u64,
-    observer: &mut dyn Observer,
-    cancel: &CancelToken,
-) -> Result<Outcome, JobError> {
-    Ok(outcome::run(
-        pipeline,
-        mission,
-        seed,
-        PlanOptions::default(),
-        observer,
-        cancel,
-    )?)
-}
-
+/// The run itself, on the worker thread: the one run path (`run::Run`),
+/// with the recorder the settings ask for.
 fn run(
     id: JobId,
     pipeline: Kind,
@@ -323,44 +302,31 @@ fn run(
         tx: tx.clone(),
         last_cost: None,
     };
+    let recorder = start_recording(id, pipeline, mission, record, tx);
+    let ran = Run::new(pipeline, seed).carry_out(mission, recorder, &mut forward, cancel);
+    let outcome = ran.result?;
     #[cfg(feature = "rerun")]
-    {
-        let mut recorder = start_recording(id, mission, record, tx);
-        let outcome = match recorder.as_mut() {
-            Some(r) => {
-                let mut both = crate::pipeline::Tee(&mut forward, r);
-                plan(pipeline, mission, seed, &mut both, cancel)
-            }
-            None => plan(pipeline, mission, seed, &mut forward, cancel),
-        }?;
-        if let Some(mut r) = recorder {
-            r.log_outcome(&outcome);
-            let finished = r.finish();
-            if let Some((path, bytes)) = finished.file {
-                let _ = tx.send(JobMsg::Recorded { id, path, bytes });
-            }
+    if let Some(finished) = ran.recorded {
+        if let Some((path, bytes)) = finished.file {
+            let _ = tx.send(JobMsg::Recorded { id, path, bytes });
         }
-        Ok(outcome)
-    }
-    #[cfg(not(feature = "rerun"))]
-    {
-        if record.rrd.is_some() || record.viewer != Viewer::Off {
-            let text = "this build has no Rerun support (feature `rerun`)".to_owned();
-            let _ = tx.send(JobMsg::Log(id, Level::Warn, text));
+        if let Some(e) = finished.error {
+            let _ = tx.send(JobMsg::Log(id, Level::Warn, format!("not recorded: {e}")));
         }
-        plan(pipeline, mission, seed, &mut forward, cancel)
     }
+    Ok(outcome)
 }
 
 /// Opens the recording sinks; every failure is a warning of the job, never fatal.
 #[cfg(feature = "rerun")]
 fn start_recording(
     id: JobId,
+    pipeline: Kind,
     mission: &Mission,
     record: &RecordSettings,
     tx: &Sender<JobMsg>,
-) -> Option<crate::record::Recorder> {
-    use crate::record::{DEFAULT_VIEWER_URL, Recorder, Sinks};
+) -> Option<Recorder> {
+    use crate::record::{DEFAULT_VIEWER_URL, Sinks};
     let sinks = Sinks {
         rrd: record.rrd.clone(),
         connect: (record.viewer == Viewer::Connect).then(|| DEFAULT_VIEWER_URL.to_owned()),
@@ -370,21 +336,30 @@ fn start_recording(
         return None;
     }
     let mut warnings = Vec::new();
-    let started = Recorder::start(&mission.name, &sinks, &mut warnings);
+    let started = Recorder::start(&mission.name, Some(pipeline), &sinks, &mut warnings);
     for w in warnings {
         let _ = tx.send(JobMsg::Log(id, Level::Warn, w));
     }
-    match started {
-        Ok(Some(mut recorder)) => {
-            recorder.log_mission(mission);
-            Some(recorder)
-        }
-        Ok(None) => None,
-        Err(e) => {
-            let _ = tx.send(JobMsg::Log(id, Level::Warn, format!("not recorded: {e}")));
-            None
-        }
+    started.unwrap_or_else(|e| {
+        let _ = tx.send(JobMsg::Log(id, Level::Warn, format!("not recorded: {e}")));
+        None
+    })
+}
+
+/// A build without Rerun records nothing, and says so when asked to.
+#[cfg(not(feature = "rerun"))]
+fn start_recording(
+    id: JobId,
+    _: Kind,
+    _: &Mission,
+    record: &RecordSettings,
+    tx: &Sender<JobMsg>,
+) -> Option<Recorder> {
+    if record.rrd.is_some() || record.viewer != Viewer::Off {
+        let text = "this build has no Rerun support (feature `rerun`)".to_owned();
+        let _ = tx.send(JobMsg::Log(id, Level::Warn, text));
     }
+    None
 }
 
 fn panic_message(panic: &(dyn std::any::Any + Send)) -> JobError {

@@ -9,6 +9,7 @@
 use ratatui::crossterm::event::KeyCode;
 
 use super::action::{Action, Focus, Pane};
+use crate::pipelines::Kind;
 
 /// A key press as the table states it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -366,19 +367,27 @@ pub static KEYS: &[KeyRow] = &[
         group: "Run",
         keys: "r",
         help: "run θ-PSO with the mission's seed",
-        bindings: &[bind(Key::Char('r'), When::Always, Action::Run)],
+        bindings: &[bind(
+            Key::Char('r'),
+            When::Always,
+            Action::Run(Kind::ThetaPso),
+        )],
     },
     KeyRow {
         group: "Run",
         keys: "F",
         help: "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
-        bindings: &[bind(Key::Char('F'), When::Always, Action::RunFlatlo)],
+        bindings: &[bind(
+            Key::Char('F'),
+            When::Always,
+            Action::Run(Kind::Flatlo),
+        )],
     },
     KeyRow {
         group: "Run",
         keys: "T",
         help: "run the distributed fleet (select Fleet and its targets with n/p to edit them; d adds a target)",
-        bindings: &[bind(Key::Char('T'), When::Always, Action::RunFleet)],
+        bindings: &[bind(Key::Char('T'), When::Always, Action::Run(Kind::Fleet))],
     },
     KeyRow {
         group: "Run",

@@ -74,7 +74,7 @@ pub fn open_document(path: Option<&Path>) -> Result<(Document, Option<String>), 
     }
     let text = mission::read(path).map_err(|e| e.to_string())?;
     let name = path.display().to_string();
-    let checked = crate::diagnose::check_text(&text, Some(&name));
+    let checked = crate::outcome::diagnose::check_text(&text, Some(&name));
     match checked.mission {
         Some(m) => {
             let errors = checked.report.error_count();

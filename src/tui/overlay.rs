@@ -326,7 +326,7 @@ pub fn load(entry: &Entry) -> Result<Loaded, String> {
             None => return Err(format!("no built-in mission {name}")),
         },
     };
-    let checked = crate::diagnose::check_text(&text, Some(&name));
+    let checked = crate::outcome::diagnose::check_text(&text, Some(&name));
     match checked.mission {
         Some(mission) => Ok(Loaded {
             mission,

@@ -204,7 +204,7 @@ fn write(path: &Path, mission: &Mission, changes: usize) -> std::io::Result<()> 
         .map(|d| d.as_secs())
         .unwrap_or(0);
     let text = format!("{HEADER}# saved_at = {stamp}\n# changes = {changes}\n{body}");
-    mission::write_atomically(path, text.as_bytes())
+    crate::base::atomic::write(path, text.as_bytes())
 }
 
 /// A copy on disk, or `None` when there is none or it cannot be read as a

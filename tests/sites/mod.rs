@@ -20,7 +20,7 @@
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
-use skyform::geometry::segment_point_distance;
+use skyform::base::geometry::segment_point_distance;
 use skyform::mission::{self, Mission, Obstacle};
 
 /// The formation shapes of the family: name and slots (x forward, y left).

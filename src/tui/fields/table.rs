@@ -7,12 +7,12 @@ use nalgebra::{Point2, Vector3};
 
 use super::Step::{Index, Key};
 use super::{Item, Spec, Table, fmt_num, number, shape_name, waypoint_choice};
+use crate::base::terrain::Lookup;
 use crate::mission::geodesy::Frame;
 use crate::mission::{
     CostKind, Encoding, FleetTarget, GeoOrigin, Mission, Obstacle, Preset, ShapeChoice, Terrain,
     WaypointChoice, spacing_of,
 };
-use crate::terrain::Lookup;
 
 /// The table of `item`'s kind.
 pub(super) fn of(item: &Item) -> &'static Table {

@@ -22,6 +22,7 @@ fn severity_span(severity: Severity, text: String) -> Span<'static> {
     }
 }
 
+/// Long (~135 lines): the inspector's sections top to bottom, each a few lines.
 pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
     let focused = app.focus() == Focus::Inspector;
     let m = app.mission();

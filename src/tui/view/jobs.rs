@@ -12,6 +12,7 @@ use ratatui::widgets::{
     Axis, Block, BorderType, Borders, Chart, Dataset, GraphType, Paragraph, Wrap,
 };
 
+use crate::outcome::Outcome;
 use crate::tui::action::Action;
 use crate::tui::app::{App, Focus};
 use crate::tui::jobs::{Job, JobState};
@@ -30,23 +31,28 @@ fn bar(progress: f64, width: usize) -> String {
 }
 
 fn state_span(job: &Job) -> Span<'static> {
-    // A θ-PSO plan is feasible or not; a flown run passes or fails.
-    let plan = job.pipeline == crate::pipeline::Kind::ThetaPso;
     match &job.state {
         JobState::Running => Span::styled(job.stage.clone(), Style::default().cyan()),
         JobState::Cancelled => Span::styled("cancelled", Style::default().yellow()),
         JobState::Failed(_) => Span::styled("FAILED", Style::default().red().bold()),
-        JobState::Done { passed: true } => Span::styled(
-            if plan { "feasible" } else { "pass" },
-            Style::default().green(),
-        ),
-        JobState::Done { passed: false } => Span::styled(
-            if plan { "INFEASIBLE" } else { "FAIL" },
-            Style::default().red().bold(),
-        ),
+        JobState::Done => {
+            let passed = job.outcome.as_ref().is_some_and(Outcome::ok);
+            let word = job
+                .outcome
+                .as_ref()
+                .and_then(Outcome::verdict_word)
+                .unwrap_or("FAIL");
+            let style = if passed {
+                Style::default().green()
+            } else {
+                Style::default().red().bold()
+            };
+            Span::styled(word, style)
+        }
     }
 }
 
+/// Long (~135 lines): the jobs panel's parts top to bottom (title, list, progress, the shown result's table, the convergence chart).
 pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
     let focused = app.focus() == Focus::Jobs;
     let border = if focused {
@@ -84,9 +90,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
             row.bindings.iter().any(|b| {
                 matches!(
                     b.action,
-                    Action::Run
-                        | Action::RunFlatlo
-                        | Action::RunFleet
+                    Action::Run(_)
                         | Action::RunNewSeed
                         | Action::ToggleRecording
                         | Action::CycleViewer
@@ -203,7 +207,7 @@ fn collapsed(text: &str) -> String {
 /// check on top, the figures, the unusable IWPs grouped by reason, then the
 /// whole verification table (`outcome::summary::verification_rows`).
 fn theta_pso_table(
-    o: &crate::planner::ThetaPsoOutcome,
+    o: &crate::pipelines::theta_pso::ThetaPsoOutcome,
     state: &JobState,
     stale: bool,
 ) -> Vec<Line<'static>> {
@@ -281,7 +285,7 @@ fn theta_pso_table(
 
 /// The fleet's result: each target's formation time, the closest approaches,
 /// the final inter-agent distances, the PSO effort.
-fn fleet_table(o: &crate::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>> {
+fn fleet_table(o: &crate::pipelines::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>> {
     let safe = o.kept_apart() && o.obstacles_clear();
     let mut lines = vec![Line::from(vec![
         Span::raw(format!(
@@ -353,7 +357,7 @@ fn fleet_table(o: &crate::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>
 }
 
 /// FLATLO's verification: every pair's closest approach, the final line, the verdict.
-fn flatlo_table(o: &crate::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'static>> {
+fn flatlo_table(o: &crate::pipelines::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'static>> {
     let verdict = match &o.verification {
         Some(v) if v.passed => Span::styled("✓ separation kept", Style::default().green()),
         Some(_) => Span::styled("✗ SEPARATION LOST", Style::default().red().bold()),

@@ -15,11 +15,11 @@ use ratatui::text::{Line as TextLine, Span};
 use ratatui::widgets::canvas::{Canvas, Context, Line, Painter, Rectangle, Shape};
 use ratatui::widgets::{Block, BorderType, Borders, Cell, Row, Table};
 
-use crate::flatlo::FlatloOutcome;
-use crate::fleet::FleetOutcome;
-use crate::geometry::segment_projection;
+use crate::base::geometry::segment_projection;
 use crate::mission::{Mission, Preset, ShapeChoice};
-use crate::planner::ThetaPsoOutcome;
+use crate::pipelines::flatlo::FlatloOutcome;
+use crate::pipelines::fleet::FleetOutcome;
+use crate::pipelines::theta_pso::ThetaPsoOutcome;
 use crate::tui::app::{App, Focus};
 use crate::tui::fields::{Item, shape_name};
 use crate::tui::jobs::Outcome;
@@ -28,7 +28,7 @@ pub use super::viewport::Viewport;
 
 /// UAV `i`'s colour (0-based), the same as in the Rerun recording.
 pub fn uav_color(i: usize) -> Color {
-    let [r, g, b] = crate::tracks::vehicle_color(i);
+    let [r, g, b] = crate::outcome::tracks::vehicle_color(i);
     Color::Rgb(r, g, b)
 }
 
@@ -277,6 +277,7 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     }
 }
 
+/// Long (~150 lines): the map's layers in drawing order (terrain, bounds, obstacles, IWPs, plans, vehicles), each a short block.
 fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     let b = &m.bounds;
     ctx.draw(&Rectangle {
@@ -686,6 +687,8 @@ fn map_title<'a>(
 
 /// Distance along the path vs altitude, with the altitude band and the
 /// obstacles the path passes.
+///
+/// Long (~130 lines): the side view's layers in drawing order (band, obstacles, path, vehicles).
 fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
     let m = app.mission();
     let result = result_of(app);
@@ -868,6 +871,8 @@ pub fn formation_split(app: &App, area: Rect) -> [Rect; 2] {
 
 /// The formation editor: slots in the formation frame (drawn through `vp`,
 /// the viewport `Drawn` reports), and the IWPs' shapes.
+///
+/// Long (~135 lines): the formation's slots, their labels and the heading, in drawing order.
 pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     let m = app.mission();
     let [top, bottom] = formation_split(app, area);

@@ -288,274 +288,311 @@ fn running_line(app: &App) -> Vec<Line<'static>> {
 
 fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
     match overlay {
-        Overlay::Help => {
-            // Two columns when there is room, else one (the README lists every key too).
-            let groups = ["General", "Select & move", "Edit", "Formation", "Run"];
-            let wide = area.width >= 120;
-            let width = if wide {
-                area.width.min(150)
-            } else {
-                96.min(area.width)
-            };
-            let inner_width = width.saturating_sub(2);
-            let (left_width, right_width) = if wide {
-                let l = inner_width * 45 / 100;
-                (l, inner_width - l)
-            } else {
-                (inner_width, inner_width)
-            };
-            let column = |names: &[&str], width: u16| {
-                let mut lines = Vec::new();
-                for name in names {
-                    if !lines.is_empty() {
-                        lines.push(Line::raw(""));
-                    }
-                    lines.push(Line::styled(
-                        name.to_string(),
-                        Style::default().bold().underlined(),
-                    ));
-                    for row in KEYS.iter().filter(|row| row.group == *name) {
-                        lines.extend(key_lines(row.keys, row.help, width));
-                    }
-                }
-                lines
-            };
-            let (left, right) = if wide {
-                (
-                    column(&groups[..2], left_width),
-                    column(&groups[2..], right_width),
-                )
-            } else {
-                (column(&groups, left_width), Vec::new())
-            };
-            let content = rows(&left, left_width).max(rows(&right, right_width));
-            let height = content + 2;
-            let r = centred(area, width, height);
-            frame.render_widget(Clear, r);
-            // Taller than the screen: it scrolls (↑ ↓ PgUp PgDn), and says so.
-            let fits = height <= r.height;
-            let max_scroll = content.saturating_sub(r.height.saturating_sub(2));
-            let scroll = app.help_scroll().min(max_scroll);
-            let title = if fits {
-                "Keys · any key closes".to_owned()
-            } else {
-                format!(
-                    "Keys · ↑↓ PgUp PgDn scroll ({}/{}) · other keys close",
-                    scroll, max_scroll
-                )
-            };
-            let block = boxed(&title, Color::Cyan);
-            let inner = block.inner(r);
-            frame.render_widget(block, r);
-            let text = |lines: Vec<Line<'static>>| {
-                Paragraph::new(lines)
-                    .wrap(Wrap { trim: false })
-                    .scroll((scroll, 0))
-            };
-            if wide {
-                // The widths the lines were wrapped to (a layout of the
-                // real rectangle may round its split a cell differently).
-                let a = Rect {
-                    width: left_width.min(inner.width),
-                    ..inner
-                };
-                let b = Rect {
-                    x: a.right(),
-                    width: inner.width - a.width,
-                    ..inner
-                };
-                frame.render_widget(text(left), a);
-                frame.render_widget(text(right), b);
-            } else {
-                frame.render_widget(text(left), inner);
-            }
-        }
-        Overlay::Quit => {
-            let mut lines = vec![Line::raw(format!(
-                "{} has unsaved changes.",
-                app.doc().title()
-            ))];
-            lines.extend(running_line(app));
-            lines.push(Line::raw(""));
-            lines.push(hints(&[
-                ("s", " save and quit   "),
-                ("y", " quit without saving   "),
-                ("Esc", " stay"),
-            ]));
-            let width = 70.min(area.width);
-            let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
-            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
-            popup(frame, area, size, ("Quit?", Color::Yellow), body);
-        }
-        Overlay::QuitRunning => {
-            let mut lines = running_line(app);
-            lines.push(Line::raw(""));
-            lines.push(hints(&[("y", " quit and cancel   "), ("Esc", " stay")]));
-            let width = 70.min(area.width);
-            let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
-            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
-            popup(frame, area, size, ("Quit?", Color::Yellow), body);
-        }
-        Overlay::SaveAs { input, .. } => {
-            let lines = vec![
-                Line::raw(format!("File (relative to {}):", app.cwd().display())),
-                Line::from(Span::styled(
-                    format!("{input}▏"),
-                    Style::default().white().on_blue(),
-                )),
-                hints(&[("Enter", " save   "), ("Esc", " cancel")]),
-            ];
-            popup(
-                frame,
-                area,
-                (72, 5),
-                ("Save as", Color::Cyan),
-                Paragraph::new(lines),
-            );
-        }
-        Overlay::Import { input } => {
-            let lines = vec![
-                Line::raw(format!(
-                    "Survey: GeoJSON, KML or KMZ (relative to {}):",
-                    app.cwd().display()
-                )),
-                Line::from(Span::styled(
-                    format!("{input}▏"),
-                    Style::default().white().on_blue(),
-                )),
-                hints(&[("Enter", " import (one undo step)   "), ("Esc", " cancel")]),
-            ];
-            popup(
-                frame,
-                area,
-                (72, 5),
-                ("Import obstacles", Color::Cyan),
-                Paragraph::new(lines),
-            );
-        }
-        Overlay::SaveInvalid { errors, .. } => {
-            let mut lines = vec![Line::raw(format!(
-                "The mission has {} error(s):",
-                errors.len()
-            ))];
-            for e in errors.iter().take(8) {
-                lines.push(Line::styled(
-                    format!("  ✗ {e}"),
-                    Style::default().light_red(),
-                ));
-            }
-            if errors.len() > 8 {
-                lines.push(Line::raw(format!("  … and {} more", errors.len() - 8)));
-            }
-            lines.push(Line::raw(
-                "It can be saved, but not run until they are fixed.",
-            ));
-            lines.push(hints(&[("y", " save anyway   "), ("Esc", " cancel")]));
-            // Tall enough for the wrapped error lines, so the hints stay in view.
-            let width = 90.min(area.width);
-            let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
-            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
-            popup(
-                frame,
-                area,
-                size,
-                ("Save an invalid mission?", Color::Red),
-                body,
-            );
-        }
+        Overlay::Help => draw_help(frame, app, area),
+        Overlay::Quit => draw_quit(frame, app, area),
+        Overlay::QuitRunning => draw_quit_running(frame, app, area),
+        Overlay::SaveAs { input, .. } => draw_save_as(frame, app, area, input),
+        Overlay::Import { input } => draw_import(frame, app, area, input),
+        Overlay::SaveInvalid { errors, .. } => draw_save_invalid(frame, area, errors),
         Overlay::Open {
             input,
             matches,
             cursor,
             ..
-        } => {
-            // Prompt line, list, hints: the list takes what the screen leaves.
-            let inner = (matches.len() as u16 + 2).min(area.height.saturating_sub(6));
-            let room = inner.saturating_sub(2) as usize;
-            let first = (cursor + 1).saturating_sub(room.max(1));
-            let mut lines = vec![Line::from(vec![
-                Span::raw("Path or filter: "),
-                Span::styled(format!("{input}▏"), Style::default().white().on_blue()),
-            ])];
-            let typed_only = !input.trim().is_empty()
-                && matches.len() == 1
-                && matches!(&matches[0], super::overlay::Entry::File(p)
-                    if *p == super::overlay::typed_path(app.cwd(), input));
-            lines.extend(
-                matches
-                    .iter()
-                    .enumerate()
-                    .skip(first)
-                    .take(room)
-                    .map(|(k, e)| {
-                        let mut label = super::overlay::entry_label(e, app.cwd());
-                        if typed_only {
-                            label = format!("{label}  (not listed: Enter opens this path)");
-                        }
-                        if k == *cursor {
-                            Line::styled(format!("▶ {label}"), Style::default().black().on_yellow())
-                        } else {
-                            Line::raw(format!("  {label}"))
-                        }
-                    }),
-            );
-            lines.push(hints(&[
-                ("type", " filter or path   "),
-                ("↑↓", " choose   "),
-                ("Enter", " open   "),
-                ("Esc", " cancel"),
-            ]));
-            let title = (
-                "Open a mission (missions/, ./, built-in, a path)",
-                Color::Cyan,
-            );
-            popup(frame, area, (72, inner + 2), title, Paragraph::new(lines));
-        }
-        Overlay::Overwrite { path, .. } => {
-            let lines = vec![
-                Line::raw(format!("{} exists. Replace it?", path.display())),
-                hints(&[("y", " replace   "), ("Esc", " cancel")]),
-            ];
-            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
-            popup(frame, area, (80, 5), ("Replace file?", Color::Yellow), body);
-        }
-        Overlay::Recover(copy) => {
-            let lines = vec![
-                Line::raw("An earlier session left unsaved changes to this mission:"),
-                Line::raw(copy.describe(std::time::SystemTime::now())),
-                Line::raw(""),
-                hints(&[
-                    ("y", " restore them (then Ctrl-s to save)   "),
-                    ("n", " discard them"),
-                ]),
-            ];
-            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
-            popup(
-                frame,
-                area,
-                (80, 7),
-                ("Recover unsaved changes?", Color::Yellow),
-                body,
-            );
-        }
-        Overlay::Discard(entry) => {
-            let lines = vec![
-                Line::raw(format!(
-                    "Discard the unsaved changes and open {}?",
-                    entry.label()
-                )),
-                hints(&[
-                    ("s", " save, then open   "),
-                    ("y", " discard and open   "),
-                    ("Esc", " cancel"),
-                ]),
-            ];
-            let width = 80.min(area.width);
-            let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
-            let body = Paragraph::new(lines).wrap(Wrap { trim: false });
-            popup(frame, area, size, ("Unsaved changes", Color::Yellow), body);
-        }
+        } => draw_open(frame, app, area, input, matches, *cursor),
+        Overlay::Overwrite { path, .. } => draw_overwrite(frame, area, path),
+        Overlay::Recover(copy) => draw_recover(frame, area, copy),
+        Overlay::Discard(entry) => draw_discard(frame, area, entry),
     }
+}
+
+/// The key table, in two columns when there is room; it scrolls when taller than the screen.
+fn draw_help(frame: &mut Frame, app: &App, area: Rect) {
+    // Two columns when there is room, else one (the README lists every key too).
+    let groups = ["General", "Select & move", "Edit", "Formation", "Run"];
+    let wide = area.width >= 120;
+    let width = if wide {
+        area.width.min(150)
+    } else {
+        96.min(area.width)
+    };
+    let inner_width = width.saturating_sub(2);
+    let (left_width, right_width) = if wide {
+        let l = inner_width * 45 / 100;
+        (l, inner_width - l)
+    } else {
+        (inner_width, inner_width)
+    };
+    let column = |names: &[&str], width: u16| {
+        let mut lines = Vec::new();
+        for name in names {
+            if !lines.is_empty() {
+                lines.push(Line::raw(""));
+            }
+            lines.push(Line::styled(
+                name.to_string(),
+                Style::default().bold().underlined(),
+            ));
+            for row in KEYS.iter().filter(|row| row.group == *name) {
+                lines.extend(key_lines(row.keys, row.help, width));
+            }
+        }
+        lines
+    };
+    let (left, right) = if wide {
+        (
+            column(&groups[..2], left_width),
+            column(&groups[2..], right_width),
+        )
+    } else {
+        (column(&groups, left_width), Vec::new())
+    };
+    let content = rows(&left, left_width).max(rows(&right, right_width));
+    let height = content + 2;
+    let r = centred(area, width, height);
+    frame.render_widget(Clear, r);
+    // Taller than the screen: it scrolls (↑ ↓ PgUp PgDn), and says so.
+    let fits = height <= r.height;
+    let max_scroll = content.saturating_sub(r.height.saturating_sub(2));
+    let scroll = app.help_scroll().min(max_scroll);
+    let title = if fits {
+        "Keys · any key closes".to_owned()
+    } else {
+        format!(
+            "Keys · ↑↓ PgUp PgDn scroll ({}/{}) · other keys close",
+            scroll, max_scroll
+        )
+    };
+    let block = boxed(&title, Color::Cyan);
+    let inner = block.inner(r);
+    frame.render_widget(block, r);
+    let text = |lines: Vec<Line<'static>>| {
+        Paragraph::new(lines)
+            .wrap(Wrap { trim: false })
+            .scroll((scroll, 0))
+    };
+    if wide {
+        // The widths the lines were wrapped to (a layout of the
+        // real rectangle may round its split a cell differently).
+        let a = Rect {
+            width: left_width.min(inner.width),
+            ..inner
+        };
+        let b = Rect {
+            x: a.right(),
+            width: inner.width - a.width,
+            ..inner
+        };
+        frame.render_widget(text(left), a);
+        frame.render_widget(text(right), b);
+    } else {
+        frame.render_widget(text(left), inner);
+    }
+}
+
+/// Quitting with unsaved changes.
+fn draw_quit(frame: &mut Frame, app: &App, area: Rect) {
+    let mut lines = vec![Line::raw(format!(
+        "{} has unsaved changes.",
+        app.doc().title()
+    ))];
+    lines.extend(running_line(app));
+    lines.push(Line::raw(""));
+    lines.push(hints(&[
+        ("s", " save and quit   "),
+        ("y", " quit without saving   "),
+        ("Esc", " stay"),
+    ]));
+    let width = 70.min(area.width);
+    let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
+    let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+    popup(frame, area, size, ("Quit?", Color::Yellow), body);
+}
+
+/// Quitting while runs are going.
+fn draw_quit_running(frame: &mut Frame, app: &App, area: Rect) {
+    let mut lines = running_line(app);
+    lines.push(Line::raw(""));
+    lines.push(hints(&[("y", " quit and cancel   "), ("Esc", " stay")]));
+    let width = 70.min(area.width);
+    let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
+    let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+    popup(frame, area, size, ("Quit?", Color::Yellow), body);
+}
+
+/// The file name to save as.
+fn draw_save_as(frame: &mut Frame, app: &App, area: Rect, input: &str) {
+    let lines = vec![
+        Line::raw(format!("File (relative to {}):", app.cwd().display())),
+        Line::from(Span::styled(
+            format!("{input}▏"),
+            Style::default().white().on_blue(),
+        )),
+        hints(&[("Enter", " save   "), ("Esc", " cancel")]),
+    ];
+    popup(
+        frame,
+        area,
+        (72, 5),
+        ("Save as", Color::Cyan),
+        Paragraph::new(lines),
+    );
+}
+
+/// The survey file to import.
+fn draw_import(frame: &mut Frame, app: &App, area: Rect, input: &str) {
+    let lines = vec![
+        Line::raw(format!(
+            "Survey: GeoJSON, KML or KMZ (relative to {}):",
+            app.cwd().display()
+        )),
+        Line::from(Span::styled(
+            format!("{input}▏"),
+            Style::default().white().on_blue(),
+        )),
+        hints(&[("Enter", " import (one undo step)   "), ("Esc", " cancel")]),
+    ];
+    popup(
+        frame,
+        area,
+        (72, 5),
+        ("Import obstacles", Color::Cyan),
+        Paragraph::new(lines),
+    );
+}
+
+/// Saving a mission with errors.
+fn draw_save_invalid(frame: &mut Frame, area: Rect, errors: &[String]) {
+    let mut lines = vec![Line::raw(format!(
+        "The mission has {} error(s):",
+        errors.len()
+    ))];
+    for e in errors.iter().take(8) {
+        lines.push(Line::styled(
+            format!("  ✗ {e}"),
+            Style::default().light_red(),
+        ));
+    }
+    if errors.len() > 8 {
+        lines.push(Line::raw(format!("  … and {} more", errors.len() - 8)));
+    }
+    lines.push(Line::raw(
+        "It can be saved, but not run until they are fixed.",
+    ));
+    lines.push(hints(&[("y", " save anyway   "), ("Esc", " cancel")]));
+    // Tall enough for the wrapped error lines, so the hints stay in view.
+    let width = 90.min(area.width);
+    let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
+    let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+    popup(
+        frame,
+        area,
+        size,
+        ("Save an invalid mission?", Color::Red),
+        body,
+    );
+}
+
+/// The open dialog: a prompt, the list it filters, the hints.
+fn draw_open(
+    frame: &mut Frame,
+    app: &App,
+    area: Rect,
+    input: &str,
+    matches: &[super::overlay::Entry],
+    cursor: usize,
+) {
+    // Prompt line, list, hints: the list takes what the screen leaves.
+    let inner = (matches.len() as u16 + 2).min(area.height.saturating_sub(6));
+    let room = inner.saturating_sub(2) as usize;
+    let first = (cursor + 1).saturating_sub(room.max(1));
+    let mut lines = vec![Line::from(vec![
+        Span::raw("Path or filter: "),
+        Span::styled(format!("{input}▏"), Style::default().white().on_blue()),
+    ])];
+    let typed_only = !input.trim().is_empty()
+        && matches.len() == 1
+        && matches!(&matches[0], super::overlay::Entry::File(p)
+            if *p == super::overlay::typed_path(app.cwd(), input));
+    lines.extend(
+        matches
+            .iter()
+            .enumerate()
+            .skip(first)
+            .take(room)
+            .map(|(k, e)| {
+                let mut label = super::overlay::entry_label(e, app.cwd());
+                if typed_only {
+                    label = format!("{label}  (not listed: Enter opens this path)");
+                }
+                if k == cursor {
+                    Line::styled(format!("▶ {label}"), Style::default().black().on_yellow())
+                } else {
+                    Line::raw(format!("  {label}"))
+                }
+            }),
+    );
+    lines.push(hints(&[
+        ("type", " filter or path   "),
+        ("↑↓", " choose   "),
+        ("Enter", " open   "),
+        ("Esc", " cancel"),
+    ]));
+    let title = (
+        "Open a mission (missions/, ./, built-in, a path)",
+        Color::Cyan,
+    );
+    popup(frame, area, (72, inner + 2), title, Paragraph::new(lines));
+}
+
+/// Replacing an existing file.
+fn draw_overwrite(frame: &mut Frame, area: Rect, path: &std::path::Path) {
+    let lines = vec![
+        Line::raw(format!("{} exists. Replace it?", path.display())),
+        hints(&[("y", " replace   "), ("Esc", " cancel")]),
+    ];
+    let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+    popup(frame, area, (80, 5), ("Replace file?", Color::Yellow), body);
+}
+
+/// Restoring an earlier session's unsaved changes.
+fn draw_recover(frame: &mut Frame, area: Rect, copy: &super::recovery::Copy) {
+    let lines = vec![
+        Line::raw("An earlier session left unsaved changes to this mission:"),
+        Line::raw(copy.describe(std::time::SystemTime::now())),
+        Line::raw(""),
+        hints(&[
+            ("y", " restore them (then Ctrl-s to save)   "),
+            ("n", " discard them"),
+        ]),
+    ];
+    let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+    popup(
+        frame,
+        area,
+        (80, 7),
+        ("Recover unsaved changes?", Color::Yellow),
+        body,
+    );
+}
+
+/// Opening another mission over unsaved changes.
+fn draw_discard(frame: &mut Frame, area: Rect, entry: &super::overlay::Entry) {
+    let lines = vec![
+        Line::raw(format!(
+            "Discard the unsaved changes and open {}?",
+            entry.label()
+        )),
+        hints(&[
+            ("s", " save, then open   "),
+            ("y", " discard and open   "),
+            ("Esc", " cancel"),
+        ]),
+    ];
+    let width = 80.min(area.width);
+    let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
+    let body = Paragraph::new(lines).wrap(Wrap { trim: false });
+    popup(frame, area, size, ("Unsaved changes", Color::Yellow), body);
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ use crate::mission::Mission;
 /// (0 lowest, 1 highest): dark green low to brown high, dim enough for the
 /// braille layer and the labels drawn over it to stay readable.
 pub fn ground_shade(t: f64) -> Color {
-    let [r, g, b] = crate::terrain::height_ramp(t, [18, 44, 22], [96, 66, 30]);
+    let [r, g, b] = crate::base::terrain::height_ramp(t, [18, 44, 22], [96, 66, 30]);
     Color::Rgb(r, g, b)
 }
 

@@ -8,7 +8,7 @@
 use nalgebra::Point2;
 use ratatui::layout::{Margin, Rect};
 
-use crate::geometry::farthest_offset;
+use crate::base::geometry::farthest_offset;
 use crate::mission::Mission;
 use crate::tui::app::App;
 

@@ -1,0 +1,10 @@
+//! The ground floor: what every layer above may use and nothing of ours it
+//! imports beyond this folder (geometry, height maps, the ODE step, the PSO
+//! engine, routes round discs, the atomic writer).
+
+pub mod atomic;
+pub mod detour;
+pub mod geometry;
+pub mod ode;
+pub mod swarm;
+pub mod terrain;

@@ -1,0 +1,419 @@
+//! The distributed fleet (Belkadi et al., Algorithm 1): every quadrotor runs
+//! its own PSO over the next step h (eqs. 6, 8) from what it observes, and
+//! flies the result with the quaternion laws (eqs. 10-13).
+//!
+//! Rounds are synchronous: every τ (or at once for an agent with a neighbour
+//! closer than c) the agents due to decide all read the same snapshot of the
+//! fleet, decide in parallel, each with its own random stream, and only then
+//! move. So the result does not depend on the number of threads.
+//!
+//! Here: the scenario, the run's predicted size (`budget`) and the outcome
+//! types; the round loop with its named stages (observe, decide, fly,
+//! record) is `simulation.rs`, the per-agent pieces `agent.rs`, `cost.rs`
+//! and `quadrotor.rs`.
+
+pub mod agent;
+pub mod cost;
+pub mod quadrotor;
+pub mod simulation;
+
+use std::collections::HashMap;
+
+use nalgebra::{Point2, Point3};
+use rand::rngs::ChaCha8Rng;
+use rand::{RngExt, SeedableRng};
+use serde::Serialize;
+
+use crate::mission::{Diagnostic, FieldPath, Mission};
+use crate::pipelines::{CancelToken, Completion, Event, Observer, PipelineError};
+
+use simulation::Simulation;
+
+/// Samples kept per simulated second (positions, distances).
+const SAMPLE_RATE: f64 = 20.0;
+
+/// One recorded instant of an agent.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AgentSample {
+    pub t: f64,
+    pub position: Point3<f64>,
+    /// Y_id: the reference the agent flies to (eq. 8).
+    pub reference: Point3<f64>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AgentOutcome {
+    pub index: usize,
+    pub start: Point2<f64>,
+    pub samples: Vec<AgentSample>,
+    /// PSO runs (decisions) and cost evaluations: the agent's planning effort.
+    pub decisions: usize,
+    pub evaluations: usize,
+}
+
+/// The desired formation around one target, and when the fleet reached it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TargetOutcome {
+    pub time: f64,
+    pub position: Point2<f64>,
+    /// Seconds after the target appeared when every distance (to the target
+    /// and between agents) entered its tolerance for good; None if never.
+    pub converged_after: Option<f64>,
+}
+
+/// A closest approach of agent `a` (0-based) to another agent or an obstacle.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Closest {
+    pub a: usize,
+    pub b: Other,
+    pub distance: f64,
+    pub time: f64,
+}
+
+/// What an agent came close to.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Other {
+    /// Another agent, 0-based.
+    Agent(usize),
+    /// An obstacle, by name.
+    Obstacle(String),
+}
+
+impl std::fmt::Display for Other {
+    /// As people read it: agents from 1, obstacles by name in quotes.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Other::Agent(j) => write!(f, "{}", j + 1),
+            Other::Obstacle(name) => write!(f, "'{name}'"),
+        }
+    }
+}
+
+/// The inter-agent distances over time (fleet paper, Fig. 13), for fleets
+/// small enough to list every pair.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DistanceSeries {
+    pub a: usize,
+    pub b: usize,
+    pub desired: f64,
+    pub values: Vec<f64>,
+}
+
+/// Fleets larger than this get no per-pair distance series (n² of them).
+pub const MAX_SERIES_AGENTS: usize = 12;
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FleetOutcome {
+    pub pipeline: crate::pipelines::Kind,
+    pub mission: String,
+    pub seed: u64,
+    pub completion: Completion,
+    pub duration: f64,
+    /// Times of the samples (and of the distance series).
+    pub times: Vec<f64>,
+    pub agents: Vec<AgentOutcome>,
+    pub targets: Vec<TargetOutcome>,
+    pub distances: Vec<DistanceSeries>,
+    /// c.
+    pub safety_distance: f64,
+    /// Closest two agents ever came (on the sample grid).
+    pub closest_agents: Option<Closest>,
+    /// Closest any agent came to an obstacle's surface.
+    pub closest_obstacle: Option<Closest>,
+}
+
+impl FleetOutcome {
+    /// No two agents and no agent and obstacle came closer than c.
+    pub fn kept_apart(&self) -> bool {
+        self.closest_agents
+            .as_ref()
+            .is_none_or(|c| c.distance >= self.safety_distance)
+    }
+
+    /// No agent came closer than c to an obstacle's surface.
+    pub fn obstacles_clear(&self) -> bool {
+        self.closest_obstacle
+            .as_ref()
+            .is_none_or(|c| c.distance >= self.safety_distance)
+    }
+
+    /// Every target's formation was reached.
+    pub fn converged(&self) -> bool {
+        self.targets.iter().all(|t| t.converged_after.is_some())
+    }
+}
+
+/// The scenario a fleet mission describes, resolved: starts, targets, d^d.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    pub starts: Vec<Point2<f64>>,
+    pub targets: Vec<(f64, Point2<f64>)>,
+    /// d_ij^d.
+    pub desired: Vec<Vec<f64>>,
+}
+
+/// Default d_ij^d: a regular polygon of radius d_ip^d around the target, the
+/// agents in index order (three agents 1 m out: 1.732 m apart).
+pub fn polygon_distances(n: usize, radius: f64) -> Vec<Vec<f64>> {
+    (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    let k = i.abs_diff(j) as f64;
+                    2.0 * radius * (std::f64::consts::PI * k / n as f64).sin()
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Resolves the mission's fleet section. Random starts are drawn (seeded)
+/// inside the bounds, at least c from each other and from obstacles.
+pub fn scenario(m: &Mission, seed: u64) -> Scenario {
+    let p = &m.fleet;
+    let n = p.agents;
+    let starts = if p.initial_positions.len() == n {
+        p.initial_positions.clone()
+    } else {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        rng.set_stream(u64::MAX);
+        let b = &m.bounds;
+        let mut starts: Vec<Point2<f64>> = Vec::with_capacity(n);
+        let mut attempts = 0;
+        while starts.len() < n {
+            let q = Point2::new(
+                rng.random_range(b.x[0]..=b.x[1]),
+                rng.random_range(b.y[0]..=b.y[1]),
+            );
+            attempts += 1;
+            let clear = starts
+                .iter()
+                .all(|s| (s - q).norm() >= 2.0 * p.safety_distance)
+                && m.obstacles
+                    .iter()
+                    .all(|o| (o.center - q).norm() - o.radius >= 2.0 * p.safety_distance);
+            // A crowded box still gets its agents (the check is a courtesy).
+            if clear || attempts > 1000 * n {
+                starts.push(q);
+            }
+        }
+        starts
+    };
+    let targets = if p.targets.is_empty() {
+        vec![(0.0, default_target(m))]
+    } else {
+        p.targets.iter().map(|t| (t.time, t.position)).collect()
+    };
+    let desired = if p.distances.len() == n {
+        p.distances.clone()
+    } else {
+        polygon_distances(n, p.target_distance)
+    };
+    Scenario {
+        starts,
+        targets,
+        desired,
+    }
+}
+
+/// Where the fleet forms when the mission names no target: the free spot
+/// nearest the bounds' centre, where the formation (agents d_ip round it,
+/// each keeping c) stays inside the bounds and keeps c from every obstacle
+/// taller than the flight altitude. A grid of at most 200 × 200 candidates;
+/// the centre itself when nothing is free.
+pub fn default_target(m: &Mission) -> Point2<f64> {
+    let p = &m.fleet;
+    let b = &m.bounds;
+    let centre = b.center_xy();
+    let reach = p.target_distance + p.safety_distance;
+    let free = |q: &Point2<f64>| {
+        q.x - reach >= b.x[0]
+            && q.x + reach <= b.x[1]
+            && q.y - reach >= b.y[0]
+            && q.y + reach <= b.y[1]
+            && m.obstacles
+                .iter()
+                .filter(|o| o.height > p.altitude)
+                .all(|o| (o.center - q).norm() - o.radius >= reach + p.safety_distance)
+    };
+    if free(&centre) {
+        return centre;
+    }
+    let span = (b.x[1] - b.x[0]).max(b.y[1] - b.y[0]);
+    let step = (reach / 2.0).max(span / 200.0).max(1e-3);
+    let (nx, ny) = (
+        ((b.x[1] - b.x[0]) / step).ceil().min(200.0) as usize,
+        ((b.y[1] - b.y[0]) / step).ceil().min(200.0) as usize,
+    );
+    let mut best: Option<(f64, Point2<f64>)> = None;
+    for i in 0..=nx {
+        for j in 0..=ny {
+            let q = Point2::new(
+                b.x[0] + (b.x[1] - b.x[0]) * i as f64 / nx.max(1) as f64,
+                b.y[0] + (b.y[1] - b.y[0]) * j as f64 / ny.max(1) as f64,
+            );
+            let d = (q - centre).norm();
+            if best.is_none_or(|(bd, _)| d < bd) && free(&q) {
+                best = Some((d, q));
+            }
+        }
+    }
+    best.map_or(centre, |(_, q)| q)
+}
+
+/// Agents within `radius` of each agent (eq. 2), by a uniform grid of that
+/// cell size: O(n) for a spread-out fleet, not all pairs.
+pub fn neighbourhoods(positions: &[Point2<f64>], radius: f64) -> Vec<Vec<usize>> {
+    let cell = radius.max(1e-6);
+    let key = |p: &Point2<f64>| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
+    let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    for (i, p) in positions.iter().enumerate() {
+        grid.entry(key(p)).or_default().push(i);
+    }
+    positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let (cx, cy) = key(p);
+            let mut found = Vec::new();
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    if let Some(cell) = grid.get(&(cx + dx, cy + dy)) {
+                        for &j in cell {
+                            if j != i && (positions[j] - p).norm() <= radius {
+                                found.push(j);
+                            }
+                        }
+                    }
+                }
+            }
+            found.sort_unstable();
+            found
+        })
+        .collect()
+}
+
+/// The fleet's predicted size against `pipeline::limits`: agents, cost
+/// evaluations (agents × re-plans × particles × iterations), dynamics steps
+/// (agents × duration / sim_step) and kept samples (agents × duration × 20 Hz).
+pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
+    use crate::pipelines::{figure, limits};
+    let p = &mission.fleet;
+    let at = |key: &str| FieldPath::root().key("fleet").key(key);
+    let mut out = Vec::new();
+    let n = p.agents as f64;
+    if p.agents > limits::FLEET_AGENTS {
+        out.push(Diagnostic::error(
+            at("agents"),
+            format!(
+                "{} agents is over the limit of {}",
+                figure(n),
+                limits::FLEET_AGENTS
+            ),
+        ));
+        return out;
+    }
+    let replans = (p.duration / p.replan_period).ceil();
+    let evaluations = n * replans * p.swarm_size as f64 * p.iterations as f64;
+    if crate::pipelines::exceeds(evaluations, limits::FLEET_EVALUATIONS) {
+        let key = if p.replan_period < 1e-3 {
+            "replan_period"
+        } else if p.swarm_size >= p.iterations {
+            "swarm_size"
+        } else {
+            "iterations"
+        };
+        out.push(Diagnostic::error(
+            at(key),
+            format!(
+                "{} agents × {} re-plans × {} particles × {} iterations make {} cost \
+                 evaluations (limit {})",
+                p.agents,
+                figure(replans),
+                figure(p.swarm_size as f64),
+                figure(p.iterations as f64),
+                figure(evaluations),
+                figure(limits::FLEET_EVALUATIONS)
+            ),
+        ));
+    }
+    let steps = n * (p.duration / p.sim_step).ceil();
+    if crate::pipelines::exceeds(steps, limits::FLEET_STEPS) {
+        let key = if p.sim_step < 1e-4 {
+            "sim_step"
+        } else {
+            "duration"
+        };
+        out.push(Diagnostic::error(
+            at(key),
+            format!(
+                "{} agents over {} s in steps of {} s: {} dynamics steps (limit {})",
+                p.agents,
+                figure(p.duration),
+                figure(p.sim_step),
+                figure(steps),
+                figure(limits::FLEET_STEPS)
+            ),
+        ));
+    }
+    let samples = n * p.duration * SAMPLE_RATE;
+    if crate::pipelines::exceeds(samples, limits::FLEET_SAMPLES) {
+        out.push(Diagnostic::error(
+            at("duration"),
+            format!(
+                "{} agents over {} s at {SAMPLE_RATE} Hz: {} samples kept (limit {})",
+                p.agents,
+                figure(p.duration),
+                figure(samples),
+                figure(limits::FLEET_SAMPLES)
+            ),
+        ));
+    }
+    out
+}
+
+/// Simulates the mission's fleet with `seed` (starts, PSO streams). Fails
+/// only on an invalid mission.
+pub fn plan(
+    mission: &Mission,
+    seed: u64,
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> Result<FleetOutcome, PipelineError> {
+    crate::pipelines::require_valid(mission)?;
+    crate::pipelines::require_within_budget(budget(mission))?;
+    observer.on_event(Event::Stage("scenario"));
+    let mut simulation = Simulation::new(mission, seed);
+    observer.on_event(Event::Stage("flight"));
+    let completion = simulation.run(observer, cancel);
+    Ok(simulation.finish(completion, observer))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn three_agents_one_metre_out_are_1_732_apart() {
+        let d = polygon_distances(3, 1.0);
+        assert!((d[0][1] - 3f64.sqrt()).abs() < 1e-12);
+        assert!((d[1][2] - 2.0 * (std::f64::consts::PI / 6.0).cos()).abs() < 1e-12);
+        assert_eq!(d[2][2], 0.0);
+    }
+
+    #[test]
+    fn the_grid_finds_exactly_the_neighbours_within_l() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let positions: Vec<Point2<f64>> = (0..300)
+            .map(|_| Point2::new(rng.random_range(-40.0..40.0), rng.random_range(-40.0..40.0)))
+            .collect();
+        let found = neighbourhoods(&positions, 5.0);
+        for (i, list) in found.iter().enumerate() {
+            let brute: Vec<usize> = (0..positions.len())
+                .filter(|&j| j != i && (positions[j] - positions[i]).norm() <= 5.0)
+                .collect();
+            assert_eq!(list, &brute, "agent {i}");
+        }
+    }
+}

@@ -1,0 +1,262 @@
+//! What every planning pipeline shares: progress reporting and cancellation.
+//!
+//! A pipeline is a plain function of a validated mission and a seed. It tells
+//! an [`Observer`] what it is doing and checks a [`CancelToken`] between
+//! iterations. It never touches a terminal, a file or Rerun: the CLI, the TUI,
+//! the recorder, the tests and the benchmarks are all observers.
+
+pub mod flatlo;
+pub mod fleet;
+pub mod theta_pso;
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use nalgebra::Point3;
+use serde::{Deserialize, Serialize};
+
+/// The planning pipelines: what `outcome::run` runs, what a track came
+/// from, what the CLI's `--pipeline` and the designer's run keys name. Its
+/// value on the command line and in the JSON is the `slug`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Kind {
+    ThetaPso,
+    Flatlo,
+    Fleet,
+}
+
+impl Kind {
+    /// For people: `θ-PSO`, `FLATLO`, `fleet`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::ThetaPso => "θ-PSO",
+            Kind::Flatlo => "FLATLO",
+            Kind::Fleet => "fleet",
+        }
+    }
+
+    /// As on the command line and in file names: `theta-pso`, `flatlo`, `fleet`.
+    pub fn slug(self) -> &'static str {
+        match self {
+            Kind::ThetaPso => "theta-pso",
+            Kind::Flatlo => "flatlo",
+            Kind::Fleet => "fleet",
+        }
+    }
+
+    /// The vehicles it plans fly with fixed wings (FLATLO's aircraft).
+    pub fn fixed_wing(self) -> bool {
+        matches!(self, Kind::Flatlo)
+    }
+}
+
+/// Severity of a log event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Level {
+    Info,
+    Warn,
+}
+
+/// Cost terms of a θ-PSO path (eqs. 2-5, 10-11), unweighted, plus the weighted total.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct CostTerms {
+    /// J1, path length, metres (eq. 3).
+    pub length: f64,
+    /// J2, mean violation of the obstacles' safe radii (eq. 4).
+    pub obstacle: f64,
+    /// J3, summed altitude-band violation, metres (eq. 5).
+    pub altitude: f64,
+    /// J_R, mean horizontal distance of the path to the enabled IWPs, metres (eq. 11).
+    pub waypoints: f64,
+    /// J_B, how far the UAVs leave the x-y bounds, summed over L shares of the path, metres.
+    pub bounds: f64,
+    /// J_T, the path's horizontal turns beyond 90°, summed, radians.
+    pub turning: f64,
+    /// J = β1 J1 + β2 J2 + β3 J3 + β_R J_R + β_B J_B + β_T J_T (eqs. 2, 10).
+    pub total: f64,
+}
+
+/// Something a pipeline reports while it runs.
+#[derive(Debug, Clone, Copy)]
+pub enum Event<'a> {
+    /// A new stage started ("planning", "trajectories", "verification", ...).
+    Stage(&'a str),
+    /// Overall progress in [0, 1].
+    Progress(f64),
+    /// θ-PSO: the best centroid path and its cost after an iteration.
+    PathIteration {
+        iteration: usize,
+        cost: &'a CostTerms,
+        path: &'a [Point3<f64>],
+    },
+    /// A message for the log.
+    Log(Level, &'a str),
+}
+
+/// Receives a pipeline's events on the pipeline's thread. Keep it cheap: it
+/// runs between iterations of the hot loop.
+pub trait Observer {
+    fn on_event(&mut self, event: Event<'_>);
+}
+
+/// An observer that ignores everything.
+#[derive(Debug, Default)]
+pub struct Silent;
+
+impl Observer for Silent {
+    fn on_event(&mut self, _: Event<'_>) {}
+}
+
+impl<F: FnMut(Event<'_>)> Observer for F {
+    fn on_event(&mut self, event: Event<'_>) {
+        self(event)
+    }
+}
+
+/// Forwards every event to two observers (progress bar and recorder, say).
+pub struct Tee<'a, 'b>(pub &'a mut dyn Observer, pub &'b mut dyn Observer);
+
+impl Observer for Tee<'_, '_> {
+    fn on_event(&mut self, event: Event<'_>) {
+        self.0.on_event(event);
+        self.1.on_event(event);
+    }
+}
+
+/// A shared flag to ask a running pipeline to stop. Cloning shares the flag.
+#[derive(Debug, Clone, Default)]
+pub struct CancelToken(Arc<AtomicBool>);
+
+impl CancelToken {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Completion {
+    /// Every iteration ran.
+    Finished,
+    /// Stopped by the cancel token; the outcome holds the best found so far.
+    Cancelled,
+}
+
+/// Why a pipeline could not produce an outcome at all.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PipelineError {
+    #[error("the mission is not valid:\n{0}")]
+    InvalidMission(String),
+    #[error("{0}")]
+    Unsupported(String),
+    /// The run would exceed a documented limit (`limits`).
+    #[error("the run is too large to start:\n{0}")]
+    OverBudget(String),
+    /// θ-PSO's route stage found no way from start to goal within its model;
+    /// the text names what closes it.
+    #[error("{0}")]
+    NoRoute(String),
+}
+
+/// Every pipeline's first step: a mission with errors is refused, naming them.
+pub fn require_valid(mission: &crate::mission::Mission) -> Result<(), PipelineError> {
+    refuse_errors(
+        crate::mission::validate(mission),
+        PipelineError::InvalidMission,
+    )
+}
+
+/// A run's predicted size over its documented limit: refused before it starts.
+pub fn require_within_budget(
+    findings: Vec<crate::mission::Diagnostic>,
+) -> Result<(), PipelineError> {
+    refuse_errors(findings, PipelineError::OverBudget)
+}
+
+/// The errors among `findings`, one per line, as the refusal `error` makes.
+fn refuse_errors(
+    findings: Vec<crate::mission::Diagnostic>,
+    error: fn(String) -> PipelineError,
+) -> Result<(), PipelineError> {
+    let errors: Vec<String> = findings
+        .into_iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.to_string())
+        .collect();
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(error(errors.join("\n")))
+    }
+}
+
+/// The documented limits on what one run may cost (README, "Limits").
+///
+/// Every pipeline predicts its work and memory from the mission alone
+/// (`theta_pso::budget`, `flatlo::budget`, `fleet::budget`) and refuses a
+/// mission over these figures before it starts. They sit far above every
+/// realistic mission (the shipped ones use under 1 % of each) and keep the
+/// largest allowed run within a few minutes and a few GiB on a 2-core,
+/// 24 GiB machine: an allocation failure or an OOM kill cannot be caught,
+/// so the only safe large run is one never started.
+pub mod limits {
+    /// θ-PSO particles (memory: particles × dimensions × 4 vectors).
+    pub const THETA_PSO_PARTICLES: usize = 100_000;
+    /// θ-PSO free waypoints (decision dimensions grow with them).
+    pub const THETA_PSO_WAYPOINTS: usize = 1_000;
+    /// θ-PSO path segments L (each cost evaluation walks them).
+    pub const THETA_PSO_SEGMENTS: usize = 100_000;
+    /// θ-PSO cost evaluations: particles × iterations × (1 + restarts)
+    /// (about 10 µs each on one core: 2e7 is a few minutes on two).
+    pub const THETA_PSO_EVALUATIONS: f64 = 2e7;
+    /// Trajectory samples kept for every UAV together (duration / 0.1 s × UAVs).
+    pub const TRAJECTORY_SAMPLES: f64 = 1e7;
+    /// FLATLO aircraft.
+    pub const FLATLO_AIRCRAFT: usize = 4_096;
+    /// FLATLO integration steps: aircraft × simulated duration / sim_step
+    /// (about 7e6 per second on this machine's two cores).
+    pub const FLATLO_STEPS: f64 = 1e9;
+    /// FLATLO sample instants scanned by verification: aircraft × duration /
+    /// sample_period.
+    pub const FLATLO_SAMPLES: f64 = 1e9;
+    /// Fleet agents.
+    pub const FLEET_AGENTS: usize = 256;
+    /// Fleet cost evaluations: agents × re-plans × particles × iterations.
+    pub const FLEET_EVALUATIONS: f64 = 2e8;
+    /// Fleet dynamics steps: agents × duration / sim_step.
+    pub const FLEET_STEPS: f64 = 1e9;
+    /// Fleet samples kept: agents × duration × 20 Hz.
+    pub const FLEET_SAMPLES: f64 = 1e7;
+}
+
+/// A figure for budget messages: `1.2e8` beyond 10⁵, `1e-6` below 10⁻⁴,
+/// plain between.
+pub fn figure(x: f64) -> String {
+    if !x.is_finite() {
+        "∞".to_owned()
+    } else if x.abs() >= 1e5 {
+        format!("{x:.1e}").replace(".0e", "e")
+    } else if x != 0.0 && x.abs() < 1e-4 {
+        format!("{x:e}")
+    } else if x == x.trunc() {
+        format!("{x:.0}")
+    } else {
+        format!("{}", (x * 1e3).round() / 1e3)
+    }
+}
+
+/// A predicted figure over its limit; NaN or infinite figures are over.
+pub fn exceeds(figure: f64, limit: f64) -> bool {
+    !figure.is_finite() || figure > limit
+}

@@ -1,0 +1,835 @@
+//! The θ-PSO cost J = β1 J1 + β2 J2 + β3 J3 + β_R J_R + β_B J_B (eqs. 2-5,
+//! 10-11), judged on every UAV's path, not only the centroid's.
+//!
+//! What verification checks is what each UAV flies: its slot offset turned
+//! with the heading, through the reconfigurations and holds (`motion`). So
+//! the cost evaluates the same function:
+//!
+//! - J1 (eq. 3): the centroid path's exact polyline length.
+//! - J2 (eq. 4), per UAV and along whole pieces of path: for each UAV n and
+//!   obstacle k, max(1 − d / r^S, 0) with r^S = r_k + r_Q + margin is
+//!   *integrated* along the UAV's path (closed form on each straight piece,
+//!   `violation_along`), not sampled at midpoints, so a thin pole between
+//!   two samples is seen. Normalised by N K J1, so a path violating by v
+//!   everywhere scores v, as the paper's mean over L segments does. Zero
+//!   exactly when every UAV keeps r_Q + margin from every obstacle.
+//! - J3 (eq. 5), per UAV: the altitude-band violation of each UAV (the ±
+//!   height of a rotated shape included), summed over L equal shares of the
+//!   path as the paper sums over its L segments; below the ground the finite
+//!   `ground_penalty`.
+//! - J_B, per UAV: how far it leaves the x-y bounds, summed the same way
+//!   (the paper keeps the centroid inside by decoding; its UAVs can still
+//!   leave, at an IWP's straight crossing).
+//! - J_R (eq. 11), as printed: mean horizontal distance of the L segment
+//!   midpoints to the enabled IWPs.
+//! - J_T (not in the paper): the centroid path's horizontal turns beyond 90°,
+//!   radians, so the swarm prefers no hairpins where a gentler route exists.
+//!
+//! Speed: a leg far from every obstacle, well inside the band and the bounds
+//! cannot put a UAV in violation (every UAV stays within the formation's
+//! reach of the centroid), so only the legs that come close are followed UAV
+//! by UAV. Along them the path of each UAV is straight between knots (the
+//! path's vertices ± the heading's span, the zones' t1..t4) except where the
+//! heading turns or the shape blends; those stretches are split finely.
+
+use nalgebra::{Point2, Point3, Vector3};
+
+use super::iwp::{Iwp, Shape, column_place};
+use super::motion::Motion;
+use super::path::{CentroidPath, heading_span};
+use crate::base::geometry::Cylinder;
+use crate::mission::{Bounds, Mission, ThetaPsoParams};
+use crate::pipelines::CostTerms;
+
+/// How far a UAV's path may stray from the chord of a piece where the heading
+/// turns, metres: a fifth of the default clearance margin.
+const CHORD_TOLERANCE: f64 = 0.02;
+/// Longest piece where the shape blends, metres.
+const BLEND_STEP: f64 = 2.0;
+/// Room the cost asks between two UAVs beyond 2 r_Q, metres (eq. 7 as
+/// verified is ≥ 2 r_Q); below the room the smallest shrink and the column
+/// leave (`route::SQUEEZE_SPACING_MARGIN`).
+pub const PAIR_FLOOR: f64 = 0.02;
+/// Step of the pair check along the changes of shape, metres.
+const PAIR_STEP: f64 = 0.5;
+/// Halvings of one knot interval at most (2^8 pieces).
+const MAX_DEPTH: u32 = 8;
+
+/// Everything the cost needs, prepared once per run.
+#[derive(Debug, Clone)]
+pub struct CostModel {
+    params: ThetaPsoParams,
+    obstacles: Vec<Cylinder>,
+    slots: Vec<Vector3<f64>>,
+    uav_radius: f64,
+    /// The clearance margin in use (the mission's, reduced where a gap is tight).
+    margin: f64,
+    span: f64,
+    /// Farthest any UAV can be from the centroid horizontally, any shape.
+    reach: f64,
+    /// Farthest any UAV can be above or below the centroid, any shape.
+    rise: f64,
+    /// The same in the nominal shape, outside the reconfiguration zones.
+    nominal_reach: f64,
+    nominal_rise: f64,
+    /// C_j of the enabled IWPs.
+    iwp_points: Vec<Point2<f64>>,
+    band: [f64; 2],
+    bounds: Bounds,
+    /// With terrain, the band is above the ground under each UAV.
+    ground: Option<crate::base::terrain::Ground>,
+    /// Cosine of the largest heading turn over one piece: the turn at which a
+    /// UAV `reach` from the centroid strays `CHORD_TOLERANCE` from the chord.
+    max_turn_cos: f64,
+}
+
+/// What the swarm adds to J for a path that breaks a constraint anywhere
+/// (Deb's feasibility rule, IEEE TEC 2000, as a penalty step): any path that
+/// keeps every UAV clear ranks before any that does not, whatever their
+/// lengths. Larger than any feasible J (J1 of a path within the trajectory
+/// budget is far below 10⁶ m).
+pub const INFEASIBLE_STEP: f64 = 1.0e6;
+
+/// A path's J, its terms, and the objective the swarm minimises.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Evaluation {
+    pub terms: CostTerms,
+    /// J for a path the cost finds clear; else J + [`INFEASIBLE_STEP`] +
+    /// β2 Σ violation / J1 (J2 not averaged over the UAVs and obstacles, so
+    /// one UAV clipping one post of a 200-post wall is not 1/200 as bad).
+    pub objective: f64,
+}
+
+/// Running sums of the per-UAV terms.
+#[derive(Default)]
+struct Sums {
+    /// Σ arc length × (1 − d / r^S)⁺ over UAVs, obstacles, pieces.
+    obstacle: f64,
+    /// Σ arc length × δ over UAVs, pieces.
+    altitude: f64,
+    /// Σ arc length × metres outside the bounds over UAVs, pieces.
+    bounds: f64,
+    /// Σ arc length × metres closer than 2 r_Q + `PAIR_FLOOR`, over the
+    /// pairs of UAVs where they can change (eq. 7).
+    spacing: f64,
+}
+
+impl Sums {
+    fn violated(&self) -> bool {
+        self.obstacle > 0.0 || self.altitude > 0.0 || self.bounds > 0.0 || self.spacing > 0.0
+    }
+}
+
+impl CostModel {
+    pub fn new(mission: &Mission, iwps: &[Iwp]) -> Self {
+        let f = &mission.formation;
+        let shapes: Vec<Shape> = iwps
+            .iter()
+            .filter(|i| i.is_via())
+            .filter_map(|i| i.shape)
+            .collect();
+        let nominal_reach = f.slots.iter().map(|o| o.xy().norm()).fold(0.0, f64::max);
+        let nominal_rise = f.slots.iter().map(|o| o.z.abs()).fold(0.0, f64::max);
+        let (mut reach, mut rise) = (nominal_reach, nominal_rise);
+        for shape in &shapes {
+            for (n, o) in f.slots.iter().enumerate() {
+                let full = shape.offset(&f.slots, n, 1.0);
+                reach = reach.max(full.xy().norm()).max(o.norm());
+                rise = rise.max(match shape {
+                    // Turning about y sweeps x into z: the whole arc.
+                    Shape::Rotation => (o.x * o.x + o.z * o.z).sqrt(),
+                    _ => full.z.abs(),
+                });
+            }
+        }
+        // Room an IWP gap leaves beside the shape that crosses it.
+        let spare = iwps
+            .iter()
+            .filter(|i| i.is_via())
+            .map(|i| {
+                let offsets = i
+                    .shape
+                    .map_or_else(|| f.slots.clone(), |s| s.offsets(&f.slots, 1.0));
+                i.gap / 2.0 - super::iwp::lateral_half_width(&offsets, f.uav_radius)
+            })
+            .fold(f64::INFINITY, f64::min);
+        let margin = mission
+            .theta_pso
+            .clearance_margin
+            .min((spare / 2.0).max(0.0));
+        CostModel {
+            params: mission.theta_pso.clone(),
+            obstacles: mission
+                .obstacles
+                .iter()
+                .map(|o| mission.cylinder(o))
+                .collect(),
+            slots: f.slots.clone(),
+            uav_radius: f.uav_radius,
+            margin,
+            span: heading_span(mission),
+            reach,
+            rise,
+            nominal_reach,
+            nominal_rise,
+            iwp_points: iwps
+                .iter()
+                .filter(|i| i.enabled)
+                .map(|i| i.position)
+                .collect(),
+            band: mission.bounds.z,
+            bounds: mission.bounds.clone(),
+            ground: mission.ground_model(),
+            max_turn_cos: {
+                let half = (1.0 - CHORD_TOLERANCE / reach.max(CHORD_TOLERANCE)).max(0.0);
+                2.0 * half * half - 1.0
+            },
+        }
+    }
+
+    /// The clearance beyond r_Q the cost asks of every UAV, metres.
+    pub fn margin(&self) -> f64 {
+        self.margin
+    }
+
+    /// J and its terms for a centroid path.
+    pub fn terms(&self, path: &CentroidPath) -> CostTerms {
+        self.evaluate_below(path, f64::INFINITY).terms
+    }
+
+    /// J, its terms and the swarm's objective, or, as soon as the objective
+    /// is known to reach `bound`, partial sums that already do (every term is
+    /// ≥ 0, so a partial sum is a lower bound). The swarm passes a particle's
+    /// personal best: a candidate that cannot beat it changes nothing,
+    /// whatever its exact cost, so the search is the same as with full
+    /// evaluations, only faster.
+    pub fn evaluate_below(&self, path: &CentroidPath, bound: f64) -> Evaluation {
+        let (terms, violation) = self.terms_below(path, bound);
+        let objective = if violation > 0.0 {
+            terms.total + INFEASIBLE_STEP + self.params.weight_obstacle * violation
+        } else {
+            terms.total
+        };
+        Evaluation { terms, objective }
+    }
+
+    /// J's terms (partial once the objective reaches `bound`) and the
+    /// undiluted obstacle violation: Σ over UAVs and obstacles of the
+    /// violation integral, over J1 (J2 before the paper's mean over N and K).
+    /// Any band or bounds violation counts as a violation too.
+    fn terms_below(&self, path: &CentroidPath, bound: f64) -> (CostTerms, f64) {
+        let points = &path.points;
+        let p = &self.params;
+        let motion = Motion::new(path, &self.slots, self.span);
+        let total = motion.length();
+        let turning = turning_excess(points);
+        let (segments, jr) = self.waypoint_term(points, total);
+        let mut terms = CostTerms {
+            length: total,
+            waypoints: jr,
+            turning,
+            total: p.weight_length * total + p.weight_waypoints * jr + p.weight_turning * turning,
+            ..CostTerms::default()
+        };
+        // Until a violation shows, the objective is at least J's sum so far
+        // (an infeasible path's is larger still, by the step).
+        if terms.total >= bound {
+            return (terms, 0.0);
+        }
+        let arcs = motion.walker().arcs();
+        let mut sums = Sums::default();
+        let mut scratch = Scratch::default();
+        let n = self.slots.len().max(1) as f64;
+        let k = self.obstacles.len();
+        let l = segments.max(1) as f64;
+        let obstacle_scale = if k > 0 && total > 0.0 {
+            1.0 / (n * k as f64 * total)
+        } else {
+            0.0
+        };
+        let share = if total > 0.0 { l / (n * total) } else { 0.0 };
+        let undiluted = if total > 0.0 { 1.0 / total } else { 0.0 };
+        let base = terms.total;
+        // The pairs' deficit (eq. 7) last: the most costly term, and not
+        // needed when the legs alone reach the bound.
+        let mut reached_bound = false;
+        for (i, leg) in points.windows(2).enumerate() {
+            let (a, b) = (leg[0], leg[1]);
+            // Outside the zones the formation keeps its nominal extent.
+            let (s0, s1) = (arcs[i], arcs[i + 1]);
+            let (reach, rise) = if path.zones.iter().any(|z| {
+                let [z0, _, _, z3] = z.arcs();
+                z0 < s1 && s0 < z3
+            }) {
+                (self.reach, self.rise)
+            } else {
+                (self.nominal_reach, self.nominal_rise)
+            };
+            scratch.near.clear();
+            for (k, c) in self.obstacles.iter().enumerate() {
+                if let Some(window) = self.touch_window(&a, &b, c, reach, rise) {
+                    scratch.near.push((k, window));
+                }
+            }
+            let low = a.z.min(b.z) - rise;
+            let high = a.z.max(b.z) + rise;
+            // Over terrain the band moves with the ground: follow every leg.
+            let band = self.ground.is_some() || low < self.band[0] || high > self.band[1];
+            let edge = self
+                .bounds
+                .horizontal_margin(&a)
+                .min(self.bounds.horizontal_margin(&b))
+                < reach;
+            if scratch.near.is_empty() && !band && !edge {
+                continue;
+            }
+            self.follow_leg(
+                &motion,
+                path,
+                arcs[i],
+                arcs[i + 1],
+                band || edge,
+                &mut scratch,
+                &mut sums,
+            );
+            let mut so_far = base
+                + p.weight_obstacle * sums.obstacle * obstacle_scale
+                + (p.weight_altitude * sums.altitude + p.weight_bounds * sums.bounds) * share;
+            if sums.violated() {
+                so_far += INFEASIBLE_STEP
+                    + p.weight_obstacle * (sums.obstacle + sums.spacing) * undiluted;
+            }
+            if so_far >= bound {
+                reached_bound = true;
+                break;
+            }
+        }
+        if !reached_bound {
+            sums.spacing = self.pair_deficit(&motion, path, &mut scratch.current);
+        }
+        terms.obstacle = sums.obstacle * obstacle_scale;
+        terms.altitude = sums.altitude * share;
+        terms.bounds = sums.bounds * share;
+        terms.total = base
+            + p.weight_obstacle * terms.obstacle
+            + p.weight_altitude * terms.altitude
+            + p.weight_bounds * terms.bounds;
+        let violation = if sums.violated() {
+            // Positive even for a band or bounds violation alone.
+            ((sums.obstacle + sums.spacing) * undiluted).max(f64::MIN_POSITIVE)
+        } else {
+            0.0
+        };
+        (terms, violation)
+    }
+
+    /// J_R (eq. 11) over about L segments (each leg a share proportional to
+    /// its length, at least one); returns the segment count and J_R.
+    fn waypoint_term(&self, points: &[Point3<f64>], total: f64) -> (usize, f64) {
+        let target = self.params.segments.max(1) as f64;
+        let mut segments = 0usize;
+        let mut sum = 0.0;
+        for leg in points.windows(2) {
+            let (a, b) = (leg[0], leg[1]);
+            let len = (b - a).norm();
+            let pieces = if total > 0.0 {
+                ((target * len / total).round() as usize).max(1)
+            } else {
+                1
+            };
+            if !self.iwp_points.is_empty() {
+                for k in 0..pieces {
+                    let u = (k as f64 + 0.5) / pieces as f64;
+                    let mid = a + (b - a) * u;
+                    sum += self
+                        .iwp_points
+                        .iter()
+                        .map(|c| (mid.xy() - c).norm())
+                        .sum::<f64>();
+                }
+            }
+            segments += pieces;
+        }
+        let m = self.iwp_points.len();
+        let jr = if m > 0 {
+            sum / (segments.max(1) as f64 * m as f64)
+        } else {
+            0.0
+        };
+        (segments, jr)
+    }
+
+    /// Where along the centroid leg a-b (fractions t0 ≤ t ≤ t1) a UAV of
+    /// the formation can come within r_Q + margin of cylinder `c`, or `None`
+    /// when nowhere (broad phase: every UAV is within `reach` of the centroid
+    /// horizontally and `rise` vertically on this leg).
+    fn touch_window(
+        &self,
+        a: &Point3<f64>,
+        b: &Point3<f64>,
+        c: &Cylinder,
+        reach: f64,
+        rise: f64,
+    ) -> Option<(f64, f64)> {
+        let safe = c.radius + self.uav_radius + self.margin + reach;
+        if a.z.min(b.z) - rise >= c.height + self.uav_radius + self.margin {
+            // Entirely above the top by more than the safe distance.
+            return None;
+        }
+        // |a + t (b − a) − c|² < safe² in the plane: a quadratic in t.
+        let d = b.xy() - a.xy();
+        let f = a.xy() - c.center;
+        let qa = d.norm_squared();
+        let qb = 2.0 * f.dot(&d);
+        let qc = f.norm_squared() - safe * safe;
+        if qa < 1e-18 {
+            return (qc < 0.0).then_some((0.0, 1.0));
+        }
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc <= 0.0 {
+            return None;
+        }
+        let root = disc.sqrt();
+        let t0 = ((-qb - root) / (2.0 * qa)).max(0.0);
+        let t1 = ((-qb + root) / (2.0 * qa)).min(1.0);
+        (t0 < t1).then_some((t0, t1))
+    }
+
+    /// Follows every UAV along the leg [s0, s1] of the centroid path: the
+    /// whole leg when `whole` (the band or the bounds are in reach), else only
+    /// the windows where a UAV can touch one of `scratch.near`'s obstacles.
+    #[allow(clippy::too_many_arguments)]
+    fn follow_leg(
+        &self,
+        motion: &Motion<'_>,
+        path: &CentroidPath,
+        s0: f64,
+        s1: f64,
+        whole: bool,
+        scratch: &mut Scratch,
+        sums: &mut Sums,
+    ) {
+        if s1 <= s0 {
+            return;
+        }
+        let Scratch {
+            near,
+            windows,
+            knots,
+            samples,
+            previous,
+            current,
+        } = scratch;
+        let len = s1 - s0;
+        // Obstacle windows as arc lengths, merged.
+        for (_, (t0, t1)) in near.iter_mut() {
+            (*t0, *t1) = (s0 + *t0 * len, s0 + *t1 * len);
+        }
+        windows.clear();
+        if whole {
+            windows.push((s0, s1));
+        } else {
+            windows.extend(near.iter().map(|(_, w)| *w));
+            windows.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut merged = 0;
+            for i in 1..windows.len() {
+                if windows[i].0 <= windows[merged].1 {
+                    windows[merged].1 = windows[merged].1.max(windows[i].1);
+                } else {
+                    merged += 1;
+                    windows[merged] = windows[i];
+                }
+            }
+            windows.truncate(merged + 1);
+        }
+        let span = motion.span();
+        for &(w0, w1) in windows.iter() {
+            knots.clear();
+            knots.push(w0);
+            knots.push(w1);
+            for &a in motion.walker().arcs() {
+                for s in [a - span, a + span] {
+                    if w0 < s && s < w1 {
+                        knots.push(s);
+                    }
+                }
+            }
+            for zone in &path.zones {
+                for s in zone.arcs() {
+                    if w0 < s && s < w1 {
+                        knots.push(s);
+                    }
+                }
+                // In file along the path, UAV n passes a vertex when the
+                // centroid is its place in the column short of it.
+                let [z0, _, _, z3] = zone.arcs();
+                let column = [Some(zone.shape), zone.from, zone.into]
+                    .into_iter()
+                    .flatten()
+                    .find(|s| matches!(s, Shape::Alignment { .. }));
+                if let Some(Shape::Alignment { spacing }) = column {
+                    for &a in motion.walker().arcs() {
+                        for n in 0..self.slots.len() {
+                            let s = a - column_place(&self.slots, n, spacing);
+                            if w0 < s && s < w1 && z0 <= s && s <= z3 {
+                                knots.push(s);
+                            }
+                        }
+                    }
+                }
+            }
+            // Over terrain, sample the band at the map's resolution (at most
+            // 4096 samples a window): the ground changes between vertices.
+            if let Some(g) = &self.ground {
+                let pixel = g.map.pixel[0].abs().min(g.map.pixel[1].abs());
+                let step = pixel.max((w1 - w0) / 4096.0);
+                let mut s = w0 + step;
+                while s < w1 {
+                    knots.push(s);
+                    s += step;
+                }
+            }
+            knots.sort_by(f64::total_cmp);
+            knots.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+
+            // Split the intervals where the heading turns (until each piece's
+            // chord stays within CHORD_TOLERANCE of the UAVs' arcs) or the
+            // shape blends.
+            samples.clear();
+            samples.push(w0);
+            let mut heading_before = motion.walker().heading(w0, span);
+            for w in knots.windows(2) {
+                let (k0, k1) = (w[0], w[1]);
+                let heading_after = motion.walker().heading(k1, span);
+                let blend_step = if motion.state_at((k0 + k1) / 2.0).is_changing() {
+                    BLEND_STEP
+                } else {
+                    f64::INFINITY
+                };
+                let piece = Piece {
+                    motion,
+                    max_turn_cos: self.max_turn_cos,
+                    step: blend_step,
+                };
+                piece.split(k0, k1, heading_before, heading_after, MAX_DEPTH, samples);
+                heading_before = heading_after;
+            }
+
+            motion.positions_into(samples[0], previous);
+            for w in samples.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                motion.positions_into(b, current);
+                for &(k, (n0, n1)) in near.iter() {
+                    if b < n0 || a > n1 {
+                        continue;
+                    }
+                    let c = &self.obstacles[k];
+                    let safe = c.radius + self.uav_radius + self.margin;
+                    for (p, q) in previous.iter().zip(current.iter()) {
+                        sums.obstacle += violation_along(p, q, c, safe);
+                    }
+                }
+                if whole {
+                    self.observe_points(current, b - a, sums);
+                }
+                std::mem::swap(previous, current);
+            }
+        }
+    }
+
+    /// How far two UAVs come closer than [`PAIR_FLOOR`] to each other
+    /// (eq. 7), integrated over the stretches where the pairs can change: the
+    /// changes of shape (a straight blend between two shapes can bring two
+    /// UAVs closer than either shape does) and a column's hold (a UAV flies at
+    /// the centroid path's point its place ahead, so a hairpin or a sharp
+    /// corner brings two of them together). A rigid shape held keeps its
+    /// pairs, which validation checked.
+    fn pair_deficit(
+        &self,
+        motion: &Motion<'_>,
+        path: &CentroidPath,
+        scratch: &mut Vec<Point3<f64>>,
+    ) -> f64 {
+        let n = self.slots.len();
+        if n < 2 {
+            return 0.0;
+        }
+        let floor = 2.0 * self.uav_radius + PAIR_FLOOR;
+        let mut deficit = 0.0;
+        let mut follow = |from: f64, to: f64, deficit: &mut f64| {
+            let samples = (((to - from) / PAIR_STEP).ceil() as usize).max(1);
+            let step = (to - from) / samples as f64;
+            for k in 0..=samples {
+                motion.positions_into(from + k as f64 * step, scratch);
+                for i in 0..n {
+                    for j in (i + 1)..n {
+                        let gap = floor - (scratch[i] - scratch[j]).norm();
+                        if gap > 0.0 {
+                            *deficit += gap * step;
+                        }
+                    }
+                }
+            }
+        };
+        for zone in &path.zones {
+            let [t1, t2, t3, t4] = zone.arcs();
+            if t2 > t1 {
+                follow(t1, t2, &mut deficit);
+            }
+            if t4 > t3 {
+                follow(t3, t4, &mut deficit);
+            }
+            if let Shape::Alignment { spacing } = zone.shape {
+                deficit += self.column_deficit(motion.walker(), [t2, t3], spacing, floor);
+            }
+        }
+        deficit
+    }
+
+    /// The same over a column's hold [t2, t3], from the path alone: UAV n is
+    /// at the path's point its place ahead of the centroid, so two UAVs are
+    /// the chord between two points of the path a whole number of spacings
+    /// apart. The path is sampled at a quarter spacing, so every such pair
+    /// falls on two samples.
+    fn column_deficit(
+        &self,
+        walker: &super::path::ArcWalker<'_>,
+        [t2, t3]: [f64; 2],
+        spacing: f64,
+        floor: f64,
+    ) -> f64 {
+        let n = self.slots.len();
+        if spacing <= 0.0 || t3 <= t2 {
+            return 0.0;
+        }
+        let step = spacing / 4.0;
+        let half = (n - 1) as f64 * spacing / 2.0;
+        let (from, to) = (t2 - half, t3 + half);
+        let samples = (((to - from) / step).ceil() as usize).max(1);
+        let points: Vec<Point3<f64>> = (0..=samples)
+            .map(|k| walker.at_extended(from + k as f64 * step))
+            .collect();
+        let mut deficit = 0.0;
+        for i in 0..points.len() {
+            for places in 1..n {
+                let j = i + 4 * places;
+                if j >= points.len() {
+                    break;
+                }
+                let gap = floor - (points[j] - points[i]).norm();
+                if gap > 0.0 {
+                    deficit += gap * step;
+                }
+            }
+        }
+        deficit
+    }
+
+    /// Band and bounds violations of the UAVs at one sample, weighted by the
+    /// arc length the sample stands for.
+    fn observe_points(&self, points: &[Point3<f64>], len: f64, sums: &mut Sums) {
+        if len <= 0.0 {
+            return;
+        }
+        for p in points {
+            let ground = self.ground.as_ref().map_or(0.0, |g| g.at(p.x, p.y));
+            sums.altitude += len * self.altitude_violation(p.z - ground);
+            let out = -self.bounds.horizontal_margin(p);
+            if out > 0.0 {
+                sums.bounds += len * out;
+            }
+        }
+    }
+
+    /// δ of eq. 5 for a UAV at height z above the ground.
+    fn altitude_violation(&self, z: f64) -> f64 {
+        let [z_min, z_max] = self.band;
+        if z <= 0.0 {
+            self.params.ground_penalty
+        } else if z > z_max {
+            z - z_max
+        } else if z < z_min {
+            z_min - z
+        } else {
+            0.0
+        }
+    }
+}
+
+/// How finely to split the pieces of a UAV's path.
+struct Piece<'a, 'm> {
+    motion: &'a Motion<'m>,
+    max_turn_cos: f64,
+    /// Longest piece, metres (where the shape blends).
+    step: f64,
+}
+
+impl Piece<'_, '_> {
+    /// Pushes the ends of the pieces of (a, b] into `samples`, halving while
+    /// a piece turns the heading by more than allowed or is longer than the step.
+    fn split(
+        &self,
+        a: f64,
+        b: f64,
+        heading_a: Vector3<f64>,
+        heading_b: Vector3<f64>,
+        depth: u32,
+        samples: &mut Vec<f64>,
+    ) {
+        if depth == 0 || (heading_a.dot(&heading_b) >= self.max_turn_cos && b - a <= self.step) {
+            samples.push(b);
+            return;
+        }
+        let mid = (a + b) / 2.0;
+        let heading_mid = self.motion.walker().heading(mid, self.motion.span());
+        self.split(a, mid, heading_a, heading_mid, depth - 1, samples);
+        self.split(mid, b, heading_mid, heading_b, depth - 1, samples);
+    }
+}
+
+/// J_T: Σ over the path's corners of the horizontal turn beyond 90°,
+/// radians. A sharper corner whips the formation round (its outer UAVs speed
+/// up with the turn rate times their offset) and doubles back on the route.
+pub fn turning_excess(points: &[Point3<f64>]) -> f64 {
+    let mut excess = 0.0;
+    let mut incoming: Option<nalgebra::Vector2<f64>> = None;
+    for w in points.windows(2) {
+        let d = w[1].xy() - w[0].xy();
+        if d.norm_squared() < 1e-18 {
+            continue;
+        }
+        if let Some(a) = incoming {
+            // Only a turn past 90° (dot < 0) counts: atan2 only then.
+            let dot = a.dot(&d);
+            if dot < 0.0 {
+                excess += a.perp(&d).abs().atan2(dot) - std::f64::consts::FRAC_PI_2;
+            }
+        }
+        incoming = Some(d);
+    }
+    excess
+}
+
+/// Buffers reused across the legs of one evaluation.
+#[derive(Default)]
+struct Scratch {
+    /// Obstacles a UAV may touch on this leg, with their window along it.
+    near: Vec<(usize, (f64, f64))>,
+    windows: Vec<(f64, f64)>,
+    knots: Vec<f64>,
+    samples: Vec<f64>,
+    previous: Vec<Point3<f64>>,
+    current: Vec<Point3<f64>>,
+}
+
+/// ∫ max(1 − d / R, 0) dℓ along the straight piece p-q of a UAV's path
+/// (eq. 4's violation, integrated instead of sampled), with d the distance to
+/// the cylinder's axis (over the top disc above it) and R = r^S.
+///
+/// Along a straight line passing h from the axis, d = √(h² + u²) with u the
+/// distance along it from the closest point, so the integral has a closed
+/// form: F(u) = u − (u √(u² + h²) + h² asinh(u / h)) / 2R, taken over the
+/// part of the piece within √(R² − h²) of the closest point. Exact for a
+/// level piece below the top; above it, h is the axis distance at the closest
+/// point (which counts the height over the top disc).
+pub fn violation_along(p: &Point3<f64>, q: &Point3<f64>, c: &Cylinder, safe: f64) -> f64 {
+    let (a, b) = (p.xy(), q.xy());
+    let ab = b - a;
+    let length = ab.norm();
+    let (t, _) = crate::base::geometry::segment_projection(&a, &b, &c.center);
+    let h = c.axis_distance(&(p + (q - p) * t));
+    if h >= safe {
+        return 0.0;
+    }
+    let reach = (safe * safe - h * h).sqrt();
+    if length < 1e-12 {
+        return 0.0;
+    }
+    // Signed distances of the piece's ends from the line's closest point.
+    let along = ab / length;
+    let s_closest = (c.center - a).dot(&along);
+    let u0 = (-s_closest).max(-reach);
+    let u1 = (length - s_closest).min(reach);
+    if u1 <= u0 {
+        return 0.0;
+    }
+    let antiderivative = |u: f64| {
+        let tail = if h > 1e-12 {
+            u * (u * u + h * h).sqrt() + h * h * (u / h).asinh()
+        } else {
+            u * u.abs()
+        };
+        u - tail / (2.0 * safe)
+    };
+    antiderivative(u1) - antiderivative(u0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipelines::theta_pso::path::CentroidPath;
+
+    /// A 60 m × 40 m box, the formation's default triangle, and one post of
+    /// radius 3 m in the middle of the straight line from start to goal.
+    fn one_post() -> Mission {
+        let text = "name = \"one post\"\n\
+             [bounds]\nx = [0.0, 60.0]\ny = [0.0, 40.0]\nz = [5.0, 15.0]\n\
+             [route]\nstart = [5.0, 20.0, 10.0]\ngoal = [55.0, 20.0, 10.0]\n\
+             [[obstacles]]\nname = \"post\"\ncenter = [30.0, 20.0]\nradius = 3.0\nheight = 30.0\n";
+        match crate::mission::parse_str(text, "one-post.toml") {
+            Ok(loaded) => loaded.mission,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// Deb's rule (cost.rs, `INFEASIBLE_STEP`): a short path through the post
+    /// has the smaller J, yet ranks after a long path round it, whatever the
+    /// weights make of the lengths.
+    #[test]
+    fn a_feasible_path_ranks_before_a_shorter_infeasible_one() {
+        let m = one_post();
+        let model = CostModel::new(&m, &[]);
+        let (s, g) = (m.route.start, m.route.goal);
+        let through = CentroidPath::bare(vec![s, g]);
+        let round = CentroidPath::bare(vec![
+            s,
+            Point3::new(20.0, 32.0, 10.0),
+            Point3::new(40.0, 32.0, 10.0),
+            g,
+        ]);
+        let a = model.evaluate_below(&through, f64::INFINITY);
+        let b = model.evaluate_below(&round, f64::INFINITY);
+        assert!(a.terms.length < b.terms.length);
+        assert!(
+            a.terms.obstacle > 0.0,
+            "the straight path must clip the post"
+        );
+        assert_eq!(b.terms.obstacle, 0.0, "the detour must keep clear");
+        assert_eq!(b.objective, b.terms.total, "a clear path's objective is J");
+        assert!(a.objective >= a.terms.total + INFEASIBLE_STEP);
+        assert!(a.objective > b.objective);
+    }
+
+    /// The step ranks infeasible paths among themselves by how badly they
+    /// break the constraints: a path that grazes the post ranks before one
+    /// through its centre.
+    #[test]
+    fn among_infeasible_paths_the_smaller_violation_ranks_first() {
+        let m = one_post();
+        let model = CostModel::new(&m, &[]);
+        let (s, g) = (m.route.start, m.route.goal);
+        let graze = |y: f64| {
+            CentroidPath::bare(vec![
+                s,
+                Point3::new(25.0, y, 10.0),
+                Point3::new(35.0, y, 10.0),
+                g,
+            ])
+        };
+        let centre = model.evaluate_below(&graze(20.0), f64::INFINITY);
+        let edge = model.evaluate_below(&graze(24.5), f64::INFINITY);
+        assert!(centre.objective >= INFEASIBLE_STEP && edge.objective >= INFEASIBLE_STEP);
+        assert!(edge.terms.obstacle < centre.terms.obstacle);
+        assert!(edge.objective < centre.objective);
+    }
+}

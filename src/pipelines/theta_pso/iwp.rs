@@ -1,0 +1,543 @@
+//! Intermediate waypoints (θ-PSO eq. 9) and the shape the formation takes there.
+//!
+//! Reading of eq. 9: for two obstacles p, q the gap d_pq is the distance
+//! between their circles along the line C_p C_q (centre distance minus both
+//! radii). An IWP sits at the midpoint of that gap when the gap is at least
+//! one UAV wide (2 r_Q) but narrower than the formation (2 (r_F + r_Q)):
+//! one UAV fits, the nominal formation does not. Two refinements a flight
+//! engineer needs and the paper leaves implicit:
+//! - a gap blocked by a third obstacle (the segment P_p P_q passes within
+//!   r_Q of it) is not a passage and gets no IWP;
+//! - both obstacles must reach into the altitude band; over a lower one the
+//!   formation can simply fly.
+//!
+//! The formation crosses an IWP straight along the gap's normal, so what must
+//! fit is its *lateral* width (UAV radius included), not r_F. Hence:
+//! - a gap at least as wide as the nominal shape's lateral width needs no
+//!   reconfiguration: the IWP is flown straight through in the nominal shape;
+//! - `auto` picks, among the shapes that narrow the formation enough, the one
+//!   that moves the UAVs least; rotation (about the lateral axis) never
+//!   narrows it, so `auto` never offers it for a gap;
+//! - a shape that does not fit (the operator's choice) makes the IWP unusable,
+//!   with the reason, instead of a plan that fails later.
+
+use nalgebra::{Point2, Vector2, Vector3};
+use serde::Serialize;
+
+use crate::base::geometry::segment_point_distance;
+use crate::mission::{Formation, Mission, ShapeChoice};
+
+/// An intermediate waypoint between two obstacles.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Iwp {
+    /// Names of the two obstacles, in file order.
+    pub between: [String; 2],
+    /// Their indices in `mission.obstacles`.
+    pub obstacles: [usize; 2],
+    /// C_j, the gap's midpoint, metres ENU.
+    pub position: Point2<f64>,
+    /// d_pq, free width of the gap, metres.
+    pub gap: f64,
+    /// Unit vector across the gap line (perpendicular to C_p C_q): the
+    /// direction the formation flies through.
+    pub normal: Vector2<f64>,
+    /// Disabled IWPs take no part in J_R and cause no reconfiguration.
+    pub enabled: bool,
+    /// The operator's choice (or the mission's default).
+    pub choice: ShapeChoice,
+    /// The shape flown through the gap; `None` when the nominal formation
+    /// already fits (or when the IWP is unusable).
+    pub shape: Option<Shape>,
+    /// Why no shape can pass this gap, when none can.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unusable: Option<String>,
+    /// h: the new shape is held this far each side of the gap line, metres
+    /// of centroid path (`hold_distance` plus the depth of the wall; for a
+    /// column, plus its length, so that every UAV passes in file).
+    pub hold: f64,
+    /// The crossing is straight this far each side of the gap line, metres:
+    /// h plus the heading's span for a rigid shape, only through the posts
+    /// for a column (whose UAVs follow the path).
+    pub straight: f64,
+}
+
+impl Iwp {
+    /// The planned path goes through this IWP.
+    pub fn is_via(&self) -> bool {
+        self.enabled && self.unusable.is_none()
+    }
+
+    /// "alignment", "shrink", …, or "nominal" when the formation passes as it is.
+    pub fn shape_name(&self) -> &'static str {
+        match (&self.shape, &self.unusable) {
+            (_, Some(_)) => "unusable",
+            (Some(shape), None) => shape.name(),
+            (None, None) => "nominal",
+        }
+    }
+}
+
+/// A formation shape at an IWP (θ-PSO paper, Fig. 2).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Shape {
+    /// Single file along the direction of travel, spaced as the closest
+    /// nominal pair (never closer than 2 r_Q).
+    Alignment { spacing: f64 },
+    /// The shape turned 90° about the formation's lateral (y) axis, into the
+    /// vertical plane across the path. A slot on the y axis (UAV 1 of the
+    /// paper's triangle) keeps its path; the others change height (Fig. 7).
+    Rotation,
+    /// The shape scaled toward the centroid.
+    Shrink { scale: f64 },
+}
+
+impl Shape {
+    /// Slot offsets (formation frame) part-way into the shape: `blend` 0 is
+    /// the nominal formation, 1 the full shape. Rotation turns rigidly; the
+    /// others move each UAV along a straight line.
+    pub fn offsets(&self, nominal: &[Vector3<f64>], blend: f64) -> Vec<Vector3<f64>> {
+        (0..nominal.len())
+            .map(|n| self.offset(nominal, n, blend))
+            .collect()
+    }
+
+    /// The offset of slot `n` alone (no allocation: the cost calls this for
+    /// every UAV at every knot).
+    pub fn offset(&self, nominal: &[Vector3<f64>], n: usize, blend: f64) -> Vector3<f64> {
+        let o = nominal[n];
+        match *self {
+            Shape::Alignment { spacing } => {
+                let x = column_place(nominal, n, spacing);
+                o.lerp(&Vector3::new(x, 0.0, 0.0), blend)
+            }
+            Shape::Rotation => {
+                let (s, c) = (blend * std::f64::consts::FRAC_PI_2).sin_cos();
+                // R_y(angle): x' = c x + s z, z' = -s x + c z.
+                Vector3::new(c * o.x + s * o.z, o.y, -s * o.x + c * o.z)
+            }
+            Shape::Shrink { scale } => o * (1.0 - blend * (1.0 - scale)),
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            Shape::Alignment { .. } => "alignment",
+            Shape::Rotation => "rotation",
+            Shape::Shrink { .. } => "shrink",
+        }
+    }
+}
+
+/// How far ahead of the centroid (negative: behind) slot `n` flies in the
+/// column, metres along the path.
+pub fn column_place(nominal: &[Vector3<f64>], n: usize, spacing: f64) -> f64 {
+    let count = nominal.len() as f64;
+    (column_rank(nominal, n) as f64 - (count - 1.0) / 2.0) * spacing
+}
+
+/// Place of slot `n` in the column, front to back by forward offset (ties by
+/// index), so that forming the column never makes two UAVs swap places.
+fn column_rank(nominal: &[Vector3<f64>], n: usize) -> usize {
+    let key = |m: usize| (nominal[m].x, m);
+    let (x, _) = key(n);
+    (0..nominal.len())
+        .filter(|&m| {
+            let (xm, _) = key(m);
+            xm < x || (xm == x && m < n)
+        })
+        .count()
+}
+
+/// Half the width the offsets occupy across the path, UAV radius included.
+pub fn lateral_half_width(offsets: &[Vector3<f64>], uav_radius: f64) -> f64 {
+    offsets.iter().map(|o| o.y.abs()).fold(0.0, f64::max) + uav_radius
+}
+
+/// Largest vertical distance of a slot from the centroid.
+pub fn vertical_half_height(offsets: &[Vector3<f64>]) -> f64 {
+    offsets.iter().map(|o| o.z.abs()).fold(0.0, f64::max)
+}
+
+/// Smallest distance between two slots (∞ for fewer than two).
+pub fn min_pair_distance(offsets: &[Vector3<f64>]) -> f64 {
+    let mut best = f64::INFINITY;
+    for i in 0..offsets.len() {
+        for j in (i + 1)..offsets.len() {
+            best = best.min((offsets[i] - offsets[j]).norm());
+        }
+    }
+    best
+}
+
+/// The spacing of the alignment column: the closest nominal pair, at least 2 r_Q.
+pub fn column_spacing(formation: &Formation) -> f64 {
+    let nominal = min_pair_distance(&formation.slots);
+    let floor = 2.0 * formation.uav_radius + COLUMN_SPARE;
+    let spacing = if nominal.is_finite() {
+        nominal.max(floor)
+    } else {
+        floor
+    };
+    // Eq. 7: the column's first and last UAVs stay within d_com of each
+    // other, with room to spare for the sampling.
+    let gaps = formation.slots.len().saturating_sub(1) as f64;
+    if gaps > 0.0 {
+        spacing
+            .min((formation.comm_range - COLUMN_SPARE) / gaps)
+            .max(floor)
+    } else {
+        spacing
+    }
+}
+
+/// What a column leaves of d_com at its ends, and beyond 2 r_Q between two
+/// UAVs, metres (room for the sampling).
+const COLUMN_SPARE: f64 = 0.05;
+
+/// Whether a column of the formation keeps eq. 7: 2 r_Q apart and its ends
+/// within d_com.
+fn column_keeps_eq7(formation: &Formation) -> bool {
+    let gaps = formation.slots.len().saturating_sub(1) as f64;
+    gaps * column_spacing(formation) <= formation.comm_range + FIT_EPS
+}
+
+/// Half length of the chord the formation frame's heading is taken from
+/// (see `path::ArcWalker::heading`).
+pub fn heading_span(mission: &Mission) -> f64 {
+    mission.formation.radius().max(1.0)
+}
+
+/// Tolerance of the width comparisons, metres.
+const FIT_EPS: f64 = 1e-9;
+
+/// How the formation passes a gap of width `gap`: `Ok(Some(shape))` to
+/// reconfigure, `Ok(None)` when the nominal shape already fits, `Err(reason)`
+/// when the chosen shape cannot pass.
+///
+/// `Auto` is the least change that fits: among the shapes that make the
+/// lateral width fit, the one that moves the UAVs least (largest slot
+/// displacement). Shrink is tried at the largest scale that leaves `margin`
+/// beside the outermost UAVs (never below the spacing 2 r_Q allows), which
+/// often beats a full alignment.
+pub fn resolve_shape(
+    choice: ShapeChoice,
+    gap: f64,
+    formation: &Formation,
+    shrink: f64,
+    margin: f64,
+) -> Result<Option<Shape>, String> {
+    let slots = &formation.slots;
+    let r_q = formation.uav_radius;
+    let fits =
+        |shape: &Shape| lateral_half_width(&shape.offsets(slots, 1.0), r_q) <= gap / 2.0 + FIT_EPS;
+    let width = |shape: &Shape| 2.0 * lateral_half_width(&shape.offsets(slots, 1.0), r_q);
+    let nominal_width = 2.0 * lateral_half_width(slots, r_q);
+    let alignment = Shape::Alignment {
+        spacing: column_spacing(formation),
+    };
+    let column_ok = column_keeps_eq7(formation);
+    let explicit = |shape: Shape| {
+        if matches!(shape, Shape::Alignment { .. }) && !column_ok {
+            Err(format!(
+                "a column of {} UAVs at least 2 r_Q = {:.2} m apart is longer than d_com = {} m (eq. 7)",
+                slots.len(),
+                2.0 * r_q,
+                formation.comm_range
+            ))
+        } else if fits(&shape) {
+            Ok(Some(shape))
+        } else {
+            Err(format!(
+                "{} leaves the formation {:.2} m wide (UAV radius included) and the gap is {gap:.2} m{}",
+                shape.name(),
+                width(&shape),
+                match shape {
+                    Shape::Rotation => ": rotation keeps the width; choose alignment or shrink",
+                    _ => "",
+                }
+            ))
+        }
+    };
+    match choice {
+        ShapeChoice::Alignment => explicit(alignment),
+        ShapeChoice::Rotation => explicit(Shape::Rotation),
+        ShapeChoice::Shrink => explicit(Shape::Shrink { scale: shrink }),
+        ShapeChoice::Auto => {
+            if nominal_width <= gap + 2.0 * FIT_EPS {
+                return Ok(None);
+            }
+            let mut candidates = if column_ok {
+                vec![alignment]
+            } else {
+                Vec::new()
+            };
+            let widest = slots.iter().map(|o| o.y.abs()).fold(0.0, f64::max);
+            if widest > 0.0 {
+                let fit = (gap / 2.0 - r_q - margin.max(0.0)) / widest;
+                let closest = min_pair_distance(slots);
+                let floor = if closest.is_finite() {
+                    2.0 * r_q / closest
+                } else {
+                    0.0
+                };
+                // fit < 1 here (the nominal shape does not fit), so a shrink
+                // at `fit` always narrows the formation.
+                if fit > 0.0 && fit >= floor {
+                    candidates.push(Shape::Shrink { scale: fit });
+                }
+            }
+            let displacement = |shape: &Shape| {
+                let target = shape.offsets(slots, 1.0);
+                slots
+                    .iter()
+                    .zip(&target)
+                    .map(|(a, b)| (a - b).norm())
+                    .fold(0.0, f64::max)
+            };
+            candidates
+                .into_iter()
+                .filter(|s| fits(s))
+                .min_by(|a, b| displacement(a).total_cmp(&displacement(b)))
+                .map(Some)
+                .ok_or_else(|| {
+                    format!(
+                        "no shape fits: the narrowest, a column, is {:.2} m wide and the gap is {gap:.2} m",
+                        width(&alignment)
+                    )
+                })
+        }
+    }
+}
+
+/// Where a UAV at offset `o` (crossing frame: forward, lateral) would be
+/// within `reach` of an obstacle at (x_k, y_k): the open interval of the
+/// centroid's forward position x' with |x' + o.x − x_k| < √(reach² − (o.y − y_k)²).
+fn conflict(o: &Vector3<f64>, x_k: f64, y_k: f64, reach: f64) -> Option<(f64, f64)> {
+    let dy = o.y - y_k;
+    // Exactly `reach` away is clear (verification asks ≥ r_Q).
+    (dy.abs() < reach - 1e-9).then(|| {
+        let q = (reach * reach - dy * dy).sqrt();
+        (x_k - o.x - q, x_k - o.x + q)
+    })
+}
+
+/// The hold of the crossing of a gap, or why its shape cannot cross.
+///
+/// Crossing straight along the gap's normal, the formation must be in its
+/// new shape wherever the nominal shape (or one part-way into the new one)
+/// would come within r_Q + margin of an obstacle of the wall it pierces: the
+/// hold is `hold_distance` beyond the deepest such point, so the shape is
+/// complete that far before any UAV reaches the obstacles (the paper's "1 m
+/// before"). And the new shape itself must keep r_Q from every obstacle while
+/// it is held; when it cannot, the IWP is unusable.
+fn crossing_hold(
+    mission: &Mission,
+    pair: [usize; 2],
+    center: Point2<f64>,
+    normal: Vector2<f64>,
+    shape: Option<Shape>,
+) -> Result<(f64, f64), String> {
+    let f = &mission.formation;
+    let r_q = f.uav_radius;
+    let margin = mission.theta_pso.clearance_margin.max(0.0);
+    let obstacles = &mission.obstacles;
+    let deepest = obstacles[pair[0]].radius.max(obstacles[pair[1]].radius);
+    let wall_zone = deepest + f.safe_radius() + margin;
+    let mut approaching = vec![f.slots.clone()];
+    if let Some(shape) = shape {
+        for blend in [0.25, 0.5, 0.75] {
+            approaching.push(shape.offsets(&f.slots, blend));
+        }
+    }
+    let held = shape.map_or_else(|| f.slots.clone(), |s| s.offsets(&f.slots, 1.0));
+    let in_band = |k: &usize| obstacles[*k].height > mission.bounds.z[0];
+    let mut depth: f64 = 0.0;
+    for sign in [1.0, -1.0] {
+        let forward = normal * sign;
+        let left = Vector2::new(-forward.y, forward.x);
+        for k in (0..obstacles.len()).filter(in_band) {
+            let d = obstacles[k].center - center;
+            let (x_k, y_k) = (d.dot(&forward), d.dot(&left));
+            let reach = obstacles[k].radius + r_q + margin;
+            for o in approaching.iter().flatten() {
+                if let Some((lo, hi)) = conflict(o, x_k, y_k, reach) {
+                    // Only conflicts at the wall: the path may turn before
+                    // an obstacle farther along the crossing line.
+                    if lo < wall_zone && hi > -wall_zone {
+                        depth = depth.max(lo.abs()).max(hi.abs());
+                    }
+                }
+            }
+        }
+    }
+    let hold = mission.reconfiguration.hold_distance + depth;
+    // A column flies along the path: the straight through the gap is the
+    // hold above, the shape is held until its last UAV is that far past the
+    // gap line (and from when its first is that far before it).
+    // A column flies along the path: it is held from before its first UAV
+    // reaches the wall until its last has left it (and at least as long as a
+    // rigid shape would be), but the path need only be straight through the
+    // posts themselves. A rigid shape is straight for the whole hold, and
+    // for the heading's span beyond it so the heading points along the
+    // crossing throughout.
+    let through_posts = deepest + r_q + margin + mission.reconfiguration.hold_distance;
+    let (hold, line) = match shape {
+        Some(Shape::Alignment { spacing }) => {
+            let half = (0..f.slots.len())
+                .map(|n| column_place(&f.slots, n, spacing).abs())
+                .fold(0.0, f64::max);
+            (hold.max(half + through_posts), through_posts)
+        }
+        _ => (hold, hold + heading_span(mission)),
+    };
+    for sign in [1.0, -1.0] {
+        let forward = normal * sign;
+        let left = Vector2::new(-forward.y, forward.x);
+        for k in (0..obstacles.len()).filter(in_band) {
+            let d = obstacles[k].center - center;
+            let (x_k, y_k) = (d.dot(&forward), d.dot(&left));
+            let reach = obstacles[k].radius + r_q;
+            // Only where the UAV is on the straight: a column's UAVs beyond
+            // it are on the path's other legs, which the cost judges.
+            let on_line = |o: &Vector3<f64>, (lo, hi): (f64, f64)| {
+                let (lo, hi) = (lo.max(-line - o.x), hi.min(line - o.x));
+                (lo < hi).then_some((lo, hi))
+            };
+            if held
+                .iter()
+                .filter_map(|o| conflict(o, x_k, y_k, reach).and_then(|c| on_line(o, c)))
+                .any(|(lo, hi)| lo < hold && hi > -hold)
+            {
+                return Err(format!(
+                    "held through the gap, the {} would pass within r_Q of '{}'",
+                    shape.map_or("nominal formation", |s| s.name()),
+                    obstacles[k].name
+                ));
+            }
+        }
+    }
+    Ok((hold, line))
+}
+
+/// The enabled IWPs no shape can pass, counted by reason (the reason's
+/// text less the obstacles it names), most common first.
+pub fn unusable_by_reason(iwps: &[Iwp]) -> Vec<(String, usize)> {
+    let mut counts: Vec<(String, usize)> = Vec::new();
+    for reason in iwps
+        .iter()
+        .filter(|i| i.enabled)
+        .filter_map(|i| i.unusable.as_deref())
+    {
+        let key = general_reason(reason);
+        match counts.iter_mut().find(|(r, _)| *r == key) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((key, 1)),
+        }
+    }
+    counts.sort_by_key(|c| std::cmp::Reverse(c.1));
+    counts
+}
+
+/// A reason with what is particular to one IWP taken out: the names in
+/// quotes and the figures.
+fn general_reason(reason: &str) -> String {
+    let mut out = String::with_capacity(reason.len());
+    let mut quoted = false;
+    for part in reason.split('\'') {
+        if quoted {
+            out.push_str("another obstacle");
+        } else {
+            out.push_str(part);
+        }
+        quoted = !quoted;
+    }
+    // Figures: "0.42 m" → "… m".
+    let words: Vec<String> = out
+        .split(' ')
+        .map(|w| {
+            if w.trim_end_matches([',', ';', ':']).parse::<f64>().is_ok() {
+                "…".to_owned()
+            } else {
+                w.to_owned()
+            }
+        })
+        .collect();
+    words.join(" ")
+}
+
+/// Every IWP of the mission by eq. 9, with the operator's choices applied.
+pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
+    let f = &mission.formation;
+    let r_q = f.uav_radius;
+    let too_narrow = 2.0 * r_q;
+    let fits_formation = 2.0 * (f.radius() + r_q);
+    let obstacles = &mission.obstacles;
+    let mut found = Vec::new();
+    for p in 0..obstacles.len() {
+        for q in (p + 1)..obstacles.len() {
+            let (a, b) = (&obstacles[p], &obstacles[q]);
+            if a.height <= mission.bounds.z[0] || b.height <= mission.bounds.z[0] {
+                continue;
+            }
+            let axis = b.center - a.center;
+            let distance = axis.norm();
+            if distance == 0.0 {
+                continue;
+            }
+            let gap = distance - a.radius - b.radius;
+            if !(too_narrow <= gap && gap < fits_formation) {
+                continue;
+            }
+            let u = axis / distance;
+            let p_p = a.center + u * a.radius;
+            let p_q = b.center - u * b.radius;
+            let blocked = obstacles.iter().enumerate().any(|(k, o)| {
+                k != p
+                    && k != q
+                    && o.height > mission.bounds.z[0]
+                    && segment_point_distance(&p_p, &p_q, &o.center) < o.radius + r_q
+            });
+            if blocked {
+                continue;
+            }
+            let choice = mission.reconfiguration.choice(&a.name, &b.name);
+            let (enabled, shape_choice, scale) = match choice {
+                Some(w) => (
+                    w.enabled,
+                    w.shape,
+                    w.scale.unwrap_or(mission.reconfiguration.shrink_scale),
+                ),
+                None => (
+                    true,
+                    mission.reconfiguration.default_shape,
+                    mission.reconfiguration.shrink_scale,
+                ),
+            };
+            let position = Point2::from((p_p.coords + p_q.coords) / 2.0);
+            let normal = Vector2::new(-u.y, u.x);
+            let margin = mission.theta_pso.clearance_margin.max(0.0);
+            let resolved = resolve_shape(shape_choice, gap, f, scale, margin).and_then(|shape| {
+                crossing_hold(mission, [p, q], position, normal, shape).map(|hold| (shape, hold))
+            });
+            let (shape, (hold, straight), unusable) = match resolved {
+                Ok((shape, hold)) => (shape, hold, None),
+                Err(reason) => (None, (0.0, 0.0), Some(reason)),
+            };
+            found.push(Iwp {
+                between: [a.name.clone(), b.name.clone()],
+                obstacles: [p, q],
+                position,
+                gap,
+                normal,
+                enabled,
+                choice: shape_choice,
+                shape,
+                unusable,
+                hold,
+                straight,
+            });
+        }
+    }
+    found
+}

@@ -1,0 +1,687 @@
+//! θ-PSO formation planning with reconfiguration (Hoang et al.; Fig. 3 is the
+//! algorithm): find the IWPs (eq. 9), search the centroid path with the
+//! angle-encoded swarm (eq. 1) against J (eqs. 2-5, 10-11), derive each UAV's
+//! timed trajectory through the reconfigurations (eqs. 12-15), and verify the
+//! result against the hard constraints and the inspection passes (eq. 8).
+
+pub mod benchmark;
+pub mod cost;
+pub mod inspection;
+pub mod iwp;
+pub mod motion;
+pub mod path;
+pub mod reference;
+pub mod repair;
+pub mod route;
+pub mod seeding;
+pub mod spso;
+pub mod trajectory;
+pub mod verify;
+
+use std::f64::consts::FRAC_PI_2;
+use std::ops::ControlFlow;
+
+use nalgebra::Point3;
+use serde::Serialize;
+
+use crate::base::swarm::{self, SearchSpace, SwarmConfig};
+use crate::mission::{Diagnostic, FieldPath, Mission};
+use crate::pipelines::{CancelToken, Completion, CostTerms, Event, Level, Observer, PipelineError};
+
+pub use cost::CostModel;
+pub use inspection::PassGeometry;
+pub use iwp::{Iwp, Shape, find_iwps};
+pub use path::{CentroidPath, PathBuilder};
+pub use trajectory::{Reconfiguration, Sample, Trajectory};
+pub use verify::{Check, InspectionResult, Verification};
+
+/// How to run (not what to plan: that is the mission).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlanOptions {
+    /// Evaluate the swarm's costs on the rayon pool (same result either way).
+    pub parallel: bool,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        PlanOptions { parallel: true }
+    }
+}
+
+/// Everything a θ-PSO run produces.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThetaPsoOutcome {
+    pub pipeline: crate::pipelines::Kind,
+    pub mission: String,
+    pub seed: u64,
+    pub completion: Completion,
+    /// Swarm iterations completed, over every run of the swarm.
+    pub iterations: usize,
+    /// Cost evaluations made, over every run of the swarm.
+    pub evaluations: usize,
+    /// Runs of the swarm after the first because the best still failed
+    /// verification (at most `theta_pso.restarts`).
+    pub restarts: usize,
+    /// The best path's cost terms.
+    pub cost: CostTerms,
+    /// Best total cost after each iteration of the run kept (iteration 0 =
+    /// initial swarm).
+    pub convergence: Vec<f64>,
+    /// The intermediate waypoints of eq. 9, enabled or not.
+    pub iwps: Vec<Iwp>,
+    /// The free waypoints the swarm chose, decoded (eq. 1).
+    pub waypoints: Vec<Point3<f64>>,
+    /// P_F*: start, waypoints, IWP crossings and inspection passes, goal.
+    pub centroid_path: Vec<Point3<f64>>,
+    /// Metres.
+    pub path_length: f64,
+    /// Seconds at the formation's ground speed.
+    pub duration: f64,
+    /// Length of the shortest 2-D route any feasible plan's centroid is at
+    /// least as long as (`reference`), metres; `None` when none exists.
+    pub reference_length: Option<f64>,
+    /// J1 / reference length: 1 would be a perfect plan.
+    pub length_ratio: Option<f64>,
+    /// Where each inspection pass lies along the centroid path, seconds.
+    pub passes: Vec<PlannedPass>,
+    pub reconfigurations: Vec<Reconfiguration>,
+    /// Usable, enabled IWPs the plan does not cross (it goes round them),
+    /// as indices into `iwps`.
+    pub bypassed: Vec<usize>,
+    /// Where the plan kept comes from: the swarm, its repair, or the corridor.
+    pub source: PlanSource,
+    /// The route stage's corridor length, metres.
+    pub route_length: f64,
+    pub trajectories: Vec<Trajectory>,
+    pub verification: Verification,
+}
+
+/// An inspection pass as planned.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlannedPass {
+    pub obstacle: String,
+    /// Start and end of the pass, seconds.
+    pub time: [f64; 2],
+    /// The obstacle is on the formation's left.
+    pub on_left: bool,
+}
+
+impl ThetaPsoOutcome {
+    pub fn feasible(&self) -> bool {
+        self.verification.feasible
+    }
+}
+
+/// The dimensions and cost of the swarm search for one mission.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    pub iwps: Vec<Iwp>,
+    pub builder: PathBuilder,
+    pub cost: CostModel,
+    pub space: SearchSpace,
+}
+
+impl Problem {
+    /// The search for `mission`, or the first inspected obstacle whose pass
+    /// cannot be flown (its index and why).
+    pub fn new(mission: &Mission) -> Result<Self, (usize, String)> {
+        let iwps = find_iwps(mission);
+        let passes = inspection::pass_geometries(mission)?;
+        let builder = PathBuilder::new(mission, &iwps, &passes);
+        let cost = CostModel::new(mission, &iwps);
+        // θ and Δθ both live in [-π/2, π/2] (Fig. 3, line 10).
+        let space =
+            SearchSpace::uniform(path::dimensions(mission), -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2);
+        Ok(Problem {
+            iwps,
+            builder,
+            cost,
+            space,
+        })
+    }
+
+    /// Particles follow the route stage's corridor: as many free waypoints
+    /// as it needs, and its squeezed stretches flown shrunk.
+    pub fn follow(&mut self, mission: &Mission, corridor: &route::Corridor) {
+        let free = seeding::free_waypoints(mission, corridor);
+        self.builder.set_free_waypoints(free);
+        self.builder.set_squeeze(corridor.squeeze.clone());
+        let inspected = mission.obstacles.iter().filter(|o| o.inspect).count();
+        self.space = SearchSpace::uniform(3 * free + inspected, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2);
+    }
+
+    /// The centroid path a particle stands for.
+    pub fn path(&self, angles: &[f64]) -> CentroidPath {
+        self.builder.build(angles)
+    }
+
+    /// J and its terms for a particle.
+    pub fn evaluate(&self, angles: &[f64]) -> CostTerms {
+        self.cost.terms(&self.path(angles))
+    }
+
+    /// The swarm's objective for a particle, or a partial sum once it
+    /// reaches `bound` (`CostModel::evaluate_below`).
+    pub fn objective_below(&self, angles: &[f64], bound: f64) -> f64 {
+        self.cost
+            .evaluate_below(&self.path(angles), bound)
+            .objective
+    }
+}
+
+/// What θ-PSO can tell about a mission before planning it: unusable IWPs
+/// (warnings: the plan goes round) and inspection passes that cannot hold
+/// eq. 8 (errors). Shown by `check` and the designer beside validation.
+pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    for iwp in find_iwps(mission) {
+        if let (true, Some(reason)) = (iwp.enabled, &iwp.unusable) {
+            let at = mission
+                .reconfiguration
+                .position(&iwp.between[0], &iwp.between[1])
+                .map_or_else(
+                    || {
+                        FieldPath::root()
+                            .key("reconfiguration")
+                            .key("default_shape")
+                    },
+                    |i| {
+                        FieldPath::root()
+                            .key("reconfiguration")
+                            .key("waypoints")
+                            .index(i)
+                            .key("shape")
+                    },
+                );
+            out.push(Diagnostic::warning(
+                at,
+                format!(
+                    "the IWP between '{}' and '{}' ({:.2} m gap) is unusable: {reason}; \
+                     the plan will not go through it",
+                    iwp.between[0], iwp.between[1], iwp.gap
+                ),
+            ));
+        }
+    }
+    if let Err((k, reason)) = inspection::pass_geometries(mission) {
+        out.push(Diagnostic::error(
+            FieldPath::root().key("obstacles").index(k).key("stand_off"),
+            format!(
+                "'{}' cannot be inspected: {reason}",
+                mission.obstacles[k].name
+            ),
+        ));
+    }
+    out
+}
+
+/// θ-PSO's predicted size against `pipeline::limits`: particles, decision
+/// dimensions, cost evaluations (particles × iterations × (1 + restarts)) and
+/// trajectory samples. The flight is at least the straight start-goal
+/// distance long, so its samples are at least that distance over the ground
+/// speed, every 0.1 s, for every UAV; `plan` checks the real figure again
+/// before it samples the planned path.
+pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
+    use crate::pipelines::{figure, limits};
+    let p = &mission.theta_pso;
+    let at = |key: &str| FieldPath::root().key("theta_pso").key(key);
+    let mut out = Vec::new();
+    if p.swarm_size > limits::THETA_PSO_PARTICLES {
+        out.push(Diagnostic::error(
+            at("swarm_size"),
+            format!(
+                "{} particles is over the limit of {} (memory grows with particles × dimensions)",
+                figure(p.swarm_size as f64),
+                figure(limits::THETA_PSO_PARTICLES as f64)
+            ),
+        ));
+    }
+    if p.waypoints > limits::THETA_PSO_WAYPOINTS {
+        out.push(Diagnostic::error(
+            at("waypoints"),
+            format!(
+                "{} free waypoints is over the limit of {}",
+                figure(p.waypoints as f64),
+                limits::THETA_PSO_WAYPOINTS
+            ),
+        ));
+    }
+    if p.segments > limits::THETA_PSO_SEGMENTS {
+        out.push(Diagnostic::error(
+            at("segments"),
+            format!(
+                "{} segments is over the limit of {} (every cost evaluation walks them)",
+                figure(p.segments as f64),
+                figure(limits::THETA_PSO_SEGMENTS as f64)
+            ),
+        ));
+    }
+    let evaluations = p.swarm_size as f64 * p.iterations as f64 * (1.0 + p.restarts as f64);
+    if crate::pipelines::exceeds(evaluations, limits::THETA_PSO_EVALUATIONS) {
+        // Name the largest factor: that is the field the user most likely mistyped.
+        let key = if p.restarts as f64 >= p.swarm_size.max(p.iterations) as f64 {
+            "restarts"
+        } else if p.swarm_size >= p.iterations {
+            "swarm_size"
+        } else {
+            "iterations"
+        };
+        out.push(Diagnostic::error(
+            at(key),
+            format!(
+                "{} particles × {} iterations × {} runs make {} cost evaluations (limit {})",
+                figure(p.swarm_size as f64),
+                figure(p.iterations as f64),
+                figure(1.0 + p.restarts as f64),
+                figure(evaluations),
+                figure(limits::THETA_PSO_EVALUATIONS)
+            ),
+        ));
+    }
+    let distance = (mission.route.goal - mission.route.start).norm();
+    let speed = mission.formation.ground_speed;
+    let duration = distance / speed;
+    let samples = trajectory_samples(duration, mission.formation.slots.len());
+    if crate::pipelines::exceeds(samples, limits::TRAJECTORY_SAMPLES) {
+        out.push(Diagnostic::error(
+            FieldPath::root().key("formation").key("ground_speed"),
+            format!(
+                "{} m/s makes a flight of at least {} s ({} trajectory samples for {} UAVs, limit {})",
+                figure(speed),
+                figure(duration),
+                figure(samples),
+                mission.formation.slots.len(),
+                figure(limits::TRAJECTORY_SAMPLES)
+            ),
+        ));
+    }
+    out
+}
+
+/// Samples of every UAV's trajectory over `duration` seconds.
+fn trajectory_samples(duration: f64, uavs: usize) -> f64 {
+    (duration / trajectory::SAMPLE_PERIOD + 1.0) * uavs as f64
+}
+
+/// A particle built into a plan and verified.
+struct Attempt {
+    position: Vec<f64>,
+    convergence: Vec<f64>,
+    path: CentroidPath,
+    cost: CostTerms,
+    trajectories: Vec<Trajectory>,
+    reconfigurations: Vec<Reconfiguration>,
+    verification: Verification,
+    source: PlanSource,
+}
+
+/// Where the plan kept comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanSource {
+    /// The swarm's best, as it came out.
+    Swarm,
+    /// The swarm's best, moved out of its violations by the repair step.
+    Repaired,
+    /// The route stage's corridor (the swarm's plans all failed).
+    Corridor,
+}
+
+impl Attempt {
+    /// `position` built, sampled and verified (`OverBudget` when the path is
+    /// too long to sample).
+    fn new(
+        mission: &Mission,
+        problem: &Problem,
+        position: Vec<f64>,
+        convergence: Vec<f64>,
+        source: PlanSource,
+    ) -> Result<Self, PipelineError> {
+        let speed = mission.formation.ground_speed;
+        let mut path = problem.path(&position);
+        problem.builder.name_squeezes(&mut path);
+        let cost = problem.cost.terms(&path);
+        // The budget checked the straight distance; the planned path is longer.
+        let samples = trajectory_samples(cost.length / speed, mission.formation.slots.len());
+        if crate::pipelines::exceeds(samples, crate::pipelines::limits::TRAJECTORY_SAMPLES) {
+            return Err(PipelineError::OverBudget(format!(
+                "formation.ground_speed: the planned path ({:.1} m at {} m/s) needs {} \
+                 trajectory samples (limit {})",
+                cost.length,
+                crate::pipelines::figure(speed),
+                crate::pipelines::figure(samples),
+                crate::pipelines::figure(crate::pipelines::limits::TRAJECTORY_SAMPLES)
+            )));
+        }
+        let names: Vec<String> = mission.obstacles.iter().map(|o| o.name.clone()).collect();
+        let (trajectories, reconfigurations) = trajectory::generate(
+            &path,
+            &problem.iwps,
+            &names,
+            &mission.formation,
+            path::heading_span(mission),
+        );
+        let verification = verify::verify(mission, &trajectories);
+        Ok(Attempt {
+            position,
+            convergence,
+            path,
+            cost,
+            trajectories,
+            reconfigurations,
+            verification,
+            source,
+        })
+    }
+
+    /// Feasible first, then the lower J.
+    fn better_than(&self, other: &Attempt) -> bool {
+        (self.verification.feasible, -self.cost.total)
+            > (other.verification.feasible, -other.cost.total)
+    }
+}
+
+/// The IWPs in a few log lines: each usable one, the unusable ones counted
+/// by reason (a forest has hundreds).
+fn log_iwps(observer: &mut dyn Observer, iwps: &[Iwp]) {
+    for iwp in iwps.iter().filter(|i| i.unusable.is_none()) {
+        let state = if iwp.enabled { "enabled" } else { "disabled" };
+        let message = format!(
+            "IWP between '{}' and '{}': gap {:.2} m, {} ({state})",
+            iwp.between[0],
+            iwp.between[1],
+            iwp.gap,
+            iwp.shape_name()
+        );
+        observer.on_event(Event::Log(Level::Info, &message));
+    }
+    for (reason, count) in iwp::unusable_by_reason(iwps) {
+        let message = format!("{count} IWP(s) unusable: {reason}");
+        observer.on_event(Event::Log(Level::Info, &message));
+    }
+}
+
+/// Plans `mission` with `seed`. Reports to `observer`, stops early (keeping
+/// the best so far) when `cancel` is set. Fails on an invalid mission and
+/// when the route stage finds no corridor (naming what closes the way);
+/// a plan that fails verification is an infeasible outcome, not an error.
+///
+/// The swarm starts partly on the route stage's corridor. When its best
+/// fails verification, the repair step moves it locally; when that fails
+/// too, the swarm runs again with new random streams of the same seed, up to
+/// `theta_pso.restarts` times; when every run fails, the corridor itself is
+/// tried. The first feasible plan is kept, else the one of lowest cost.
+///
+/// Long (~200 lines) because it is Fig. 3 in order: route, swarm, repair, restarts, corridor, each step a few lines that read the one before.
+pub fn plan(
+    mission: &Mission,
+    seed: u64,
+    options: PlanOptions,
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> Result<ThetaPsoOutcome, PipelineError> {
+    if mission.theta_pso.cost == crate::mission::CostKind::Spso {
+        return benchmark::plan(mission, seed, observer, cancel);
+    }
+    crate::pipelines::require_valid(mission)?;
+    crate::pipelines::require_within_budget(budget(mission))?;
+    let errors: Vec<String> = diagnostics(mission)
+        .into_iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.to_string())
+        .collect();
+    if !errors.is_empty() {
+        return Err(PipelineError::InvalidMission(errors.join("\n")));
+    }
+
+    observer.on_event(Event::Stage("intermediate waypoints"));
+    let mut problem = Problem::new(mission).map_err(|(_, e)| PipelineError::InvalidMission(e))?;
+    log_iwps(observer, &problem.iwps);
+    observer.on_event(Event::Stage("route"));
+    let corridor = route::find(
+        mission,
+        &problem.builder,
+        &problem.iwps,
+        problem.cost.margin(),
+    )
+    .map_err(|blocked| PipelineError::NoRoute(blocked.reason))?;
+    problem.follow(mission, &corridor);
+    observer.on_event(Event::Log(
+        Level::Info,
+        &format!(
+            "route: a corridor of {:.1} m, {} free waypoints{}",
+            corridor.length,
+            problem.builder.free_waypoints(),
+            if corridor.squeeze.is_some() {
+                ", squeezed where the site is narrower than the formation"
+            } else {
+                ""
+            }
+        ),
+    ));
+    let speed = mission.formation.ground_speed;
+    let resolution = speed * trajectory::SAMPLE_PERIOD;
+    let reference = reference::lower_bound(mission, &problem.iwps, resolution);
+    let starts = seeding::particles(mission, &problem, &corridor, seed);
+
+    let p = &mission.theta_pso;
+    let mut kept: Option<Attempt> = None;
+    let (mut iterations, mut evaluations, mut restarts) = (0usize, 0usize, 0usize);
+    let mut completion = Completion::Finished;
+    for attempt in 0..=p.restarts {
+        if attempt > 0 {
+            restarts = attempt;
+            let message = format!(
+                "the best plan fails verification ({}); restart {attempt} of {} with new random streams",
+                kept.as_ref()
+                    .and_then(|k| k.verification.first_failure())
+                    .unwrap_or_default(),
+                p.restarts
+            );
+            observer.on_event(Event::Log(Level::Warn, &message));
+        }
+        observer.on_event(Event::Stage("planning"));
+        let (result, convergence) = run_swarm(
+            &problem, p, options, seed, attempt, iterations, &starts, observer, cancel,
+        );
+        iterations += result.iterations;
+        evaluations += result.evaluations;
+        if result.stopped {
+            observer.on_event(Event::Log(
+                Level::Warn,
+                &format!(
+                    "cancelled after {} iterations; keeping the best so far",
+                    result.iterations
+                ),
+            ));
+            completion = Completion::Cancelled;
+        }
+        observer.on_event(Event::Stage("verification"));
+        let mut tried = Attempt::new(
+            mission,
+            &problem,
+            result.best.position,
+            convergence,
+            PlanSource::Swarm,
+        )?;
+        if !tried.verification.feasible
+            && completion == Completion::Finished
+            && let Some(fixed) = repair::repair(mission, &problem, &tried.position)
+        {
+            observer.on_event(Event::Log(
+                Level::Info,
+                &format!(
+                    "the best plan failed verification ({}); the repair step moved it clear",
+                    tried.verification.first_failure().unwrap_or_default()
+                ),
+            ));
+            let convergence = std::mem::take(&mut tried.convergence);
+            tried = Attempt::new(mission, &problem, fixed, convergence, PlanSource::Repaired)?;
+        }
+        let done = tried.verification.feasible || completion == Completion::Cancelled;
+        if kept.as_ref().is_none_or(|k| tried.better_than(k)) {
+            kept = Some(tried);
+        }
+        if done {
+            break;
+        }
+    }
+    // Every run of the swarm failed: fly the corridor itself, if it verifies.
+    if let (Some(k), Some(start)) = (&kept, starts.first())
+        && !k.verification.feasible
+        && completion == Completion::Finished
+    {
+        let position = repair::repair(mission, &problem, start).unwrap_or_else(|| start.clone());
+        let convergence = k.convergence.clone();
+        let fallback = Attempt::new(
+            mission,
+            &problem,
+            position,
+            convergence,
+            PlanSource::Corridor,
+        )?;
+        if fallback.verification.feasible {
+            observer.on_event(Event::Log(
+                Level::Warn,
+                "every run of the swarm failed verification; the route stage's corridor is flown",
+            ));
+            kept = Some(fallback);
+        }
+    }
+    let Some(best) = kept else {
+        return Err(PipelineError::Unsupported(
+            "the swarm never ran (no attempt)".into(),
+        ));
+    };
+    for check in best.verification.checks.iter().filter(|c| !c.ok) {
+        let message = format!(
+            "constraint broken: {} {} {} (worst {:.3})",
+            check.name,
+            check.relation,
+            check.limit,
+            check.worst.unwrap_or(f64::NAN)
+        );
+        observer.on_event(Event::Log(Level::Warn, &message));
+    }
+    for i in best.verification.inspections.iter().filter(|i| !i.ok) {
+        let message = format!(
+            "inspection of '{}' broken: {:.1} m of {} m within [{}, {}] m (eq. 8)",
+            i.obstacle, i.achieved, i.required, i.band[0], i.band[1]
+        );
+        observer.on_event(Event::Log(Level::Warn, &message));
+    }
+    // A cancelled run stays at the share it got through.
+    if completion == Completion::Finished {
+        observer.on_event(Event::Progress(1.0));
+    }
+
+    let waypoints = problem.builder.decode(&best.position);
+    let bypassed = problem
+        .iwps
+        .iter()
+        .enumerate()
+        .filter(|(i, iwp)| iwp.is_via() && !best.path.crossed.contains(i))
+        .map(|(i, _)| i)
+        .collect();
+    let passes = best
+        .path
+        .passes
+        .iter()
+        .map(|pass| PlannedPass {
+            obstacle: mission.obstacles[pass.obstacle].name.clone(),
+            time: [pass.arcs[0] / speed, pass.arcs[1] / speed],
+            on_left: pass.on_left,
+        })
+        .collect();
+    let reference_length = reference.map(|r| r.length);
+    Ok(ThetaPsoOutcome {
+        pipeline: crate::pipelines::Kind::ThetaPso,
+        mission: mission.name.clone(),
+        seed,
+        completion,
+        iterations,
+        evaluations,
+        restarts,
+        cost: best.cost,
+        convergence: best.convergence,
+        iwps: problem.iwps,
+        waypoints,
+        path_length: best.cost.length,
+        duration: best.cost.length / speed,
+        reference_length,
+        length_ratio: reference_length
+            .filter(|r| *r > 0.0)
+            .map(|r| best.cost.length / r),
+        passes,
+        centroid_path: best.path.points,
+        reconfigurations: best.reconfigurations,
+        bypassed,
+        source: best.source,
+        route_length: corridor.length,
+        trajectories: best.trajectories,
+        verification: best.verification,
+    })
+}
+
+/// One run of the swarm from `starts` (the rest at random) on the `attempt`-th
+/// set of random streams, reporting each iteration's best path and J; the
+/// result and the convergence of J (iteration 0 = the initial swarm).
+#[allow(clippy::too_many_arguments)]
+fn run_swarm(
+    problem: &Problem,
+    p: &crate::mission::ThetaPsoParams,
+    options: PlanOptions,
+    seed: u64,
+    attempt: usize,
+    iterations_before: usize,
+    starts: &[Vec<f64>],
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> (swarm::SwarmResult, Vec<f64>) {
+    let config = SwarmConfig {
+        particles: p.swarm_size,
+        iterations: p.iterations,
+        inertia: p.inertia,
+        cognitive: p.cognitive,
+        social: p.social,
+        parallel: options.parallel,
+        streams: attempt as u64,
+    };
+    let mut convergence = Vec::with_capacity(p.iterations + 1);
+    let mut shown: Option<(CentroidPath, CostTerms)> = None;
+    let offset = iterations_before + attempt;
+    let result = swarm::minimize(
+        &problem.space,
+        &config,
+        seed,
+        starts,
+        |angles, bound| problem.objective_below(angles, bound),
+        |report| {
+            // The best only changes on improvement; rebuild its path only then.
+            if report.improved || shown.is_none() {
+                let path = problem.path(&report.best.position);
+                let cost = problem.cost.terms(&path);
+                shown = Some((path, cost));
+            }
+            if let Some((path, cost)) = &shown {
+                // J of the best, not the objective (which adds the
+                // infeasibility step while the best still breaks a constraint).
+                convergence.push(cost.total);
+                observer.on_event(Event::PathIteration {
+                    iteration: offset + report.iteration,
+                    cost,
+                    path: &path.points,
+                });
+            }
+            observer.on_event(Event::Progress(
+                0.95 * report.iteration as f64 / p.iterations.max(1) as f64,
+            ));
+            if cancel.is_cancelled() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+    );
+    (result, convergence)
+}

@@ -1,0 +1,154 @@
+//! The mission as static data: bounds, obstacles, inspected surfaces, route,
+//! terrain, IWPs and the mission file.
+
+use rerun::RecordingStream;
+
+use super::{f32x3, paths};
+use crate::mission::{Mission, to_toml_string};
+use crate::pipelines::theta_pso::find_iwps;
+
+/// The mission as static data.
+pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamResult<()> {
+    stream.log_static(paths::WORLD, &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+    let b = &m.bounds;
+    stream.log_static(
+        paths::BOUNDS,
+        &rerun::Boxes3D::from_mins_and_sizes(
+            [[b.x[0] as f32, b.y[0] as f32, b.z[0] as f32]],
+            [[
+                (b.x[1] - b.x[0]) as f32,
+                (b.y[1] - b.y[0]) as f32,
+                (b.z[1] - b.z[0]) as f32,
+            ]],
+        )
+        .with_labels(["altitude band"]),
+    )?;
+    if !m.obstacles.is_empty() {
+        let o = &m.obstacles;
+        stream.log_static(
+            paths::OBSTACLES,
+            &rerun::Cylinders3D::from_lengths_and_radii(
+                o.iter().map(|o| o.height as f32),
+                o.iter().map(|o| o.radius as f32),
+            )
+            .with_centers(o.iter().map(|o| {
+                [
+                    o.center.x as f32,
+                    o.center.y as f32,
+                    (o.height / 2.0) as f32,
+                ]
+            }))
+            .with_labels(o.iter().map(|o| o.name.clone()))
+            .with_colors(o.iter().map(|o| {
+                if o.inspect {
+                    rerun::Color::from_rgb(200, 90, 200)
+                } else {
+                    rerun::Color::from_rgb(150, 150, 160)
+                }
+            })),
+        )?;
+        // Inspected surfaces (eq. 8): the stand-off band's outer shell,
+        // translucent, over the altitude band.
+        let inspected: Vec<_> = o.iter().filter(|o| o.inspect).collect();
+        if !inspected.is_empty() {
+            let band_height = (m.bounds.z[1] - m.bounds.z[0]) as f32;
+            stream.log_static(
+                paths::INSPECTION,
+                &rerun::Cylinders3D::from_lengths_and_radii(
+                    inspected.iter().map(|_| band_height),
+                    inspected
+                        .iter()
+                        .map(|o| (o.radius + o.stand_off_band(&m.formation)[1]) as f32),
+                )
+                .with_centers(inspected.iter().map(|o| {
+                    [
+                        o.center.x as f32,
+                        o.center.y as f32,
+                        ((m.bounds.z[0] + m.bounds.z[1]) / 2.0) as f32,
+                    ]
+                }))
+                .with_labels(inspected.iter().map(|o| {
+                    let [lo, hi] = o.stand_off_band(&m.formation);
+                    format!("inspect {}: {lo}-{hi} m", o.name)
+                }))
+                .with_colors(
+                    inspected
+                        .iter()
+                        .map(|_| rerun::Color::from_unmultiplied_rgba(200, 90, 200, 40)),
+                ),
+            )?;
+        }
+    }
+    stream.log_static(
+        paths::ROUTE,
+        &rerun::Points3D::new([f32x3(&m.route.start), f32x3(&m.route.goal)])
+            .with_labels(["start", "goal"])
+            .with_radii([0.6f32, 0.6])
+            .with_colors([
+                rerun::Color::from_rgb(60, 200, 60),
+                rerun::Color::from_rgb(220, 60, 60),
+            ]),
+    )?;
+    if let (Some(terrain), Some(map)) = (&m.terrain, m.height_map()) {
+        log_terrain(stream, map, terrain.lookup)?;
+    }
+    let iwps = find_iwps(m);
+    if !iwps.is_empty() {
+        let z = ((m.bounds.z[0] + m.bounds.z[1]) / 2.0) as f32;
+        stream.log_static(
+            paths::IWPS,
+            &rerun::Points3D::new(
+                iwps.iter()
+                    .map(|i| [i.position.x as f32, i.position.y as f32, z]),
+            )
+            .with_labels(iwps.iter().map(|i| {
+                let state = if i.enabled { "" } else { " (disabled)" };
+                format!("IWP {} | {}{state}", i.between[0], i.between[1])
+            }))
+            .with_radii(iwps.iter().map(|_| 0.4f32))
+            .with_colors(iwps.iter().map(|i| {
+                if i.enabled {
+                    rerun::Color::from_rgb(250, 200, 0)
+                } else {
+                    rerun::Color::from_rgb(120, 120, 120)
+                }
+            })),
+        )?;
+    }
+    let toml = to_toml_string(m).unwrap_or_default();
+    stream.log_static(
+        paths::MISSION,
+        &rerun::TextDocument::from_markdown(format!(
+            "# {}\n\n{}\n\nskyform {}\n\n```toml\n{toml}\n```\n",
+            m.name,
+            m.description,
+            env!("CARGO_PKG_VERSION")
+        )),
+    )?;
+    Ok(())
+}
+
+/// The mission's height map as a mesh of at most 200 × 200 points, coloured
+/// by height (`terrain::height_colour`: the hues of the designer's map, brighter).
+fn log_terrain(
+    stream: &RecordingStream,
+    map: &crate::base::terrain::HeightMap,
+    lookup: crate::base::terrain::Lookup,
+) -> rerun::RecordingStreamResult<()> {
+    let grid = crate::base::terrain::Grid::of(map, lookup, 200);
+    let [low, high] = map.range;
+    let span = f64::from(high - low).max(1e-9);
+    stream.log_static(
+        paths::TERRAIN,
+        &rerun::Mesh3D::new(
+            grid.points
+                .iter()
+                .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32]),
+        )
+        .with_triangle_indices(grid.triangles())
+        .with_vertex_colors(grid.points.iter().map(|p| {
+            let [r, g, b] = crate::base::terrain::height_colour((p[2] - f64::from(low)) / span);
+            rerun::Color::from_rgb(r, g, b)
+        })),
+    )
+}
