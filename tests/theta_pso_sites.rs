@@ -12,8 +12,8 @@ mod sites;
 use std::collections::BTreeSet;
 
 use rayon::prelude::*;
-use skyform::pipelines::{CancelToken, Silent};
 use skyform::pipelines::theta_pso::{PlanOptions, plan};
+use skyform::pipelines::{CancelToken, Silent};
 
 /// Sites 400-423 (a range the planner was never tuned on), one seed each.
 const SHARE: std::ops::Range<u64> = 400..424;
