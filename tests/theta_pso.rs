@@ -841,16 +841,7 @@ fn a_walled_in_start_is_refused_by_the_route_stage_naming_the_ring() {
         })
         .collect();
     m.route.start = Point3::new(20.0, 50.0, 10.0);
-    let refused = plan(
-        &m,
-        1,
-        PlanOptions::default(),
-        &mut Silent,
-        &CancelToken::new(),
-    );
-    let Err(PipelineError::NoRoute(why)) = refused else {
-        panic!("expected the route stage to refuse: {refused:?}")
-    };
+    let why = refusal(&m);
     assert!(why.contains("round the start"), "{why}");
     assert!(
         why.contains("24 obstacles ('ring 0', 'ring 1', 'ring 2', …)"),

@@ -66,6 +66,24 @@ pub struct Reached {
     pub stage: Vec<Option<usize>>,
 }
 
+/// The jumps (indices) leaving each cell.
+fn jumps_from(graph: &Graph<'_>) -> std::collections::HashMap<usize, Vec<usize>> {
+    let mut index: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
+    for (j, jump) in graph.jumps.iter().enumerate() {
+        index.entry(jump.from).or_default().push(j);
+    }
+    index
+}
+
+/// The least, over `targets` (a point and what is left from it), of the
+/// straight distance from `p` to the point plus what is left.
+fn lower_bound(targets: &[(Point2<f64>, f64)], p: Point2<f64>) -> f64 {
+    targets
+        .iter()
+        .map(|(q, c)| (p - q).norm() + c)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The cells reached from `start` when `goal` is not among them, in a
 /// relaxation of the search's graph: a cell open in any layer is open to
 /// all, every jump may be taken at any stage. No plain flood (a few
@@ -76,10 +94,7 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
     let mut seen = vec![false; field.len()];
     let mut queue = std::collections::VecDeque::from([start]);
     seen[start] = true;
-    let mut jumps: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
-    for jump in graph.jumps {
-        jumps.entry(jump.from).or_default().push(jump.to);
-    }
+    let jumps = jumps_from(graph);
     while let Some(cell) = queue.pop_front() {
         if cell == goal {
             return None;
@@ -87,7 +102,13 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
         let next = field
             .neighbourhood(cell)
             .filter(|&j| graph.open[j] != 0 || j == goal)
-            .chain(jumps.get(&cell).into_iter().flatten().copied());
+            .chain(
+                jumps
+                    .get(&cell)
+                    .into_iter()
+                    .flatten()
+                    .map(|&j| graph.jumps[j].to),
+            );
         for j in next {
             if !seen[j] {
                 seen[j] = true;
@@ -121,31 +142,19 @@ pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>,
     targets[graph.stages].push((goal_point, 0.0));
     for stage in (0..graph.stages).rev() {
         let after = &targets[stage + 1];
-        let bound = |p: Point2<f64>| {
-            after
-                .iter()
-                .map(|(q, c)| (p - q).norm() + c)
-                .fold(f64::INFINITY, f64::min)
-        };
         let list: Vec<(Point2<f64>, f64)> = graph
             .jumps
             .iter()
             .filter(|j| j.pass_at == Some(stage))
-            .map(|j| (field.center(j.from), j.length + bound(field.center(j.to))))
+            .map(|j| {
+                let end = field.center(j.to);
+                (field.center(j.from), j.length + lower_bound(after, end))
+            })
             .collect();
         targets[stage] = list;
     }
-    let heuristic = |cell: usize, stage: usize| {
-        let p = field.center(cell);
-        targets[stage]
-            .iter()
-            .map(|(q, c)| (p - q).norm() + c)
-            .fold(f64::INFINITY, f64::min)
-    };
-    let mut index: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
-    for (j, jump) in graph.jumps.iter().enumerate() {
-        index.entry(jump.from).or_default().push(j);
-    }
+    let heuristic = |cell: usize, stage: usize| lower_bound(&targets[stage], field.center(cell));
+    let index = jumps_from(graph);
 
     let mut open = BinaryHeap::new();
     let first = state(start, 0, 0);
