@@ -11,7 +11,6 @@
 //! Adding a pipeline: see "Adding a pipeline" in `docs/architecture.md`.
 
 pub mod diagnose;
-pub mod iwp_groups;
 pub mod summary;
 pub mod tracks;
 
@@ -203,7 +202,7 @@ impl Outcome {
         match self {
             Outcome::ThetaPso(o) => summary::theta_pso(o, verbose),
             Outcome::Flatlo(o) => summary::flatlo(o),
-            Outcome::Fleet(o) => summary::fleet(o),
+            Outcome::Fleet(o) => summary::fleet(o, &self.verdict()),
         }
     }
 

@@ -2,9 +2,10 @@
 //! are numbered from 1 here as everywhere a person reads them (UAV 1,
 //! aircraft 1, agent 1); the JSON keeps the 0-based indices.
 
+use super::Verdict;
 use crate::pipelines::flatlo::FlatloOutcome;
 use crate::pipelines::fleet::FleetOutcome;
-use crate::pipelines::theta_pso::ThetaPsoOutcome;
+use crate::pipelines::theta_pso::{ThetaPsoOutcome, unusable};
 
 /// How many unusable IWPs the summary names (the nearest the route).
 const NAMED_UNUSABLE: usize = 3;
@@ -185,16 +186,19 @@ fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
         }
         return;
     }
-    for (reason, count) in crate::pipelines::theta_pso::iwp::unusable_by_reason(&o.iwps) {
-        let _ = writeln!(s, "  IWP          {count} unusable: {reason}");
+    for group in unusable::unusable_groups(&o.iwps, &[], 0) {
+        let _ = writeln!(
+            s,
+            "  IWP          {} unusable: {}",
+            group.count, group.reason
+        );
     }
     if unusable.is_empty() {
         return;
     }
     // The few nearest the path: those a user most likely meant the plan to take.
-    let distance = |i: &crate::pipelines::theta_pso::Iwp| {
-        super::iwp_groups::distance_to(&o.centroid_path, &i.position)
-    };
+    let distance =
+        |i: &crate::pipelines::theta_pso::Iwp| unusable::distance_to(&o.centroid_path, &i.position);
     let mut nearest: Vec<(f64, &crate::pipelines::theta_pso::Iwp)> =
         unusable.iter().map(|i| (distance(i), *i)).collect();
     nearest.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -293,7 +297,7 @@ pub fn flatlo(o: &FlatloOutcome) -> String {
 }
 
 /// The human summary of a fleet outcome.
-pub fn fleet(o: &FleetOutcome) -> String {
+pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(s, "Fleet for \"{}\" (seed {})", o.mission, o.seed);
@@ -359,10 +363,11 @@ pub fn fleet(o: &FleetOutcome) -> String {
         "  PSO effort   {decisions} decisions, {evaluations} cost evaluations ({:.0} per agent per second)",
         evaluations as f64 / (o.agents.len().max(1) as f64 * o.duration.max(1e-9))
     );
-    let verdict = if o.kept_apart() && o.obstacles_clear() && o.converged() {
-        "PASS"
-    } else {
-        "FAIL"
+    // The pass rule is `Outcome::verdict`'s, written once.
+    let verdict = match verdict {
+        Verdict::Passed => "PASS",
+        Verdict::Failed(_) => "FAIL",
+        Verdict::Cancelled => "CANCELLED",
     };
     let _ = writeln!(s, "  result       {verdict}");
     s

@@ -420,52 +420,6 @@ fn crossing_hold(
     Ok((hold, line))
 }
 
-/// The enabled IWPs no shape can pass, counted by reason (the reason's
-/// text less the obstacles it names), most common first.
-pub fn unusable_by_reason(iwps: &[Iwp]) -> Vec<(String, usize)> {
-    let mut counts: Vec<(String, usize)> = Vec::new();
-    for reason in iwps
-        .iter()
-        .filter(|i| i.enabled)
-        .filter_map(|i| i.unusable.as_deref())
-    {
-        let key = general_reason(reason);
-        match counts.iter_mut().find(|(r, _)| *r == key) {
-            Some((_, n)) => *n += 1,
-            None => counts.push((key, 1)),
-        }
-    }
-    counts.sort_by_key(|c| std::cmp::Reverse(c.1));
-    counts
-}
-
-/// A reason with what is particular to one IWP taken out: the names in
-/// quotes and the figures.
-fn general_reason(reason: &str) -> String {
-    let mut out = String::with_capacity(reason.len());
-    let mut quoted = false;
-    for part in reason.split('\'') {
-        if quoted {
-            out.push_str("another obstacle");
-        } else {
-            out.push_str(part);
-        }
-        quoted = !quoted;
-    }
-    // Figures: "0.42 m" → "… m".
-    let words: Vec<String> = out
-        .split(' ')
-        .map(|w| {
-            if w.trim_end_matches([',', ';', ':']).parse::<f64>().is_ok() {
-                "…".to_owned()
-            } else {
-                w.to_owned()
-            }
-        })
-        .collect();
-    words.join(" ")
-}
-
 /// Every IWP of the mission by eq. 9, with the operator's choices applied.
 pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
     let f = &mission.formation;

@@ -16,6 +16,7 @@ pub mod route;
 pub mod seeding;
 pub mod spso;
 pub mod trajectory;
+pub mod unusable;
 pub mod verify;
 
 use std::f64::consts::FRAC_PI_2;
@@ -395,8 +396,8 @@ fn log_iwps(observer: &mut dyn Observer, iwps: &[Iwp]) {
         );
         observer.on_event(Event::Log(Level::Info, &message));
     }
-    for (reason, count) in iwp::unusable_by_reason(iwps) {
-        let message = format!("{count} IWP(s) unusable: {reason}");
+    for group in unusable::unusable_groups(iwps, &[], 0) {
+        let message = format!("{} IWP(s) unusable: {}", group.count, group.reason);
         observer.on_event(Event::Log(Level::Info, &message));
     }
 }

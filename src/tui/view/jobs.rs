@@ -246,7 +246,8 @@ fn theta_pso_table(
         o.reconfigurations.len()
     )));
     let enabled = o.iwps.iter().filter(|i| i.enabled).count();
-    let groups = crate::outcome::iwp_groups::unusable_groups(&o.iwps, &o.centroid_path, 2);
+    let groups =
+        crate::pipelines::theta_pso::unusable::unusable_groups(&o.iwps, &o.centroid_path, 2);
     let unusable: usize = groups.iter().map(|g| g.count).sum();
     let mut iwps = format!("IWPs {} found, {enabled} enabled", o.iwps.len());
     if unusable > 0 {

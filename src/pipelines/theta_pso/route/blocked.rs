@@ -22,6 +22,8 @@ use crate::pipelines::theta_pso::path::PathBuilder;
 const SIDES: [&str; 4] = ["west", "east", "south", "north"];
 
 /// The reason of the route stage's refusal.
+///
+/// Long (~170 lines): one case after another (a stop out of reach, a boxed-in start or goal, a wall between two bounds), each a sentence with its widths.
 #[allow(clippy::too_many_arguments)]
 pub fn explain(
     mission: &Mission,

@@ -32,6 +32,7 @@
 
 mod blocked;
 pub mod field;
+mod guide;
 mod search;
 
 use std::f64::consts::{PI, TAU};
@@ -40,6 +41,7 @@ use std::sync::Arc;
 use nalgebra::Point2;
 
 use self::field::{Disc, Field};
+use self::guide::Guide;
 use self::search::{Graph, Jump, LAYERS, Step, bit};
 use super::iwp::{Iwp, Shape as FormationShape, column_spacing, min_pair_distance};
 use super::path::PathBuilder;
@@ -104,6 +106,9 @@ pub struct SqueezeMap {
     /// Per cell, how many cells away the nearest region cell is (Chebyshev,
     /// capped at 255): a sample this far out lets the next few be skipped.
     free: Vec<u8>,
+    /// The box every point of a region lies in (lower and upper corner): a
+    /// leg that misses it needs no sample.
+    extent: [Point2<f64>; 2],
 }
 
 impl SqueezeMap {
@@ -126,6 +131,11 @@ impl SqueezeMap {
             let d = f64::from(self.free[i]);
             (None, (d - 1.0).max(0.0) * self.field.cell())
         }
+    }
+
+    /// The box holding every point that is in a region.
+    pub fn extent(&self) -> [Point2<f64>; 2] {
+        self.extent
     }
 
     /// Side of the grid's cells, metres: the resolution to sample paths at.
@@ -242,6 +252,8 @@ fn blocking(mission: &Mission) -> Vec<(usize, Disc)> {
 }
 
 /// The route stage for `mission`: the cheapest corridor, or why none exists.
+///
+/// Long (~170 lines): the stage in order (grid, open layers, stops, jumps, search, corridor, squeeze map), each step reading the one before.
 pub fn find(
     mission: &Mission,
     builder: &PathBuilder,
@@ -370,10 +382,16 @@ pub fn find(
             .max(field.cell()),
     };
     let (s, g) = (field.index_of(start), field.index_of(goal));
-    let found = match search::unreachable(&graph, s, g) {
-        Some(reached) => Err(reached),
-        None => search::search(&graph, s, g),
-    };
+    let guide = Guide::new(&graph, g);
+    let found = search::search(&graph, s, g, Some(&guide)).or_else(|_| {
+        // No route. What the formation reaches, to say what closes the way:
+        // a plain flood when not even the relaxation reaches the goal, else
+        // the whole search without the guide's pruning.
+        match search::unreachable(&graph, s, g) {
+            Some(reached) => Err(reached),
+            None => search::search(&graph, s, g, None),
+        }
+    });
     let steps = match found {
         Ok(steps) => steps,
         Err(reached) => {
@@ -628,13 +646,32 @@ fn squeeze_map(
         return None;
     }
     let free = chebyshev_distance(field, &region);
+    let extent = region_extent(field, &region);
     Some(SqueezeMap {
         field: field.clone(),
         region,
         shapes,
         obstacle_of: Vec::new(),
         free,
+        extent,
     })
+}
+
+/// The box holding every point whose cell is in a region.
+fn region_extent(field: &Field, region: &[u16]) -> [Point2<f64>; 2] {
+    // A point belongs to the cell whose centre is nearest: half a cell (and
+    // a hair) beyond the region cells' centres.
+    let pad = field.cell() * 0.5 + 1e-9;
+    let mut extent = [
+        Point2::new(f64::INFINITY, f64::INFINITY),
+        Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+    ];
+    for (i, _) in region.iter().enumerate().filter(|(_, r)| **r > 0) {
+        let c = field.center(i);
+        extent[0] = extent[0].inf(&Point2::new(c.x - pad, c.y - pad));
+        extent[1] = extent[1].sup(&Point2::new(c.x + pad, c.y + pad));
+    }
+    extent
 }
 
 /// Per cell, the Chebyshev distance in cells to the nearest cell with a
@@ -677,53 +714,4 @@ fn flood(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The room `at_with_room` reports is never wrong: within it of the
-    /// sampled point no point is in a region, so the path builder may skip
-    /// those samples and find the same squeezed stretches.
-    #[test]
-    fn the_room_round_a_sample_holds_no_squeezed_region() {
-        let field = Field::new([[0.0, 40.0], [0.0, 30.0]], &[], 0.25, 5.0);
-        let mut region = vec![0u16; field.len()];
-        // Two regions: a block and a single cell.
-        for (i, r) in region.iter_mut().enumerate() {
-            let c = field.center(i);
-            if (10.0..12.0).contains(&c.x) && (5.0..20.0).contains(&c.y) {
-                *r = 1;
-            }
-        }
-        let lone = field.index_of(Point2::new(30.0, 25.0));
-        region[lone] = 2;
-        let free = chebyshev_distance(&field, &region);
-        let map = SqueezeMap {
-            field,
-            region,
-            shapes: vec![FormationShape::Shrink { scale: 0.5 }; 2],
-            obstacle_of: Vec::new(),
-            free,
-        };
-        let mut checked = 0;
-        for ix in 0..80 {
-            for iy in 0..60 {
-                let p = Point2::new(ix as f64 * 0.5 + 0.13, iy as f64 * 0.5 + 0.07);
-                let (hit, room) = map.at_with_room(p);
-                assert_eq!(hit.is_some(), map.at(p).is_some());
-                if room <= 0.0 {
-                    continue;
-                }
-                for k in 0..16 {
-                    let a = k as f64 * std::f64::consts::TAU / 16.0;
-                    let q = p + nalgebra::Vector2::new(a.cos(), a.sin()) * (room * 0.999);
-                    assert!(map.at(q).is_none(), "{q:?} within {room} m of {p:?}");
-                    checked += 1;
-                }
-            }
-        }
-        assert!(checked > 10_000, "{checked}");
-        // Next to the block the room is small; far from both, large.
-        assert!(map.at_with_room(Point2::new(12.6, 10.0)).1 < 1.0);
-        assert!(map.at_with_room(Point2::new(25.0, 5.0)).1 > 5.0);
-    }
-}
+mod tests;

@@ -8,6 +8,7 @@ use std::collections::BinaryHeap;
 use nalgebra::Point2;
 
 use super::field::Field;
+use super::guide::Guide;
 
 /// The layers, widest first: the nominal shape, the smallest shrink, the
 /// column (single file along the path).
@@ -75,15 +76,6 @@ fn jumps_from(graph: &Graph<'_>) -> std::collections::HashMap<usize, Vec<usize>>
     index
 }
 
-/// The least, over `targets` (a point and what is left from it), of the
-/// straight distance from `p` to the point plus what is left.
-fn lower_bound(targets: &[(Point2<f64>, f64)], p: Point2<f64>) -> f64 {
-    targets
-        .iter()
-        .map(|(q, c)| (p - q).norm() + c)
-        .fold(f64::INFINITY, f64::min)
-}
-
 /// The cells reached from `start` when `goal` is not among them, in a
 /// relaxation of the search's graph: a cell open in any layer is open to
 /// all, every jump may be taken at any stage. No plain flood (a few
@@ -121,9 +113,18 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
     Some(Reached { stage })
 }
 
-/// The cheapest route from `start` to `goal` through every stage, or the
-/// cells reached when there is none.
-pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>, Reached> {
+/// The cheapest route from `start` to `goal` through every stage (up to
+/// the `guide`'s slack), or the cells reached when there is none: all of
+/// them without a guide; with one, only those from which the guide's
+/// relaxation reaches the goal.
+///
+/// Long (~140 lines): one A* loop whose moves (steps, layer changes, crossings, passes) share its state arrays.
+pub fn search(
+    graph: &Graph<'_>,
+    start: usize,
+    goal: usize,
+    guide: Option<&Guide>,
+) -> Result<Vec<Step>, Reached> {
     let field = graph.field;
     let cells = field.len();
     let layers = LAYERS;
@@ -132,38 +133,24 @@ pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>,
     let mut cost = vec![f64::INFINITY; states];
     let mut parent = vec![u32::MAX; states];
     let mut via = vec![u32::MAX; states];
-    let goal_point = field.center(goal);
-    // A lower bound of what is left from each stage: at the last, the
-    // straight line to the goal; before it, the way to one of the stage's
-    // stop edges (an inspection pass, a requested crossing), the edge, and
-    // the bound from where it ends. Without it the search floods the site
-    // on its way to an inspection off the straight line.
-    let mut targets: Vec<Vec<(Point2<f64>, f64)>> = vec![Vec::new(); graph.stages + 1];
-    targets[graph.stages].push((goal_point, 0.0));
-    for stage in (0..graph.stages).rev() {
-        let after = &targets[stage + 1];
-        let list: Vec<(Point2<f64>, f64)> = graph
-            .jumps
-            .iter()
-            .filter(|j| j.pass_at == Some(stage))
-            .map(|j| {
-                let end = field.center(j.to);
-                (field.center(j.from), j.length + lower_bound(after, end))
-            })
-            .collect();
-        targets[stage] = list;
-    }
-    let heuristic = |cell: usize, stage: usize| lower_bound(&targets[stage], field.center(cell));
+    // What is left from each state, bounded on a coarse grid: states that
+    // cannot reach the goal are never entered. Without a guide, Dijkstra.
+    let heuristic = |cell: usize, layer: usize, stage: usize| match guide {
+        Some(guide) => guide.bound(cell, layer, stage),
+        None => Some(0.0),
+    };
     let index = jumps_from(graph);
 
     let mut open = BinaryHeap::new();
     let first = state(start, 0, 0);
     cost[first] = 0.0;
-    open.push(Entry {
-        estimate: heuristic(start, 0),
-        reached: 0.0,
-        state: first,
-    });
+    if let Some(estimate) = heuristic(start, 0, 0) {
+        open.push(Entry {
+            estimate,
+            reached: 0.0,
+            state: first,
+        });
+    }
     let mut done = None;
     while let Some(Entry {
         state: s, reached, ..
@@ -182,11 +169,16 @@ pub fn search(graph: &Graph<'_>, start: usize, goal: usize) -> Result<Vec<Step>,
         }
         let mut relax = |to: usize, g_to: f64, through: u32, open: &mut BinaryHeap<Entry>| {
             if g_to < cost[to] {
+                let Some(left) =
+                    heuristic(to % cells, (to / cells) % layers, to / (cells * layers))
+                else {
+                    return; // no way on from there, even relaxed
+                };
                 cost[to] = g_to;
                 parent[to] = s as u32;
                 via[to] = through;
                 open.push(Entry {
-                    estimate: g_to + heuristic(to % cells, to / (cells * layers)),
+                    estimate: g_to + left,
                     reached: g_to,
                     state: to,
                 });

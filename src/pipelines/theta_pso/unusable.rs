@@ -1,12 +1,13 @@
 //! Unusable IWPs grouped for a reader: a 200-tree forest has dozens, each
 //! with the same few reasons. Grouped by reason (the names and widths of
 //! each taken out), counted, the few nearest the route named; the IWP
-//! table and the inspector list every one.
+//! table and the inspector list every one. The run's log, the CLI summary
+//! and the designer's jobs panel all group them here.
 
 use nalgebra::{Point2, Point3};
 
+use super::Iwp;
 use crate::base::geometry::segment_point_distance;
-use crate::pipelines::theta_pso::Iwp;
 
 /// Unusable IWPs that share a reason.
 #[derive(Debug, Clone, PartialEq)]
@@ -86,7 +87,7 @@ fn reason_kind(reason: &str) -> String {
 }
 
 /// The x-y distance from `p` to the polyline `route` (∞ without one).
-pub(crate) fn distance_to(route: &[Point3<f64>], p: &Point2<f64>) -> f64 {
+pub fn distance_to(route: &[Point3<f64>], p: &Point2<f64>) -> f64 {
     match route {
         [] => f64::INFINITY,
         [only] => (only.xy() - p).norm(),

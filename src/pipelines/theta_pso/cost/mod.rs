@@ -41,6 +41,8 @@ use crate::base::geometry::Cylinder;
 use crate::mission::{Bounds, Mission, ThetaPsoParams};
 use crate::pipelines::CostTerms;
 
+mod pairs;
+
 /// How far a UAV's path may stray from the chord of a piece where the heading
 /// turns, metres: a fifth of the default clearance margin.
 const CHORD_TOLERANCE: f64 = 0.02;
@@ -537,94 +539,6 @@ impl CostModel {
         }
     }
 
-    /// How far two UAVs come closer than [`PAIR_FLOOR`] to each other
-    /// (eq. 7), integrated over the stretches where the pairs can change: the
-    /// changes of shape (a straight blend between two shapes can bring two
-    /// UAVs closer than either shape does) and a column's hold (a UAV flies at
-    /// the centroid path's point its place ahead, so a hairpin or a sharp
-    /// corner brings two of them together). A rigid shape held keeps its
-    /// pairs, which validation checked.
-    fn pair_deficit(
-        &self,
-        motion: &Motion<'_>,
-        path: &CentroidPath,
-        scratch: &mut Vec<Point3<f64>>,
-    ) -> f64 {
-        let n = self.slots.len();
-        if n < 2 {
-            return 0.0;
-        }
-        let floor = 2.0 * self.uav_radius + PAIR_FLOOR;
-        let mut deficit = 0.0;
-        let mut follow = |from: f64, to: f64, deficit: &mut f64| {
-            let samples = (((to - from) / PAIR_STEP).ceil() as usize).max(1);
-            let step = (to - from) / samples as f64;
-            for k in 0..=samples {
-                motion.positions_into(from + k as f64 * step, scratch);
-                for i in 0..n {
-                    for j in (i + 1)..n {
-                        let gap = floor - (scratch[i] - scratch[j]).norm();
-                        if gap > 0.0 {
-                            *deficit += gap * step;
-                        }
-                    }
-                }
-            }
-        };
-        for zone in &path.zones {
-            let [t1, t2, t3, t4] = zone.arcs();
-            if t2 > t1 {
-                follow(t1, t2, &mut deficit);
-            }
-            if t4 > t3 {
-                follow(t3, t4, &mut deficit);
-            }
-            if let Shape::Alignment { spacing } = zone.shape {
-                deficit += self.column_deficit(motion.walker(), [t2, t3], spacing, floor);
-            }
-        }
-        deficit
-    }
-
-    /// The same over a column's hold [t2, t3], from the path alone: UAV n is
-    /// at the path's point its place ahead of the centroid, so two UAVs are
-    /// the chord between two points of the path a whole number of spacings
-    /// apart. The path is sampled at a quarter spacing, so every such pair
-    /// falls on two samples.
-    fn column_deficit(
-        &self,
-        walker: &super::path::ArcWalker<'_>,
-        [t2, t3]: [f64; 2],
-        spacing: f64,
-        floor: f64,
-    ) -> f64 {
-        let n = self.slots.len();
-        if spacing <= 0.0 || t3 <= t2 {
-            return 0.0;
-        }
-        let step = spacing / 4.0;
-        let half = (n - 1) as f64 * spacing / 2.0;
-        let (from, to) = (t2 - half, t3 + half);
-        let samples = (((to - from) / step).ceil() as usize).max(1);
-        let points: Vec<Point3<f64>> = (0..=samples)
-            .map(|k| walker.at_extended(from + k as f64 * step))
-            .collect();
-        let mut deficit = 0.0;
-        for i in 0..points.len() {
-            for places in 1..n {
-                let j = i + 4 * places;
-                if j >= points.len() {
-                    break;
-                }
-                let gap = floor - (points[j] - points[i]).norm();
-                if gap > 0.0 {
-                    deficit += gap * step;
-                }
-            }
-        }
-        deficit
-    }
-
     /// Band and bounds violations of the UAVs at one sample, weighted by the
     /// arc length the sample stands for.
     fn observe_points(&self, points: &[Point3<f64>], len: f64, sums: &mut Sums) {
@@ -765,71 +679,4 @@ pub fn violation_along(p: &Point3<f64>, q: &Point3<f64>, c: &Cylinder, safe: f64
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::pipelines::theta_pso::path::CentroidPath;
-
-    /// A 60 m × 40 m box, the formation's default triangle, and one post of
-    /// radius 3 m in the middle of the straight line from start to goal.
-    fn one_post() -> Mission {
-        let text = "name = \"one post\"\n\
-             [bounds]\nx = [0.0, 60.0]\ny = [0.0, 40.0]\nz = [5.0, 15.0]\n\
-             [route]\nstart = [5.0, 20.0, 10.0]\ngoal = [55.0, 20.0, 10.0]\n\
-             [[obstacles]]\nname = \"post\"\ncenter = [30.0, 20.0]\nradius = 3.0\nheight = 30.0\n";
-        match crate::mission::parse_str(text, "one-post.toml") {
-            Ok(loaded) => loaded.mission,
-            Err(e) => panic!("{e}"),
-        }
-    }
-
-    /// Deb's rule (cost.rs, `INFEASIBLE_STEP`): a short path through the post
-    /// has the smaller J, yet ranks after a long path round it, whatever the
-    /// weights make of the lengths.
-    #[test]
-    fn a_feasible_path_ranks_before_a_shorter_infeasible_one() {
-        let m = one_post();
-        let model = CostModel::new(&m, &[]);
-        let (s, g) = (m.route.start, m.route.goal);
-        let through = CentroidPath::bare(vec![s, g]);
-        let round = CentroidPath::bare(vec![
-            s,
-            Point3::new(20.0, 32.0, 10.0),
-            Point3::new(40.0, 32.0, 10.0),
-            g,
-        ]);
-        let a = model.evaluate_below(&through, f64::INFINITY);
-        let b = model.evaluate_below(&round, f64::INFINITY);
-        assert!(a.terms.length < b.terms.length);
-        assert!(
-            a.terms.obstacle > 0.0,
-            "the straight path must clip the post"
-        );
-        assert_eq!(b.terms.obstacle, 0.0, "the detour must keep clear");
-        assert_eq!(b.objective, b.terms.total, "a clear path's objective is J");
-        assert!(a.objective >= a.terms.total + INFEASIBLE_STEP);
-        assert!(a.objective > b.objective);
-    }
-
-    /// The step ranks infeasible paths among themselves by how badly they
-    /// break the constraints: a path that grazes the post ranks before one
-    /// through its centre.
-    #[test]
-    fn among_infeasible_paths_the_smaller_violation_ranks_first() {
-        let m = one_post();
-        let model = CostModel::new(&m, &[]);
-        let (s, g) = (m.route.start, m.route.goal);
-        let graze = |y: f64| {
-            CentroidPath::bare(vec![
-                s,
-                Point3::new(25.0, y, 10.0),
-                Point3::new(35.0, y, 10.0),
-                g,
-            ])
-        };
-        let centre = model.evaluate_below(&graze(20.0), f64::INFINITY);
-        let edge = model.evaluate_below(&graze(24.5), f64::INFINITY);
-        assert!(centre.objective >= INFEASIBLE_STEP && edge.objective >= INFEASIBLE_STEP);
-        assert!(edge.terms.obstacle < centre.terms.obstacle);
-        assert!(edge.objective < centre.objective);
-    }
-}
+mod tests;

@@ -1,0 +1,331 @@
+//! Each pipeline's parameters: θ-PSO's swarm, FLATLO's squadron and
+//! controller, the fleet's agents and their PSO.
+
+use super::*;
+
+impl Checker {
+    pub(super) fn theta_pso(&mut self, path: &FieldPath, p: &ThetaPsoParams) {
+        self.at_least_one(path.key("swarm_size"), p.swarm_size, "particle");
+        self.at_least_one(path.key("waypoints"), p.waypoints, "waypoint");
+        self.at_least_one(path.key("iterations"), p.iterations, "iteration");
+        if p.segments < p.waypoints + 1 {
+            self.error(
+                path.key("segments"),
+                format!(
+                    "{} segments cannot split a path through {} waypoints; \
+                     needs at least {}",
+                    p.segments,
+                    p.waypoints,
+                    p.waypoints + 1
+                ),
+            );
+        }
+        for (key, value) in [
+            ("inertia", p.inertia),
+            ("cognitive", p.cognitive),
+            ("social", p.social),
+            ("weight_length", p.weight_length),
+            ("weight_obstacle", p.weight_obstacle),
+            ("weight_altitude", p.weight_altitude),
+            ("weight_waypoints", p.weight_waypoints),
+            ("weight_bounds", p.weight_bounds),
+            ("weight_turning", p.weight_turning),
+            ("clearance_margin", p.clearance_margin),
+        ] {
+            self.non_negative(path.key(key), value, "");
+        }
+        self.positive(path.key("ground_penalty"), p.ground_penalty, "");
+        if p.inertia >= 1.0 {
+            self.warning(
+                path.key("inertia"),
+                format!(
+                    "w = {} ≥ 1 lets the swarm's velocities grow without bound",
+                    p.inertia
+                ),
+            );
+        }
+        if p.weight_obstacle == 0.0 {
+            self.warning(
+                path.key("weight_obstacle"),
+                "is 0: the planner will ignore obstacles (the result is still verified)",
+            );
+        }
+    }
+
+    pub(super) fn flatlo(&mut self, path: &FieldPath, p: &FlatloParams) {
+        if p.aircraft < 2 {
+            self.error(
+                path.key("aircraft"),
+                format!(
+                    "a squadron transition needs at least 2 aircraft, got {}",
+                    p.aircraft
+                ),
+            );
+        }
+        for (key, value, unit) in [
+            ("spacing", p.spacing, " m"),
+            ("airspeed", p.airspeed, " m/s"),
+            ("turn_radius", p.turn_radius, " m"),
+            ("altitude", p.altitude, " m"),
+            ("final_leg", p.final_leg, " m"),
+            ("sample_period", p.sample_period, " s"),
+            ("sim_step", p.sim_step, " s"),
+            ("mass", p.mass, " kg"),
+            ("wing_area", p.wing_area, " m²"),
+            ("air_density", p.air_density, " kg/m³"),
+            ("max_thrust", p.max_thrust, " N"),
+            ("max_bank_deg", p.max_bank_deg, "°"),
+        ] {
+            self.positive(path.key(key), value, unit);
+        }
+        for (key, value) in [
+            ("drag_cd0", p.drag_cd0),
+            ("drag_k", p.drag_k),
+            ("noise", p.noise),
+            ("min_separation", p.min_separation),
+        ] {
+            self.non_negative(path.key(key), value, "");
+        }
+        for (i, gain) in p.pid.iter().enumerate() {
+            self.non_negative(path.key("pid").index(i), *gain, "");
+        }
+        if self.range(path.key("load_factor"), p.load_factor, "") && p.load_factor[1] <= 1.0 {
+            self.error(
+                path.key("load_factor"),
+                format!(
+                    "n_max = {} cannot hold level flight (needs n > 1 to turn)",
+                    p.load_factor[1]
+                ),
+            );
+        }
+        if p.max_bank_deg >= 90.0 {
+            self.error(
+                path.key("max_bank_deg"),
+                format!("must be below 90°, got {}°", p.max_bank_deg),
+            );
+        }
+        if p.climb_deg.abs() >= 90.0 {
+            self.error(
+                path.key("climb_deg"),
+                format!("must be within ±90°, got {}°", p.climb_deg),
+            );
+        }
+        if p.sim_step > p.sample_period {
+            self.warning(
+                path.key("sim_step"),
+                format!(
+                    "the RK4 step {} s is longer than the reference period {} s",
+                    p.sim_step, p.sample_period
+                ),
+            );
+        }
+        // Algorithm 1, line 41: Δ2 = √2 (Δ − 2r(1 − cos π/4)) must not be
+        // negative for the smallest lateral offset Δ that is not zero.
+        let smallest_offset = if p.aircraft.is_multiple_of(2) {
+            p.spacing / 2.0
+        } else {
+            p.spacing
+        };
+        let needed = 2.0 * p.turn_radius * (1.0 - std::f64::consts::FRAC_PI_4.cos());
+        if smallest_offset < needed {
+            self.error(
+                path.key("turn_radius"),
+                format!(
+                    "a turn radius of {} m needs a lateral offset of at least {needed:.1} m \
+                     (Algorithm 1, line 41), but the innermost aircraft is {smallest_offset} m \
+                     from the longitudinal line",
+                    p.turn_radius
+                ),
+            );
+        }
+        if p.noise > 0.05 {
+            self.warning(
+                path.key("noise"),
+                format!(
+                    "{} % noise is far above the paper's 0.25 %",
+                    p.noise * 100.0
+                ),
+            );
+        }
+    }
+
+    /// Long (~130 lines): one rule per key of `[fleet]`, in the order of the section.
+    pub(super) fn fleet(&mut self, path: &FieldPath, p: &FleetParams, mission: &Mission) {
+        let bounds = &mission.bounds;
+        let obstacles = &mission.obstacles;
+        self.at_least_one(path.key("agents"), p.agents, "agent");
+        self.at_least_one(path.key("swarm_size"), p.swarm_size, "particle");
+        self.at_least_one(path.key("iterations"), p.iterations, "iteration");
+        for (key, value, unit) in [
+            ("rho", p.rho, ""),
+            ("sigma", p.sigma, ""),
+            ("safety_distance", p.safety_distance, " m"),
+            ("detection_range", p.detection_range, " m"),
+            ("neighbourhood", p.neighbourhood, " m"),
+            ("step_max", p.step_max, " m"),
+            ("replan_period", p.replan_period, " s"),
+            ("altitude", p.altitude, " m"),
+            ("sim_step", p.sim_step, " s"),
+            ("duration", p.duration, " s"),
+            ("mass", p.mass, " kg"),
+            ("max_thrust", p.max_thrust, " N"),
+            ("max_tilt_deg", p.max_tilt_deg, "°"),
+            ("tolerance", p.tolerance, ""),
+        ] {
+            self.positive(path.key(key), value, unit);
+        }
+        self.non_negative(path.key("target_distance"), p.target_distance, " m");
+        for (i, v) in p.inertia_diag.iter().enumerate() {
+            self.positive(path.key("inertia_diag").index(i), *v, " kg·m²");
+        }
+        for (key, gains) in [
+            ("position_gains", p.position_gains),
+            ("attitude_gains", p.attitude_gains),
+        ] {
+            for (i, v) in gains.iter().enumerate() {
+                self.positive(path.key(key).index(i), *v, "");
+            }
+        }
+        if p.max_thrust.is_finite() && p.mass > 0.0 && p.max_thrust <= p.mass * G {
+            self.error(
+                path.key("max_thrust"),
+                format!(
+                    "{} N cannot lift {} kg (weight {:.2} N)",
+                    p.max_thrust,
+                    p.mass,
+                    p.mass * G
+                ),
+            );
+        }
+        if p.max_tilt_deg >= 90.0 {
+            self.error(
+                path.key("max_tilt_deg"),
+                format!("must be below 90°, got {}°", p.max_tilt_deg),
+            );
+        }
+        if p.replan_period < p.sim_step {
+            self.error(
+                path.key("replan_period"),
+                format!(
+                    "τ = {} s is shorter than the simulation step {} s",
+                    p.replan_period, p.sim_step
+                ),
+            );
+        }
+        self.fleet_distances(path, p);
+        if !p.initial_positions.is_empty() && p.initial_positions.len() != p.agents {
+            self.error(
+                path.key("initial_positions"),
+                format!(
+                    "gives {} positions for {} agents",
+                    p.initial_positions.len(),
+                    p.agents
+                ),
+            );
+        }
+        for (i, q) in p.initial_positions.iter().enumerate() {
+            if !bounds.contains_xy(q) {
+                self.error(
+                    path.key("initial_positions").index(i),
+                    format!("({}, {}) is outside the bounds", q.x, q.y),
+                );
+            }
+        }
+        let mut previous = f64::NEG_INFINITY;
+        for (i, t) in p.targets.iter().enumerate() {
+            let at = path.key("targets").index(i);
+            self.non_negative(at.key("time"), t.time, " s");
+            if t.time < previous {
+                self.error(
+                    at.key("time"),
+                    format!(
+                        "targets must be in time order: {} s comes after {previous} s",
+                        t.time
+                    ),
+                );
+            }
+            previous = t.time;
+            if !bounds.contains_xy(&t.position) {
+                self.error(
+                    at.key("position"),
+                    format!("({}, {}) is outside the bounds", t.position.x, t.position.y),
+                );
+            }
+            for o in obstacles.iter().filter(|o| o.height > p.altitude) {
+                let gap = (o.center - t.position).norm() - o.radius;
+                if gap < p.safety_distance {
+                    self.warning(
+                        at.key("position"),
+                        format!(
+                            "({}, {}) is within the safety distance c = {} m of obstacle '{}' \
+                             ({gap:.2} m from it): the agents cannot form around it",
+                            t.position.x, t.position.y, p.safety_distance, o.name
+                        ),
+                    );
+                }
+            }
+        }
+        for (i, push) in p.pushes.iter().enumerate() {
+            let at = path.key("pushes").index(i);
+            if push.agent >= p.agents {
+                self.error(
+                    at.key("agent"),
+                    format!(
+                        "there are only {} agents (0-based index {})",
+                        p.agents, push.agent
+                    ),
+                );
+            }
+            self.non_negative(at.key("time"), push.time, " s");
+        }
+    }
+
+    /// The desired distances must be a symmetric n×n matrix that keeps every
+    /// pair at least the safety distance c apart (fleet paper, eq. 5).
+    pub(super) fn fleet_distances(&mut self, path: &FieldPath, p: &FleetParams) {
+        let n = p.agents;
+        let at = path.key("distances");
+        if p.distances.is_empty() {
+            if n >= 2 {
+                let side = 2.0 * p.target_distance * (std::f64::consts::PI / n as f64).sin();
+                if side < p.safety_distance {
+                    self.error(
+                        path.key("target_distance"),
+                        format!(
+                            "{n} agents at {} m from the target are {side:.3} m apart, \
+                             closer than the safety distance c = {} m",
+                            p.target_distance, p.safety_distance
+                        ),
+                    );
+                }
+            }
+            return;
+        }
+        if p.distances.len() != n || p.distances.iter().any(|row| row.len() != n) {
+            self.error(at, format!("must be a {n}×{n} matrix (one row per agent)"));
+            return;
+        }
+        for i in 0..n {
+            if p.distances[i][i] != 0.0 {
+                self.error(at.index(i).index(i), "the diagonal must be 0");
+            }
+            for j in (i + 1)..n {
+                let (a, b) = (p.distances[i][j], p.distances[j][i]);
+                if a != b {
+                    self.error(
+                        at.index(i).index(j),
+                        format!("is {a} but distances[{j}][{i}] is {b}; must be symmetric"),
+                    );
+                } else if a < p.safety_distance {
+                    self.error(
+                        at.index(i).index(j),
+                        format!(
+                            "{a} m is below the safety distance c = {} m",
+                            p.safety_distance
+                        ),
+                    );
+                }
+            }
+        }
+    }
+}

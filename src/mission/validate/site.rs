@@ -1,0 +1,355 @@
+//! The site's rules: the origin, the bounds, start and goal (and whether the
+//! formation fits there), the obstacles and the terrain.
+
+use super::*;
+
+impl Checker {
+    pub(super) fn origin(&mut self, path: &FieldPath, origin: &GeoOrigin) {
+        if origin.latitude.abs() > 90.0 {
+            self.error(
+                path.key("latitude"),
+                format!("must be within ±90°, got {}", origin.latitude),
+            );
+        }
+        if origin.longitude.abs() > 180.0 {
+            self.error(
+                path.key("longitude"),
+                format!("must be within ±180°, got {}", origin.longitude),
+            );
+        }
+    }
+
+    pub(super) fn bounds(&mut self, path: &FieldPath, b: &Bounds) {
+        self.range(path.key("x"), b.x, " m");
+        self.range(path.key("y"), b.y, " m");
+        if self.range(path.key("z"), b.z, " m") && b.z[0] < 0.0 {
+            self.error(
+                path.key("z"),
+                format!("z_min is below the ground: {} m < 0 m", b.z[0]),
+            );
+        }
+    }
+
+    pub(super) fn route(&mut self, path: &FieldPath, mission: &Mission) {
+        let Route { start, goal } = &mission.route;
+        self.route_point(path.key("start"), "start", start, mission);
+        self.route_point(path.key("goal"), "goal", goal, mission);
+        if (goal - start).norm() < 1e-9 {
+            self.error(path.key("goal"), "is the same point as the start");
+        }
+    }
+
+    pub(super) fn route_point(
+        &mut self,
+        path: FieldPath,
+        what: &str,
+        p: &Point3<f64>,
+        mission: &Mission,
+    ) {
+        if !p.iter().all(|v| v.is_finite()) {
+            return;
+        }
+        // Each coordinate outside its range is an error on that coordinate.
+        let b = &mission.bounds;
+        for (k, (v, [lo, hi], range)) in [
+            (p.x, b.x, "the bounds' x"),
+            (p.y, b.y, "the bounds' y"),
+            (p.z, b.z, "the altitude band z"),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if !(lo..=hi).contains(&v) {
+                self.error(
+                    path.index(k),
+                    format!(
+                        "{what} ({}, {}, {}) is outside the bounds: {} m is not in {range} [{}, {}] m",
+                        p.x,
+                        p.y,
+                        p.z,
+                        compact(v),
+                        compact(lo),
+                        compact(hi)
+                    ),
+                );
+            }
+        }
+        self.formation_fits(path, what, p, mission);
+    }
+
+    /// The formation standing at `p` in its nominal shape: an error when no
+    /// heading keeps every UAV inside the bounds and r_Q clear of every
+    /// obstacle (naming the UAV and by how much, at the best heading), a
+    /// warning when only some headings do (the plan must leave that way).
+    pub(super) fn formation_fits(
+        &mut self,
+        path: FieldPath,
+        what: &str,
+        p: &Point3<f64>,
+        mission: &Mission,
+    ) {
+        let f = &mission.formation;
+        // Non-finite numbers have errors of their own; the fit means nothing then.
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let b = &mission.bounds;
+        if f.slots.is_empty()
+            || !f.uav_radius.is_finite()
+            || !finite(p.coords.as_slice())
+            || !f.slots.iter().all(|s| finite(s.as_slice()))
+            || !finite(&[b.x[0], b.x[1], b.y[0], b.y[1], b.z[0], b.z[1]])
+            || !mission
+                .obstacles
+                .iter()
+                .all(|o| finite(&[o.center.x, o.center.y, o.radius, o.height]))
+        {
+            return;
+        }
+        // Every UAV within `reach` of the centroid: clear of everything by
+        // that much, every heading fits (the usual case, decided at once).
+        let reach = f.slots.iter().map(|o| o.xy().norm()).fold(0.0, f64::max);
+        let roomy = mission.bounds.horizontal_margin(p) >= reach
+            && mission
+                .obstacles
+                .iter()
+                .all(|o| mission.cylinder(o).clearance(p) >= reach + f.uav_radius);
+        if roomy {
+            return;
+        }
+        let misfit = |heading: f64| fit_at(mission, p, heading);
+        let headings: Vec<(f64, Misfit)> = (0..HEADINGS)
+            .map(|k| {
+                let degrees = 360.0 * k as f64 / HEADINGS as f64;
+                (degrees, misfit(degrees.to_radians()))
+            })
+            .collect();
+        let fitting = headings.iter().filter(|(_, m)| m.depth <= 0.0).count();
+        if fitting == headings.len() {
+            return;
+        }
+        let Some((best, worst)) = headings
+            .iter()
+            .min_by(|a, b| a.1.depth.total_cmp(&b.1.depth))
+            .map(|(h, m)| (*h, m.clone()))
+        else {
+            return;
+        };
+        if fitting == 0 {
+            self.error(
+                path,
+                format!(
+                    "the formation does not fit at the {what} in any heading: even facing {best:.0}° \
+                     (from east, anticlockwise), UAV {} is {:.2} m {}",
+                    worst.uav + 1,
+                    worst.depth,
+                    worst.what
+                ),
+            );
+        } else {
+            self.warning(
+                path,
+                format!(
+                    "the formation fits at the {what} only in {fitting} of {HEADINGS} headings (facing \
+                     {best:.0}° from east, anticlockwise, is one): the plan must leave that way"
+                ),
+            );
+        }
+    }
+
+    pub(super) fn obstacles(&mut self, path: &FieldPath, mission: &Mission) {
+        let (obstacles, bounds) = (&mission.obstacles, &mission.bounds);
+        for (i, o) in obstacles.iter().enumerate() {
+            let at = path.index(i);
+            if let Some(band) = o.stand_off
+                && self.range(at.key("stand_off"), band, " m")
+            {
+                self.non_negative(at.key("stand_off"), band[0], " m");
+            }
+            if o.inspect {
+                let [d_min, _] = o.stand_off_band(&mission.formation);
+                if o.height.is_finite() && o.height <= bounds.z[0] {
+                    self.error(
+                        at.key("inspect"),
+                        format!(
+                            "'{}' is {} m tall, below the altitude band's floor z_min = {} m: \
+                             the formation cannot fly beside its surface (eq. 8)",
+                            o.name, o.height, bounds.z[0]
+                        ),
+                    );
+                }
+                if d_min < mission.formation.uav_radius {
+                    self.warning(
+                        at.key("stand_off"),
+                        format!(
+                            "the stand-off band starts at {d_min} m, inside the UAV's safe radius \
+                             r_Q = {} m: clearance (≥ r_Q) binds first",
+                            mission.formation.uav_radius
+                        ),
+                    );
+                }
+            }
+            if o.name.trim().is_empty() {
+                self.error(at.key("name"), "must not be empty");
+            } else if let Some(j) = obstacles
+                .iter()
+                .enumerate()
+                .position(|(j, p)| j != i && p.name == o.name)
+            {
+                // Both carry the error: the one just renamed shows it too.
+                self.error(
+                    at.key("name"),
+                    format!(
+                        "'{}' is also the name of obstacle {}; names must be unique",
+                        o.name,
+                        j + 1
+                    ),
+                );
+            }
+            self.positive(at.key("radius"), o.radius, " m");
+            self.positive(at.key("height"), o.height, " m");
+            if !o.center.iter().all(|v| v.is_finite()) {
+                continue;
+            }
+            if !bounds.contains_xy(&o.center) {
+                self.error(
+                    at.key("center"),
+                    format!(
+                        "({}, {}) is outside the bounds x {:?}, y {:?}",
+                        o.center.x, o.center.y, bounds.x, bounds.y
+                    ),
+                );
+            } else if o.radius > 0.0 {
+                let inside = o.center.x - o.radius >= bounds.x[0]
+                    && o.center.x + o.radius <= bounds.x[1]
+                    && o.center.y - o.radius >= bounds.y[0]
+                    && o.center.y + o.radius <= bounds.y[1];
+                if !inside {
+                    self.warning(at.key("radius"), "the cylinder reaches outside the bounds");
+                }
+            }
+        }
+    }
+
+    /// `[terrain]`: the file loaded, its pixels placed, the bounds on it; and
+    /// what `cost = "spso"` and the spherical encoding need.
+    pub(super) fn terrain(&mut self, path: &FieldPath, mission: &Mission) {
+        use crate::mission::model::{CostKind, Encoding};
+        let p = &mission.theta_pso;
+        let at = FieldPath::root().key("theta_pso");
+        if p.cost == CostKind::Spso {
+            if mission.terrain.is_none() {
+                self.error(
+                    at.key("cost"),
+                    "\"spso\" needs a [terrain] height map (its J3 and J4 read the ground)",
+                );
+            }
+            let most = crate::mission::SPSO_MAX_NODES;
+            if p.waypoints > most {
+                self.error(
+                    at.key("waypoints"),
+                    format!("the SPSO cost takes at most {most} free nodes"),
+                );
+            }
+        } else if p.encoding == Encoding::Spherical {
+            self.error(
+                at.key("encoding"),
+                "\"spherical\" encodes the SPSO benchmark's paths: it needs cost = \"spso\"",
+            );
+        }
+        let Some(t) = &mission.terrain else { return };
+        for (i, v) in t.pixel_size.iter().enumerate() {
+            if *v == 0.0 {
+                self.error(path.key("pixel_size").index(i), "must not be 0");
+            }
+        }
+        match &t.map.0 {
+            None => self.error(path.key("file"), "was not loaded"),
+            Some(Err(e)) => self.error(path.key("file"), e.clone()),
+            Some(Ok(map)) => {
+                let b = &mission.bounds;
+                // The bounds must lie on the map (half a pixel beyond the
+                // outer centres still reads the edge pixel).
+                let half = [map.pixel[0].abs() / 2.0, map.pixel[1].abs() / 2.0];
+                let [x0, x1] = map.x_extent();
+                let [y0, y1] = map.y_extent();
+                if b.x[0] < x0 - half[0]
+                    || b.x[1] > x1 + half[0]
+                    || b.y[0] < y0 - half[1]
+                    || b.y[1] > y1 + half[1]
+                {
+                    self.error(
+                        path.key("origin"),
+                        format!(
+                            "the map covers x [{}, {}], y [{}, {}] (pixel centres), \
+                             not the bounds x {:?}, y {:?}",
+                            compact(x0),
+                            compact(x1),
+                            compact(y0),
+                            compact(y1),
+                            b.x,
+                            b.y
+                        ),
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Headings the start and the goal are tried in, evenly round.
+const HEADINGS: usize = 72;
+
+/// How badly a formation fails to fit at one heading: the UAV that fails
+/// worst, by how much (metres; ≤ 0 when every UAV fits), and what it hits.
+#[derive(Debug, Clone)]
+struct Misfit {
+    uav: usize,
+    depth: f64,
+    what: String,
+}
+
+/// The nominal formation with its centroid at `p`, turned to `heading`
+/// (radians from east, anticlockwise): the worst UAV's distance outside the
+/// x-y bounds or inside r_Q of an obstacle.
+fn fit_at(mission: &Mission, p: &Point3<f64>, heading: f64) -> Misfit {
+    let f = &mission.formation;
+    let b = &mission.bounds;
+    let (sin, cos) = heading.sin_cos();
+    let mut worst = Misfit {
+        uav: 0,
+        depth: f64::NEG_INFINITY,
+        what: String::new(),
+    };
+    for (n, o) in f.slots.iter().enumerate() {
+        let q = Point3::new(
+            p.x + cos * o.x - sin * o.y,
+            p.y + sin * o.x + cos * o.y,
+            p.z + o.z,
+        );
+        let sides = [
+            (b.x[0] - q.x, "west of x min"),
+            (q.x - b.x[1], "east of x max"),
+            (b.y[0] - q.y, "south of y min"),
+            (q.y - b.y[1], "north of y max"),
+        ];
+        for (out, side) in sides {
+            if out > worst.depth {
+                worst = Misfit {
+                    uav: n,
+                    depth: out,
+                    what: format!("outside the bounds ({side})"),
+                };
+            }
+        }
+        for obstacle in &mission.obstacles {
+            let inside = f.uav_radius - mission.cylinder(obstacle).clearance(&q);
+            if inside > worst.depth {
+                worst = Misfit {
+                    uav: n,
+                    depth: inside,
+                    what: format!("inside r_Q of '{}'", obstacle.name),
+                };
+            }
+        }
+    }
+    worst
+}

@@ -1,0 +1,164 @@
+//! The squeezed stretches of a path: where its centroid enters a region of
+//! the route stage's squeeze map, the formation flies the region's shape.
+
+use nalgebra::{Point2, Point3};
+
+use super::{CentroidPath, PathBuilder, Zone, ZoneCause};
+use crate::pipelines::theta_pso::iwp::Shape;
+use crate::pipelines::theta_pso::path::ArcWalker;
+
+impl PathBuilder {
+    /// Names the obstacles each squeezed stretch of `path` passes between
+    /// (where it is narrowest: in its middle), for the plan as reported.
+    pub fn name_squeezes(&self, path: &mut CentroidPath) {
+        let Some(map) = &self.squeeze else { return };
+        let walker = ArcWalker::new(&path.points);
+        for zone in &mut path.zones {
+            let middle = (zone.hold[0] + zone.hold[1]) / 2.0;
+            for cause in &mut zone.causes {
+                if let ZoneCause::Squeeze { pair, .. } = cause {
+                    *pair = map.sides(walker.at(middle).xy(), walker.heading(middle, 1.0).xy());
+                }
+            }
+        }
+    }
+
+    /// A zone for each stretch of the path inside a squeezed region of the
+    /// route stage: the shrink at the region's scale, held from
+    /// `hold_distance` before the region to `hold_distance` after it.
+    ///
+    /// A stretch within an IWP's zone ([t1, t4]) is that IWP's: its shape
+    /// was chosen (by the operator or as the least change) and checked for
+    /// that gap, so the squeeze does not override it.
+    pub(super) fn squeeze_zones(
+        &self,
+        map: &crate::pipelines::theta_pso::route::SqueezeMap,
+        points: &[Point3<f64>],
+        arcs: &[f64],
+        crossings: &[Zone],
+    ) -> Vec<Zone> {
+        let total = arcs.last().copied().unwrap_or(0.0);
+        let step = map.resolution();
+        // (region, shape, first s, last s)
+        let mut runs: Vec<(u16, Shape, f64, f64)> = Vec::new();
+        let mut current: Option<(u16, Shape, f64, f64)> = None;
+        // The last sample looked up outside the regions, and how far along
+        // the path from it none can be (a straight or a polyline from it
+        // is at least as long as the distance it covers).
+        let mut clear_until = f64::NEG_INFINITY;
+        let extent = map.extent();
+        for (i, w) in points.windows(2).enumerate() {
+            let (a, b) = (w[0].xy(), w[1].xy());
+            let length = arcs[i + 1] - arcs[i];
+            let n = ((length / step).ceil() as usize).max(1);
+            // Only the samples within the regions' box can be in one; those
+            // outside it end a run as any sample outside would.
+            let Some([u0, u1]) = clip(a, b, extent) else {
+                runs.extend(current.take());
+                continue;
+            };
+            let first = ((u0 * n as f64).floor() as usize).min(n);
+            let last = ((u1 * n as f64).ceil() as usize).min(n);
+            if first > 0 {
+                runs.extend(current.take());
+            }
+            for k in first..=last {
+                let u = k as f64 / n as f64;
+                let s = arcs[i] + length * u;
+                if s < clear_until {
+                    continue; // outside every region, as the last sample
+                }
+                let (hit, room) = map.at_with_room(a + (b - a) * u);
+                if hit.is_none() && room > 0.0 {
+                    clear_until = s + room;
+                }
+                match (hit, current.as_mut()) {
+                    (Some((r, _)), Some(run)) if run.0 == r => run.3 = s,
+                    (hit, _) => {
+                        if let Some(run) = current.take() {
+                            runs.push(run);
+                        }
+                        current = hit.map(|(r, shape)| (r, shape, s, s));
+                    }
+                }
+            }
+            if last < n {
+                runs.extend(current.take());
+            }
+        }
+        runs.extend(current);
+        let within_a_crossing = |first: f64, last: f64| {
+            crossings.iter().any(|z| {
+                let [t1, _, _, t4] = z.arcs();
+                t1 <= first && last <= t4
+            })
+        };
+        runs.into_iter()
+            .filter(|&(_, _, first, last)| !within_a_crossing(first, last))
+            .map(|(region, shape, first, last)| {
+                // A column is complete before its first UAV enters and held
+                // until its last has left.
+                let half = match shape {
+                    Shape::Alignment { spacing } => (0..self.slots.len())
+                        .map(|n| {
+                            crate::pipelines::theta_pso::iwp::column_place(&self.slots, n, spacing)
+                                .abs()
+                        })
+                        .fold(0.0, f64::max),
+                    _ => 0.0,
+                };
+                let hold = [
+                    (first - self.hold_distance - half).max(0.0),
+                    (last + self.hold_distance + half).min(total),
+                ];
+                let middle = (first + last) / 2.0;
+                Zone {
+                    // Named only for the plan kept (`name_squeezes`): the
+                    // swarm does not need the names.
+                    causes: vec![ZoneCause::Squeeze {
+                        region,
+                        pair: [usize::MAX; 2],
+                    }],
+                    shape,
+                    arc: middle,
+                    hold,
+                    transition_in: self.transition.min(hold[0]),
+                    transition_out: self.transition.min(total - hold[1]),
+                    from: None,
+                    into: None,
+                }
+            })
+            .collect()
+    }
+}
+
+/// The share [u0, u1] of the segment a → b inside the box `[lower, upper]`
+/// (Liang-Barsky), or `None` when it misses the box.
+pub(super) fn clip(
+    a: Point2<f64>,
+    b: Point2<f64>,
+    [lower, upper]: [Point2<f64>; 2],
+) -> Option<[f64; 2]> {
+    let d = b - a;
+    let (mut u0, mut u1) = (0.0f64, 1.0f64);
+    for (p, q) in [
+        (-d.x, a.x - lower.x),
+        (d.x, upper.x - a.x),
+        (-d.y, a.y - lower.y),
+        (d.y, upper.y - a.y),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None; // parallel to this side and outside it
+            }
+        } else {
+            let u = q / p;
+            if p < 0.0 {
+                u0 = u0.max(u);
+            } else {
+                u1 = u1.min(u);
+            }
+        }
+    }
+    (u0 <= u1).then_some([u0, u1])
+}

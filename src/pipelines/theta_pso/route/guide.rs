@@ -1,0 +1,271 @@
+//! What is left of the route from each cell, layer and stage, bounded from
+//! below on a coarse grid: the A*'s heuristic.
+//!
+//! A straight-line bound knows nothing of the walls nor of the transitions,
+//! so on a site whose route bends round piers and changes shape at a gap the
+//! search expands every state closer than the route's length: most of the
+//! site, in every layer and stage (178,000 states on the bridge). This guide
+//! runs one Dijkstra per stage, backwards from the goal (or from the stage's
+//! stop edges and what is left after them), over a grid `FACTOR` times
+//! coarser, in a relaxation of the search's graph:
+//! - a coarse cell is open in a layer when any of its cells is;
+//! - the layer changes cost what they cost in the search;
+//! - a crossing is left in a layer its near cell is open in and lands in
+//!   that layer or any narrower one its far cell is open in.
+//!
+//! Every route of the search is a route of the relaxation, so a state from
+//! which the relaxation cannot reach the goal is never entered (pruned), and
+//! the relaxed distance left, taken from the coarse cells round a cell plus
+//! the way to their centres, less half a coarse diagonal of slack, ranks the
+//! states (19,000 expanded on the bridge). The bound can overestimate by the
+//! difference between coarse and fine grid steps, which costs at most that
+//! much of the corridor's optimality, never its existence: the search stays
+//! complete, and the corridor is pulled tight afterwards anyway.
+
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap};
+
+use super::search::{Graph, LAYERS, bit};
+
+/// Fine cells per coarse cell along each axis.
+const FACTOR: usize = 4;
+
+/// Per stage, layer and coarse cell, the relaxed distance left to the goal.
+pub struct Guide {
+    fine_nx: usize,
+    fine_cell: f64,
+    nx: usize,
+    ny: usize,
+    cells: usize,
+    left: Vec<f32>,
+    slack: f64,
+}
+
+/// The relaxed graph on the coarse grid, for one backward Dijkstra.
+struct Coarse {
+    nx: usize,
+    ny: usize,
+    cells: usize,
+    side: f64,
+    /// Per coarse cell, the layers any of its cells is open in.
+    open: Vec<u8>,
+    switch_cost: f64,
+    /// The free crossings backwards: from the coarse cell they land in, the
+    /// one they leave and their ends' layers (`Ends`).
+    back: HashMap<usize, Vec<Ends>>,
+}
+
+impl Guide {
+    /// The guide for `graph` towards the fine cell `goal`.
+    pub fn new(graph: &Graph<'_>, goal: usize) -> Self {
+        let field = graph.field;
+        let (fine_nx, fine_ny) = field.size();
+        let (nx, ny) = (fine_nx.div_ceil(FACTOR), fine_ny.div_ceil(FACTOR));
+        let cells = nx * ny;
+        let coarse = |i: usize| (i / fine_nx / FACTOR) * nx + (i % fine_nx) / FACTOR;
+        let all = (0..LAYERS).fold(0, |bits, l| bits | bit(l));
+        let mut open = vec![0u8; cells];
+        for (i, bits) in graph.open.iter().enumerate() {
+            open[coarse(i)] |= *bits;
+        }
+        open[coarse(goal)] = all;
+        let ends = |jump: &super::search::Jump| Ends {
+            from: coarse(jump.from),
+            length: jump.length,
+            leave: graph.open[jump.from],
+            lands_from: (0..LAYERS)
+                .find(|&l| graph.open[jump.to] & bit(l) != 0)
+                .unwrap_or(LAYERS),
+        };
+        let mut back: HashMap<usize, Vec<Ends>> = HashMap::new();
+        for jump in graph.jumps.iter().filter(|j| j.pass_at.is_none()) {
+            back.entry(coarse(jump.to)).or_default().push(ends(jump));
+        }
+        let relaxed = Coarse {
+            nx,
+            ny,
+            cells,
+            side: FACTOR as f64 * field.cell(),
+            open,
+            switch_cost: graph.switch_cost,
+            back,
+        };
+        let stages = graph.stages;
+        let per_stage = cells * LAYERS;
+        let mut left = vec![f32::INFINITY; per_stage * (stages + 1)];
+        for stage in (0..=stages).rev() {
+            // Where the stage's routes end: the goal, or a stop edge and
+            // what is left after it.
+            let mut sources: Vec<(usize, f64)> = Vec::new();
+            if stage == stages {
+                let g = coarse(goal);
+                sources.extend((0..LAYERS).map(|l| (l * cells + g, 0.0)));
+            } else {
+                let after = &left[(stage + 1) * per_stage..(stage + 2) * per_stage];
+                for jump in graph.jumps.iter().filter(|j| j.pass_at == Some(stage)) {
+                    let (from, to) = (coarse(jump.from), coarse(jump.to));
+                    if !jump.crossing {
+                        // A pass: in the nominal layer, to the nominal layer.
+                        sources.push((from, jump.length + f64::from(after[to])));
+                        continue;
+                    }
+                    // A crossing lands in the layer it is entered in, or the
+                    // widest narrower one its far end is open in.
+                    let e = ends(jump);
+                    for l in (0..LAYERS).filter(|&l| e.leave & bit(l) != 0) {
+                        let rest = (l.max(e.lands_from)..LAYERS)
+                            .map(|a| after[a * cells + to])
+                            .fold(f32::INFINITY, f32::min);
+                        sources.push((l * cells + from, jump.length + f64::from(rest)));
+                    }
+                }
+            }
+            sources.retain(|(_, d)| d.is_finite());
+            relaxed.dijkstra(
+                &mut left[stage * per_stage..(stage + 1) * per_stage],
+                &sources,
+            );
+        }
+        Guide {
+            fine_nx,
+            fine_cell: field.cell(),
+            nx,
+            ny,
+            cells,
+            left,
+            slack: relaxed.side * std::f64::consts::FRAC_1_SQRT_2,
+        }
+    }
+
+    /// A bound of the route left from fine cell `cell` in `layer` at
+    /// `stage`, or `None` when the relaxation has none (nor has the search):
+    /// the least over the coarse cells round it of what is left from their
+    /// centre plus the way there, less the slack.
+    pub fn bound(&self, cell: usize, layer: usize, stage: usize) -> Option<f64> {
+        let (fx, fy) = (cell % self.fine_nx, cell / self.fine_nx);
+        let (cx, cy) = (fx / FACTOR, fy / FACTOR);
+        let plane = &self.left[(stage * LAYERS + layer) * self.cells..][..self.cells];
+        let own = plane[cy * self.nx + cx];
+        if !own.is_finite() {
+            return None;
+        }
+        // Fine cells from the coarse cell's centre, and the centre's offset.
+        let centre = (FACTOR as f64 - 1.0) / 2.0;
+        let mut best = f64::INFINITY;
+        for v in cy.saturating_sub(1)..=(cy + 1).min(self.ny - 1) {
+            for u in cx.saturating_sub(1)..=(cx + 1).min(self.nx - 1) {
+                let left = f64::from(plane[v * self.nx + u]);
+                if left.is_finite() {
+                    let dx = fx as f64 - (u * FACTOR) as f64 - centre;
+                    let dy = fy as f64 - (v * FACTOR) as f64 - centre;
+                    best = best.min(left + dx.hypot(dy) * self.fine_cell);
+                }
+            }
+        }
+        Some((best - self.slack).max(0.0))
+    }
+}
+
+impl Coarse {
+    /// Distances over the coarse states (layer × cell) to `sources`, into
+    /// `dist`, following the search's moves backwards.
+    fn dijkstra(&self, dist: &mut [f32], sources: &[(usize, f64)]) {
+        let cells = self.cells;
+        let mut heap = BinaryHeap::new();
+        for &(state, d) in sources {
+            if (d as f32) < dist[state] {
+                dist[state] = d as f32;
+                heap.push(Item(d, state));
+            }
+        }
+        let diagonal = self.side * std::f64::consts::SQRT_2;
+        while let Some(Item(d, state)) = heap.pop() {
+            if d as f32 > dist[state] {
+                continue;
+            }
+            let (layer, c) = (state / cells, state % cells);
+            let mut relax = |to: usize, length: f64, heap: &mut BinaryHeap<Item>| {
+                let next = d + length;
+                if (next as f32) < dist[to] {
+                    dist[to] = next as f32;
+                    heap.push(Item(next, to));
+                }
+            };
+            let here = bit(layer);
+            let (x, y) = ((c % self.nx) as isize, (c / self.nx) as isize);
+            if self.open[c] & here != 0 {
+                for dy in -1..=1isize {
+                    for dx in -1..=1isize {
+                        let (u, v) = (x + dx, y + dy);
+                        if (dx, dy) == (0, 0)
+                            || u < 0
+                            || v < 0
+                            || u as usize >= self.nx
+                            || v as usize >= self.ny
+                        {
+                            continue;
+                        }
+                        let from = v as usize * self.nx + u as usize;
+                        if self.open[from] & here != 0 {
+                            let length = if dx != 0 && dy != 0 {
+                                diagonal
+                            } else {
+                                self.side
+                            };
+                            relax(layer * cells + from, length, &mut heap);
+                        }
+                    }
+                }
+            }
+            for other in (0..LAYERS).filter(|&l| l != layer) {
+                if self.open[c] & bit(other.min(layer)) != 0 {
+                    relax(other * cells + c, self.switch_cost, &mut heap);
+                }
+            }
+            // A crossing landing here in this layer was entered in it or in a
+            // wider one its near end is open in.
+            for e in self.back.get(&c).map_or(&[][..], Vec::as_slice) {
+                if layer < e.lands_from {
+                    continue;
+                }
+                for l in (0..=layer).filter(|&l| e.leave & bit(l) != 0) {
+                    relax(l * cells + e.from, e.length, &mut heap);
+                }
+            }
+        }
+    }
+}
+/// A crossing as the relaxation flies it.
+struct Ends {
+    /// The coarse cell it leaves.
+    from: usize,
+    length: f64,
+    /// The layers its near end's cell is open in (it is entered in one).
+    leave: u8,
+    /// The widest layer its far end's cell is open in: it lands in that one
+    /// or narrower.
+    lands_from: usize,
+}
+
+/// A coarse cell on the open list, nearest first.
+struct Item(f64, usize);
+
+impl PartialEq for Item {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for Item {}
+
+impl Ord for Item {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.0.total_cmp(&self.0).then(other.1.cmp(&self.1))
+    }
+}
+
+impl PartialOrd for Item {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}

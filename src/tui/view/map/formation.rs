@@ -1,0 +1,170 @@
+//! The formation editor's drawing: the slots at the top, the IWP table
+//! below.
+
+use super::*;
+
+/// Narrower than this inside its border (an 80-column screen), the IWP
+/// table gives each IWP two lines instead of five columns squeezed to a few
+/// letters each.
+const IWP_TABLE_WIDE: u16 = 56;
+
+fn iwp_table_is_narrow(area: Rect) -> bool {
+    area.width.saturating_sub(2) < IWP_TABLE_WIDE
+}
+
+/// The formation editor's drawing (top) and IWP table (bottom).
+pub fn formation_split(app: &App, area: Rect) -> [Rect; 2] {
+    let n = app.iwps().len() as u16;
+    // Borders, plus a header row or a second line per IWP.
+    let wanted = if iwp_table_is_narrow(area) {
+        2 * n + 2
+    } else {
+        n + 3
+    };
+    let list_height = wanted.clamp(4, area.height / 2);
+    ratatui::layout::Layout::vertical([
+        ratatui::layout::Constraint::Min(6),
+        ratatui::layout::Constraint::Length(list_height),
+    ])
+    .areas(area)
+}
+
+/// The formation editor: slots in the formation frame (drawn through `vp`,
+/// the viewport `Drawn` reports), and the IWPs' shapes.
+///
+/// Long (~135 lines): the formation's slots, their labels and the heading, in drawing order.
+pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
+    let m = app.mission();
+    let [top, bottom] = formation_split(app, area);
+    let vp = *vp;
+    let title = TextLine::from(vec![
+        Span::styled(" Formation ", Style::default().bold()),
+        Span::raw(format!(
+            "· {} UAVs · r_F {:.2} m · forward ↑ · P preset ({}) · a add · Del remove ",
+            m.formation.slots.len(),
+            m.formation.radius(),
+            app.current_preset().map_or("custom", Preset::name)
+        )),
+    ]);
+    let dot = vp.metres_per_column() / 2.0;
+    let canvas = Canvas::default()
+        .block(pane_block(title, app.focus() == Focus::Map))
+        .marker(Marker::Braille)
+        .x_bounds(vp.x)
+        .y_bounds(vp.y)
+        .paint(|ctx| {
+            // Axes through the centroid.
+            ctx.draw(&Line::new(vp.x[0], 0.0, vp.x[1], 0.0, Color::DarkGray));
+            ctx.draw(&Line::new(0.0, vp.y[0], 0.0, vp.y[1], Color::DarkGray));
+            ctx.draw(&Ring {
+                x: 0.0,
+                y: 0.0,
+                radius: m.formation.radius(),
+                color: Color::DarkGray,
+                dot,
+            });
+            ctx.layer();
+            for (i, s) in m.formation.slots.iter().enumerate() {
+                let selected = *app.selected() == Item::Slot(i);
+                let color = if selected {
+                    Color::Yellow
+                } else {
+                    uav_color(i)
+                };
+                ctx.draw(&Ring {
+                    x: -s.y,
+                    y: s.x,
+                    radius: m.formation.uav_radius,
+                    color,
+                    dot,
+                });
+                let style = if selected {
+                    Style::default().yellow().bold()
+                } else {
+                    Style::default().fg(color)
+                };
+                ctx.print(-s.y, s.x, Span::styled(format!("{}", i + 1), style));
+            }
+            ctx.print(
+                vp.x[0],
+                vp.y[1],
+                Span::styled("forward", Style::default().fg(Color::DarkGray)),
+            );
+        });
+    frame.render_widget(canvas, top);
+
+    let narrow = iwp_table_is_narrow(bottom);
+    let rows: Vec<Row> = app
+        .iwps()
+        .iter()
+        .map(|w| {
+            let selected = *app.selected() == Item::Waypoint(w.between.clone());
+            let style = if selected {
+                Style::default().black().on_yellow()
+            } else if w.enabled {
+                Style::default()
+            } else {
+                Style::default().fg(Color::DarkGray)
+            };
+            let between = format!("{} ↔ {}", w.between[0], w.between[1]);
+            let choice = if w.choice == ShapeChoice::Auto {
+                "auto".to_owned()
+            } else {
+                shape_name(w.choice).to_owned()
+            };
+            if narrow {
+                let mark = if w.enabled { "◆" } else { "◇" };
+                let off = if w.enabled { "" } else { " · off" };
+                let shape = if w.choice == ShapeChoice::Auto {
+                    format!("auto → {}", w.shape_name())
+                } else {
+                    format!("{} (chosen)", w.shape_name())
+                };
+                let text = ratatui::text::Text::from(vec![
+                    TextLine::raw(format!("{mark} {between}{off}")),
+                    TextLine::raw(format!("  gap {:.2} m · {shape}", w.gap)),
+                ]);
+                return Row::new([Cell::from(text)]).height(2).style(style);
+            }
+            Row::new([
+                Cell::from(between),
+                Cell::from(format!("{:.2}", w.gap)),
+                Cell::from(if w.enabled { "yes" } else { "no" }),
+                Cell::from(choice),
+                Cell::from(w.shape_name()),
+            ])
+            .style(style)
+        })
+        .collect();
+    let empty = app.iwps().is_empty();
+    // With errors elsewhere the IWPs are not looked for: "none" would say
+    // no gap needs one.
+    let errors = app.doc().diagnostics().iter().any(|d| d.is_error());
+    let title = match (empty, narrow) {
+        (true, _) if errors => " IWPs (eq. 9): not found until the mission's errors are fixed ",
+        (true, false) => " IWPs (eq. 9): none: no gap narrower than the formation ",
+        (true, true) => " IWPs (eq. 9): none ",
+        (false, false) => " IWPs (eq. 9) · s cycle shape · space on/off ",
+        (false, true) => " IWPs · s shape · Space on/off ",
+    };
+    let block = pane_block(TextLine::from(title), false);
+    let table = if narrow {
+        Table::new(rows, [ratatui::layout::Constraint::Fill(1)]).block(block)
+    } else {
+        let header = Row::new(["IWP between", "gap m", "on", "choice", "shape used"])
+            .style(Style::default().bold());
+        Table::new(
+            rows,
+            [
+                ratatui::layout::Constraint::Min(20),
+                ratatui::layout::Constraint::Length(6),
+                ratatui::layout::Constraint::Length(3),
+                ratatui::layout::Constraint::Length(10),
+                ratatui::layout::Constraint::Length(10),
+            ],
+        )
+        .header(header)
+        .block(block)
+    };
+    frame.render_widget(table, bottom);
+}

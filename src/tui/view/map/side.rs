@@ -1,0 +1,161 @@
+//! The side view: distance along the path against altitude.
+
+use super::*;
+
+/// Distance along the path vs altitude, with the altitude band and the
+/// obstacles the path passes.
+///
+/// Long (~130 lines): the side view's layers in drawing order (band, obstacles, path, vehicles).
+pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
+    let m = app.mission();
+    let result = result_of(app);
+    let centroid: Vec<Point3<f64>> = match &result {
+        Some((o, _)) => o.centroid_path.clone(),
+        None => vec![m.route.start, m.route.goal],
+    };
+    let along = cumulative(&centroid);
+    let length = along.last().copied().unwrap_or(0.0).max(1.0);
+    // With terrain: the ground under the path, and the band above it.
+    let ground = super::super::terrain::ground_profile(m, &centroid, &along, 400);
+    let highest = ground.iter().map(|g| g.1).fold(0.0, f64::max);
+    let top = m
+        .obstacles
+        .iter()
+        .map(|o| o.height)
+        .fold(m.bounds.z[1] + highest, f64::max)
+        .max(1.0)
+        * 1.15;
+    let title = TextLine::from(vec![
+        Span::styled(" Side view ", Style::default().bold()),
+        Span::raw(format!(
+            "· distance along the path (0-{length:.0} m) vs altitude (0-{top:.0} m) · v: top view "
+        )),
+    ]);
+    let stale = result.as_ref().is_some_and(|(_, s)| *s);
+    let canvas = Canvas::default()
+        .block(pane_block(title, app.focus() == Focus::Map))
+        .marker(Marker::Braille)
+        .x_bounds([-0.02 * length, 1.02 * length])
+        .y_bounds([0.0, top])
+        .paint(|ctx| {
+            if ground.is_empty() {
+                for z in m.bounds.z {
+                    ctx.draw(&Line::new(0.0, z, length, z, Color::DarkGray));
+                }
+            } else {
+                for z in m.bounds.z {
+                    let band: Vec<(f64, f64)> = ground.iter().map(|&(s, g)| (s, g + z)).collect();
+                    ctx.draw(&Polyline {
+                        points: &band,
+                        color: Color::DarkGray,
+                    });
+                }
+                ctx.draw(&Polyline {
+                    points: &ground,
+                    color: Color::Yellow,
+                });
+                ctx.print(
+                    length * 0.85,
+                    highest,
+                    Span::styled("ground", Style::default().fg(Color::Yellow)),
+                );
+            }
+            // The altitude axis: the band's limits with their numbers.
+            for (z, name) in [(m.bounds.z[1], "z max"), (m.bounds.z[0], "z min")] {
+                ctx.print(
+                    0.0,
+                    z,
+                    Span::styled(
+                        format!("{name} {} m", crate::tui::fields::fmt_num(z)),
+                        Style::default().fg(Color::DarkGray),
+                    ),
+                );
+            }
+            // Obstacles the formation passes within its safe radius, and
+            // every inspected one (the mission's subject, however far the
+            // path stays from it), at its closest point along the path.
+            let reach = m.formation.safe_radius();
+            for o in &m.obstacles {
+                if let Some((s, d)) = closest_along(&centroid, &along, &o.center)
+                    && (o.inspect || d < o.radius + reach)
+                {
+                    let color = if o.inspect {
+                        Color::LightMagenta
+                    } else {
+                        Color::LightRed
+                    };
+                    ctx.draw(&Rectangle {
+                        x: s - o.radius,
+                        y: 0.0,
+                        width: 2.0 * o.radius,
+                        height: o.height,
+                        color,
+                    });
+                    if o.inspect {
+                        ctx.print(
+                            s,
+                            o.height,
+                            Span::styled(o.name.clone(), Style::default().fg(color)),
+                        );
+                    }
+                }
+            }
+            ctx.layer();
+            if let Some((o, _)) = &result {
+                for (k, t) in o.trajectories.iter().enumerate() {
+                    let color = if stale { Color::DarkGray } else { uav_color(k) };
+                    let speed = m.formation.ground_speed;
+                    let pts = decimate(
+                        t.samples.iter().map(|s| (s.t * speed, s.position.z)),
+                        length / 400.0,
+                    );
+                    ctx.draw(&Polyline {
+                        points: &pts,
+                        color,
+                    });
+                }
+            }
+            let pts: Vec<(f64, f64)> = along
+                .iter()
+                .zip(&centroid)
+                .map(|(s, p)| (*s, p.z))
+                .collect();
+            ctx.draw(&Polyline {
+                points: &pts,
+                color: if stale { Color::Gray } else { Color::White },
+            });
+            if result.is_none() {
+                ctx.print(
+                    0.05 * length,
+                    top * 0.9,
+                    Span::raw("straight line start → goal; run θ-PSO (r) for the plan"),
+                );
+            }
+        });
+    frame.render_widget(canvas, area);
+}
+
+fn cumulative(points: &[Point3<f64>]) -> Vec<f64> {
+    let mut s = 0.0;
+    let mut out = Vec::with_capacity(points.len());
+    for (i, p) in points.iter().enumerate() {
+        if i > 0 {
+            s += (p - points[i - 1]).xy().norm();
+        }
+        out.push(s);
+    }
+    out
+}
+
+/// Along-path distance of the closest approach to `c`, and that distance.
+fn closest_along(points: &[Point3<f64>], along: &[f64], c: &Point2<f64>) -> Option<(f64, f64)> {
+    let mut best: Option<(f64, f64)> = None;
+    for i in 1..points.len() {
+        let (a, b) = (points[i - 1].xy(), points[i].xy());
+        let (t, d) = segment_projection(&a, &b, c);
+        if best.is_none_or(|(_, bd)| d < bd) {
+            best = Some((along[i - 1] + t * (b - a).norm(), d));
+        }
+    }
+    best
+}
