@@ -383,7 +383,12 @@ pub fn find(
     };
     let (s, g) = (field.index_of(start), field.index_of(goal));
     let guide = Guide::new(&graph, g);
-    let found = search::search(&graph, s, g, Some(&guide)).or_else(|_| {
+    // Not even the relaxation leaves the start: no search to set up.
+    let guided = match guide.bound(s, 0, 0) {
+        Some(_) => search::search(&graph, s, g, Some(&guide)),
+        None => Err(search::Reached { stage: Vec::new() }),
+    };
+    let found = guided.or_else(|_| {
         // No route. What the formation reaches, to say what closes the way:
         // a plain flood when not even the relaxation reaches the goal, else
         // the whole search without the guide's pruning.
