@@ -621,6 +621,35 @@ pub struct FleetParams {
     /// Disturbances.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pushes: Vec<FleetPush>,
+    /// What each agent hears of the others (`[fleet.network]`); ideal when
+    /// absent: every neighbour's state of this very step.
+    #[serde(skip_serializing_if = "FleetNetwork::is_ideal")]
+    pub network: FleetNetwork,
+}
+
+/// The network between the fleet's agents: each agent broadcasts its state
+/// (position, velocity, reference) every simulation step; a neighbour hears
+/// it `latency` steps later, unless it is lost or out of `range`. Whether a
+/// message is lost is a pure function of (seed, sender, receiver, step), so a
+/// run is reproducible. See docs/fleet.md.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct FleetNetwork {
+    /// Metres a message carries; absent: the neighbourhood radius l.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range: Option<f64>,
+    /// Whole simulation steps (`fleet.sim_step`) from sending to hearing.
+    pub latency: usize,
+    /// Probability that one message to one receiver is lost, in [0, 1).
+    pub loss: f64,
+}
+
+impl FleetNetwork {
+    /// No latency, no loss, the range of the neighbourhood: the fleet as
+    /// the paper simulates it.
+    pub fn is_ideal(&self) -> bool {
+        self.range.is_none() && self.latency == 0 && self.loss == 0.0
+    }
 }
 
 impl Default for FleetParams {
@@ -655,6 +684,7 @@ impl Default for FleetParams {
             initial_positions: Vec::new(),
             targets: Vec::new(),
             pushes: Vec::new(),
+            network: FleetNetwork::default(),
         }
     }
 }

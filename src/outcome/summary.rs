@@ -356,6 +356,29 @@ pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
         o.safety_distance
     );
     let _ = writeln!(s, "  obstacles    {obstacle}");
+    // The network's traffic, when it is not the ideal one.
+    let (sent, received, lost) = o.agents.iter().fold((0, 0, 0), |t, a| {
+        (
+            t.0 + a.network.sent,
+            t.1 + a.network.received,
+            t.2 + a.network.lost,
+        )
+    });
+    let worst = o
+        .agents
+        .iter()
+        .map(|a| a.network.worst_age)
+        .fold(0.0, f64::max);
+    if lost > 0 || worst > 0.0 {
+        let mean =
+            o.agents.iter().map(|a| a.network.mean_age).sum::<f64>() / o.agents.len().max(1) as f64;
+        let _ = writeln!(
+            s,
+            "  network      {sent} sent, {received} heard, {lost} lost ({:.1} %); \
+             neighbour information {mean:.3} s old on average, {worst:.3} s at worst",
+            100.0 * lost as f64 / (lost + received).max(1) as f64
+        );
+    }
     let decisions: usize = o.agents.iter().map(|a| a.decisions).sum();
     let evaluations: usize = o.agents.iter().map(|a| a.evaluations).sum();
     let _ = writeln!(

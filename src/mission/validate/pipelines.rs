@@ -175,6 +175,7 @@ impl Checker {
             self.positive(path.key(key), value, unit);
         }
         self.non_negative(path.key("target_distance"), p.target_distance, " m");
+        self.fleet_network(&path.key("network"), p);
         for (i, v) in p.inertia_diag.iter().enumerate() {
             self.positive(path.key("inertia_diag").index(i), *v, " kg·m²");
         }
@@ -326,6 +327,36 @@ impl Checker {
                     );
                 }
             }
+        }
+    }
+
+    /// `[fleet.network]`: a range that carries, a latency within the run, a
+    /// loss that leaves some messages.
+    pub(super) fn fleet_network(&mut self, path: &FieldPath, p: &FleetParams) {
+        let n = &p.network;
+        if let Some(range) = n.range {
+            self.positive(path.key("range"), range, " m");
+        }
+        if !(n.loss.is_finite() && (0.0..1.0).contains(&n.loss)) {
+            self.error(
+                path.key("loss"),
+                format!(
+                    "must be a probability in [0, 1) (1 would lose every message), got {}",
+                    compact(n.loss)
+                ),
+            );
+        }
+        let steps = (p.duration / p.sim_step).round();
+        if p.sim_step > 0.0 && p.duration > 0.0 && steps.is_finite() && n.latency as f64 > steps {
+            self.error(
+                path.key("latency"),
+                format!(
+                    "{} steps of {} s is longer than the whole run ({} s): no message would arrive",
+                    n.latency,
+                    compact(p.sim_step),
+                    compact(p.duration)
+                ),
+            );
         }
     }
 }

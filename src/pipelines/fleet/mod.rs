@@ -14,6 +14,7 @@
 
 pub mod agent;
 pub mod cost;
+pub mod network;
 pub mod quadrotor;
 pub mod simulation;
 
@@ -49,6 +50,8 @@ pub struct AgentOutcome {
     /// PSO runs (decisions) and cost evaluations: the agent's planning effort.
     pub decisions: usize,
     pub evaluations: usize,
+    /// Messages it sent, heard and lost, and the age of what it decided on.
+    pub network: network::LinkStats,
 }
 
 /// The desired formation around one target, and when the fleet reached it.

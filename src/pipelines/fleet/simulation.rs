@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use super::agent::Planner;
 use super::cost::{Detected, Neighbour, Observation};
+use super::network::{Message, Network};
 use super::quadrotor::{self, Body, State};
 use super::{
     AgentOutcome, AgentSample, Closest, DistanceSeries, FleetOutcome, MAX_SERIES_AGENTS, Other,
@@ -37,6 +38,7 @@ struct Clock {
 
 /// The fleet as every agent sees it at the start of a step.
 pub struct Snapshot {
+    step: usize,
     t: f64,
     /// The target in force (index into the scenario's targets) and where it is.
     active: usize,
@@ -75,6 +77,8 @@ pub struct Simulation<'m> {
     /// Each agent's neighbours within `watch_radius`, rebuilt every round.
     near: Vec<Vec<usize>>,
     watch_radius: f64,
+    /// What each agent has heard of the others (`network`).
+    network: Network,
     log: Log,
 }
 
@@ -157,6 +161,7 @@ impl<'m> Simulation<'m> {
             watch_radius: p
                 .neighbourhood
                 .max(p.safety_distance + 2.0 * std::f64::consts::SQRT_2 * p.step_max + 1.0),
+            network: Network::new(&p.network, p.neighbourhood, n, seed, dt),
             log,
         }
     }
@@ -170,11 +175,13 @@ impl<'m> Simulation<'m> {
                 self.record(&now);
             }
             self.disturb(now.t);
+            self.broadcast(&now);
             let due = self.due(&now);
             // Before the first target appears the agents hold their starts.
             let started = now.t >= self.scenario.targets[0].0;
             if started && due.iter().any(|&d| d) {
                 let observations = self.observe(&now, &due);
+                self.count_ages(&now, &due);
                 self.decide(&now, &observations);
                 self.round += 1;
             }
@@ -219,6 +226,7 @@ impl<'m> Simulation<'m> {
             self.near = neighbourhoods(&positions, self.watch_radius);
         }
         Snapshot {
+            step: k,
             t,
             active,
             target: targets[active].1,
@@ -305,15 +313,58 @@ impl<'m> Simulation<'m> {
         (0..positions.len())
             .map(|i| {
                 now.scheduled
-                    || self.near[i]
-                        .iter()
-                        .any(|&j| (positions[j] - positions[i]).norm() < self.p.safety_distance)
+                    || self
+                        .heard_neighbours(i)
+                        .any(|m| (m.position - positions[i]).norm() < self.p.safety_distance)
             })
             .collect()
     }
 
-    /// What each agent due to decide observes of the snapshot: its
-    /// neighbours within l and the obstacles within d_obs, nothing else.
+    /// Every agent broadcasts its state of this step; what arrives now is
+    /// heard (`network`).
+    fn broadcast(&mut self, now: &Snapshot) {
+        let out = self
+            .flights
+            .iter()
+            .enumerate()
+            .map(|(i, f)| Message {
+                sender: i,
+                step: now.step,
+                position: now.positions[i],
+                velocity: Vector2::new(f.state[3], f.state[4]),
+                reference: f.reference.xy(),
+            })
+            .collect();
+        self.network.exchange(now.step, out, &self.near);
+    }
+
+    /// The last message agent `i` heard from each agent on its list.
+    fn heard_neighbours(&self, i: usize) -> impl Iterator<Item = &Message> + '_ {
+        self.near[i]
+            .iter()
+            .filter_map(move |&j| self.network.heard(i, j))
+    }
+
+    /// The neighbours agent `i` decides on: those it heard within l of it.
+    fn in_reach(&self, i: usize, me: Point2<f64>) -> impl Iterator<Item = &Message> + '_ {
+        let l = self.p.neighbourhood;
+        self.heard_neighbours(i)
+            .filter(move |m| (m.position - me).norm() <= l)
+    }
+
+    /// The age of every neighbour state each deciding agent used.
+    fn count_ages(&mut self, now: &Snapshot, due: &[bool]) {
+        for i in (0..due.len()).filter(|&i| due[i]) {
+            let used: Vec<Message> = self.in_reach(i, now.positions[i]).copied().collect();
+            for m in &used {
+                self.network.used(i, m, now.step);
+            }
+        }
+    }
+
+    /// What each agent due to decide observes: the neighbours it heard
+    /// within l (their last messages) and the obstacles within d_obs,
+    /// nothing else.
     fn observe(&self, now: &Snapshot, due: &[bool]) -> Vec<Option<Observation>> {
         (0..due.len())
             .into_par_iter()
@@ -331,12 +382,12 @@ impl<'m> Simulation<'m> {
             target_distance: p.target_distance,
             // Eq. 2: Ξ_i, the agents within l (the round's lists reach a little
             // further, for the safety check).
-            neighbours: self.near[i]
-                .iter()
-                .filter(|&&j| (positions[j] - me).norm() <= p.neighbourhood)
-                .map(|&j| Neighbour {
-                    position: positions[j],
-                    desired: self.scenario.desired[i][j],
+            // What it heard of them, not where they are.
+            neighbours: self
+                .in_reach(i, me)
+                .map(|m| Neighbour {
+                    position: m.position,
+                    desired: self.scenario.desired[i][m.sender],
                 })
                 .collect(),
             obstacles: self
@@ -390,6 +441,7 @@ impl<'m> Simulation<'m> {
             flights,
             clock,
             log,
+            network,
             ..
         } = self;
         let end = log.times.last().copied().unwrap_or(0.0);
@@ -438,6 +490,7 @@ impl<'m> Simulation<'m> {
                 samples,
                 decisions: f.planner.decisions,
                 evaluations: f.planner.evaluations,
+                network: network.stats()[i],
             })
             .collect();
         FleetOutcome {

@@ -1,0 +1,104 @@
+//! The fleet's network model (`[fleet.network]`, issue 26): each agent
+//! decides from the messages it heard, with latency and loss reproducible
+//! from the seed, and the ideal network flies the fleet the paper simulates.
+
+use skyform::mission::{self, FleetNetwork, Mission, Severity};
+use skyform::pipelines::fleet::{self, FleetOutcome};
+use skyform::pipelines::{CancelToken, Silent};
+
+fn triangle_mission() -> Mission {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/fleet-triangle.toml");
+    mission::load(std::path::Path::new(path))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission
+}
+
+fn run(m: &Mission, seed: u64) -> FleetOutcome {
+    let report = mission::validate(m);
+    assert!(report.iter().all(|d| !d.is_error()), "{report:?}");
+    fleet::plan(m, seed, &mut Silent, &CancelToken::new()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// With no `[fleet.network]` every agent hears every neighbour's state of
+/// this very step: the run is the one before the network existed, bit for
+/// bit. The figures are those the snapshot-reading fleet gave for seed 3
+/// (`skyform run fleet missions/fleet-triangle.toml --seed 3 --json`,
+/// commit 3a490ec); a range of exactly l written out changes nothing.
+#[test]
+fn the_ideal_network_flies_the_fleet_of_the_perfect_snapshot_bit_for_bit() {
+    let m = triangle_mission();
+    assert!(m.fleet.network.is_ideal());
+    let o = run(&m, 3);
+    let closest = o.closest_agents.as_ref().map(|c| c.distance.to_bits());
+    assert_eq!(closest, Some(1.124276646824256f64.to_bits()));
+    let last = o.agents[1].samples.last().map(|s| s.position);
+    let want = [2.452569341028794, -2.8916654882559207, 1.000009411727045];
+    assert_eq!(
+        last.map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]),
+        Some(want.map(f64::to_bits))
+    );
+    // Every message arrived, none was lost, all of it fresh.
+    for a in &o.agents {
+        assert_eq!(a.network.lost, 0);
+        assert!(a.network.received > 0 && a.network.worst_age == 0.0);
+    }
+    let mut explicit = m.clone();
+    explicit.fleet.network.range = Some(m.fleet.neighbourhood);
+    assert_eq!(run(&explicit, 3), o);
+}
+
+/// A network 0.1 s late that loses 30 % of the messages: the same seed
+/// gives the same run (loss is a function of seed, sender, receiver and
+/// step), the losses are counted at about the rate asked, and the agents
+/// decided on information at least the latency old.
+#[test]
+fn a_late_lossy_network_is_reproducible_and_counted() {
+    let mut m = triangle_mission();
+    m.fleet.duration = 20.0;
+    let latency = (0.1 / m.fleet.sim_step).round() as usize;
+    m.fleet.network = FleetNetwork {
+        range: None,
+        latency,
+        loss: 0.3,
+    };
+    let (a, b) = (run(&m, 1), run(&m, 1));
+    assert_eq!(a, b, "the same mission and seed fly the same");
+    let (lost, received): (usize, usize) = a
+        .agents
+        .iter()
+        .map(|x| (x.network.lost, x.network.received))
+        .fold((0, 0), |s, x| (s.0 + x.0, s.1 + x.1));
+    let rate = lost as f64 / (lost + received) as f64;
+    assert!((rate - 0.3).abs() < 0.02, "lost {rate} of the messages");
+    for x in &a.agents {
+        assert!(x.network.mean_age >= 0.1 - 1e-9, "{:?}", x.network);
+        assert!(x.network.worst_age >= x.network.mean_age);
+    }
+    let mut ideal = m.clone();
+    ideal.fleet.network = FleetNetwork::default();
+    let perfect = run(&ideal, 1);
+    assert_ne!(
+        perfect.agents[0].samples, a.agents[0].samples,
+        "late, lossy information changes the flight"
+    );
+}
+
+/// A loss of 1 would lose every message, and a latency longer than the run
+/// would deliver none: both are refused naming the field.
+#[test]
+fn an_impossible_network_is_refused_naming_the_field() {
+    let mut m = triangle_mission();
+    m.fleet.network.loss = 1.0;
+    m.fleet.network.latency = 1_000_000;
+    let report = mission::validate(&m);
+    let at = |path: &str| {
+        report
+            .iter()
+            .find(|d| d.severity == Severity::Error && d.path.to_string() == path)
+            .map(|d| d.message.clone())
+    };
+    let loss = at("fleet.network.loss").unwrap_or_default();
+    assert!(loss.contains("[0, 1)"), "{loss}");
+    let late = at("fleet.network.latency").unwrap_or_default();
+    assert!(late.contains("longer than the whole run"), "{late}");
+}
