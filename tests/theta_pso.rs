@@ -115,7 +115,7 @@ fn terms_with(
     m: &Mission,
     obstacles: Vec<Obstacle>,
     path: &CentroidPath,
-) -> skyform::pipelines::CostTerms {
+) -> skyform::pipelines::theta_pso::CostTerms {
     let mut m = m.clone();
     m.obstacles = obstacles;
     CostModel::new(&m, &[]).terms(path)

@@ -29,10 +29,10 @@ use serde::Serialize;
 use crate::mission::Mission;
 use crate::outcome::tracks::{self, Track};
 use crate::pipelines::Kind;
+use crate::pipelines::Limits;
 use crate::pipelines::flatlo::FlatloOutcome;
 use crate::pipelines::fleet::FleetOutcome;
 use crate::pipelines::theta_pso::ThetaPsoOutcome;
-use crate::pipelines::theta_pso::verify::Limits;
 
 pub use geodesy::{Frame, Geodetic};
 pub use reverify::Reverification;

@@ -19,7 +19,8 @@ use serde::Serialize;
 use super::VehiclePlan;
 use crate::mission::Mission;
 use crate::outcome::tracks::{Track, TrackSample};
-use crate::pipelines::theta_pso::verify::{Limits, Verification, verify_within};
+use crate::pipelines::Limits;
+use crate::pipelines::theta_pso::verify::{Verification, verify_within};
 use crate::pipelines::theta_pso::{Sample, Trajectory};
 
 /// A broken constraint of the flown plans, located.

@@ -24,7 +24,7 @@ use super::model::Mission;
 pub fn edit_in_place(mission: &Mission, original: &str) -> Option<String> {
     let mut doc: DocumentMut = original.parse().ok()?;
     let source = super::source::SourceMap::new(original);
-    let (before, forms) = super::file::read_model(original, &source).ok()?;
+    let (before, forms) = super::read::read_model(original, &source).ok()?;
     let mut old = tree(&before)?;
     let mut new = tree(mission)?;
     super::geodetic::write_forms(&mut old, &before, &forms);

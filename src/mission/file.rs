@@ -4,12 +4,11 @@ use std::fs;
 use std::io;
 use std::path::Path;
 
-use serde::Deserialize;
 use toml::de::DeTable;
 
 use super::diagnostic::{Diagnostic, Report};
-use super::geodetic::{self, Forms};
 use super::model::Mission;
+use super::read::{locate_toml_error, read_model};
 use super::source::SourceMap;
 use super::validate::validate;
 
@@ -75,33 +74,6 @@ pub fn check_str(text: &str, file: Option<&str>) -> Checked {
             report: Report::new(diagnostics.into_iter().map(locate).collect()),
         },
     }
-}
-
-/// The typed mission of a file's text, its latitude/longitude positions
-/// converted to ENU (`geodetic.rs`), not validated; and the forms the file
-/// wrote its positions in (a save writes them back so). Fails on the first
-/// type error, or on every position that cannot be converted.
-pub(super) fn read_model(
-    text: &str,
-    source: &SourceMap<'_>,
-) -> Result<(Mission, Forms), Vec<Diagnostic>> {
-    let root = DeTable::parse(text).map_err(|e| vec![locate_toml_error(&e, source)])?;
-    let conversions = geodetic::convert(&root)?;
-    let root = geodetic::apply(root, &conversions);
-    let mission = Mission::deserialize(toml::de::Deserializer::from(root))
-        .map_err(|e| vec![locate_toml_error(&e, source)])?;
-    Ok((mission, conversions.forms))
-}
-
-/// A toml error as a diagnostic on the field under its span.
-fn locate_toml_error(e: &toml::de::Error, source: &SourceMap<'_>) -> Diagnostic {
-    let path = e
-        .span()
-        .map(|span| source.path_at(span.start))
-        .unwrap_or_default();
-    let mut d = Diagnostic::error(path, e.message().trim().to_owned());
-    d.location = e.span().map(|span| source.line_col(span.start));
-    d
 }
 
 /// A valid mission and the warnings it raised.

@@ -9,6 +9,7 @@ pub mod geodesy;
 pub mod geodetic;
 mod model;
 mod presets;
+mod read;
 mod source;
 mod template;
 mod validate;

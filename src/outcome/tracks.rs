@@ -35,7 +35,7 @@ pub fn vehicle_color(i: usize) -> [u8; 3] {
 
 /// One instant of a track (seconds, metres ENU, m/s): the same sample as a
 /// θ-PSO trajectory's, so those tracks are the trajectories themselves.
-pub use crate::pipelines::theta_pso::Sample as TrackSample;
+pub use crate::pipelines::TrackSample;
 
 /// One vehicle's timed track.
 #[derive(Debug, Clone, PartialEq, Serialize)]

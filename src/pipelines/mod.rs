@@ -51,31 +51,38 @@ impl Kind {
     }
 }
 
+/// One timed sample of a vehicle's track, planned or flown: seconds,
+/// metres ENU, m/s. θ-PSO's trajectories are made of them, and every
+/// pipeline's tracks (`outcome::tracks`) and the exports read them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TrackSample {
+    pub t: f64,
+    pub position: Point3<f64>,
+    pub velocity: nalgebra::Vector3<f64>,
+}
+
+/// The thresholds a verification holds tracks to, whichever pipeline flew
+/// them: θ-PSO's are `Limits::theta_pso` (`theta_pso::verify`); the exports
+/// re-verify FLATLO and fleet plans with their own pipeline's thresholds
+/// through the same checks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Least clearance to every obstacle's surface, metres (θ-PSO: r_Q).
+    pub clearance: f64,
+    /// Least distance between two vehicles at the same instant, metres (eq. 7: 2 r_Q).
+    pub closest: f64,
+    /// Largest distance between two vehicles, metres (eq. 7: d_com); `None`: no such limit.
+    pub farthest: Option<f64>,
+    /// Check eq. 8 over each inspected obstacle's pass.
+    pub inspections: bool,
+}
+
 /// Severity of a log event.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Level {
     Info,
     Warn,
-}
-
-/// Cost terms of a θ-PSO path (eqs. 2-5, 10-11), unweighted, plus the weighted total.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
-pub struct CostTerms {
-    /// J1, path length, metres (eq. 3).
-    pub length: f64,
-    /// J2, mean violation of the obstacles' safe radii (eq. 4).
-    pub obstacle: f64,
-    /// J3, summed altitude-band violation, metres (eq. 5).
-    pub altitude: f64,
-    /// J_R, mean horizontal distance of the path to the enabled IWPs, metres (eq. 11).
-    pub waypoints: f64,
-    /// J_B, how far the UAVs leave the x-y bounds, summed over L shares of the path, metres.
-    pub bounds: f64,
-    /// J_T, the path's horizontal turns beyond 90°, summed, radians.
-    pub turning: f64,
-    /// J = β1 J1 + β2 J2 + β3 J3 + β_R J_R + β_B J_B + β_T J_T (eqs. 2, 10).
-    pub total: f64,
 }
 
 /// Something a pipeline reports while it runs.
@@ -88,7 +95,7 @@ pub enum Event<'a> {
     /// θ-PSO: the best centroid path and its cost after an iteration.
     PathIteration {
         iteration: usize,
-        cost: &'a CostTerms,
+        cost: &'a theta_pso::CostTerms,
         path: &'a [Point3<f64>],
     },
     /// A message for the log.

@@ -30,7 +30,8 @@ use rerun::{RecordingStream, RecordingStreamBuilder};
 
 use crate::mission::Mission;
 use crate::outcome::Outcome;
-use crate::pipelines::{CostTerms, Event, Kind, Level, Observer};
+use crate::pipelines::theta_pso::CostTerms;
+use crate::pipelines::{Event, Kind, Level, Observer};
 
 mod flatlo;
 mod fleet;

@@ -8,8 +8,9 @@ use rerun::RecordingStream;
 use super::paths::{self, theta_pso as at};
 use super::{f32x3, log_moving_point, log_series, uav_color};
 use crate::mission::Mission;
+use crate::pipelines::Kind;
+use crate::pipelines::theta_pso::CostTerms;
 use crate::pipelines::theta_pso::ThetaPsoOutcome;
-use crate::pipelines::{CostTerms, Kind};
 
 /// Picks one term out of the cost breakdown.
 type CostTerm = fn(&CostTerms) -> f64;

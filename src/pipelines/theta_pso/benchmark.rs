@@ -5,14 +5,17 @@
 //! the CLI, the designer and the recording show it as they show any plan.
 //!
 //! The outcome's cost terms carry the benchmark's: `length` = J1,
-//! `obstacle` = J2, `altitude` = J3, `turning` = J4 (degrees), `total` = J.
+//! `obstacle` = J2, `altitude` = J3, `turning` = J4 in radians (as every
+//! `CostTerms::turning`; the benchmark's own `spso::Terms::smoothness` is in
+//! degrees, its unit), `total` = J (the benchmark's, J4 in degrees in it).
 
 use std::ops::ControlFlow;
 
+use super::CostTerms;
 use super::{ThetaPsoOutcome, path, trajectory, verify};
 use crate::mission::Mission;
 use crate::pipelines::theta_pso::spso::{self, Decoder};
-use crate::pipelines::{CancelToken, Completion, CostTerms, Event, Level, Observer, PipelineError};
+use crate::pipelines::{CancelToken, Completion, Event, Level, Observer, PipelineError};
 
 /// The benchmark's terms as `CostTerms`.
 pub fn cost_terms(t: &spso::Terms) -> CostTerms {
@@ -22,7 +25,7 @@ pub fn cost_terms(t: &spso::Terms) -> CostTerms {
         altitude: t.altitude,
         waypoints: 0.0,
         bounds: 0.0,
-        turning: t.smoothness,
+        turning: t.smoothness.to_radians(),
         total: t.total,
     }
 }

@@ -27,9 +27,9 @@ use serde::Serialize;
 
 use crate::base::swarm::{self, SearchSpace, SwarmConfig};
 use crate::mission::{Diagnostic, FieldPath, Mission};
-use crate::pipelines::{CancelToken, Completion, CostTerms, Event, Level, Observer, PipelineError};
+use crate::pipelines::{CancelToken, Completion, Event, Level, Observer, PipelineError};
 
-pub use cost::CostModel;
+pub use cost::{CostModel, CostTerms};
 pub use inspection::PassGeometry;
 pub use iwp::{Iwp, Shape, find_iwps};
 pub use path::{CentroidPath, PathBuilder};

@@ -14,13 +14,8 @@ use super::motion::Motion;
 use super::path::{CentroidPath, Zone, ZoneCause};
 use crate::mission::Formation;
 
-/// One sample of a UAV's trajectory. Seconds, metres ENU, m/s.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Sample {
-    pub t: f64,
-    pub position: Point3<f64>,
-    pub velocity: Vector3<f64>,
-}
+/// One sample of a UAV's trajectory: the shared timed sample.
+pub use crate::pipelines::TrackSample as Sample;
 
 /// The timed trajectory T_n of one UAV (eq. 15).
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use super::trajectory::Trajectory;
 use crate::mission::Mission;
+use crate::pipelines::Limits;
 
 /// Where a worst value happens.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -142,21 +143,7 @@ impl Tracker {
     }
 }
 
-/// The limits a verification holds trajectories to. θ-PSO's are
-/// [`Limits::theta_pso`]; the exports re-verify FLATLO and fleet plans with
-/// their own pipeline's thresholds through the same checks.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Limits {
-    /// Least clearance to every obstacle's surface, metres (θ-PSO: r_Q).
-    pub clearance: f64,
-    /// Least distance between two vehicles at the same instant, metres (eq. 7: 2 r_Q).
-    pub closest: f64,
-    /// Largest distance between two vehicles, metres (eq. 7: d_com); `None`: no such limit.
-    pub farthest: Option<f64>,
-    /// Check eq. 8 over each inspected obstacle's pass.
-    pub inspections: bool,
-}
-
+/// θ-PSO's own thresholds, in the shared vocabulary of the checks.
 impl Limits {
     /// θ-PSO's hard constraints: r_Q, [2 r_Q, d_com] (eq. 7), eq. 8.
     pub fn theta_pso(mission: &Mission) -> Self {

@@ -39,7 +39,7 @@ use super::motion::Motion;
 use super::path::{CentroidPath, heading_span};
 use crate::base::geometry::Cylinder;
 use crate::mission::{Bounds, Mission, ThetaPsoParams};
-use crate::pipelines::CostTerms;
+use serde::Serialize;
 
 mod pairs;
 
@@ -83,6 +83,25 @@ pub struct CostModel {
     /// Cosine of the largest heading turn over one piece: the turn at which a
     /// UAV `reach` from the centroid strays `CHORD_TOLERANCE` from the chord.
     max_turn_cos: f64,
+}
+
+/// Cost terms of a θ-PSO path (eqs. 2-5, 10-11), unweighted, plus the weighted total.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct CostTerms {
+    /// J1, path length, metres (eq. 3).
+    pub length: f64,
+    /// J2, mean violation of the obstacles' safe radii (eq. 4).
+    pub obstacle: f64,
+    /// J3, summed altitude-band violation, metres (eq. 5).
+    pub altitude: f64,
+    /// J_R, mean horizontal distance of the path to the enabled IWPs, metres (eq. 11).
+    pub waypoints: f64,
+    /// J_B, how far the UAVs leave the x-y bounds, summed over L shares of the path, metres.
+    pub bounds: f64,
+    /// J_T, the path's horizontal turns beyond 90°, summed, radians.
+    pub turning: f64,
+    /// J = β1 J1 + β2 J2 + β3 J3 + β_R J_R + β_B J_B + β_T J_T (eqs. 2, 10).
+    pub total: f64,
 }
 
 /// What the swarm adds to J for a path that breaks a constraint anywhere

@@ -28,6 +28,7 @@ mod squeeze;
 mod walker;
 mod zone;
 
+pub use squeeze::SqueezeMap;
 pub use walker::{ArcWalker, cumulative_lengths};
 pub use zone::{MIN_BLEND, ShapeState, Zone, ZoneCause, schedule};
 
@@ -85,7 +86,7 @@ pub struct PathBuilder {
     hold_distance: f64,
     transition: f64,
     /// Where the route stage found the site narrower than the formation.
-    squeeze: Option<std::sync::Arc<super::route::SqueezeMap>>,
+    squeeze: Option<std::sync::Arc<SqueezeMap>>,
 }
 
 /// A usable IWP as a via: its straight crossing.
@@ -210,7 +211,7 @@ impl PathBuilder {
     }
 
     /// Paths of this builder fly squeezed through `map`'s regions.
-    pub fn set_squeeze(&mut self, map: Option<std::sync::Arc<super::route::SqueezeMap>>) {
+    pub fn set_squeeze(&mut self, map: Option<std::sync::Arc<SqueezeMap>>) {
         self.squeeze = map;
     }
 
@@ -352,63 +353,6 @@ impl PathBuilder {
             passes.push((i, leg + 1, on_left));
         }
 
-        self.finish(points, &crossings, &passes)
-    }
-
-    /// The path of a corridor found by the route stage, as a particle's path
-    /// would be built: its points lifted to heights along start → goal (in
-    /// each via's band), its crossings and passes as vias.
-    pub fn from_corridor(&self, corridor: &super::route::Corridor) -> CentroidPath {
-        use super::route::Leg;
-        let plane = &corridor.points;
-        let total = corridor.length.max(1e-9);
-        let mut s = 0.0;
-        let mut points = Vec::with_capacity(plane.len() + corridor.legs.len());
-        let mut crossings = Vec::new();
-        let mut passes = Vec::new();
-        let height = |s: f64| {
-            let u = s / total;
-            (self.start.z + (self.goal.z - self.start.z) * u)
-                .clamp(self.bounds[2][0], self.bounds[2][1])
-        };
-        points.push(self.start);
-        for (k, leg) in corridor.legs.iter().enumerate() {
-            let (a, b) = (plane[k], plane[k + 1]);
-            match *leg {
-                Leg::Crossing(c) => {
-                    let via = &self.crossings[c];
-                    let z = height(s).clamp(via.z_range[0], via.z_range[1]);
-                    // The leg into the crossing ends at its first point.
-                    if let Some(last) = points.last_mut() {
-                        last.z = z;
-                    }
-                    crossings.push((c, points.len() - 1));
-                    points.push(Point3::new(via.center.x, via.center.y, z));
-                    points.push(Point3::new(b.x, b.y, z));
-                }
-                Leg::Pass(i) => {
-                    let ins = &self.inspections[i];
-                    let z = height(s).clamp(ins.z_range[0], ins.z_range[1]);
-                    if let Some(last) = points.last_mut() {
-                        last.z = z;
-                    }
-                    passes.push((i, points.len() - 1, corridor.passes[i].1));
-                    points.push(Point3::new(b.x, b.y, z));
-                }
-                Leg::Free { .. } => {
-                    let z = if k + 1 == corridor.legs.len() {
-                        self.goal.z
-                    } else {
-                        height(s + (b - a).norm())
-                    };
-                    points.push(Point3::new(b.x, b.y, z));
-                }
-            }
-            s += (b - a).norm();
-        }
-        if let Some(last) = points.last_mut() {
-            *last = self.goal;
-        }
         self.finish(points, &crossings, &passes)
     }
 

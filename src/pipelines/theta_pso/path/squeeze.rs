@@ -5,7 +5,90 @@ use nalgebra::{Point2, Point3};
 
 use super::{CentroidPath, PathBuilder, Zone, ZoneCause};
 use crate::pipelines::theta_pso::iwp::Shape;
+use crate::pipelines::theta_pso::iwp::Shape as FormationShape;
 use crate::pipelines::theta_pso::path::ArcWalker;
+use crate::pipelines::theta_pso::route::field::Field;
+
+/// The squeezed stretches of the site the corridor uses: a path whose
+/// centroid enters one flies it in the region's shape (a shrink, or the
+/// column).
+#[derive(Debug, Clone)]
+pub struct SqueezeMap {
+    pub(crate) field: Field,
+    /// Per cell, the region (1-based) or 0.
+    pub(crate) region: Vec<u16>,
+    /// Per region, the shape flown there.
+    pub(crate) shapes: Vec<FormationShape>,
+    /// The mission's index and the centre of each of the field's discs.
+    pub(crate) obstacle_of: Vec<(usize, Point2<f64>)>,
+    /// Per cell, how many cells away the nearest region cell is (Chebyshev,
+    /// capped at 255): a sample this far out lets the next few be skipped.
+    pub(crate) free: Vec<u8>,
+    /// The box every point of a region lies in (lower and upper corner): a
+    /// leg that misses it needs no sample.
+    pub(crate) extent: [Point2<f64>; 2],
+}
+
+impl SqueezeMap {
+    /// The region at `p` and its shape, if `p` is in one.
+    pub fn at(&self, p: Point2<f64>) -> Option<(u16, FormationShape)> {
+        let r = self.region[self.field.index_of(p)];
+        (r > 0).then(|| (r, self.shapes[r as usize - 1]))
+    }
+
+    /// The region at `p` as [`Self::at`], and outside them the distance
+    /// within which no point is in one (0 inside).
+    pub fn at_with_room(&self, p: Point2<f64>) -> (Option<(u16, FormationShape)>, f64) {
+        let i = self.field.index_of(p);
+        let r = self.region[i];
+        if r > 0 {
+            (Some((r, self.shapes[r as usize - 1])), 0.0)
+        } else {
+            // Within d − 1 cells (in x and in y) of this cell's point every
+            // cell is d − 1 or fewer steps away, so none is a region's.
+            let d = f64::from(self.free[i]);
+            (None, (d - 1.0).max(0.0) * self.field.cell())
+        }
+    }
+
+    /// The box holding every point that is in a region.
+    pub fn extent(&self) -> [Point2<f64>; 2] {
+        self.extent
+    }
+
+    /// Side of the grid's cells, metres: the resolution to sample paths at.
+    pub fn resolution(&self) -> f64 {
+        self.field.cell()
+    }
+
+    /// The obstacles nearest `p` on the left and on the right of the
+    /// direction `along` (mission indices; one twice when the other side is
+    /// open or a bound).
+    pub fn sides(&self, p: Point2<f64>, along: nalgebra::Vector2<f64>) -> [usize; 2] {
+        let left = nalgebra::Vector2::new(-along.y, along.x).normalize();
+        let probe = |sign: f64| {
+            let mut d = 0.0;
+            while d <= 50.0 {
+                let i = self.field.index_of(p + left * sign * d);
+                if let Some(&(k, center)) = self
+                    .field
+                    .nearest_disc(i)
+                    .and_then(|k| self.obstacle_of.get(k))
+                    && (center - p).dot(&left) * sign > 0.0
+                {
+                    return Some(k);
+                }
+                d += self.field.cell();
+            }
+            None
+        };
+        match (probe(1.0), probe(-1.0)) {
+            (Some(a), Some(b)) => [a, b],
+            (Some(a), None) | (None, Some(a)) => [a, a],
+            (None, None) => [0, 0],
+        }
+    }
+}
 
 impl PathBuilder {
     /// Names the obstacles each squeezed stretch of `path` passes between
@@ -32,7 +115,7 @@ impl PathBuilder {
     /// that gap, so the squeeze does not override it.
     pub(super) fn squeeze_zones(
         &self,
-        map: &crate::pipelines::theta_pso::route::SqueezeMap,
+        map: &SqueezeMap,
         points: &[Point3<f64>],
         arcs: &[f64],
         crossings: &[Zone],

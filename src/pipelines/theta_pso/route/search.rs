@@ -8,7 +8,6 @@ use std::collections::BinaryHeap;
 use nalgebra::Point2;
 
 use super::field::Field;
-use super::guide::Guide;
 
 /// The layers, widest first: the nominal shape, the smallest shrink, the
 /// column (single file along the path).
@@ -113,17 +112,18 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
     Some(Reached { stage })
 }
 
-/// The cheapest route from `start` to `goal` through every stage (up to
-/// the `guide`'s slack), or the cells reached when there is none: all of
-/// them without a guide; with one, only those from which the guide's
-/// relaxation reaches the goal.
+/// The cheapest route from `start` to `goal` through every stage, ranked by
+/// `heuristic` (cell, layer, stage → a bound of what is left, or `None`
+/// where the goal is out of reach: the state is never entered), or the
+/// cells reached when there is none: all of them when the heuristic prunes
+/// nothing.
 ///
 /// Long (~140 lines): one A* loop whose moves (steps, layer changes, crossings, passes) share its state arrays.
 pub fn search(
     graph: &Graph<'_>,
     start: usize,
     goal: usize,
-    guide: Option<&Guide>,
+    heuristic: impl Fn(usize, usize, usize) -> Option<f64>,
 ) -> Result<Vec<Step>, Reached> {
     let field = graph.field;
     let cells = field.len();
@@ -133,12 +133,6 @@ pub fn search(
     let mut cost = vec![f64::INFINITY; states];
     let mut parent = vec![u32::MAX; states];
     let mut via = vec![u32::MAX; states];
-    // What is left from each state, bounded on a coarse grid: states that
-    // cannot reach the goal are never entered. Without a guide, Dijkstra.
-    let heuristic = |cell: usize, layer: usize, stage: usize| match guide {
-        Some(guide) => guide.bound(cell, layer, stage),
-        None => Some(0.0),
-    };
     let index = jumps_from(graph);
 
     let mut open = BinaryHeap::new();
