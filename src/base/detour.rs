@@ -7,10 +7,11 @@
 //! particles (`spso::seeding`); it sits below both so neither imports the
 //! other for it.
 
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use nalgebra::{Point2, Vector2};
+
+use super::nearest::Nearest;
 
 /// Vertices of the polygon inscribed in each disc.
 const POLYGON: usize = 24;
@@ -97,11 +98,11 @@ pub fn shortest_route(
     let mut done = vec![false; n];
     let mut open = BinaryHeap::new();
     best[0] = 0.0;
-    open.push(Entry {
-        estimate: (goal - start).norm(),
+    open.push(Nearest {
+        key: (goal - start).norm(),
         node: 0,
     });
-    while let Some(Entry { node: u, .. }) = open.pop() {
+    while let Some(Nearest { node: u, .. }) = open.pop() {
         if done[u] {
             continue;
         }
@@ -109,13 +110,13 @@ pub fn shortest_route(
         if u == 1 {
             break;
         }
-        let mut relax = |v: usize, length: f64, open: &mut BinaryHeap<Entry>| {
+        let mut relax = |v: usize, length: f64, open: &mut BinaryHeap<Nearest>| {
             let through = best[u] + length;
             if through < best[v] {
                 best[v] = through;
                 from[v] = u;
-                open.push(Entry {
-                    estimate: through + (goal - nodes[v]).norm(),
+                open.push(Nearest {
+                    key: through + (goal - nodes[v]).norm(),
                     node: v,
                 });
             }
@@ -149,30 +150,6 @@ pub fn shortest_route(
         points,
         length: best[1],
     })
-}
-
-#[derive(Debug, PartialEq)]
-struct Entry {
-    estimate: f64,
-    node: usize,
-}
-
-impl Eq for Entry {}
-
-impl Ord for Entry {
-    fn cmp(&self, other: &Self) -> Ordering {
-        // Smallest estimate first.
-        other
-            .estimate
-            .total_cmp(&self.estimate)
-            .then(other.node.cmp(&self.node))
-    }
-}
-
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
 }
 
 #[cfg(test)]

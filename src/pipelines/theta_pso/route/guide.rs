@@ -22,10 +22,10 @@
 //! much of the corridor's optimality, never its existence: the search stays
 //! complete, and the corridor is pulled tight afterwards anyway.
 
-use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap};
 
 use super::search::{Graph, LAYERS, bit};
+use crate::base::nearest::Nearest;
 
 /// Fine cells per coarse cell along each axis.
 const FACTOR: usize = 4;
@@ -175,20 +175,30 @@ impl Coarse {
         for &(state, d) in sources {
             if (d as f32) < dist[state] {
                 dist[state] = d as f32;
-                heap.push(Item(d, state));
+                heap.push(Nearest {
+                    key: d,
+                    node: state,
+                });
             }
         }
         let diagonal = self.side * std::f64::consts::SQRT_2;
-        while let Some(Item(d, state)) = heap.pop() {
+        while let Some(Nearest {
+            key: d,
+            node: state,
+        }) = heap.pop()
+        {
             if d as f32 > dist[state] {
                 continue;
             }
             let (layer, c) = (state / cells, state % cells);
-            let mut relax = |to: usize, length: f64, heap: &mut BinaryHeap<Item>| {
+            let mut relax = |to: usize, length: f64, heap: &mut BinaryHeap<Nearest>| {
                 let next = d + length;
                 if (next as f32) < dist[to] {
                     dist[to] = next as f32;
-                    heap.push(Item(next, to));
+                    heap.push(Nearest {
+                        key: next,
+                        node: to,
+                    });
                 }
             };
             let here = bit(layer);
@@ -245,27 +255,4 @@ struct Ends {
     /// The widest layer its far end's cell is open in: it lands in that one
     /// or narrower.
     lands_from: usize,
-}
-
-/// A coarse cell on the open list, nearest first.
-struct Item(f64, usize);
-
-impl PartialEq for Item {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-
-impl Eq for Item {}
-
-impl Ord for Item {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.0.total_cmp(&self.0).then(other.1.cmp(&self.1))
-    }
-}
-
-impl PartialOrd for Item {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
 }

@@ -302,20 +302,20 @@ pub fn find(
     };
     let (s, g) = (field.index_of(start), field.index_of(goal));
     let guide = Guide::new(&graph, g);
-    // Not even the relaxation leaves the start: no search to set up.
-    let guided = match guide.bound(s, 0, 0) {
-        Some(_) => search::search(&graph, s, g, |c, l, st| guide.bound(c, l, st)),
-        None => Err(search::Reached { stage: Vec::new() }),
-    };
-    let found = guided.or_else(|_| {
+    // A start the relaxation cannot leave needs no search.
+    let guided = guide
+        .bound(s, 0, 0)
+        .and_then(|_| search::search(&graph, s, g, |c, l, st| guide.bound(c, l, st)).ok());
+    let found = match guided {
+        Some(steps) => Ok(steps),
         // No route. What the formation reaches, to say what closes the way:
         // a plain flood when not even the relaxation reaches the goal, else
         // the whole search without the guide's pruning.
-        match search::unreachable(&graph, s, g) {
+        None => match search::unreachable(&graph, s, g) {
             Some(reached) => Err(reached),
             None => search::search(&graph, s, g, |_, _, _| Some(0.0)),
-        }
-    });
+        },
+    };
     let steps = match found {
         Ok(steps) => steps,
         Err(reached) => {
