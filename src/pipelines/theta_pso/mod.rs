@@ -164,8 +164,13 @@ impl Problem {
     /// The swarm's objective for a particle, or a partial sum once it
     /// reaches `bound` (`CostModel::evaluate_below`).
     pub fn objective_below(&self, angles: &[f64], bound: f64) -> f64 {
+        let placed = self.builder.place(angles);
+        let lead = self.cost.lead(&placed.points);
+        if lead.total >= bound {
+            return lead.total;
+        }
         self.cost
-            .evaluate_below(&self.path(angles), bound)
+            .evaluate_rest(&self.builder.finish(placed), lead, bound)
             .objective
     }
 }

@@ -17,7 +17,7 @@
 use nalgebra::{Point3, Vector3};
 
 use super::iwp::{Shape, column_place};
-use super::path::{ArcWalker, CentroidPath, ShapeState, Zone};
+use super::path::{ArcWalker, CentroidPath, Hint, ShapeState, Zone};
 
 /// The formation frame at one arc length.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,9 +74,13 @@ impl<'a> Motion<'a> {
 
     /// The formation frame at arc length `s`.
     pub fn frame(&self, s: f64) -> Frame {
-        let forward = self.walker.heading(s, self.span);
+        self.frame_from(s, &mut Reader::default())
+    }
+
+    fn frame_from(&self, s: f64, reader: &mut Reader) -> Frame {
+        let forward = self.walker.heading_from(s, self.span, &mut reader.chord);
         Frame {
-            centroid: self.walker.at(s),
+            centroid: self.walker.at_from(s, &mut reader.centre),
             forward,
             left: Vector3::new(-forward.y, forward.x, 0.0),
         }
@@ -94,14 +98,27 @@ impl<'a> Motion<'a> {
     /// Where UAV `n` is at `s` in the shape state `state`, the frame there
     /// being `frame`.
     pub fn place(&self, n: usize, s: f64, frame: &Frame, state: ShapeState) -> Point3<f64> {
-        let column = |shape: Option<Shape>| match shape {
+        self.place_from(n, s, frame, state, &mut Hint::default())
+    }
+
+    /// [`Self::place`], reading a column's place on the path through `hint`.
+    fn place_from(
+        &self,
+        n: usize,
+        s: f64,
+        frame: &Frame,
+        state: ShapeState,
+        hint: &mut Hint,
+    ) -> Point3<f64> {
+        let mut column = |shape: Option<Shape>| match shape {
             Some(Shape::Alignment { spacing }) => Some(
                 self.walker
-                    .at_extended(s + column_place(self.slots, n, spacing)),
+                    .at_extended_from(s + column_place(self.slots, n, spacing), hint),
             ),
             _ => None,
         };
-        match (column(state.from), column(state.to)) {
+        let (from, to) = (column(state.from), column(state.to));
+        match (from, to) {
             (None, None) => frame.place(&state.offset(self.slots, n)),
             (from, to) => {
                 let end = |shape: Option<Shape>, on_path: Option<Point3<f64>>| {
@@ -118,9 +135,29 @@ impl<'a> Motion<'a> {
 
     /// Every UAV's position at `s`, into `out` (cleared first).
     pub fn positions_into(&self, s: f64, out: &mut Vec<Point3<f64>>) {
-        let frame = self.frame(s);
+        self.read_into(s, out, &mut Reader::default());
+    }
+
+    /// [`Self::positions_into`] through a [`Reader`]: reading at arc lengths
+    /// in order (as the cost and the trajectories do) finds each point of
+    /// the path without a search.
+    pub fn read_into(&self, s: f64, out: &mut Vec<Point3<f64>>, reader: &mut Reader) {
+        let frame = self.frame_from(s, reader);
         let state = self.state_at(s);
         out.clear();
-        out.extend((0..self.slots.len()).map(|n| self.place(n, s, &frame, state)));
+        reader.column.resize(self.slots.len(), Hint::default());
+        for n in 0..self.slots.len() {
+            let p = self.place_from(n, s, &frame, state, &mut reader.column[n]);
+            out.push(p);
+        }
     }
+}
+
+/// Where a reader of a [`Motion`] last was on the path: the centroid, the
+/// two ends of the heading's chord, and each UAV's place in a column.
+#[derive(Debug, Clone, Default)]
+pub struct Reader {
+    centre: Hint,
+    chord: [Hint; 2],
+    column: Vec<Hint>,
 }

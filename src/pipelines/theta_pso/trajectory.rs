@@ -69,8 +69,9 @@ pub fn generate(
     let n = formation.slots.len();
     let mut positions = vec![Vec::with_capacity(times.len()); n];
     let mut here = Vec::with_capacity(n);
+    let mut reader = super::motion::Reader::default();
     for &t in &times {
-        motion.positions_into(t * speed, &mut here);
+        motion.read_into(t * speed, &mut here, &mut reader);
         for (uav, p) in here.iter().enumerate() {
             positions[uav].push(*p);
         }

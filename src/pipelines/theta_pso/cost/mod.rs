@@ -35,7 +35,8 @@
 use nalgebra::{Point2, Point3, Vector3};
 
 use super::iwp::{Iwp, Shape, column_place};
-use super::motion::Motion;
+use super::motion::{Motion, Reader};
+use super::path::Hint;
 use super::path::{CentroidPath, heading_span};
 use crate::base::geometry::Cylinder;
 use crate::mission::{Bounds, Mission, ThetaPsoParams};
@@ -119,6 +120,21 @@ pub struct Evaluation {
     /// β2 Σ violation / J1 (J2 not averaged over the UAVs and obstacles, so
     /// one UAV clipping one post of a 200-post wall is not 1/200 as bad).
     pub objective: f64,
+}
+
+/// The terms a centroid path's points alone give (`CostModel::lead`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lead {
+    /// J1, metres.
+    pub length: f64,
+    /// J_R, metres.
+    pub waypoints: f64,
+    /// J_T, radians.
+    pub turning: f64,
+    /// The L segments J_R was taken over (J3 and J_B are summed over them).
+    segments: usize,
+    /// β1 J1 + β_R J_R + β_T J_T.
+    pub total: f64,
 }
 
 /// Running sums of the per-UAV terms.
@@ -225,7 +241,35 @@ impl CostModel {
     /// whatever its exact cost, so the search is the same as with full
     /// evaluations, only faster.
     pub fn evaluate_below(&self, path: &CentroidPath, bound: f64) -> Evaluation {
-        let (terms, violation) = self.terms_below(path, bound);
+        self.evaluate_rest(path, self.lead(&path.points), bound)
+    }
+
+    /// J1, J_R and J_T with their weighted sum: what the path's points alone
+    /// give, before any UAV is followed. Every other term is ≥ 0, so the
+    /// sum is a lower bound of the objective: a particle whose lead reaches
+    /// its bound needs no zones and no UAV followed.
+    pub fn lead(&self, points: &[Point3<f64>]) -> Lead {
+        let p = &self.params;
+        let length = super::path::cumulative_lengths(points)
+            .last()
+            .copied()
+            .unwrap_or(0.0);
+        let turning = turning_excess(points);
+        let (segments, waypoints) = self.waypoint_term(points, length);
+        Lead {
+            length,
+            waypoints,
+            turning,
+            segments,
+            total: p.weight_length * length
+                + p.weight_waypoints * waypoints
+                + p.weight_turning * turning,
+        }
+    }
+
+    /// [`Self::evaluate_below`] given the path's [`Lead`].
+    pub fn evaluate_rest(&self, path: &CentroidPath, lead: Lead, bound: f64) -> Evaluation {
+        let (terms, violation) = self.terms_below(path, lead, bound);
         let objective = if violation > 0.0 {
             terms.total + INFEASIBLE_STEP + self.params.weight_obstacle * violation
         } else {
@@ -238,18 +282,16 @@ impl CostModel {
     /// undiluted obstacle violation: Σ over UAVs and obstacles of the
     /// violation integral, over J1 (J2 before the paper's mean over N and K).
     /// Any band or bounds violation counts as a violation too.
-    fn terms_below(&self, path: &CentroidPath, bound: f64) -> (CostTerms, f64) {
+    fn terms_below(&self, path: &CentroidPath, lead: Lead, bound: f64) -> (CostTerms, f64) {
         let points = &path.points;
         let p = &self.params;
-        let motion = Motion::new(path, &self.slots, self.span);
-        let total = motion.length();
-        let turning = turning_excess(points);
-        let (segments, jr) = self.waypoint_term(points, total);
+        let total = lead.length;
+        let segments = lead.segments;
         let mut terms = CostTerms {
             length: total,
-            waypoints: jr,
-            turning,
-            total: p.weight_length * total + p.weight_waypoints * jr + p.weight_turning * turning,
+            waypoints: lead.waypoints,
+            turning: lead.turning,
+            total: lead.total,
             ..CostTerms::default()
         };
         // Until a violation shows, the objective is at least J's sum so far
@@ -257,6 +299,7 @@ impl CostModel {
         if terms.total >= bound {
             return (terms, 0.0);
         }
+        let motion = Motion::new(path, &self.slots, self.span);
         let arcs = motion.walker().arcs();
         let mut sums = Sums::default();
         let mut scratch = Scratch::default();
@@ -271,9 +314,7 @@ impl CostModel {
         let share = if total > 0.0 { l / (n * total) } else { 0.0 };
         let undiluted = if total > 0.0 { 1.0 / total } else { 0.0 };
         let base = terms.total;
-        // The pairs' deficit (eq. 7) last: the most costly term, and not
-        // needed when the legs alone reach the bound.
-        let mut reached_bound = false;
+        // Which legs a UAV may break a constraint on, and with which obstacles.
         for (i, leg) in points.windows(2).enumerate() {
             let (a, b) = (leg[0], leg[1]);
             // Outside the zones the formation keeps its nominal extent.
@@ -286,30 +327,67 @@ impl CostModel {
             } else {
                 (self.nominal_reach, self.nominal_rise)
             };
-            scratch.near.clear();
+            let first = scratch.all_near.len();
+            let mut depth = f64::NEG_INFINITY;
             for (k, c) in self.obstacles.iter().enumerate() {
                 if let Some(window) = self.touch_window(&a, &b, c, reach, rise) {
-                    scratch.near.push((k, window));
+                    scratch.all_near.push((k, window));
+                    if bound.is_finite() {
+                        let (_, closest) =
+                            crate::base::geometry::segment_projection(&a.xy(), &b.xy(), &c.center);
+                        let room = c.radius + self.uav_radius + self.margin + reach;
+                        depth = depth.max(room - closest);
+                    }
                 }
             }
             let low = a.z.min(b.z) - rise;
             let high = a.z.max(b.z) + rise;
             // Over terrain the band moves with the ground: follow every leg.
             let band = self.ground.is_some() || low < self.band[0] || high > self.band[1];
-            let edge = self
+            let inside = self
                 .bounds
                 .horizontal_margin(&a)
-                .min(self.bounds.horizontal_margin(&b))
-                < reach;
-            if scratch.near.is_empty() && !band && !edge {
+                .min(self.bounds.horizontal_margin(&b));
+            let edge = inside < reach;
+            if scratch.all_near.len() == first && !band && !edge {
                 continue;
             }
+            if edge {
+                depth = depth.max(reach - inside);
+            }
+            scratch.legs.push(LegWork {
+                leg: i,
+                whole: band || edge,
+                near: first..scratch.all_near.len(),
+                depth,
+            });
+        }
+        // Against a bound, the legs that reach deepest into an obstacle (or
+        // out of the bounds) first: a path that breaks a constraint usually
+        // shows it there, and the evaluation stops at the first violation.
+        if bound.is_finite() {
+            scratch.legs.sort_by(|a, b| b.depth.total_cmp(&a.depth));
+        }
+        // The pairs' deficit (eq. 7) last: the most costly term, and not
+        // needed when the legs alone reach the bound.
+        let mut reached_bound = false;
+        let legs = std::mem::take(&mut scratch.legs);
+        // Any violation adds the step: against a bound it reaches, the first
+        // one found ends the evaluation.
+        let stop_at_violation = bound <= base + INFEASIBLE_STEP;
+        for work in &legs {
+            scratch.near.clear();
+            scratch
+                .near
+                .extend_from_slice(&scratch.all_near[work.near.clone()]);
+            let i = work.leg;
             self.follow_leg(
                 &motion,
                 path,
                 arcs[i],
                 arcs[i + 1],
-                band || edge,
+                work.whole,
+                stop_at_violation,
                 &mut scratch,
                 &mut sums,
             );
@@ -418,7 +496,8 @@ impl CostModel {
 
     /// Follows every UAV along the leg [s0, s1] of the centroid path: the
     /// whole leg when `whole` (the band or the bounds are in reach), else only
-    /// the windows where a UAV can touch one of `scratch.near`'s obstacles.
+    /// the windows where a UAV can touch one of `scratch.near`'s obstacles;
+    /// when `stop`, only up to the first violation.
     #[allow(clippy::too_many_arguments)]
     fn follow_leg(
         &self,
@@ -427,6 +506,7 @@ impl CostModel {
         s0: f64,
         s1: f64,
         whole: bool,
+        stop: bool,
         scratch: &mut Scratch,
         sums: &mut Sums,
     ) {
@@ -440,6 +520,7 @@ impl CostModel {
             samples,
             previous,
             current,
+            ..
         } = scratch;
         let len = s1 - s0;
         // Obstacle windows as arc lengths, merged.
@@ -518,10 +599,11 @@ impl CostModel {
             // shape blends.
             samples.clear();
             samples.push(w0);
-            let mut heading_before = motion.walker().heading(w0, span);
+            let mut chord = [Hint::default(); 2];
+            let mut heading_before = motion.walker().heading_from(w0, span, &mut chord);
             for w in knots.windows(2) {
                 let (k0, k1) = (w[0], w[1]);
-                let heading_after = motion.walker().heading(k1, span);
+                let heading_after = motion.walker().heading_from(k1, span, &mut chord);
                 let blend_step = if motion.state_at((k0 + k1) / 2.0).is_changing() {
                     BLEND_STEP
                 } else {
@@ -532,14 +614,23 @@ impl CostModel {
                     max_turn_cos: self.max_turn_cos,
                     step: blend_step,
                 };
-                piece.split(k0, k1, heading_before, heading_after, MAX_DEPTH, samples);
+                piece.split(
+                    k0,
+                    k1,
+                    heading_before,
+                    heading_after,
+                    MAX_DEPTH,
+                    samples,
+                    &mut chord,
+                );
                 heading_before = heading_after;
             }
 
-            motion.positions_into(samples[0], previous);
+            let mut reader = Reader::default();
+            motion.read_into(samples[0], previous, &mut reader);
             for w in samples.windows(2) {
                 let (a, b) = (w[0], w[1]);
-                motion.positions_into(b, current);
+                motion.read_into(b, current, &mut reader);
                 for &(k, (n0, n1)) in near.iter() {
                     if b < n0 || a > n1 {
                         continue;
@@ -554,6 +645,9 @@ impl CostModel {
                     self.observe_points(current, b - a, sums);
                 }
                 std::mem::swap(previous, current);
+                if stop && sums.violated() {
+                    return;
+                }
             }
         }
     }
@@ -599,7 +693,9 @@ struct Piece<'a, 'm> {
 
 impl Piece<'_, '_> {
     /// Pushes the ends of the pieces of (a, b] into `samples`, halving while
-    /// a piece turns the heading by more than allowed or is longer than the step.
+    /// a piece turns the heading by more than allowed or is longer than the
+    /// step (the heading read through `chord`).
+    #[allow(clippy::too_many_arguments)]
     fn split(
         &self,
         a: f64,
@@ -608,15 +704,19 @@ impl Piece<'_, '_> {
         heading_b: Vector3<f64>,
         depth: u32,
         samples: &mut Vec<f64>,
+        chord: &mut [Hint; 2],
     ) {
         if depth == 0 || (heading_a.dot(&heading_b) >= self.max_turn_cos && b - a <= self.step) {
             samples.push(b);
             return;
         }
         let mid = (a + b) / 2.0;
-        let heading_mid = self.motion.walker().heading(mid, self.motion.span());
-        self.split(a, mid, heading_a, heading_mid, depth - 1, samples);
-        self.split(mid, b, heading_mid, heading_b, depth - 1, samples);
+        let heading_mid = self
+            .motion
+            .walker()
+            .heading_from(mid, self.motion.span(), chord);
+        self.split(a, mid, heading_a, heading_mid, depth - 1, samples, chord);
+        self.split(mid, b, heading_mid, heading_b, depth - 1, samples, chord);
     }
 }
 
@@ -643,9 +743,23 @@ pub fn turning_excess(points: &[Point3<f64>]) -> f64 {
     excess
 }
 
+/// A leg a UAV may break a constraint on: its index, whether it is followed
+/// whole (the band or the bounds are in reach), its obstacles (a range of
+/// `Scratch::all_near`), and how deep the formation's reach goes into one
+/// of them or out of the bounds, metres.
+struct LegWork {
+    leg: usize,
+    whole: bool,
+    near: std::ops::Range<usize>,
+    depth: f64,
+}
+
 /// Buffers reused across the legs of one evaluation.
 #[derive(Default)]
 struct Scratch {
+    /// Every leg's obstacles with their windows, leg after leg.
+    all_near: Vec<(usize, (f64, f64))>,
+    legs: Vec<LegWork>,
     /// Obstacles a UAV may touch on this leg, with their window along it.
     near: Vec<(usize, (f64, f64))>,
     windows: Vec<(f64, f64)>,

@@ -26,8 +26,9 @@ impl CostModel {
         let mut follow = |from: f64, to: f64, deficit: &mut f64| {
             let samples = (((to - from) / PAIR_STEP).ceil() as usize).max(1);
             let step = (to - from) / samples as f64;
+            let mut reader = crate::pipelines::theta_pso::motion::Reader::default();
             for k in 0..=samples {
-                motion.positions_into(from + k as f64 * step, scratch);
+                motion.read_into(from + k as f64 * step, scratch, &mut reader);
                 for i in 0..n {
                     for j in (i + 1)..n {
                         let gap = floor - (scratch[i] - scratch[j]).norm();
@@ -73,8 +74,9 @@ impl CostModel {
         let half = (n - 1) as f64 * spacing / 2.0;
         let (from, to) = (t2 - half, t3 + half);
         let samples = (((to - from) / step).ceil() as usize).max(1);
+        let mut hint = crate::pipelines::theta_pso::path::Hint::default();
         let points: Vec<Point3<f64>> = (0..=samples)
-            .map(|k| walker.at_extended(from + k as f64 * step))
+            .map(|k| walker.at_extended_from(from + k as f64 * step, &mut hint))
             .collect();
         let mut deficit = 0.0;
         for i in 0..points.len() {

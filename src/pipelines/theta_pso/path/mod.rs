@@ -29,7 +29,7 @@ mod walker;
 mod zone;
 
 pub use squeeze::SqueezeMap;
-pub use walker::{ArcWalker, cumulative_lengths};
+pub use walker::{ArcWalker, Hint, cumulative_lengths};
 pub use zone::{MIN_BLEND, ShapeState, Zone, ZoneCause, schedule};
 
 /// An inspection pass as placed on one path: which obstacle, and the arc
@@ -63,6 +63,17 @@ impl CentroidPath {
             crossed: Vec::new(),
         }
     }
+}
+
+/// A particle's points with its vias placed, before the zones are worked
+/// out (`PathBuilder::place`, then `PathBuilder::finish`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Placed {
+    pub points: Vec<Point3<f64>>,
+    /// (crossing index, index of its first point).
+    crossings: Vec<(usize, usize)>,
+    /// (inspection index, index of its first point, obstacle on the left).
+    passes: Vec<(usize, usize, bool)>,
 }
 
 /// What is fixed for a mission while the swarm searches.
@@ -323,6 +334,13 @@ impl PathBuilder {
     /// where the path goes through its gap, each inspection pass where it
     /// adds the least length.
     pub fn build(&self, angles: &[f64]) -> CentroidPath {
+        self.finish(self.place(angles))
+    }
+
+    /// A particle's points with its vias placed, lifted onto the terrain:
+    /// all that J1, J_R and J_T read. The zones (`finish`) cost more to
+    /// work out, so the swarm first checks these terms against its bound.
+    pub fn place(&self, angles: &[f64]) -> Placed {
         let waypoints = self.decode(angles);
         let extra = 3 * self.crossings.len() + 2 * self.inspections.len();
         let mut points = Vec::with_capacity(waypoints.len() + 2 + extra);
@@ -352,24 +370,25 @@ impl PathBuilder {
             shift(&mut crossings, &mut passes, leg, 2);
             passes.push((i, leg + 1, on_left));
         }
-
-        self.finish(points, &crossings, &passes)
-    }
-
-    /// The path's zones and passes once its points and vias are placed:
-    /// `crossings` (crossing index, index of its first point), `passes`
-    /// (inspection index, index of its first point, obstacle on the left).
-    fn finish(
-        &self,
-        mut points: Vec<Point3<f64>>,
-        crossings: &[(usize, usize)],
-        passes: &[(usize, usize, bool)],
-    ) -> CentroidPath {
         if let Some(g) = &self.ground {
             for p in &mut points {
                 p.z += g.at(p.x, p.y);
             }
         }
+        Placed {
+            points,
+            crossings,
+            passes,
+        }
+    }
+
+    /// The path's zones and passes once its points and vias are placed.
+    pub fn finish(&self, placed: Placed) -> CentroidPath {
+        let Placed {
+            points,
+            crossings,
+            passes,
+        } = placed;
         let arcs = cumulative_lengths(&points);
         let total = arcs.last().copied().unwrap_or(0.0);
         let mut zones: Vec<Zone> = crossings

@@ -44,6 +44,13 @@ impl<'a> ArcWalker<'a> {
 
     /// Position at arc length `s` (clamped to the path).
     pub fn at(&self, s: f64) -> Point3<f64> {
+        self.at_from(s, &mut Hint::default())
+    }
+
+    /// [`Self::at`], starting the search for the leg at `hint` (the leg of
+    /// the last read through it) and leaving it at this read's leg: a
+    /// caller reading along the path finds each leg by a step or two.
+    pub fn at_from(&self, s: f64, hint: &mut Hint) -> Point3<f64> {
         let n = self.points.len();
         if n == 0 {
             return Point3::origin();
@@ -52,7 +59,16 @@ impl<'a> ArcWalker<'a> {
             return self.points[0];
         }
         let s = s.clamp(0.0, self.length());
-        let i = self.arcs.partition_point(|&a| a <= s).clamp(1, n - 1);
+        // The leg holding s: i = 1 + the inner vertices at or before it (the
+        // first vertex is at 0 ≤ s), whichever leg the search starts from.
+        let mut i = hint.0.clamp(1, n - 1);
+        while i < n - 1 && self.arcs[i] <= s {
+            i += 1;
+        }
+        while i > 1 && self.arcs[i - 1] > s {
+            i -= 1;
+        }
+        hint.0 = i;
         let (a, b) = (self.points[i - 1], self.points[i]);
         let len = self.arcs[i] - self.arcs[i - 1];
         if len <= 0.0 {
@@ -65,10 +81,15 @@ impl<'a> ArcWalker<'a> {
     /// along the first or the last leg (where a column's first and last UAVs
     /// are while the centroid is near the start or the goal).
     pub fn at_extended(&self, s: f64) -> Point3<f64> {
+        self.at_extended_from(s, &mut Hint::default())
+    }
+
+    /// [`Self::at_extended`] through a [`Hint`], as [`Self::at_from`].
+    pub fn at_extended_from(&self, s: f64, hint: &mut Hint) -> Point3<f64> {
         let length = self.length();
         let n = self.points.len();
         if n < 2 || (0.0..=length).contains(&s) {
-            return self.at(s);
+            return self.at_from(s, hint);
         }
         let (from, to, beyond) = if s < 0.0 {
             (self.points[1], self.points[0], -s)
@@ -100,8 +121,14 @@ impl<'a> ArcWalker<'a> {
     /// s − span and s + span: continuous in s, so the formation frame turns
     /// smoothly through the path's corners instead of snapping.
     pub fn heading(&self, s: f64, span: f64) -> Vector3<f64> {
-        let ahead = self.at(s + span);
-        let behind = self.at(s - span);
+        self.heading_from(s, span, &mut [Hint::default(); 2])
+    }
+
+    /// [`Self::heading`] through two [`Hint`]s: behind and ahead.
+    pub fn heading_from(&self, s: f64, span: f64, hints: &mut [Hint; 2]) -> Vector3<f64> {
+        let [behind_hint, ahead_hint] = hints;
+        let ahead = self.at_from(s + span, ahead_hint);
+        let behind = self.at_from(s - span, behind_hint);
         let d = Vector3::new(ahead.x - behind.x, ahead.y - behind.y, 0.0);
         if d.norm() > 1e-9 {
             d.normalize()
@@ -116,3 +143,7 @@ impl<'a> ArcWalker<'a> {
         }
     }
 }
+
+/// Where a reader of an [`ArcWalker`] last was: the leg of its last read.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Hint(usize);

@@ -155,10 +155,52 @@ impl Field {
             })
     }
 
+    /// The cells whose centres lie in the square of half side `r` round `p`.
+    pub fn cells_within(&self, p: Point2<f64>, r: f64) -> impl Iterator<Item = usize> + '_ {
+        let (x0, x1) = span(p.x - r, p.x + r, self.origin.x, self.cell, self.nx);
+        let (y0, y1) = span(p.y - r, p.y + r, self.origin.y, self.cell, self.ny);
+        (y0..y1).flat_map(move |y| (x0..x1).map(move |x| y * self.nx + x))
+    }
+
     /// The cells a segment passes, sampled at a third of a cell.
     pub fn cells_along(&self, a: Point2<f64>, b: Point2<f64>) -> impl Iterator<Item = usize> + '_ {
         let steps = (((b - a).norm() / (self.cell / 3.0)).ceil() as usize).max(1);
         (0..=steps).map(move |k| self.index_of(a + (b - a) * (k as f64 / steps as f64)))
+    }
+}
+
+/// Items filed by cell, each cell's in the order given: the jumps leaving a
+/// cell, read on every expansion of the searches (a slice per cell, no
+/// hashing).
+#[derive(Debug, Clone)]
+pub struct CellLists<T> {
+    /// Cell c's items are `items[start[c]..start[c + 1]]`.
+    start: Vec<u32>,
+    items: Vec<T>,
+}
+
+impl<T> CellLists<T> {
+    /// `pairs` (cell, item) over `cells` cells.
+    pub fn new(cells: usize, pairs: Vec<(usize, T)>) -> Self {
+        let mut start = vec![0u32; cells + 1];
+        for (c, _) in &pairs {
+            start[c + 1] += 1;
+        }
+        for c in 0..cells {
+            start[c + 1] += start[c];
+        }
+        // A stable sort by cell keeps each cell's items in the given order.
+        let mut pairs = pairs;
+        pairs.sort_by_key(|(c, _)| *c);
+        CellLists {
+            start,
+            items: pairs.into_iter().map(|(_, item)| item).collect(),
+        }
+    }
+
+    /// The items of cell `c`.
+    pub fn at(&self, c: usize) -> &[T] {
+        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
     }
 }
 

@@ -22,8 +22,7 @@
 //! much of the corridor's optimality, never its existence: the search stays
 //! complete, and the corridor is pulled tight afterwards anyway.
 
-use std::collections::{BinaryHeap, HashMap};
-
+use super::field::CellLists;
 use super::search::{Graph, LAYERS, bit};
 use crate::base::nearest::Nearest;
 
@@ -33,12 +32,15 @@ const FACTOR: usize = 4;
 /// Per stage, layer and coarse cell, the relaxed distance left to the goal.
 pub struct Guide {
     fine_nx: usize,
-    fine_cell: f64,
     nx: usize,
     ny: usize,
     cells: usize,
     left: Vec<f32>,
     slack: f64,
+    /// The way from a fine cell to the centres of the 3 × 3 coarse cells
+    /// round its own, metres, by its place in its coarse cell: `bound`
+    /// reads it for every state the search enters.
+    way: Vec<[f64; 9]>,
 }
 
 /// The relaxed graph on the coarse grid, for one backward Dijkstra.
@@ -52,7 +54,7 @@ struct Coarse {
     switch_cost: f64,
     /// The free crossings backwards: from the coarse cell they land in, the
     /// one they leave and their ends' layers (`Ends`).
-    back: HashMap<usize, Vec<Ends>>,
+    back: CellLists<Ends>,
 }
 
 impl Guide {
@@ -77,10 +79,15 @@ impl Guide {
                 .find(|&l| graph.open[jump.to] & bit(l) != 0)
                 .unwrap_or(LAYERS),
         };
-        let mut back: HashMap<usize, Vec<Ends>> = HashMap::new();
-        for jump in graph.jumps.iter().filter(|j| j.pass_at.is_none()) {
-            back.entry(coarse(jump.to)).or_default().push(ends(jump));
-        }
+        let back = CellLists::new(
+            cells,
+            graph
+                .jumps
+                .iter()
+                .filter(|j| j.pass_at.is_none())
+                .map(|jump| (coarse(jump.to), ends(jump)))
+                .collect(),
+        );
         let relaxed = Coarse {
             nx,
             ny,
@@ -126,14 +133,27 @@ impl Guide {
                 &sources,
             );
         }
+        // Fine cells from the coarse cell's centre, and the centre's offset.
+        let centre = (FACTOR as f64 - 1.0) / 2.0;
+        let way = (0..FACTOR * FACTOR)
+            .map(|k| {
+                let (ox, oy) = ((k % FACTOR) as f64, (k / FACTOR) as f64);
+                std::array::from_fn(|n| {
+                    let (du, dv) = ((n % 3) as f64 - 1.0, (n / 3) as f64 - 1.0);
+                    let dx = ox - du * FACTOR as f64 - centre;
+                    let dy = oy - dv * FACTOR as f64 - centre;
+                    dx.hypot(dy) * field.cell()
+                })
+            })
+            .collect();
         Guide {
             fine_nx,
-            fine_cell: field.cell(),
             nx,
             ny,
             cells,
             left,
             slack: relaxed.side * std::f64::consts::FRAC_1_SQRT_2,
+            way,
         }
     }
 
@@ -149,16 +169,15 @@ impl Guide {
         if !own.is_finite() {
             return None;
         }
-        // Fine cells from the coarse cell's centre, and the centre's offset.
-        let centre = (FACTOR as f64 - 1.0) / 2.0;
+        let way = &self.way[(fy % FACTOR) * FACTOR + fx % FACTOR];
         let mut best = f64::INFINITY;
         for v in cy.saturating_sub(1)..=(cy + 1).min(self.ny - 1) {
             for u in cx.saturating_sub(1)..=(cx + 1).min(self.nx - 1) {
                 let left = f64::from(plane[v * self.nx + u]);
                 if left.is_finite() {
-                    let dx = fx as f64 - (u * FACTOR) as f64 - centre;
-                    let dy = fy as f64 - (v * FACTOR) as f64 - centre;
-                    best = best.min(left + dx.hypot(dy) * self.fine_cell);
+                    // u = cx + du, v = cy + dv with du, dv in -1..=1.
+                    let n = (v + 1 - cy) * 3 + (u + 1 - cx);
+                    best = best.min(left + way[n]);
                 }
             }
         }
@@ -171,7 +190,7 @@ impl Coarse {
     /// `dist`, following the search's moves backwards.
     fn dijkstra(&self, dist: &mut [f32], sources: &[(usize, f64)]) {
         let cells = self.cells;
-        let mut heap = BinaryHeap::new();
+        let mut heap = Buckets::new(self.side);
         for &(state, d) in sources {
             if (d as f32) < dist[state] {
                 dist[state] = d as f32;
@@ -191,7 +210,7 @@ impl Coarse {
                 continue;
             }
             let (layer, c) = (state / cells, state % cells);
-            let mut relax = |to: usize, length: f64, heap: &mut BinaryHeap<Nearest>| {
+            let mut relax = |to: usize, length: f64, heap: &mut Buckets| {
                 let next = d + length;
                 if (next as f32) < dist[to] {
                     dist[to] = next as f32;
@@ -234,7 +253,7 @@ impl Coarse {
             }
             // A crossing landing here in this layer was entered in it or in a
             // wider one its near end is open in.
-            for e in self.back.get(&c).map_or(&[][..], Vec::as_slice) {
+            for e in self.back.at(c) {
                 if layer < e.lands_from {
                     continue;
                 }
@@ -255,4 +274,45 @@ struct Ends {
     /// The widest layer its far end's cell is open in: it lands in that one
     /// or narrower.
     lands_from: usize,
+}
+
+/// The open list of the guide's Dijkstra: buckets of keys `width` apart,
+/// taken in order (Dial's algorithm). Every move of the coarse grid is at
+/// least a coarse side long, so when a bucket is reached every entry in it
+/// is final: taking them in any order gives the distances a heap would,
+/// without its ordering work. A shorter move (a crossing narrower than a
+/// cell) can land in the bucket being emptied; an entry improved that way
+/// is simply taken again, so the distances stay exact.
+struct Buckets {
+    width: f64,
+    lists: Vec<Vec<Nearest>>,
+    current: usize,
+}
+
+impl Buckets {
+    fn new(width: f64) -> Self {
+        Buckets {
+            width: width.max(f64::MIN_POSITIVE),
+            lists: Vec::new(),
+            current: 0,
+        }
+    }
+
+    fn push(&mut self, entry: Nearest) {
+        let b = ((entry.key / self.width) as usize).max(self.current);
+        if b >= self.lists.len() {
+            self.lists.resize_with(b + 1, Vec::new);
+        }
+        self.lists[b].push(entry);
+    }
+
+    fn pop(&mut self) -> Option<Nearest> {
+        while let Some(list) = self.lists.get_mut(self.current) {
+            if let Some(entry) = list.pop() {
+                return Some(entry);
+            }
+            self.current += 1;
+        }
+        None
+    }
 }

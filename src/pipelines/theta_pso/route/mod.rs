@@ -222,13 +222,13 @@ pub fn find(
     // wherever it is itself clear.
     for end in [start, goal] {
         let around = shape.reach + cell;
-        for (i, bits) in open.iter_mut().enumerate() {
+        for i in field.cells_within(end, around) {
             let p = field.center(i);
             if (p - end).norm() <= around
                 && field.clearance(i) >= shape.r_q + margin
                 && b.contains_xy(&p)
             {
-                *bits |= bit(0) | bit(1) | bit(2);
+                open[i] |= bit(0) | bit(1) | bit(2);
             }
         }
     }
@@ -599,21 +599,51 @@ fn region_extent(field: &Field, region: &[u16]) -> [Point2<f64>; 2] {
 }
 
 /// Per cell, the Chebyshev distance in cells to the nearest cell with a
-/// region (0 on one), capped at 255: two passes of the 8-neighbour chamfer,
-/// exact for this metric.
+/// region (0 on one), capped at 255: the two passes of the 8-neighbour
+/// chamfer (each from the neighbours already passed), exact for this metric.
 fn chebyshev_distance(field: &Field, region: &[u16]) -> Vec<u8> {
+    let (nx, ny) = field.size();
     let mut d: Vec<u8> = region
         .iter()
         .map(|&r| if r > 0 { 0 } else { 255 })
         .collect();
-    let mut relax = |i: usize| {
-        d[i] = field
-            .neighbourhood(i)
-            .map(|j| d[j].saturating_add(1))
-            .fold(d[i], u8::min);
-    };
-    (0..field.len()).for_each(&mut relax);
-    (0..field.len()).rev().for_each(&mut relax);
+    let at = |d: &[u8], x: usize, y: usize| d[y * nx + x].saturating_add(1);
+    for y in 0..ny {
+        for x in 0..nx {
+            let mut v = d[y * nx + x];
+            if x > 0 {
+                v = v.min(at(&d, x - 1, y));
+            }
+            if y > 0 {
+                v = v.min(at(&d, x, y - 1));
+                if x > 0 {
+                    v = v.min(at(&d, x - 1, y - 1));
+                }
+                if x + 1 < nx {
+                    v = v.min(at(&d, x + 1, y - 1));
+                }
+            }
+            d[y * nx + x] = v;
+        }
+    }
+    for y in (0..ny).rev() {
+        for x in (0..nx).rev() {
+            let mut v = d[y * nx + x];
+            if x + 1 < nx {
+                v = v.min(at(&d, x + 1, y));
+            }
+            if y + 1 < ny {
+                v = v.min(at(&d, x, y + 1));
+                if x + 1 < nx {
+                    v = v.min(at(&d, x + 1, y + 1));
+                }
+                if x > 0 {
+                    v = v.min(at(&d, x - 1, y + 1));
+                }
+            }
+            d[y * nx + x] = v;
+        }
+    }
     d
 }
 

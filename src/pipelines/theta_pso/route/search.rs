@@ -7,7 +7,7 @@ use std::collections::BinaryHeap;
 
 use nalgebra::Point2;
 
-use super::field::Field;
+use super::field::{CellLists, Field};
 
 /// The layers, widest first: the nominal shape, the smallest shrink, the
 /// column (single file along the path).
@@ -60,6 +60,9 @@ pub enum Step {
     },
 }
 
+/// `link` of the start state (no parent).
+const ROOT: u32 = u32::MAX;
+
 /// The cells reached by the search, for explaining a failure.
 pub struct Reached {
     /// Per cell, the highest stage reached there (`None`: never reached).
@@ -67,12 +70,14 @@ pub struct Reached {
 }
 
 /// The jumps (indices) leaving each cell.
-fn jumps_from(graph: &Graph<'_>) -> std::collections::HashMap<usize, Vec<usize>> {
-    let mut index: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
-    for (j, jump) in graph.jumps.iter().enumerate() {
-        index.entry(jump.from).or_default().push(j);
-    }
-    index
+fn jumps_from(graph: &Graph<'_>) -> CellLists<usize> {
+    let pairs = graph
+        .jumps
+        .iter()
+        .enumerate()
+        .map(|(j, jump)| (jump.from, j))
+        .collect();
+    CellLists::new(graph.field.len(), pairs)
 }
 
 /// The cells reached from `start` when `goal` is not among them, in a
@@ -93,13 +98,7 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
         let next = field
             .neighbourhood(cell)
             .filter(|&j| graph.open[j] != 0 || j == goal)
-            .chain(
-                jumps
-                    .get(&cell)
-                    .into_iter()
-                    .flatten()
-                    .map(|&j| graph.jumps[j].to),
-            );
+            .chain(jumps.at(cell).iter().map(|&j| graph.jumps[j].to));
         for j in next {
             if !seen[j] {
                 seen[j] = true;
@@ -130,14 +129,23 @@ pub fn search(
     let layers = LAYERS;
     let states = cells * layers * (graph.stages + 1);
     let state = |cell: usize, layer: usize, stage: usize| (stage * layers + layer) * cells + cell;
-    let mut cost = vec![f64::INFINITY; states];
-    let mut parent = vec![u32::MAX; states];
-    let mut via = vec![u32::MAX; states];
+    // Zeroed arrays: the system hands them out untouched, so a search that
+    // reaches a corner of a large site pays only for that corner's pages.
+    // `link[s]` is 0 for a state never reached, `ROOT` for the start, else
+    // its parent + 1; `cost[s]` holds only where `link[s]` is not 0; `via[s]`
+    // is the jump taken there + 1, or 0.
+    let mut cost = vec![0.0f64; states];
+    let mut link = vec![0u32; states];
+    let mut via = vec![0u32; states];
+    let known = |link: &[u32], cost: &[f64], s: usize| {
+        if link[s] == 0 { f64::INFINITY } else { cost[s] }
+    };
     let index = jumps_from(graph);
 
     let mut open = BinaryHeap::new();
     let first = state(start, 0, 0);
     cost[first] = 0.0;
+    link[first] = ROOT;
     if let Some(estimate) = heuristic(start, 0, 0) {
         open.push(Entry {
             estimate,
@@ -153,7 +161,7 @@ pub fn search(
         let cell = s % cells;
         let layer = (s / cells) % layers;
         let stage = s / (cells * layers);
-        let g = cost[s];
+        let g = known(&link, &cost, s);
         if reached > g {
             continue; // stale entry: a cheaper way here was found since
         }
@@ -162,14 +170,14 @@ pub fn search(
             break;
         }
         let mut relax = |to: usize, g_to: f64, through: u32, open: &mut BinaryHeap<Entry>| {
-            if g_to < cost[to] {
+            if g_to < known(&link, &cost, to) {
                 let Some(left) =
                     heuristic(to % cells, (to / cells) % layers, to / (cells * layers))
                 else {
                     return; // no way on from there, even relaxed
                 };
                 cost[to] = g_to;
-                parent[to] = s as u32;
+                link[to] = s as u32 + 1;
                 via[to] = through;
                 open.push(Entry {
                     estimate: g_to + left,
@@ -181,7 +189,7 @@ pub fn search(
         let here = bit(layer);
         for (next, length) in field.steps(cell) {
             if graph.open[next] & here != 0 || next == goal {
-                relax(state(next, layer, stage), g + length, u32::MAX, &mut open);
+                relax(state(next, layer, stage), g + length, 0, &mut open);
             }
         }
         // A transition to another layer, flown where the wider shape fits.
@@ -190,13 +198,13 @@ pub fn search(
                 relax(
                     state(cell, other, stage),
                     g + graph.switch_cost,
-                    u32::MAX,
+                    0,
                     &mut open,
                 );
             }
         }
-        if let Some(list) = index.get(&cell) {
-            for &j in list {
+        {
+            for &j in index.at(cell) {
                 let jump = &graph.jumps[j];
                 let next_stage = match jump.pass_at {
                     None => stage,
@@ -208,7 +216,7 @@ pub fn search(
                         relax(
                             state(jump.to, 0, next_stage),
                             g + jump.length,
-                            j as u32,
+                            j as u32 + 1,
                             &mut open,
                         );
                     }
@@ -223,7 +231,7 @@ pub fn search(
                 relax(
                     state(jump.to, arrive, next_stage),
                     g + jump.length,
-                    j as u32,
+                    j as u32 + 1,
                     &mut open,
                 );
             }
@@ -231,8 +239,8 @@ pub fn search(
     }
     let Some(end) = done else {
         let mut stage = vec![None; cells];
-        for (s, c) in cost.iter().enumerate() {
-            if c.is_finite() {
+        for (s, l) in link.iter().enumerate() {
+            if *l != 0 {
                 let (cell, st) = (s % cells, s / (cells * layers));
                 if stage[cell].is_none_or(|old| st > old) {
                     stage[cell] = Some(st);
@@ -246,20 +254,20 @@ pub fn search(
     loop {
         let cell = s % cells;
         let layer = (s / cells) % layers;
-        let step = if via[s] != u32::MAX {
+        let step = if via[s] != 0 {
             Step::Jump {
                 cell,
-                tag: graph.jumps[via[s] as usize].tag,
+                tag: graph.jumps[via[s] as usize - 1].tag,
                 layer,
             }
         } else {
             Step::Cell { cell, layer }
         };
         steps.push(step);
-        if parent[s] == u32::MAX {
+        if link[s] == ROOT {
             break;
         }
-        s = parent[s] as usize;
+        s = link[s] as usize - 1;
     }
     steps.reverse();
     Ok(steps)
