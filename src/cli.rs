@@ -131,6 +131,43 @@ pub enum Command {
     ///
     /// Exit status: 0 every run finished, 1 an error.
     Sweep(sweep_cmd::SweepArgs),
+    /// Fly some of a fleet's agents in this process, talking to the others
+    /// over Zenoh (`skyform run fleet --distributed` starts these itself).
+    ///
+    /// Connects to a coordinator's hub, says which agents it flies and which
+    /// mission (a different mission or seed is refused), then flies them
+    /// step by step until the coordinator ends the run. Exits when the
+    /// coordinator goes away. Exit status: 0 the run ended, 1 an error
+    /// (printed on stderr).
+    #[cfg(feature = "zenoh")]
+    Agent(AgentArgs),
+}
+
+/// `skyform agent`.
+#[cfg(feature = "zenoh")]
+#[derive(Debug, clap::Args)]
+pub struct AgentArgs {
+    /// Mission TOML file (the coordinator's mission: checked by fingerprint).
+    pub mission: PathBuf,
+    /// The agents to fly, numbered from 1: `2`, `1-3`, `1,4-6`.
+    #[arg(long)]
+    pub ids: String,
+    /// The coordinator's hub, e.g. tcp/127.0.0.1:7447.
+    #[arg(long, value_name = "ENDPOINT")]
+    pub connect: String,
+    /// The run's name (the coordinator gives it; keys are under
+    /// skyform/<mission>/<run>).
+    #[arg(long, default_value = "run")]
+    pub run: String,
+    /// Seed of the run (default: the mission's `seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Fly on this process's own clock instead of the coordinator's steps.
+    #[arg(long)]
+    pub realtime: bool,
+    /// Longest wait for the coordinator, seconds.
+    #[arg(long, default_value_t = 20.0)]
+    pub timeout: f64,
 }
 
 #[derive(Debug, Subcommand)]
@@ -206,6 +243,17 @@ pub struct FleetArgs {
     /// Write the whole outcome as JSON to FILE, or to stdout with `-`.
     #[arg(long, value_name = "FILE|-")]
     pub json: Option<PathBuf>,
+    /// Fly the agents in P processes of their own on this machine, talking
+    /// over Zenoh (loopback TCP); this process coordinates. Lockstep, the
+    /// result is the in-process run's, bit for bit.
+    #[cfg(feature = "zenoh")]
+    #[arg(long, value_name = "P")]
+    pub distributed: Option<usize>,
+    /// With --distributed: each process flies on its own wall clock, as
+    /// onboard (not reproducible), instead of the coordinator's steps.
+    #[cfg(feature = "zenoh")]
+    #[arg(long, requires = "distributed")]
+    pub realtime: bool,
     #[command(flatten)]
     pub record: RecordArgs,
 }
@@ -285,15 +333,25 @@ pub fn main() -> ExitCode {
                 verbose,
             ))
         }
-        Command::Run(RunCommand::Fleet(a)) => ExitCode::from(run_pipeline(
-            Kind::Fleet,
-            &a.mission,
-            a.seed,
-            a.json.as_deref(),
-            &a.record.sinks(),
-            PlanOptions::default(),
-            false,
-        )),
+        Command::Run(RunCommand::Fleet(a)) => {
+            #[cfg(feature = "zenoh")]
+            let distributed = a.distributed.map(|processes| crate::run::Distribution {
+                processes,
+                realtime: a.realtime,
+            });
+            #[cfg(not(feature = "zenoh"))]
+            let distributed = None;
+            ExitCode::from(run_pipeline_with(
+                Kind::Fleet,
+                &a.mission,
+                a.seed,
+                a.json.as_deref(),
+                &a.record.sinks(),
+                PlanOptions::default(),
+                false,
+                distributed,
+            ))
+        }
         Command::Run(RunCommand::Flatlo {
             mission,
             seed,
@@ -315,6 +373,41 @@ pub fn main() -> ExitCode {
         Command::Import(args) => ExitCode::from(import_cmd::import_command(&args)),
         Command::Eval(args) => ExitCode::from(eval_cmd::eval_command(&args)),
         Command::Sweep(args) => ExitCode::from(sweep_cmd::sweep_command(&args)),
+        #[cfg(feature = "zenoh")]
+        Command::Agent(args) => ExitCode::from(agent(&args)),
+    }
+}
+
+/// `skyform agent`: errors go to stderr (the coordinator relays them).
+#[cfg(feature = "zenoh")]
+fn agent(args: &AgentArgs) -> u8 {
+    let Some(mission) = load_reporting(&args.mission) else {
+        return exit::ERROR;
+    };
+    let ids = match crate::distributed::wire::parse_ids(&args.ids, mission.fleet.agents) {
+        Ok(ids) => ids,
+        Err(e) => {
+            eprintln!("error: --ids: {e}");
+            return exit::ERROR;
+        }
+    };
+    if !(args.timeout.is_finite() && args.timeout > 0.0) {
+        eprintln!("error: --timeout: must be a positive number of seconds");
+        return exit::ERROR;
+    }
+    let options = crate::distributed::AgentOptions {
+        connect: args.connect.clone(),
+        run: args.run.clone(),
+        seed: args.seed.unwrap_or(mission.seed),
+        timeout: std::time::Duration::from_secs_f64(args.timeout.min(86_400.0)),
+        realtime: args.realtime,
+    };
+    match crate::distributed::fly(&mission, ids, &options) {
+        Ok(()) => exit::OK,
+        Err(e) => {
+            eprintln!("error: {e}");
+            exit::ERROR
+        }
     }
 }
 
@@ -562,6 +655,21 @@ fn run_pipeline(
     options: PlanOptions,
     verbose: bool,
 ) -> u8 {
+    run_pipeline_with(kind, path, seed, json, sinks, options, verbose, None)
+}
+
+/// [`run_pipeline`], a fleet's agents flown where `distributed` says.
+#[allow(clippy::too_many_arguments)]
+fn run_pipeline_with(
+    kind: Kind,
+    path: &std::path::Path,
+    seed: Option<u64>,
+    json: Option<&std::path::Path>,
+    sinks: &Sinks,
+    options: PlanOptions,
+    verbose: bool,
+    distributed: Option<crate::run::Distribution>,
+) -> u8 {
     let Some(mission) = load_reporting(path) else {
         return exit::ERROR;
     };
@@ -569,6 +677,7 @@ fn run_pipeline(
         kind,
         seed: seed.unwrap_or(mission.seed),
         options,
+        distributed,
     };
     let mut warnings = Vec::new();
     let recorder = match Recorder::start(&mission.name, Some(kind), sinks, &mut warnings) {

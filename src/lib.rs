@@ -9,6 +9,8 @@
 pub mod base;
 #[cfg(feature = "rerun")]
 pub mod cli;
+#[cfg(feature = "zenoh")]
+pub mod distributed;
 pub mod export;
 pub mod import;
 pub mod mission;

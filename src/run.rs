@@ -13,13 +13,26 @@ use crate::pipelines::{CancelToken, Kind, Observer, PipelineError, Tee};
 #[cfg(feature = "rerun")]
 pub use crate::record::{Finished, Recorder};
 
-/// What to run: a pipeline, a seed and θ-PSO's options.
+/// What to run: a pipeline, a seed, θ-PSO's options and where a fleet's
+/// agents fly.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Run {
     pub kind: Kind,
     pub seed: u64,
     /// Only θ-PSO reads them.
     pub options: PlanOptions,
+    /// The fleet's agents in processes of their own, over Zenoh (`None`: in
+    /// this process). Only the fleet reads it.
+    pub distributed: Option<Distribution>,
+}
+
+/// A fleet flown by agent processes on this machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Distribution {
+    /// How many agent processes.
+    pub processes: usize,
+    /// Each on its own wall clock (not reproducible) instead of lockstep.
+    pub realtime: bool,
 }
 
 /// What a run left: the outcome (or why there is none) and the recording.
@@ -36,6 +49,7 @@ impl Run {
             kind,
             seed,
             options: PlanOptions::default(),
+            distributed: None,
         }
     }
 
@@ -73,6 +87,9 @@ impl Run {
         observer: &mut dyn Observer,
         cancel: &CancelToken,
     ) -> Result<Outcome, PipelineError> {
+        if let (Kind::Fleet, Some(d)) = (self.kind, self.distributed) {
+            return distributed(mission, self.seed, d, observer, cancel);
+        }
         outcome::run(
             self.kind,
             mission,
@@ -82,6 +99,36 @@ impl Run {
             cancel,
         )
     }
+}
+
+/// The fleet over agent processes (the coordinator in this process).
+#[cfg(feature = "zenoh")]
+fn distributed(
+    mission: &Mission,
+    seed: u64,
+    d: Distribution,
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> Result<Outcome, PipelineError> {
+    let mut options = crate::distributed::Options::new(d.processes);
+    options.realtime = d.realtime;
+    crate::distributed::coordinate(mission, seed, &options, observer, cancel)
+        .map(|o| Outcome::Fleet(Box::new(o)))
+}
+
+/// A build without Zenoh flies every fleet in process.
+#[cfg(not(feature = "zenoh"))]
+fn distributed(
+    _: &Mission,
+    _: u64,
+    _: Distribution,
+    _: &mut dyn Observer,
+    _: &CancelToken,
+) -> Result<Outcome, PipelineError> {
+    Err(PipelineError::Unsupported(
+        "this build has no Zenoh (built without the `zenoh` feature): fly the fleet in process"
+            .into(),
+    ))
 }
 
 /// A build without Rerun (`--no-default-features`) records nothing: no

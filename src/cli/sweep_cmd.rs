@@ -129,6 +129,7 @@ pub fn run_seed(mission: &Mission, kind: Kind, seed: u64) -> SeedRow {
         kind,
         seed,
         options: PlanOptions { parallel: false },
+        distributed: None,
     };
     match run.carry_out(mission, None, &mut Silent, &cancel).result {
         Ok(o) => {

@@ -135,6 +135,13 @@ impl Outcome {
                     Verdict::Failed("two agents came closer than the safety distance".into())
                 } else if !o.obstacles_clear() {
                     Verdict::Failed("an agent came closer to an obstacle than c".into())
+                } else if let Some(l) = o.lost.first() {
+                    Verdict::Failed(format!(
+                        "agent {} was lost at t = {:.2} s ({})",
+                        l.agent + 1,
+                        l.time,
+                        l.reason
+                    ))
                 } else if !o.converged() {
                     Verdict::Failed("a target's formation was never reached".into())
                 } else {

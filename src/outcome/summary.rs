@@ -379,6 +379,48 @@ pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
             100.0 * lost as f64 / (lost + received).max(1) as f64
         );
     }
+    if let Some(d) = &o.distributed {
+        let rounds = if d.round_mean > 0.0 {
+            format!(
+                "round {:.3} ms mean, {:.3} ms worst; ",
+                1e3 * d.round_mean,
+                1e3 * d.round_worst
+            )
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            s,
+            "  distributed  {} agent process(es) over Zenoh, {} clock; ready in {:.2} s; \
+             {rounds}{} states received by the coordinator",
+            d.processes, d.clock, d.startup, d.messages
+        );
+    }
+    // Per agent, when its messages went over a transport or a model.
+    if o.distributed.is_some() || lost > 0 || worst > 0.0 {
+        for a in &o.agents {
+            let n = &a.network;
+            let _ = writeln!(
+                s,
+                "  agent {:<6} {} sent, {} heard, {} lost; neighbour information {:.3} s old on average, {:.3} s at worst",
+                a.index + 1,
+                n.sent,
+                n.received,
+                n.lost,
+                n.mean_age,
+                n.worst_age
+            );
+        }
+    }
+    for l in &o.lost {
+        let _ = writeln!(
+            s,
+            "  LOST         agent {} at t = {:.2} s: {}; the others flew on (its samples end there)",
+            l.agent + 1,
+            l.time,
+            l.reason
+        );
+    }
     let decisions: usize = o.agents.iter().map(|a| a.decisions).sum();
     let evaluations: usize = o.agents.iter().map(|a| a.evaluations).sum();
     let _ = writeln!(

@@ -174,6 +174,11 @@ pub enum PipelineError {
     /// the text names what closes it.
     #[error("{0}")]
     NoRoute(String),
+    /// The transport between a distributed fleet's processes failed (a
+    /// process that never answered, a mission that differs): in words,
+    /// naming the step and the agents.
+    #[error("distributed run: {0}")]
+    Transport(String),
 }
 
 /// Every pipeline's first step: a mission with errors is refused, naming them.

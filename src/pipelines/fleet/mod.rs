@@ -124,6 +124,36 @@ pub struct FleetOutcome {
     pub closest_agents: Option<Closest>,
     /// Closest any agent came to an obstacle's surface.
     pub closest_obstacle: Option<Closest>,
+    /// Per sample (fleets up to `MAX_SERIES_AGENTS`), the pairs of agents
+    /// (i < j) that each heard the other within l: the links the network
+    /// kept up.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub links: Vec<Vec<(usize, usize)>>,
+    /// Agents whose process went away during the run (distributed runs).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub lost: Vec<simulation::LostAgent>,
+    /// How the run was carried out over processes, when it was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distributed: Option<Distributed>,
+}
+
+/// A fleet flown by agents in processes of their own (`skyform run fleet
+/// --distributed`): how, and what the transport cost.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Distributed {
+    /// Agent processes.
+    pub processes: usize,
+    /// "lockstep" (the coordinator's clock, reproducible) or "realtime"
+    /// (each agent on its own timer).
+    pub clock: String,
+    /// Seconds from the first process started to every agent ready.
+    pub startup: f64,
+    /// Per communication round (a step's states in, the round announced),
+    /// seconds: mean and worst, as the coordinator timed them.
+    pub round_mean: f64,
+    pub round_worst: f64,
+    /// Messages the coordinator received over the transport (agents' states).
+    pub messages: usize,
 }
 
 impl FleetOutcome {
@@ -389,8 +419,11 @@ pub fn plan(
     observer.on_event(Event::Stage("scenario"));
     let mut simulation = Simulation::new(mission, seed);
     observer.on_event(Event::Stage("flight"));
-    let completion = simulation.run(observer, cancel);
-    Ok(simulation.finish(completion, observer))
+    let mut link = simulation::Loopback::new(mission.fleet.agents);
+    let completion = simulation
+        .run(&mut link, observer, cancel)
+        .map_err(|e| PipelineError::Transport(e.to_string()))?;
+    Ok(simulation.finish(completion, &[], observer))
 }
 
 #[cfg(test)]

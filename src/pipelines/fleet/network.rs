@@ -16,7 +16,7 @@
 //! the agent uses.
 
 use nalgebra::{Point2, Vector2};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::mission::FleetNetwork;
 
@@ -27,12 +27,15 @@ pub struct Message {
     /// The step it was sent at.
     pub step: usize,
     pub position: Point2<f64>,
+    /// Its height, metres (the flight altitude, give or take the flight's
+    /// own motion): not used by the neighbours, kept for the record.
+    pub height: f64,
     pub velocity: Vector2<f64>,
     pub reference: Point2<f64>,
 }
 
 /// One agent's traffic over the run.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct LinkStats {
     /// Broadcasts: one per step.
     pub sent: usize,
@@ -45,8 +48,7 @@ pub struct LinkStats {
     pub mean_age: f64,
     pub worst_age: f64,
     /// Neighbour states used in decisions (the mean age's count).
-    #[serde(skip)]
-    ages: usize,
+    pub used: usize,
 }
 
 /// The fleet's network in one process: what was sent, what each heard.
@@ -58,7 +60,7 @@ pub struct Network {
     agents: usize,
     dt: f64,
     /// The last `latency + 1` steps' broadcasts, oldest first.
-    sent: std::collections::VecDeque<Vec<Message>>,
+    sent: std::collections::VecDeque<Vec<Option<Message>>>,
     /// Per receiver × sender, the last message heard (`None`: never).
     heard: Vec<Option<Message>>,
     stats: Vec<LinkStats>,
@@ -87,10 +89,22 @@ impl Network {
         }
     }
 
-    /// Step `step`'s broadcasts go out, and what arrives at this step is
-    /// heard: for each receiver, from the senders in `watched[receiver]`.
-    pub fn exchange(&mut self, step: usize, broadcasts: Vec<Message>, watched: &[Vec<usize>]) {
-        for s in &mut self.stats {
+    /// Step `step`'s broadcasts go out (per agent, in agent order: `None`
+    /// for an agent that sent nothing, lost or not heard from), and what
+    /// arrives at this step is heard: for each receiver, from the senders in
+    /// `watched[receiver]`.
+    pub fn exchange(
+        &mut self,
+        step: usize,
+        broadcasts: Vec<Option<Message>>,
+        watched: &[Vec<usize>],
+    ) {
+        for (s, _) in self
+            .stats
+            .iter_mut()
+            .zip(&broadcasts)
+            .filter(|(_, m)| m.is_some())
+        {
             s.sent += 1;
         }
         self.sent.push_back(broadcasts);
@@ -101,9 +115,14 @@ impl Network {
             return; // nothing sent long enough ago yet
         };
         for (receiver, senders) in watched.iter().enumerate() {
-            let at = arriving[receiver].position;
+            // Where the receiver was when they were sent.
+            let Some(at) = arriving[receiver].map(|m| m.position) else {
+                continue;
+            };
             for &sender in senders {
-                let message = arriving[sender];
+                let Some(message) = arriving[sender] else {
+                    continue;
+                };
                 if (message.position - at).norm() > self.range {
                     continue;
                 }
@@ -126,8 +145,8 @@ impl Network {
     pub fn used(&mut self, receiver: usize, message: &Message, step: usize) {
         let age = step.saturating_sub(message.step) as f64 * self.dt;
         let s = &mut self.stats[receiver];
-        s.ages += 1;
-        s.mean_age += (age - s.mean_age) / s.ages as f64;
+        s.used += 1;
+        s.mean_age += (age - s.mean_age) / s.used as f64;
         s.worst_age = s.worst_age.max(age);
     }
 
@@ -182,6 +201,7 @@ mod tests {
             sender,
             step,
             position: Point2::new(x, 0.0),
+            height: 1.0,
             velocity: Vector2::zeros(),
             reference: Point2::new(x, 0.0),
         }
@@ -201,9 +221,9 @@ mod tests {
         for k in 0..4 {
             // Agent 2 is 10 m away: out of range.
             let out = vec![
-                message(0, k, 0.0),
-                message(1, k, 1.0 + k as f64),
-                message(2, k, 10.0),
+                Some(message(0, k, 0.0)),
+                Some(message(1, k, 1.0 + k as f64)),
+                Some(message(2, k, 10.0)),
             ];
             net.exchange(k, out, &watched);
             match k {

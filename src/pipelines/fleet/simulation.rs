@@ -1,12 +1,20 @@
 //! The fleet's synchronous rounds as a simulation with named stages on state
-//! it owns: every step it takes a [`Snapshot`] of the fleet, `record`s it on
-//! the sample grid, applies the `disturb`ances, lets each agent due to decide
-//! `observe` (an [`Observation`]: everything its planner may know, a plain
-//! value a transport could carry) and `decide` from that alone, and `fly`s
-//! one step. `finish` turns what was recorded into the outcome.
+//! it owns. Every step: `disturb` the agents flown here, `broadcast` their
+//! states, `exchange` them over the [`Link`] for every agent's (the whole
+//! fleet's [`Snapshot`]), `record` it on the sample grid, let the `network`
+//! decide what each agent hears, let each agent due to decide `observe` (an
+//! [`Observation`]: everything its planner may know) and `decide` from that
+//! alone, and `fly` one step. `finish` turns what was recorded into the
+//! outcome.
+//!
+//! One process flies the whole fleet ([`Loopback`]); with a transport between
+//! processes each flies its own agents and every process runs the same
+//! network model on the same messages, so each knows which agents decide in
+//! a round and every agent's random stream is the one of the in-process run.
 
 use nalgebra::{Point2, Point3, Vector2};
 use rayon::prelude::*;
+use serde::Serialize;
 
 use super::agent::Planner;
 use super::cost::{Detected, Neighbour, Observation};
@@ -20,6 +28,79 @@ use crate::base::ode::rk4_step;
 use crate::mission::{FleetParams, FleetPush, Mission};
 use crate::pipelines::{CancelToken, Completion, Event, Level, Observer};
 
+/// What carries each step's messages between the processes that fly the
+/// fleet: a process hands over its own agents' messages of the step and
+/// gets back every agent's, and the agents lost since the last step.
+pub trait Link {
+    /// Every agent's message of `step` (`local` among them), in agent order:
+    /// `None` for an agent not heard from at this step (lost, or with
+    /// nothing new on a wall clock).
+    fn exchange(&mut self, step: usize, local: &[Message]) -> Result<Delivery, LinkError>;
+}
+
+/// One step's messages, as a [`Link`] delivers them.
+#[derive(Debug, Clone, Default)]
+pub struct Delivery {
+    /// Per agent, its message of the step, if one came.
+    pub messages: Vec<Option<Message>>,
+    /// Agents lost at this step, and why (in words).
+    pub lost: Vec<(usize, String)>,
+}
+
+/// A transport that failed: which step, and why (naming the agents waited for).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("step {step} (t = {time:.3} s): {reason}")]
+pub struct LinkError {
+    pub step: usize,
+    pub time: f64,
+    pub reason: String,
+}
+
+/// The whole fleet in one process: every message is local.
+pub struct Loopback {
+    agents: usize,
+}
+
+impl Loopback {
+    pub fn new(agents: usize) -> Self {
+        Loopback { agents }
+    }
+}
+
+impl Link for Loopback {
+    fn exchange(&mut self, _step: usize, local: &[Message]) -> Result<Delivery, LinkError> {
+        let mut messages = vec![None; self.agents];
+        for m in local {
+            messages[m.sender] = Some(*m);
+        }
+        Ok(Delivery {
+            messages,
+            lost: Vec::new(),
+        })
+    }
+}
+
+/// An agent whose process went away, and when.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LostAgent {
+    /// 0-based.
+    pub agent: usize,
+    pub step: usize,
+    /// Seconds of flight.
+    pub time: f64,
+    pub reason: String,
+}
+
+/// What one agent did over a run: its planning effort and its traffic.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
+pub struct Effort {
+    /// 0-based.
+    pub agent: usize,
+    pub decisions: usize,
+    pub evaluations: usize,
+    pub network: super::network::LinkStats,
+}
+
 /// One quadrotor in flight.
 struct Flight {
     planner: Planner,
@@ -28,15 +109,29 @@ struct Flight {
 }
 
 /// The step counts of the run, from the mission's periods.
-struct Clock {
-    dt: f64,
-    steps: usize,
+#[derive(Debug, Clone, Copy)]
+pub struct Clock {
+    pub dt: f64,
+    pub steps: usize,
     replan_every: usize,
     record_every: usize,
     report_every: usize,
 }
 
-/// The fleet as every agent sees it at the start of a step.
+impl Clock {
+    pub fn of(p: &FleetParams) -> Self {
+        let dt = p.sim_step;
+        Clock {
+            dt,
+            steps: (p.duration / dt).round() as usize,
+            replan_every: ((p.replan_period / dt).round() as usize).max(1),
+            record_every: ((1.0 / (SAMPLE_RATE * dt)).round() as usize).max(1),
+            report_every: ((1.0 / dt).round() as usize).max(1),
+        }
+    }
+}
+
+/// The fleet as every agent sees it at a step, from the step's messages.
 pub struct Snapshot {
     step: usize,
     t: f64,
@@ -58,6 +153,9 @@ struct Log {
     /// Per target: the last sampled time the formation was outside tolerance.
     outside: Vec<Option<f64>>,
     inside_at_end: Vec<bool>,
+    /// Per sample, the pairs (i < j) where each heard the other within l at
+    /// that step (fleets up to `MAX_SERIES_AGENTS`): the links of the recording.
+    links: Vec<Vec<(usize, usize)>>,
 }
 
 /// The fleet in flight, with everything the round loop needs.
@@ -69,22 +167,38 @@ pub struct Simulation<'m> {
     /// The obstacles in the flight plane (the fleet flies over the others).
     obstacles: Vec<Detected>,
     body: Body,
+    /// The agents flown here, and their indices in the fleet.
     flights: Vec<Flight>,
+    local: Vec<usize>,
     clock: Clock,
     pushes: Vec<&'m FleetPush>,
     next_push: usize,
     round: u64,
+    /// Each agent's last message (its state at the step being run).
+    current: Vec<Message>,
+    /// Agents whose process went away: no longer flown, heard or recorded.
+    alive: Vec<bool>,
+    lost: Vec<LostAgent>,
     /// Each agent's neighbours within `watch_radius`, rebuilt every round.
     near: Vec<Vec<usize>>,
     watch_radius: f64,
     /// What each agent has heard of the others (`network`).
     network: Network,
+    /// Records samples (off in a process that only flies its agents).
+    recording: bool,
     log: Log,
 }
 
 impl<'m> Simulation<'m> {
-    /// The fleet at its starts (drawn with `seed`), hovering.
+    /// The whole fleet at its starts (drawn with `seed`), hovering.
     pub fn new(mission: &'m Mission, seed: u64) -> Self {
+        let all = (0..mission.fleet.agents).collect();
+        Self::flying(mission, seed, all, true)
+    }
+
+    /// The fleet, flying here only the agents `local` (0-based), recording
+    /// the samples when `recording`.
+    pub fn flying(mission: &'m Mission, seed: u64, local: Vec<usize>, recording: bool) -> Self {
         let p = &mission.fleet;
         let n = p.agents;
         let sc = scenario(mission, seed);
@@ -97,11 +211,11 @@ impl<'m> Simulation<'m> {
                 radius: o.radius,
             })
             .collect();
-        let flights = sc
-            .starts
+        let local: Vec<usize> = local.into_iter().filter(|&i| i < n).collect();
+        let flights = local
             .iter()
-            .enumerate()
-            .map(|(i, s)| {
+            .map(|&i| {
+                let s = sc.starts[i];
                 let start = Point3::new(s.x, s.y, p.altitude);
                 Flight {
                     planner: Planner::new(i, seed, p),
@@ -110,17 +224,28 @@ impl<'m> Simulation<'m> {
                 }
             })
             .collect();
-        let dt = p.sim_step;
-        let clock = Clock {
-            dt,
-            steps: (p.duration / dt).round() as usize,
-            replan_every: ((p.replan_period / dt).round() as usize).max(1),
-            record_every: ((1.0 / (SAMPLE_RATE * dt)).round() as usize).max(1),
-            report_every: ((1.0 / dt).round() as usize).max(1),
+        // Before the first exchange every agent is where it starts.
+        let current = sc
+            .starts
+            .iter()
+            .enumerate()
+            .map(|(i, s)| Message {
+                sender: i,
+                step: 0,
+                position: *s,
+                height: p.altitude,
+                velocity: Vector2::zeros(),
+                reference: *s,
+            })
+            .collect();
+        let clock = Clock::of(p);
+        let kept = if recording {
+            clock.steps / clock.record_every + 1
+        } else {
+            0
         };
-        let kept = clock.steps / clock.record_every + 1;
         let mut distances = Vec::new();
-        if n <= MAX_SERIES_AGENTS {
+        if recording && n <= MAX_SERIES_AGENTS {
             for a in 0..n {
                 for b in a + 1..n {
                     distances.push(DistanceSeries {
@@ -140,6 +265,7 @@ impl<'m> Simulation<'m> {
             closest_obstacle: None,
             outside: vec![None; sc.targets.len()],
             inside_at_end: vec![false; sc.targets.len()],
+            links: Vec::new(),
         };
         let mut pushes: Vec<&FleetPush> = p.pushes.iter().collect();
         pushes.sort_by(|a, b| a.time.total_cmp(&b.time));
@@ -151,31 +277,51 @@ impl<'m> Simulation<'m> {
             obstacles,
             body: Body::from_params(p),
             flights,
+            local,
             clock,
             pushes,
             next_push: 0,
             round: 0,
+            current,
+            alive: vec![true; n],
+            lost: Vec::new(),
             near: vec![Vec::new(); n],
             // Each reference is at most √2·h_max from its agent, so two agents
             // close in on each other by well under 2·√2·h_max + 1 m in one τ.
             watch_radius: p
                 .neighbourhood
                 .max(p.safety_distance + 2.0 * std::f64::consts::SQRT_2 * p.step_max + 1.0),
-            network: Network::new(&p.network, p.neighbourhood, n, seed, dt),
+            network: Network::new(&p.network, p.neighbourhood, n, seed, clock.dt),
+            recording,
             log,
         }
     }
 
-    /// Runs every step to the mission's duration, or until `cancel`.
-    pub fn run(&mut self, observer: &mut dyn Observer, cancel: &CancelToken) -> Completion {
+    /// The run's step counts.
+    pub fn clock(&self) -> Clock {
+        self.clock
+    }
+
+    /// Runs every step to the mission's duration, or until `cancel`, every
+    /// step's messages carried by `link`.
+    pub fn run(
+        &mut self,
+        link: &mut dyn Link,
+        observer: &mut dyn Observer,
+        cancel: &CancelToken,
+    ) -> Result<Completion, LinkError> {
         let steps = self.clock.steps;
         for k in 0..=steps {
+            let t = k as f64 * self.clock.dt;
+            self.disturb(t);
+            let out = self.broadcast(k);
+            let delivery = link.exchange(k, &out)?;
+            let fresh = self.receive(k, t, delivery, observer);
             let now = self.snapshot(k);
-            if k.is_multiple_of(self.clock.record_every) {
+            if self.recording && k.is_multiple_of(self.clock.record_every) {
                 self.record(&now);
             }
-            self.disturb(now.t);
-            self.broadcast(&now);
+            self.network.exchange(k, fresh, &self.near);
             let due = self.due(&now);
             // Before the first target appears the agents hold their starts.
             let started = now.t >= self.scenario.targets[0].0;
@@ -197,18 +343,53 @@ impl<'m> Simulation<'m> {
                         now.t, self.p.duration
                     );
                     observer.on_event(Event::Log(Level::Warn, &text));
-                    return Completion::Cancelled;
+                    return Ok(Completion::Cancelled);
                 }
             }
         }
-        Completion::Finished
+        Ok(Completion::Finished)
     }
 
-    /// The fleet at step `k`; at a scheduled round the neighbour lists are
-    /// rebuilt, reaching beyond c by what two agents can close within τ: in
-    /// between, the same lists serve the "closer than c" check and the
-    /// closest-approach record. Eq. 2's Ξ_i (within l) is taken from them in
-    /// `observe`.
+    /// Takes in a step's messages: the agents lost, and each agent's state
+    /// (an agent not heard from this step stays where it was last heard).
+    /// Returns the step's fresh messages, per agent.
+    fn receive(
+        &mut self,
+        k: usize,
+        t: f64,
+        delivery: Delivery,
+        observer: &mut dyn Observer,
+    ) -> Vec<Option<Message>> {
+        for (agent, reason) in delivery.lost {
+            if self.alive.get(agent).copied().unwrap_or(false) {
+                self.alive[agent] = false;
+                let text = format!("agent {} lost at t = {t:.2} s: {reason}", agent + 1);
+                observer.on_event(Event::Log(Level::Warn, &text));
+                self.lost.push(LostAgent {
+                    agent,
+                    step: k,
+                    time: t,
+                    reason,
+                });
+            }
+        }
+        let mut fresh = delivery.messages;
+        fresh.resize(self.current.len(), None);
+        for (i, m) in fresh.iter_mut().enumerate() {
+            if !self.alive[i] {
+                *m = None;
+            } else if let Some(m) = m {
+                self.current[i] = *m;
+            }
+        }
+        fresh
+    }
+
+    /// The fleet at step `k`, from the step's messages; at a scheduled round
+    /// the neighbour lists are rebuilt (among the agents still flying),
+    /// reaching beyond c by what two agents can close within τ: in between,
+    /// the same lists serve the "closer than c" check and the closest-approach
+    /// record. Eq. 2's Ξ_i (within l) is taken from them in `observe`.
     fn snapshot(&mut self, k: usize) -> Snapshot {
         let t = k as f64 * self.clock.dt;
         let targets = &self.scenario.targets;
@@ -216,14 +397,20 @@ impl<'m> Simulation<'m> {
             .iter()
             .rposition(|(time, _)| *time <= t)
             .unwrap_or(0);
-        let positions: Vec<Point2<f64>> = self
-            .flights
-            .iter()
-            .map(|f| quadrotor::position(&f.state).xy())
-            .collect();
+        let positions: Vec<Point2<f64>> = self.current.iter().map(|m| m.position).collect();
         let scheduled = k.is_multiple_of(self.clock.replan_every);
         if scheduled {
             self.near = neighbourhoods(&positions, self.watch_radius);
+            if !self.lost.is_empty() {
+                let alive = &self.alive;
+                for (i, list) in self.near.iter_mut().enumerate() {
+                    if alive[i] {
+                        list.retain(|&j| alive[j]);
+                    } else {
+                        list.clear();
+                    }
+                }
+            }
         }
         Snapshot {
             step: k,
@@ -240,11 +427,14 @@ impl<'m> Simulation<'m> {
     fn record(&mut self, now: &Snapshot) {
         let (p, log, positions, t) = (self.p, &mut self.log, &now.positions, now.t);
         log.times.push(t);
-        for (i, f) in self.flights.iter().enumerate() {
+        for (i, m) in self.current.iter().enumerate() {
+            if !self.alive[i] {
+                continue;
+            }
             log.samples[i].push(AgentSample {
                 t,
-                position: quadrotor::position(&f.state),
-                reference: f.reference,
+                position: Point3::new(m.position.x, m.position.y, m.height),
+                reference: Point3::new(m.reference.x, m.reference.y, p.altitude),
             });
             for &j in self.near[i].iter().filter(|&&j| j > i) {
                 let d = (positions[j] - positions[i]).norm();
@@ -278,13 +468,31 @@ impl<'m> Simulation<'m> {
         for s in &mut log.distances {
             s.values.push((positions[s.a] - positions[s.b]).norm());
         }
+        if self.current.len() <= MAX_SERIES_AGENTS {
+            let l = p.neighbourhood;
+            let heard = |i: usize, j: usize| {
+                self.network
+                    .heard(i, j)
+                    .is_some_and(|m| (m.position - positions[i]).norm() <= l)
+            };
+            let n = self.current.len();
+            log.links.push(
+                (0..n)
+                    .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+                    .filter(|&(i, j)| self.alive[i] && self.alive[j] && heard(i, j) && heard(j, i))
+                    .collect(),
+            );
+        }
         let within =
             |d: f64, want: f64| (d - want).abs() <= p.tolerance * want.max(p.safety_distance);
         let desired = &self.scenario.desired;
+        let alive = &self.alive;
         let formed = positions
             .iter()
-            .all(|q| within((q - now.target).norm(), p.target_distance))
-            && (0..positions.len()).all(|i| {
+            .enumerate()
+            .filter(|(i, _)| alive[*i])
+            .all(|(_, q)| within((q - now.target).norm(), p.target_distance))
+            && (0..positions.len()).filter(|&i| alive[i]).all(|i| {
                 self.near[i]
                     .iter()
                     .all(|&j| within((positions[j] - positions[i]).norm(), desired[i][j]))
@@ -295,10 +503,13 @@ impl<'m> Simulation<'m> {
         }
     }
 
-    /// Disturbances (4.2): an impulse due by `t` changes the velocity at once.
+    /// Disturbances (4.2): an impulse due by `t` changes the velocity at once
+    /// (of an agent flown here).
     fn disturb(&mut self, t: f64) {
         while let Some(push) = self.pushes.get(self.next_push).filter(|p| p.time <= t) {
-            if let Some(f) = self.flights.get_mut(push.agent) {
+            if let Some(k) = self.local.iter().position(|&i| i == push.agent)
+                && let Some(f) = self.flights.get_mut(k)
+            {
                 f.state[3] += push.impulse.x / self.p.mass;
                 f.state[4] += push.impulse.y / self.p.mass;
             }
@@ -306,36 +517,40 @@ impl<'m> Simulation<'m> {
         }
     }
 
-    /// Who decides now: everyone at a scheduled round; an agent with a
-    /// neighbour closer than c at once.
-    fn due(&self, now: &Snapshot) -> Vec<bool> {
-        let positions = &now.positions;
-        (0..positions.len())
-            .map(|i| {
-                now.scheduled
-                    || self
-                        .heard_neighbours(i)
-                        .any(|m| (m.position - positions[i]).norm() < self.p.safety_distance)
+    /// The state of step `k` each agent flown here broadcasts.
+    fn broadcast(&self, k: usize) -> Vec<Message> {
+        self.flights
+            .iter()
+            .zip(&self.local)
+            .filter(|(_, i)| self.alive[**i])
+            .map(|(f, &i)| {
+                let at = quadrotor::position(&f.state);
+                Message {
+                    sender: i,
+                    step: k,
+                    position: at.xy(),
+                    height: at.z,
+                    velocity: Vector2::new(f.state[3], f.state[4]),
+                    reference: f.reference.xy(),
+                }
             })
             .collect()
     }
 
-    /// Every agent broadcasts its state of this step; what arrives now is
-    /// heard (`network`).
-    fn broadcast(&mut self, now: &Snapshot) {
-        let out = self
-            .flights
-            .iter()
-            .enumerate()
-            .map(|(i, f)| Message {
-                sender: i,
-                step: now.step,
-                position: now.positions[i],
-                velocity: Vector2::new(f.state[3], f.state[4]),
-                reference: f.reference.xy(),
+    /// Who decides now: everyone at a scheduled round; an agent with a
+    /// neighbour closer than c at once (every agent's, from the replicated
+    /// network: the round's number depends on it).
+    fn due(&self, now: &Snapshot) -> Vec<bool> {
+        let positions = &now.positions;
+        (0..positions.len())
+            .map(|i| {
+                self.alive[i]
+                    && (now.scheduled
+                        || self
+                            .heard_neighbours(i)
+                            .any(|m| (m.position - positions[i]).norm() < self.p.safety_distance))
             })
-            .collect();
-        self.network.exchange(now.step, out, &self.near);
+            .collect()
     }
 
     /// The last message agent `i` heard from each agent on its list.
@@ -362,14 +577,14 @@ impl<'m> Simulation<'m> {
         }
     }
 
-    /// What each agent due to decide observes: the neighbours it heard
-    /// within l (their last messages) and the obstacles within d_obs,
-    /// nothing else.
+    /// What each agent flown here and due to decide observes: the neighbours
+    /// it heard within l (their last messages) and the obstacles within
+    /// d_obs, nothing else.
     fn observe(&self, now: &Snapshot, due: &[bool]) -> Vec<Option<Observation>> {
-        (0..due.len())
-            .into_par_iter()
+        self.local
+            .par_iter()
             .with_min_len(8)
-            .map(|i| due[i].then(|| self.observation(i, now)))
+            .map(|&i| due[i].then(|| self.observation(i, now)))
             .collect()
     }
 
@@ -404,16 +619,19 @@ impl<'m> Simulation<'m> {
         }
     }
 
-    /// Every agent with an observation runs its PSO on it (each on its own
-    /// random stream, in parallel) and moves its reference by the step found.
+    /// Every agent flown here with an observation runs its PSO on it (each on
+    /// its own random stream, in parallel) and moves its reference by the
+    /// step found.
     fn decide(&mut self, now: &Snapshot, observations: &[Option<Observation>]) {
         let (round, altitude, positions) = (self.round, self.p.altitude, &now.positions);
+        let local = &self.local;
         self.flights
             .par_iter_mut()
             .enumerate()
             .with_min_len(8)
-            .for_each(|(i, f)| {
-                if let Some(view) = &observations[i] {
+            .for_each(|(k, f)| {
+                if let Some(view) = &observations[k] {
+                    let i = local[k];
                     let h: Vector2<f64> = f.planner.decide(view, round);
                     // Eq. 8: Y_id(t + τ) = Y_i(t) + h, in the flight plane.
                     f.reference = Point3::new(positions[i].x + h.x, positions[i].y + h.y, altitude);
@@ -431,17 +649,57 @@ impl<'m> Simulation<'m> {
         });
     }
 
-    /// The outcome of what was flown; logs each target's result.
-    pub fn finish(self, completion: Completion, observer: &mut dyn Observer) -> FleetOutcome {
+    /// What the agents flown here did: their planning effort and their
+    /// traffic.
+    pub fn effort(&self) -> Vec<Effort> {
+        self.flights
+            .iter()
+            .zip(&self.local)
+            .map(|(f, &i)| Effort {
+                agent: i,
+                decisions: f.planner.decisions,
+                evaluations: f.planner.evaluations,
+                network: self.network.stats()[i],
+            })
+            .collect()
+    }
+
+    /// The agents lost so far.
+    pub fn lost(&self) -> &[LostAgent] {
+        &self.lost
+    }
+
+    /// The outcome of what was flown; logs each target's result. `remote`
+    /// is what the agents flown elsewhere did, as their processes reported
+    /// it (an agent with no report keeps no effort and the traffic this
+    /// process's network model counted for it).
+    pub fn finish(
+        self,
+        completion: Completion,
+        remote: &[Effort],
+        observer: &mut dyn Observer,
+    ) -> FleetOutcome {
+        let mut effort: Vec<Effort> = (0..self.p.agents)
+            .map(|i| Effort {
+                agent: i,
+                decisions: 0,
+                evaluations: 0,
+                network: self.network.stats()[i],
+            })
+            .collect();
+        for e in self.effort().into_iter().chain(remote.iter().copied()) {
+            if let Some(slot) = effort.get_mut(e.agent) {
+                *slot = e;
+            }
+        }
         let Simulation {
             mission,
             p,
             seed,
             scenario: sc,
-            flights,
             clock,
             log,
-            network,
+            lost,
             ..
         } = self;
         let end = log.times.last().copied().unwrap_or(0.0);
@@ -480,17 +738,17 @@ impl<'m> Simulation<'m> {
         if completion == Completion::Finished {
             observer.on_event(Event::Progress(1.0));
         }
-        let agents = flights
+        let agents = log
+            .samples
             .into_iter()
-            .zip(log.samples)
             .enumerate()
-            .map(|(i, (f, samples))| AgentOutcome {
+            .map(|(i, samples)| AgentOutcome {
                 index: i,
                 start: sc.starts[i],
                 samples,
-                decisions: f.planner.decisions,
-                evaluations: f.planner.evaluations,
-                network: network.stats()[i],
+                decisions: effort[i].decisions,
+                evaluations: effort[i].evaluations,
+                network: effort[i].network,
             })
             .collect();
         FleetOutcome {
@@ -506,6 +764,9 @@ impl<'m> Simulation<'m> {
             safety_distance: p.safety_distance,
             closest_agents: log.closest_agents,
             closest_obstacle: log.closest_obstacle,
+            links: log.links,
+            lost,
+            distributed: None,
         }
     }
 }
