@@ -29,6 +29,10 @@ pub struct Cli {
     /// Mission file to open in the designer (a new, minimal mission when it
     /// does not exist; written on the first save).
     pub file: Option<PathBuf>,
+    /// Open the designer with live planning off (L turns it on): plans only
+    /// when asked, with r.
+    #[arg(long)]
+    pub no_live: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -38,6 +42,9 @@ pub enum Command {
         /// Mission TOML file (a new, minimal mission when it does not exist;
         /// written on the first save).
         file: PathBuf,
+        /// Live planning off at the start (L turns it on).
+        #[arg(long)]
+        no_live: bool,
     },
     /// Start a new mission file and open it in the designer.
     ///
@@ -197,6 +204,12 @@ pub enum RunCommand {
         /// Evaluate the swarm on one thread (same result, slower).
         #[arg(long)]
         sequential: bool,
+        /// Start part of the swarm from the plan in FILE (a JSON object with
+        /// `waypoints` and `pass_angles`: a run's outcome, or the
+        /// `warm_start` record of a warm-started one, to repeat it) and stop
+        /// the swarm once it settles, as the designer's live re-plans do.
+        #[arg(long, value_name = "FILE")]
+        warm_from: Option<PathBuf>,
         #[command(flatten)]
         record: RecordArgs,
     },
@@ -298,10 +311,10 @@ pub mod exit {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let Some(command) = cli.command else {
-        return ExitCode::from(edit(cli.file));
+        return ExitCode::from(edit(cli.file, !cli.no_live));
     };
     match command {
-        Command::Edit { file } => ExitCode::from(edit(Some(file))),
+        Command::Edit { file, no_live } => ExitCode::from(edit(Some(file), !no_live)),
         Command::New {
             file,
             from,
@@ -318,12 +331,20 @@ pub fn main() -> ExitCode {
             seed,
             json,
             sequential,
+            warm_from,
             record,
         }) => {
             let options = PlanOptions {
                 parallel: !sequential,
             };
-            ExitCode::from(run_pipeline(
+            let warm = match warm_from.as_deref().map(read_warm_start).transpose() {
+                Ok(w) => w.map(std::sync::Arc::new),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(exit::ERROR);
+                }
+            };
+            ExitCode::from(run_pipeline_with(
                 Kind::ThetaPso,
                 &mission,
                 seed,
@@ -331,6 +352,8 @@ pub fn main() -> ExitCode {
                 &record.sinks(),
                 options,
                 verbose,
+                None,
+                warm,
             ))
         }
         Command::Run(RunCommand::Fleet(a)) => {
@@ -350,6 +373,7 @@ pub fn main() -> ExitCode {
                 PlanOptions::default(),
                 false,
                 distributed,
+                None,
             ))
         }
         Command::Run(RunCommand::Flatlo {
@@ -412,8 +436,8 @@ fn agent(args: &AgentArgs) -> u8 {
 }
 
 /// The TUI; errors (not a terminal, a file that is not a mission) go to stderr.
-fn edit(file: Option<PathBuf>) -> u8 {
-    match crate::tui::run(file) {
+fn edit(file: Option<PathBuf>, live: bool) -> u8 {
+    match crate::tui::run(file, live) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e}");
@@ -460,7 +484,7 @@ fn new_mission(file: &std::path::Path, from: Option<&str>, no_open: bool) -> u8 
     if no_open {
         exit::OK
     } else {
-        edit(Some(file.to_path_buf()))
+        edit(Some(file.to_path_buf()), true)
     }
 }
 
@@ -640,6 +664,8 @@ impl Observer for StderrProgress {
                 };
                 eprintln!("{tag}: {message}");
             }
+            // The log says who was lost, and when.
+            Event::Agents { .. } => {}
         }
     }
 }
@@ -655,7 +681,33 @@ fn run_pipeline(
     options: PlanOptions,
     verbose: bool,
 ) -> u8 {
-    run_pipeline_with(kind, path, seed, json, sinks, options, verbose, None)
+    run_pipeline_with(kind, path, seed, json, sinks, options, verbose, None, None)
+}
+
+/// The plan in `path` to warm-start from: a JSON object with `waypoints`
+/// (and `pass_angles`), as a θ-PSO outcome and its `warm_start` record have.
+fn read_warm_start(
+    path: &std::path::Path,
+) -> Result<crate::pipelines::theta_pso::WarmStart, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("--warm-from {}: {e}", path.display()))?;
+    let mut warm: crate::pipelines::theta_pso::WarmStart = serde_json::from_str(&text)
+        .map_err(|e| {
+            format!(
+                "--warm-from {}: not a plan (a JSON object with `waypoints` and `pass_angles`): {e}",
+                path.display()
+            )
+        })?;
+    if warm.waypoints.is_empty() {
+        return Err(format!(
+            "--warm-from {}: the plan has no waypoints",
+            path.display()
+        ));
+    }
+    if warm.from.is_empty() {
+        warm.from = format!("the plan in {}", path.display());
+    }
+    Ok(warm)
 }
 
 /// [`run_pipeline`], a fleet's agents flown where `distributed` says.
@@ -669,6 +721,7 @@ fn run_pipeline_with(
     options: PlanOptions,
     verbose: bool,
     distributed: Option<crate::run::Distribution>,
+    warm: Option<std::sync::Arc<crate::pipelines::theta_pso::WarmStart>>,
 ) -> u8 {
     let Some(mission) = load_reporting(path) else {
         return exit::ERROR;
@@ -678,6 +731,7 @@ fn run_pipeline_with(
         seed: seed.unwrap_or(mission.seed),
         options,
         distributed,
+        warm,
     };
     let mut warnings = Vec::new();
     let recorder = match Recorder::start(&mission.name, Some(kind), sinks, &mut warnings) {

@@ -13,9 +13,9 @@ use crate::pipelines::{CancelToken, Kind, Observer, PipelineError, Tee};
 #[cfg(feature = "rerun")]
 pub use crate::record::{Finished, Recorder};
 
-/// What to run: a pipeline, a seed, θ-PSO's options and where a fleet's
-/// agents fly.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What to run: a pipeline, a seed, θ-PSO's options (and the plan it starts
+/// warm from) and where a fleet's agents fly.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Run {
     pub kind: Kind,
     pub seed: u64,
@@ -24,6 +24,9 @@ pub struct Run {
     /// The fleet's agents in processes of their own, over Zenoh (`None`: in
     /// this process). Only the fleet reads it.
     pub distributed: Option<Distribution>,
+    /// θ-PSO: start part of the swarm from this plan (the designer's live
+    /// re-plans); `None`, a cold run. Only θ-PSO reads it.
+    pub warm: Option<std::sync::Arc<crate::pipelines::theta_pso::WarmStart>>,
 }
 
 /// A fleet flown by agent processes on this machine.
@@ -50,6 +53,7 @@ impl Run {
             seed,
             options: PlanOptions::default(),
             distributed: None,
+            warm: None,
         }
     }
 
@@ -89,6 +93,17 @@ impl Run {
     ) -> Result<Outcome, PipelineError> {
         if let (Kind::Fleet, Some(d)) = (self.kind, self.distributed) {
             return distributed(mission, self.seed, d, observer, cancel);
+        }
+        if let (Kind::ThetaPso, Some(warm)) = (self.kind, &self.warm) {
+            let plan = crate::pipelines::theta_pso::plan_warm(
+                mission,
+                self.seed,
+                self.options,
+                Some(warm),
+                observer,
+                cancel,
+            )?;
+            return Ok(Outcome::ThetaPso(Box::new(plan)));
         }
         outcome::run(
             self.kind,

@@ -421,3 +421,95 @@ fn each_pipelines_log_lines_land_under_its_own_path() {
         }
     }
 }
+
+/// The network in a fleet recording: at every sample the links between the
+/// agents that heard each other (`/fleet/links`), and an agent lost on the
+/// way as a warning on the events log at its time and a marker where it was.
+#[test]
+fn a_fleet_recording_shows_the_links_and_the_lost_agents() {
+    use skyform::outcome::Outcome;
+    use skyform::pipelines::fleet::{self, simulation::LostAgent};
+    use skyform::pipelines::{CancelToken, Silent};
+    use skyform::record::{Recorder, Sinks};
+    let mut m = skyform::mission::load(Path::new("missions/fleet-triangle.toml"))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    m.fleet.duration = 4.0;
+    let mut o =
+        fleet::plan(&m, 3, &mut Silent, &CancelToken::new()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(o.links.len(), o.times.len(), "a set of links per sample");
+    assert!(
+        o.links.iter().any(|pairs| pairs.len() == 3),
+        "all three hear each other"
+    );
+    // Agent 2 lost at 2 s: its samples end there.
+    o.agents[1].samples.retain(|s| s.t <= 2.0);
+    o.lost.push(LostAgent {
+        agent: 1,
+        step: 400,
+        time: 2.0,
+        reason: "its process went away".into(),
+    });
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let rrd = dir.path().join("fleet.rrd");
+    let sinks = Sinks {
+        rrd: Some(rrd.clone()),
+        connect: None,
+        spawn: false,
+    };
+    let mut warnings = Vec::new();
+    let mut recorder = Recorder::start(
+        &m.name,
+        Some(skyform::pipelines::Kind::Fleet),
+        &sinks,
+        &mut warnings,
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+    .unwrap_or_else(|| panic!("no recorder"));
+    recorder.log_outcome(&Outcome::Fleet(Box::new(o.clone())));
+    recorder.finish();
+    let chunks = chunks(&rrd);
+    let paths = entity_paths(&chunks);
+    for entity in [
+        "/fleet/links",
+        "/fleet/lost/agent_1",
+        "/fleet/agents/agent_1",
+    ] {
+        assert!(
+            paths.contains(&entity.to_owned()),
+            "{entity} missing from {paths:?}"
+        );
+    }
+    // The links are logged at every sample, up to the end of the run.
+    let end = last_time(&chunks, "/fleet/links", "sim_time");
+    assert_eq!(end, Some(4_000_000_000));
+    // The lost agent's point stops at 2 s; the others fly to the end.
+    assert_eq!(
+        last_time(&chunks, "/fleet/agents/agent_1", "sim_time"),
+        Some(2_000_000_000)
+    );
+    assert_eq!(
+        last_time(&chunks, "/fleet/agents/agent_0", "sim_time"),
+        Some(4_000_000_000)
+    );
+    let texts: Vec<String> = chunks
+        .iter()
+        .filter(|c| c.entity_path().to_string() == "/fleet/events")
+        .flat_map(|c| {
+            c.component_descriptors()
+                .filter(|d| d.component.as_str() == "TextLog:text")
+                .flat_map(|d| {
+                    c.iter_slices::<String>(d.component)
+                        .flat_map(|s| s.into_iter().map(|t| t.to_string()))
+                        .collect::<Vec<_>>()
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.contains("agent 2 lost: its process went away")),
+        "{texts:?}"
+    );
+}

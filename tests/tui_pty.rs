@@ -461,3 +461,60 @@ fn a_new_mission_built_with_keys_only_saves_what_was_typed() {
         }
     }
 }
+
+/// The agent processes of a distributed fleet: skyform processes whose
+/// command line runs `agent`.
+fn agent_processes() -> Vec<u32> {
+    let Ok(entries) = std::fs::read_dir("/proc") else {
+        return Vec::new();
+    };
+    entries
+        .filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
+        .filter(|pid| {
+            let cmdline = std::fs::read(format!("/proc/{pid}/cmdline")).unwrap_or_default();
+            let args: Vec<&[u8]> = cmdline.split(|&b| b == 0).collect();
+            let zombie = std::fs::read_to_string(format!("/proc/{pid}/stat"))
+                .is_ok_and(|s| s.rsplit_once(") ").is_some_and(|(_, r)| r.starts_with('Z')));
+            !zombie
+                && args.first().is_some_and(|a| a.ends_with(b"skyform"))
+                && args.get(1) == Some(&&b"agent"[..])
+        })
+        .collect()
+}
+
+/// `Z` flies the fleet with its agents in processes of their own: the job
+/// shows its agents alive while it runs and its processes in the result,
+/// the verdict is the in-process one, and no agent process is left.
+#[cfg(feature = "zenoh")]
+#[test]
+fn z_runs_the_fleet_over_agent_processes() {
+    let dir = tempfile::tempdir().unwrap();
+    let state = dir.path().join("state");
+    let file = dir.path().join("fleet.toml");
+    let mut m = mission::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/missions/fleet-triangle.toml"
+    )))
+    .unwrap()
+    .mission;
+    m.fleet.duration = 14.0;
+    m.fleet.targets.truncate(1);
+    std::fs::write(&file, mission::to_toml_string(&m).unwrap()).unwrap();
+    let mut s = launch(&file, &state);
+    s.wait_for("Inspector", Duration::from_secs(20));
+    s.send("Z");
+    s.wait_for("agent process(es) over Zenoh", Duration::from_secs(30));
+    s.wait_for("⇄3/3", Duration::from_secs(30));
+    s.wait_for(
+        "3 agent process(es) over Zenoh, lockstep",
+        Duration::from_secs(60),
+    );
+    s.wait_for("pass ⇄3/3", Duration::from_secs(5));
+    s.send("q");
+    assert_eq!(s.wait_exit(Duration::from_secs(10)), 0);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !agent_processes().is_empty() && Instant::now() < deadline {
+        thread::sleep(Duration::from_millis(50));
+    }
+    assert_eq!(agent_processes(), Vec::<u32>::new(), "agent processes left");
+}

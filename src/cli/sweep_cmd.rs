@@ -130,6 +130,7 @@ pub fn run_seed(mission: &Mission, kind: Kind, seed: u64) -> SeedRow {
         seed,
         options: PlanOptions { parallel: false },
         distributed: None,
+        warm: None,
     };
     match run.carry_out(mission, None, &mut Silent, &cancel).result {
         Ok(o) => {

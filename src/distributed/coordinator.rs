@@ -321,6 +321,10 @@ pub fn coordinate(
         .put(Clock::Control(Control::Start).encode())
         .wait()
         .map_err(z("starting the run"))?;
+    observer.on_event(Event::Agents {
+        alive: mission.fleet.agents,
+        total: mission.fleet.agents,
+    });
 
     observer.on_event(Event::Stage("flight"));
     let mut simulation = Simulation::flying(mission, seed, Vec::new(), true);

@@ -100,6 +100,9 @@ pub enum Event<'a> {
     },
     /// A message for the log.
     Log(Level, &'a str),
+    /// A distributed fleet: how many of its agents are still flying (their
+    /// processes answer), of how many.
+    Agents { alive: usize, total: usize },
 }
 
 /// Receives a pipeline's events on the pipeline's thread. Keep it cheap: it

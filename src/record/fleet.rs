@@ -28,6 +28,12 @@ pub fn log_outcome(stream: &RecordingStream, o: &FleetOutcome) -> rerun::Recordi
     )?;
     let times = rerun::TimeColumn::new_duration_secs("sim_time", o.times.iter().copied());
     for a in &o.agents {
+        // A lost agent's samples end where it was lost.
+        let times = if a.samples.len() == o.times.len() {
+            times.clone()
+        } else {
+            rerun::TimeColumn::new_duration_secs("sim_time", a.samples.iter().map(|s| s.t))
+        };
         let color = uav_color(a.index);
         let positions: Vec<[f32; 3]> = a.samples.iter().map(|s| f32x3(&s.position)).collect();
         let references: Vec<[f32; 3]> = a.samples.iter().map(|s| f32x3(&s.reference)).collect();
@@ -110,6 +116,51 @@ pub fn log_outcome(stream: &RecordingStream, o: &FleetOutcome) -> rerun::Recordi
             )?;
         }
     }
+    log_network(stream, o)?;
     stream.reset_time();
+    Ok(())
+}
+
+/// The network: at each sample, a line between every two agents that heard
+/// each other within l (`fleet/links`), and the agents lost on the way
+/// (where and when, on the events log and as a marker).
+fn log_network(stream: &RecordingStream, o: &FleetOutcome) -> rerun::RecordingStreamResult<()> {
+    let position = |agent: usize, k: usize| {
+        o.agents
+            .get(agent)
+            .and_then(|a| a.samples.get(k))
+            .map(|s| f32x3(&s.position))
+    };
+    for (k, (t, pairs)) in o.times.iter().zip(&o.links).enumerate() {
+        let strips: Vec<Vec<[f32; 3]>> = pairs
+            .iter()
+            .filter_map(|&(i, j)| Some(vec![position(i, k)?, position(j, k)?]))
+            .collect();
+        stream.set_duration_secs("sim_time", *t);
+        stream.log(
+            at::LINKS,
+            &rerun::LineStrips3D::new(strips)
+                .with_colors([rerun::Color::from_unmultiplied_rgba(120, 200, 255, 140)])
+                .with_radii([0.01f32]),
+        )?;
+    }
+    let events = paths::events(Kind::Fleet);
+    for l in &o.lost {
+        stream.set_duration_secs("sim_time", l.time);
+        stream.log(
+            events.as_str(),
+            &rerun::TextLog::new(format!("agent {} lost: {}", l.agent + 1, l.reason))
+                .with_level(rerun::TextLogLevel::WARN),
+        )?;
+        if let Some(last) = o.agents.get(l.agent).and_then(|a| a.samples.last()) {
+            stream.log(
+                at::agent("lost", l.agent),
+                &rerun::Points3D::new([f32x3(&last.position)])
+                    .with_colors([rerun::Color::from_rgb(255, 60, 60)])
+                    .with_radii([0.2f32])
+                    .with_labels([format!("agent {} lost", l.agent + 1)]),
+            )?;
+        }
+    }
     Ok(())
 }

@@ -85,6 +85,8 @@ enum Message {
     },
     Log(Level, String),
     Outcome(Box<Outcome>),
+    /// A live plan, the `revision`-th of the designer's session.
+    Live(u64, Box<Outcome>),
 }
 
 /// A recording in progress. `finish` (or drop) flushes it and closes the file.
@@ -211,6 +213,13 @@ impl Recorder {
         self.send(Message::Outcome(Box::new(outcome.clone())));
     }
 
+    /// Logs a live plan of the designer as revision `revision`: its plan
+    /// entities on the `revision` timeline, so each replaces the last in the
+    /// view and the timeline keeps them all.
+    pub fn log_live(&mut self, revision: u64, outcome: &Outcome) {
+        self.send(Message::Live(revision, Box::new(outcome.clone())));
+    }
+
     /// Flushes everything and closes the sinks; the `.rrd` is complete after this.
     pub fn finish(mut self) -> Finished {
         self.close()
@@ -267,7 +276,7 @@ impl Observer for Recorder {
                 path: path.iter().map(f32x3).collect(),
             }),
             Event::Log(level, text) => self.send(Message::Log(level, text.to_owned())),
-            Event::Stage(_) | Event::Progress(_) => {}
+            Event::Stage(_) | Event::Progress(_) | Event::Agents { .. } => {}
         }
     }
 }
@@ -440,10 +449,55 @@ fn log_message(stream: &RecordingStream, message: Message, scene: Option<&Missio
             stream.log(log, &rerun::TextLog::new(text).with_level(level))
         }
         Message::Iteration { .. } => Ok(()),
+        Message::Live(revision, outcome) => log_live(stream, revision, &outcome),
     };
     // A logging error (a sink gone) must not stop the run; the recording is
     // best effort from here on.
     let _ = result;
+}
+
+/// A live plan on the `revision` timeline: the centroid path, each UAV's
+/// track and the verdict (θ-PSO); FLATLO's flown paths and its verdict.
+fn log_live(
+    stream: &RecordingStream,
+    revision: u64,
+    outcome: &Outcome,
+) -> rerun::RecordingStreamResult<()> {
+    stream.set_time_sequence("revision", revision as i64);
+    let verdict = match outcome.verdict() {
+        crate::outcome::Verdict::Passed => "feasible".to_owned(),
+        crate::outcome::Verdict::Failed(why) => format!("INFEASIBLE: {why}"),
+        crate::outcome::Verdict::Cancelled => "cancelled".to_owned(),
+    };
+    let tracks = outcome.tracks();
+    for (k, track) in tracks.iter().enumerate() {
+        let points: Vec<[f32; 3]> = track.samples.iter().map(|s| f32x3(&s.position)).collect();
+        stream.log(
+            paths::live_track(k),
+            &rerun::LineStrips3D::new([points]).with_colors([uav_color(k)]),
+        )?;
+    }
+    if let Some(o) = outcome.theta_pso() {
+        stream.log(
+            paths::LIVE_CENTROID,
+            &rerun::LineStrips3D::new([o.centroid_path.iter().map(f32x3).collect::<Vec<_>>()])
+                .with_colors([rerun::Color::from_rgb(255, 255, 255)])
+                .with_labels(["centroid"]),
+        )?;
+    }
+    let warm = outcome
+        .theta_pso()
+        .and_then(|o| o.warm_start.as_ref())
+        .map_or_else(|| "cold".to_owned(), |w| format!("warm from {}", w.from));
+    stream.log(
+        paths::LIVE_EVENTS,
+        &rerun::TextLog::new(format!(
+            "live plan {revision}: {verdict} ({warm}); {}",
+            outcome.headline()
+        )),
+    )?;
+    stream.reset_time();
+    Ok(())
 }
 
 /// `skyform record`: the mission scene alone.

@@ -37,6 +37,15 @@ pub fn origin(path: &str) -> String {
 }
 
 /// θ-PSO's entities.
+/// The designer's live plans, one per `revision`.
+pub const LIVE_CENTROID: &str = "live/plan/centroid";
+pub const LIVE_EVENTS: &str = "live/events";
+
+/// Vehicle `k` (0-based) of a live plan, named from 1.
+pub fn live_track(k: usize) -> String {
+    format!("live/plan/vehicle_{}", k + 1)
+}
+
 pub mod theta_pso {
     /// The cost terms on the `iteration` timeline.
     pub const COST: &str = "theta_pso/cost";
@@ -86,6 +95,8 @@ pub mod fleet {
     pub const DISTANCES: &str = "fleet/distances";
     pub const SAFETY_C: &str = "fleet/distances/safety_c";
     pub const TARGET: &str = "fleet/target";
+    /// At each sample, the agents that heard each other.
+    pub const LINKS: &str = "fleet/links";
 
     /// `part` is `trails`, `agents` or `references`.
     pub fn agent(part: &str, index: usize) -> String {

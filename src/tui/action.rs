@@ -89,6 +89,11 @@ pub enum Action {
 
     /// Run a pipeline with the mission's seed.
     Run(Kind),
+    /// Live planning on or off: the plan follows every edit.
+    ToggleLive,
+    /// Run the fleet with its agents in processes of their own, over Zenoh
+    /// (lockstep: the same result as `Run(Kind::Fleet)`).
+    RunDistributed,
     /// Move the fleet replay by this many seconds (and pause it).
     Scrub(f64),
     /// Play or pause the fleet replay.

@@ -318,9 +318,15 @@ impl App {
             Save | SaveAs | Open | Confirm | Import => self.update_files(action),
             ChangeStep(_) | Zoom(..) | Pan(..) | Fit => self.update_camera(action),
             Scrub(_) | TogglePlay => self.update_replay(action),
-            Run(_) | RunNewSeed | Cancel | JobUp | JobDown | ToggleRecording | CycleViewer => self
-                .board
-                .update(action, self.editor.doc(), &self.cwd, &mut self.status),
+            Run(_) | RunDistributed | RunNewSeed | Cancel | JobUp | JobDown | ToggleRecording
+            | CycleViewer => {
+                self.board
+                    .update(action, self.editor.doc(), &self.cwd, &mut self.status)
+            }
+            ToggleLive => {
+                self.board.toggle_live(Instant::now(), &mut self.status);
+                self.poll_live(Instant::now());
+            }
             ShowJob => {
                 if self.board.show_selected() {
                     self.pane = Pane::Map;
@@ -339,6 +345,70 @@ impl App {
             | EditInput(_) | EditBackspace | EditClear | EditCommit | EditCancel | Undo | Redo
             | DragStart(..) | DragTo(_) | DragEnd => self.update_editor(action),
         }
+        // Whatever changed the mission (an edit, an undo, an import, an
+        // open), live planning follows it.
+        self.board.follow(self.editor.doc(), Instant::now());
+    }
+
+    /// Live planning on, for θ-PSO, when the mission is of a size planned
+    /// in well under a second (the designer's start; tests leave it off).
+    pub fn enable_live(&mut self) {
+        let now = Instant::now();
+        if crate::outcome::interactive(crate::pipelines::Kind::ThetaPso, self.mission())
+            && self
+                .board
+                .start_live(crate::pipelines::Kind::ThetaPso, now)
+                .is_ok()
+        {
+            self.board.follow(self.editor.doc(), now);
+        }
+    }
+
+    /// Live planning on for `pipeline` (θ-PSO or FLATLO), whatever the size.
+    pub fn start_live(&mut self, pipeline: crate::pipelines::Kind) -> Result<(), String> {
+        let now = Instant::now();
+        self.board.start_live(pipeline, now)?;
+        self.board.follow(self.editor.doc(), now);
+        Ok(())
+    }
+
+    /// Does what the designer's loop does for live planning (starts the
+    /// run due, applies the runs' messages) until nothing is due or under
+    /// way: tests and the live benchmark. False on timeout.
+    pub fn settle_live(&mut self, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let now = Instant::now();
+            if self.wake_at().is_some_and(|at| at <= now) {
+                self.poll_live(now);
+                continue;
+            }
+            let live = self.board.live();
+            if live.due().is_none() && !live.any_running() {
+                self.drain_job_messages();
+                return true;
+            }
+            if now >= deadline {
+                return false;
+            }
+            let wait = self
+                .wake_at()
+                .map_or(deadline - now, |at| at.saturating_duration_since(now))
+                .min(deadline - now);
+            if let Ok(msg) = self.board.messages().recv_timeout(wait) {
+                self.on_job_msg(msg, Instant::now());
+            }
+        }
+    }
+
+    /// Starts the live run that is due by `now`, if one is.
+    pub fn poll_live(&mut self, now: Instant) {
+        self.board.poll_live(self.editor.doc(), now);
+    }
+
+    /// When the loop must wake by itself next (a live run due), if ever.
+    pub fn wake_at(&self) -> Option<Instant> {
+        self.board.live().due()
     }
 
     /// Quitting, closing, focus and what the left pane shows.

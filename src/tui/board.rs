@@ -13,8 +13,13 @@ use crossbeam_channel::{Receiver, Sender, unbounded};
 use super::action::Action;
 use super::document::Document;
 use super::jobs::{self, Job, JobId, JobMsg, Kind, RecordSettings, Viewer};
+use super::live::Live;
 use super::status::StatusLine;
 use crate::pipelines::Level;
+
+/// Agent processes a distributed fleet job starts at most (the designer
+/// shares the machine with them).
+const DESIGNER_PROCESSES: usize = 3;
 
 pub struct JobBoard {
     jobs: Vec<Job>,
@@ -25,6 +30,12 @@ pub struct JobBoard {
     /// Record runs to an `.rrd` beside the mission.
     record_rrd: bool,
     viewer: Viewer,
+    /// Live planning: the plan follows the edit.
+    live: Live,
+    /// With a viewer on, the live plans' recording: one for the session,
+    /// each plan a `revision`.
+    #[cfg(feature = "rerun")]
+    live_recording: Option<crate::record::Recorder>,
     tx: Sender<JobMsg>,
     rx: Receiver<JobMsg>,
 }
@@ -38,6 +49,9 @@ impl Default for JobBoard {
             shown: None,
             record_rrd: false,
             viewer: Viewer::Off,
+            live: Live::default(),
+            #[cfg(feature = "rerun")]
+            live_recording: None,
             tx,
             rx,
         }
@@ -59,10 +73,101 @@ impl JobBoard {
         self.shown
     }
 
-    /// The job whose result is on the map.
+    /// The job whose result is on the map (a listed run or the newest live one).
     pub fn shown(&self) -> Option<&Job> {
         let id = self.shown?;
+        if Live::owns(id) {
+            return self.live.latest().filter(|j| j.id == id);
+        }
         self.jobs.iter().find(|j| j.id == id)
+    }
+
+    /// Live planning.
+    pub fn live(&self) -> &Live {
+        &self.live
+    }
+
+    /// Turns live planning on for the pipeline shown (θ-PSO or FLATLO; θ-PSO
+    /// when nothing is), or off.
+    pub fn toggle_live(&mut self, now: Instant, status: &mut StatusLine) {
+        if self.live.is_on() {
+            self.live.stop();
+            status.say("live planning off: press r to plan");
+            return;
+        }
+        let pipeline = match self.shown().map(|j| j.pipeline) {
+            Some(Kind::Flatlo) => Kind::Flatlo,
+            _ => Kind::ThetaPso,
+        };
+        match self.live.start(pipeline, now) {
+            Ok(()) => status.say(format!(
+                "live planning on: {} re-plans after every edit (L turns it off)",
+                pipeline.name()
+            )),
+            Err(e) => status.error(e),
+        }
+    }
+
+    /// Turns live planning on for `pipeline` (the designer's start).
+    pub fn start_live(&mut self, pipeline: Kind, now: Instant) -> Result<(), String> {
+        self.live.start(pipeline, now)
+    }
+
+    /// The document may have changed: live planning follows it.
+    pub fn follow(&mut self, doc: &Document, now: Instant) {
+        self.live.follow(doc, now);
+    }
+
+    /// With a viewer on, the newest live plan goes to the session's live
+    /// recording (started at the first), as the next revision.
+    #[cfg(feature = "rerun")]
+    fn record_live(&mut self, status: &mut StatusLine) {
+        use crate::record::{DEFAULT_VIEWER_URL, Recorder, Sinks};
+        if self.viewer == Viewer::Off {
+            if let Some(r) = self.live_recording.take() {
+                r.finish();
+            }
+            return;
+        }
+        let Some(job) = self.live.latest() else {
+            return;
+        };
+        if self.live_recording.is_none() {
+            let sinks = Sinks {
+                rrd: None,
+                connect: (self.viewer == Viewer::Connect).then(|| DEFAULT_VIEWER_URL.to_owned()),
+                spawn: self.viewer == Viewer::Spawn,
+            };
+            let mut warnings = Vec::new();
+            let name = format!("{} (live)", job.mission.name);
+            match Recorder::start(&name, Some(job.pipeline), &sinks, &mut warnings) {
+                Ok(Some(mut r)) => {
+                    r.log_mission(&job.mission);
+                    self.live_recording = Some(r);
+                }
+                Ok(None) => {}
+                Err(e) => status.error(format!("live recording: {e}")),
+            }
+            if let Some(w) = warnings.first() {
+                status.error(format!("warning: {w}"));
+            }
+        }
+        if let (Some(r), Some(o)) = (self.live_recording.as_mut(), job.outcome.as_ref()) {
+            r.log_live(self.live.revision(), o);
+        }
+    }
+
+    #[cfg(not(feature = "rerun"))]
+    fn record_live(&mut self, _: &mut StatusLine) {}
+
+    /// Starts the live run due by `now`, if one is.
+    pub fn poll_live(&mut self, doc: &Document, now: Instant) {
+        let warm_from = self
+            .shown
+            .filter(|id| !Live::owns(*id))
+            .and_then(|id| self.jobs.iter().find(|j| j.id == id));
+        self.live
+            .poll(doc, now, warm_from, RecordSettings::default(), &self.tx);
     }
 
     pub fn record_rrd(&self) -> bool {
@@ -123,7 +228,15 @@ impl JobBoard {
         use Action::*;
         let seed = doc.mission().seed;
         match action {
-            Run(kind) => self.run(kind, seed, doc, cwd, status),
+            Run(kind) => self.run(crate::run::Run::new(kind, seed), doc, cwd, status),
+            RunDistributed => {
+                let mut run = crate::run::Run::new(Kind::Fleet, seed);
+                run.distributed = Some(crate::run::Distribution {
+                    processes: doc.mission().fleet.agents.clamp(1, DESIGNER_PROCESSES),
+                    realtime: false,
+                });
+                self.run(run, doc, cwd, status);
+            }
             RunNewSeed => {
                 let seed = self
                     .jobs
@@ -131,8 +244,11 @@ impl JobBoard {
                     .map(|j| j.seed)
                     .max()
                     .map_or(seed.wrapping_add(1), |s| s.wrapping_add(1));
-                let pipeline = self.jobs.last().map_or(Kind::ThetaPso, |j| j.pipeline);
-                self.run(pipeline, seed, doc, cwd, status);
+                let last = self.jobs.last();
+                let mut run =
+                    crate::run::Run::new(last.map_or(Kind::ThetaPso, |j| j.pipeline), seed);
+                run.distributed = last.and_then(|j| j.distributed);
+                self.run(run, doc, cwd, status);
             }
             Cancel => self.cancel(status),
             JobUp => self.cursor = self.cursor.saturating_sub(1),
@@ -181,14 +297,8 @@ impl JobBoard {
         }
     }
 
-    fn run(
-        &mut self,
-        pipeline: Kind,
-        seed: u64,
-        doc: &Document,
-        cwd: &Path,
-        status: &mut StatusLine,
-    ) {
+    fn run(&mut self, run: crate::run::Run, doc: &Document, cwd: &Path, status: &mut StatusLine) {
+        let (pipeline, seed) = (run.kind, run.seed);
         let errors = doc.error_lines();
         if let Some(first) = errors.first() {
             status.error(format!(
@@ -199,6 +309,7 @@ impl JobBoard {
         }
         let id = self.jobs.last().map_or(1, |j| j.id + 1);
         let mut job = Job::new(id, pipeline, seed, doc.mission().clone(), Instant::now());
+        job.distributed = run.distributed;
         // A new name rather than over an earlier recording (of this session
         // or a file already there).
         let taken: Vec<&Path> = self.jobs.iter().filter_map(|j| j.rrd.as_deref()).collect();
@@ -209,11 +320,13 @@ impl JobBoard {
             rrd: job.rrd.clone(),
             viewer: self.viewer,
         };
+        let how = run.distributed.map_or_else(String::new, |d| {
+            format!(" in {} agent process(es) over Zenoh", d.processes)
+        });
         jobs::spawn_pipeline(
             id,
-            pipeline,
+            run,
             job.mission.clone(),
-            seed,
             job.cancel.clone(),
             record,
             self.tx.clone(),
@@ -225,7 +338,7 @@ impl JobBoard {
         self.jobs.push(job);
         self.cursor = self.jobs.len() - 1;
         status.say(format!(
-            "job {id}: {} started with seed {seed}{recording} (x cancels)",
+            "job {id}: {}{how} started with seed {seed}{recording} (x cancels)",
             pipeline.name()
         ));
     }
@@ -234,6 +347,19 @@ impl JobBoard {
     /// finished and its result is now the one shown.
     pub fn on_msg(&mut self, msg: JobMsg, now: Instant, status: &mut StatusLine) -> bool {
         let id = msg.job();
+        if Live::owns(id) {
+            let came_in = self.live.on_msg(msg, now);
+            if came_in && let Some(job) = self.live.latest() {
+                self.shown = Some(job.id);
+                if let jobs::JobState::Failed(e) = &job.state {
+                    status.error(format!("live plan failed: {e}"));
+                }
+            }
+            if came_in {
+                self.record_live(status);
+            }
+            return came_in;
+        }
         let note = match &msg {
             JobMsg::Log(_, Level::Warn, text) => Some((true, format!("job {id}: {text}"))),
             JobMsg::Recorded { path, bytes, .. } => Some((

@@ -18,7 +18,7 @@ use crate::mission::Mission;
 pub use crate::outcome::Outcome;
 pub use crate::pipelines::Kind;
 use crate::pipelines::{CancelToken, Completion, Event, Level, Observer};
-use crate::run::{Recorder, Run};
+use crate::run::{Distribution, Recorder, Run};
 
 pub type JobId = usize;
 
@@ -71,6 +71,12 @@ pub enum JobMsg {
         path: Option<Vec<Point3<f64>>>,
     },
     Log(JobId, Level, String),
+    /// A distributed fleet's agents still flying, of how many.
+    Agents {
+        id: JobId,
+        alive: usize,
+        total: usize,
+    },
     /// The run's recording was written.
     Recorded {
         id: JobId,
@@ -131,6 +137,10 @@ pub struct Job {
     pub rrd: Option<PathBuf>,
     /// The recording written, and its size in bytes.
     pub recorded: Option<(PathBuf, u64)>,
+    /// A fleet flown by agent processes (`None`: in this process).
+    pub distributed: Option<Distribution>,
+    /// Its agents still flying, of how many (once the processes are ready).
+    pub agents: Option<(usize, usize)>,
 }
 
 impl Job {
@@ -152,6 +162,8 @@ impl Job {
             cancel: CancelToken::new(),
             rrd: None,
             recorded: None,
+            distributed: None,
+            agents: None,
         }
     }
 
@@ -187,6 +199,7 @@ impl Job {
             JobMsg::Log(_, Level::Warn, text) => self.last_warning = Some(text),
             JobMsg::Recorded { path, bytes, .. } => self.recorded = Some((path, bytes)),
             JobMsg::Log(_, Level::Info, _) => {}
+            JobMsg::Agents { alive, total, .. } => self.agents = Some((alive, total)),
             JobMsg::Done(_, result) => {
                 self.ended = Some(now);
                 match result {
@@ -219,7 +232,9 @@ impl JobMsg {
             | JobMsg::Progress(id, _)
             | JobMsg::Log(id, _, _)
             | JobMsg::Done(id, _) => *id,
-            JobMsg::Iteration { id, .. } | JobMsg::Recorded { id, .. } => *id,
+            JobMsg::Iteration { id, .. }
+            | JobMsg::Recorded { id, .. }
+            | JobMsg::Agents { id, .. } => *id,
         }
     }
 }
@@ -246,24 +261,29 @@ impl Observer for Forward {
                 }
             }
             Event::Log(level, text) => JobMsg::Log(self.id, level, text.to_owned()),
+            Event::Agents { alive, total } => JobMsg::Agents {
+                id: self.id,
+                alive,
+                total,
+            },
         };
         // The UI may be gone (quitting): nothing left to tell.
         let _ = self.tx.send(msg);
     }
 }
 
-/// Starts a run of `pipeline` on `mission` on a worker thread.
+/// Starts a run on `mission` on a worker thread (a fleet's agents flown
+/// where `run.distributed` says).
 pub fn spawn_pipeline(
     id: JobId,
-    pipeline: Kind,
+    run: Run,
     mission: Mission,
-    seed: u64,
     cancel: CancelToken,
     record: RecordSettings,
     tx: Sender<JobMsg>,
 ) {
     spawn(id, tx, move |tx| {
-        run(id, pipeline, &mission, seed, &cancel, &record, tx)
+        carry_out(id, run, &mission, &cancel, &record, tx)
     });
 }
 
@@ -288,11 +308,10 @@ where
 
 /// The run itself, on the worker thread: the one run path (`run::Run`),
 /// with the recorder the settings ask for.
-fn run(
+fn carry_out(
     id: JobId,
-    pipeline: Kind,
+    run: Run,
     mission: &Mission,
-    seed: u64,
     cancel: &CancelToken,
     record: &RecordSettings,
     tx: &Sender<JobMsg>,
@@ -302,8 +321,8 @@ fn run(
         tx: tx.clone(),
         last_cost: None,
     };
-    let recorder = start_recording(id, pipeline, mission, record, tx);
-    let ran = Run::new(pipeline, seed).carry_out(mission, recorder, &mut forward, cancel);
+    let recorder = start_recording(id, run.kind, mission, record, tx);
+    let ran = run.carry_out(mission, recorder, &mut forward, cancel);
     let outcome = ran.result?;
     #[cfg(feature = "rerun")]
     if let Some(finished) = ran.recorded {

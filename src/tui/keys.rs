@@ -391,6 +391,18 @@ pub static KEYS: &[KeyRow] = &[
     },
     KeyRow {
         group: "Run",
+        keys: "L",
+        help: "live planning on / off: the plan follows every edit (θ-PSO, or FLATLO when shown)",
+        bindings: &[bind(Key::Char('L'), When::Always, Action::ToggleLive)],
+    },
+    KeyRow {
+        group: "Run",
+        keys: "Z",
+        help: "run the fleet with its agents as processes over Zenoh (lockstep: the result of T)",
+        bindings: &[bind(Key::Char('Z'), When::Always, Action::RunDistributed)],
+    },
+    KeyRow {
+        group: "Run",
         keys: ",  .  >",
         help: "fleet replay: back / forward one second, play or pause",
         bindings: &[

@@ -24,6 +24,7 @@ mod import;
 pub mod input;
 pub mod jobs;
 pub mod keys;
+pub mod live;
 pub mod overlay;
 pub mod recovery;
 pub mod replay;
@@ -119,7 +120,7 @@ pub fn new_document(path: &Path) -> Result<Document, String> {
 /// Runs the TUI on `path` (or the built-in mission) until the operator
 /// quits; returns the exit code (128 + the signal's number when a signal
 /// ended it, as shells expect).
-pub fn run(path: Option<PathBuf>) -> Result<u8, String> {
+pub fn run(path: Option<PathBuf>, live: bool) -> Result<u8, String> {
     let (doc, note) = open_document(path.as_deref())?;
     if !io::stdout().is_terminal() || !io::stdin().is_terminal() {
         return Err("the mission designer needs a terminal; for scripts use `skyform run` or `skyform check` (see --help)".into());
@@ -133,6 +134,9 @@ pub fn run(path: Option<PathBuf>) -> Result<u8, String> {
         Some(p) => recovery::Origin::File(p.clone()),
         None => recovery::Origin::Builtin(mission::BUILTIN[0].file_name.to_owned()),
     });
+    if live {
+        app.enable_live();
+    }
     let signals = spawn_signals();
 
     let mut terminal =
@@ -240,10 +244,10 @@ fn event_loop(
         if app.should_quit() {
             return Ok(code);
         }
-        let tick = if app.wants_tick() {
-            after(TICK)
-        } else {
-            never()
+        let tick = match app.wake_at() {
+            Some(at) => crossbeam_channel::at(at.min(Instant::now() + TICK)),
+            None if app.wants_tick() => after(TICK),
+            None => never(),
         };
         redraw = false;
         select! {
@@ -273,6 +277,11 @@ fn event_loop(
         redraw |= app.drain_job_messages();
         while let Ok(event) = input.try_recv() {
             redraw |= handle(terminal, app, drawn.as_ref(), event?)?;
+        }
+        // A live run due by now starts (after every edit's debounce).
+        if app.wake_at().is_some_and(|at| at <= Instant::now()) {
+            app.poll_live(Instant::now());
+            redraw = true;
         }
     }
 }

@@ -373,6 +373,12 @@ impl<'m> Simulation<'m> {
                 });
             }
         }
+        if !self.lost.is_empty() && self.lost.last().is_some_and(|l| l.step == k) {
+            observer.on_event(Event::Agents {
+                alive: self.alive.iter().filter(|&&a| a).count(),
+                total: self.alive.len(),
+            });
+        }
         let mut fresh = delivery.messages;
         fresh.resize(self.current.len(), None);
         for (i, m) in fresh.iter_mut().enumerate() {

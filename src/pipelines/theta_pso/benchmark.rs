@@ -133,6 +133,8 @@ pub fn plan(
         convergence: run.convergence,
         iwps: Vec::new(),
         waypoints,
+        pass_angles: Vec::new(),
+        warm_start: None,
         path_length: length,
         duration: length / speed,
         reference_length: None,
@@ -143,6 +145,13 @@ pub fn plan(
         bypassed: Vec::new(),
         source: super::PlanSource::Swarm,
         route_length: length,
+        corridor: super::route::Corridor {
+            points: Vec::new(),
+            legs: Vec::new(),
+            passes: Vec::new(),
+            length: 0.0,
+            squeeze: None,
+        },
         trajectories,
         verification,
     })

@@ -23,7 +23,7 @@ use std::f64::consts::FRAC_PI_2;
 use std::ops::ControlFlow;
 
 use nalgebra::Point3;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::base::swarm::{self, SearchSpace, SwarmConfig};
 use crate::mission::{Diagnostic, FieldPath, Mission};
@@ -49,6 +49,31 @@ impl Default for PlanOptions {
     }
 }
 
+/// Where a warm-started run's swarm starts besides the corridor: a plan of
+/// an earlier run (of this mission or of one a little different), so a
+/// small edit converges in a few iterations. Recorded in the outcome, so the
+/// run can be repeated (`skyform run theta-pso --warm-from`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WarmStart {
+    /// Which plan, in words ("job 3's plan, J 172.65").
+    #[serde(default)]
+    pub from: String,
+    /// Its free waypoints, metres ENU (refitted to the count this run needs).
+    pub waypoints: Vec<Point3<f64>>,
+    /// Its pass angles round each inspected obstacle, radians (builder order).
+    #[serde(default)]
+    pub pass_angles: Vec<f64>,
+    /// Its route stage's corridor: reused, without a search, when it still
+    /// holds on this mission (`route::reuse`).
+    #[serde(default)]
+    pub corridor: Option<route::Corridor>,
+}
+
+/// A warm-started swarm stops once its best has not improved by more than
+/// this share of J for `WARM_STALL` iterations: it starts next to the answer.
+const WARM_TOLERANCE: f64 = 1e-4;
+const WARM_STALL: usize = 12;
+
 /// Everything a θ-PSO run produces.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThetaPsoOutcome {
@@ -72,6 +97,13 @@ pub struct ThetaPsoOutcome {
     pub iwps: Vec<Iwp>,
     /// The free waypoints the swarm chose, decoded (eq. 1).
     pub waypoints: Vec<Point3<f64>>,
+    /// Where each inspection pass lies round its obstacle, radians (the
+    /// particle's pass angles, decoded; builder order).
+    pub pass_angles: Vec<f64>,
+    /// The plan the swarm was warm-started from (`None`: a cold run, the same
+    /// for the same mission and seed whatever ran before).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warm_start: Option<WarmStart>,
     /// P_F*: start, waypoints, IWP crossings and inspection passes, goal.
     pub centroid_path: Vec<Point3<f64>>,
     /// Metres.
@@ -93,6 +125,9 @@ pub struct ThetaPsoOutcome {
     pub source: PlanSource,
     /// The route stage's corridor length, metres.
     pub route_length: f64,
+    /// The route stage's corridor: points, legs (free in a layer, a
+    /// crossing, a pass) and pass angles.
+    pub corridor: route::Corridor,
     pub trajectories: Vec<Trajectory>,
     pub verification: Verification,
 }
@@ -417,12 +452,25 @@ fn log_iwps(observer: &mut dyn Observer, iwps: &[Iwp]) {
 /// too, the swarm runs again with new random streams of the same seed, up to
 /// `theta_pso.restarts` times; when every run fails, the corridor itself is
 /// tried. The first feasible plan is kept, else the one of lowest cost.
-///
-/// Long (~200 lines) because it is Fig. 3 in order: route, swarm, repair, restarts, corridor, each step a few lines that read the one before.
 pub fn plan(
     mission: &Mission,
     seed: u64,
     options: PlanOptions,
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> Result<ThetaPsoOutcome, PipelineError> {
+    plan_warm(mission, seed, options, None, observer, cancel)
+}
+
+/// [`plan`], part of the swarm started from `warm`'s plan (and the swarm
+/// stopped once it stalls, see [`WarmStart`]); `None` is [`plan`] exactly.
+///
+/// Long (~220 lines) because it is Fig. 3 in order: route, swarm, repair, restarts, corridor, each step a few lines that read the one before.
+pub fn plan_warm(
+    mission: &Mission,
+    seed: u64,
+    options: PlanOptions,
+    warm: Option<&WarmStart>,
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<ThetaPsoOutcome, PipelineError> {
@@ -444,13 +492,31 @@ pub fn plan(
     let mut problem = Problem::new(mission).map_err(|(_, e)| PipelineError::InvalidMission(e))?;
     log_iwps(observer, &problem.iwps);
     observer.on_event(Event::Stage("route"));
-    let corridor = route::find(
-        mission,
-        &problem.builder,
-        &problem.iwps,
-        problem.cost.margin(),
-    )
-    .map_err(|blocked| PipelineError::NoRoute(blocked.reason))?;
+    let reused = warm.and_then(|w| w.corridor.as_ref()).and_then(|previous| {
+        route::reuse(
+            mission,
+            &problem.builder,
+            &problem.iwps,
+            problem.cost.margin(),
+            previous,
+        )
+    });
+    if reused.is_some() {
+        observer.on_event(Event::Log(
+            Level::Info,
+            "route: the warm start's corridor still holds; no search",
+        ));
+    }
+    let corridor = match reused {
+        Some(c) => c,
+        None => route::find(
+            mission,
+            &problem.builder,
+            &problem.iwps,
+            problem.cost.margin(),
+        )
+        .map_err(|blocked| PipelineError::NoRoute(blocked.reason))?,
+    };
     problem.follow(mission, &corridor);
     observer.on_event(Event::Log(
         Level::Info,
@@ -468,7 +534,26 @@ pub fn plan(
     let speed = mission.formation.ground_speed;
     let resolution = speed * trajectory::SAMPLE_PERIOD;
     let reference = reference::lower_bound(mission, &problem.iwps, resolution);
-    let starts = seeding::particles(mission, &problem, &corridor, seed);
+    let mut starts = seeding::particles(mission, &problem, &corridor, seed);
+    if let Some(w) = warm {
+        // The earlier plan first: it stands where this one most likely is.
+        let mut warmed = seeding::warm(&problem, w, seed);
+        warmed.extend(starts);
+        warmed.truncate(mission.theta_pso.swarm_size.max(1));
+        starts = warmed;
+        observer.on_event(Event::Log(
+            Level::Info,
+            &format!(
+                "warm start from {}",
+                if w.from.is_empty() {
+                    "a plan given"
+                } else {
+                    &w.from
+                }
+            ),
+        ));
+    }
+    let stall = warm.map(|_| (WARM_STALL, WARM_TOLERANCE));
 
     let p = &mission.theta_pso;
     let mut kept: Option<Attempt> = None;
@@ -487,12 +572,20 @@ pub fn plan(
             observer.on_event(Event::Log(Level::Warn, &message));
         }
         observer.on_event(Event::Stage("planning"));
-        let (result, convergence) = run_swarm(
-            &problem, p, options, seed, attempt, iterations, &starts, observer, cancel,
+        let (result, convergence, converged) = run_swarm(
+            &problem, p, options, seed, attempt, iterations, &starts, stall, observer, cancel,
         );
         iterations += result.iterations;
         evaluations += result.evaluations;
-        if result.stopped {
+        if converged {
+            observer.on_event(Event::Log(
+                Level::Info,
+                &format!(
+                    "warm-started swarm settled after {} iterations",
+                    result.iterations
+                ),
+            ));
+        } else if result.stopped {
             observer.on_event(Event::Log(
                 Level::Warn,
                 &format!(
@@ -582,6 +675,7 @@ pub fn plan(
     }
 
     let waypoints = problem.builder.decode(&best.position);
+    let pass_angles = problem.builder.pass_angles(&best.position);
     let bypassed = problem
         .iwps
         .iter()
@@ -612,6 +706,8 @@ pub fn plan(
         convergence: best.convergence,
         iwps: problem.iwps,
         waypoints,
+        pass_angles,
+        warm_start: warm.cloned(),
         path_length: best.cost.length,
         duration: best.cost.length / speed,
         reference_length,
@@ -624,6 +720,7 @@ pub fn plan(
         bypassed,
         source: best.source,
         route_length: corridor.length,
+        corridor,
         trajectories: best.trajectories,
         verification: best.verification,
     })
@@ -631,7 +728,10 @@ pub fn plan(
 
 /// One run of the swarm from `starts` (the rest at random) on the `attempt`-th
 /// set of random streams, reporting each iteration's best path and J; the
-/// result and the convergence of J (iteration 0 = the initial swarm).
+/// result, the convergence of J (iteration 0 = the initial swarm), and
+/// whether it stopped because it stalled: `stall` (iterations, share of J)
+/// stops it once its best J has improved by no more than that share over
+/// that many iterations.
 #[allow(clippy::too_many_arguments)]
 fn run_swarm(
     problem: &Problem,
@@ -641,9 +741,10 @@ fn run_swarm(
     attempt: usize,
     iterations_before: usize,
     starts: &[Vec<f64>],
+    stall: Option<(usize, f64)>,
     observer: &mut dyn Observer,
     cancel: &CancelToken,
-) -> (swarm::SwarmResult, Vec<f64>) {
+) -> (swarm::SwarmResult, Vec<f64>, bool) {
     let config = SwarmConfig {
         particles: p.swarm_size,
         iterations: p.iterations,
@@ -656,6 +757,7 @@ fn run_swarm(
     let mut convergence = Vec::with_capacity(p.iterations + 1);
     let mut shown: Option<(CentroidPath, CostTerms)> = None;
     let offset = iterations_before + attempt;
+    let mut stalled = false;
     let result = swarm::minimize(
         &problem.space,
         &config,
@@ -682,6 +784,17 @@ fn run_swarm(
             observer.on_event(Event::Progress(
                 0.95 * report.iteration as f64 / p.iterations.max(1) as f64,
             ));
+            if let Some((window, share)) = stall
+                && convergence.len() > window
+                && report.best.cost < cost::INFEASIBLE_STEP
+            {
+                let now = convergence[convergence.len() - 1];
+                let before = convergence[convergence.len() - 1 - window];
+                if before - now <= share * now.abs() {
+                    stalled = true;
+                    return ControlFlow::Break(());
+                }
+            }
             if cancel.is_cancelled() {
                 ControlFlow::Break(())
             } else {
@@ -689,5 +802,5 @@ fn run_swarm(
             }
         },
     );
-    (result, convergence)
+    (result, convergence, stalled && !cancel.is_cancelled())
 }

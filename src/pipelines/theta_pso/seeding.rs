@@ -69,6 +69,74 @@ pub fn particles(
         .collect()
 }
 
+/// Particles a warm-started swarm begins with: the earlier plan exactly
+/// (its waypoints refitted to this run's count), and a few about it.
+pub const WARM_PARTICLES: usize = 10;
+
+/// The warm start's particles: the plan of `warm` encoded for `problem`
+/// (its waypoints, as many as the builder decodes: the corners that turn it
+/// most kept, the longest legs halved), then copies jittered by up to 0.02
+/// rad (a few metres on a site the bridge's size), on a stream of their own.
+pub fn warm(problem: &Problem, warm: &super::WarmStart, seed: u64) -> Vec<Vec<f64>> {
+    let builder = &problem.builder;
+    let count = builder.free_waypoints();
+    let points = fit_waypoints(builder.start(), builder.goal(), &warm.waypoints, count);
+    let exact = builder.encode(&points, &warm.pass_angles);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(u64::MAX - 1);
+    (0..WARM_PARTICLES)
+        .map(|j| {
+            let spread = 0.02 * j as f64 / WARM_PARTICLES as f64;
+            match Normal::new(0.0, spread) {
+                Ok(noise) if j > 0 => exact
+                    .iter()
+                    .map(|theta| (theta + noise.sample(&mut rng)).clamp(-FRAC_PI_2, FRAC_PI_2))
+                    .collect(),
+                _ => exact.clone(),
+            }
+        })
+        .collect()
+}
+
+/// Exactly `count` waypoints from `waypoints` (between `start` and `goal`):
+/// in the plane as [`fit_corners`] chooses them, each kept point with its
+/// height, an added one at its neighbours' mean.
+fn fit_waypoints(
+    start: Point3<f64>,
+    goal: Point3<f64>,
+    waypoints: &[Point3<f64>],
+    count: usize,
+) -> Vec<Point3<f64>> {
+    if waypoints.len() == count {
+        return waypoints.to_vec();
+    }
+    let flat: Vec<Point2<f64>> = waypoints.iter().map(|p| p.xy()).collect();
+    let free = vec![true; flat.len() + 1];
+    let chosen = fit_corners(start.xy(), goal.xy(), flat.clone(), free, count);
+    let all: Vec<Point3<f64>> = std::iter::once(start)
+        .chain(waypoints.iter().copied())
+        .chain(std::iter::once(goal))
+        .collect();
+    chosen
+        .iter()
+        .map(|p| {
+            if let Some(k) = flat.iter().position(|q| q == p) {
+                return waypoints[k];
+            }
+            // A midpoint of two neighbours: the height of the nearest leg's ends.
+            let nearest = all
+                .windows(2)
+                .min_by(|a, b| {
+                    let d =
+                        |w: &[Point3<f64>]| (nalgebra::center(&w[0].xy(), &w[1].xy()) - p).norm();
+                    d(a).total_cmp(&d(b))
+                })
+                .map_or(start.z, |w| (w[0].z + w[1].z) / 2.0);
+            Point3::new(p.x, p.y, nearest)
+        })
+        .collect()
+}
+
 /// The corridor's inner points as free waypoints (fitted to the builder's
 /// count), at heights along start → goal, and its pass angles.
 fn waypoints(problem: &Problem, corridor: &Corridor) -> (Vec<Point3<f64>>, Vec<f64>) {

@@ -30,6 +30,50 @@ fn bar(progress: f64, width: usize) -> String {
     )
 }
 
+/// The live plan's line: which, how long it took (edit to plan), whether it
+/// was warm-started, and whether the next is on its way or waits.
+fn live_line(app: &App, job: &Job) -> Line<'static> {
+    let l = app.board().live();
+    let warm = job
+        .outcome
+        .as_ref()
+        .and_then(|o| o.theta_pso())
+        .and_then(|o| o.warm_start.as_ref())
+        .map_or_else(|| "cold".to_owned(), |w| format!("warm from {}", w.from));
+    let state = match (l.is_on(), l.paused(), l.replanning()) {
+        (false, ..) => "live off (L)".to_owned(),
+        (true, Some(why), _) => format!("paused: {why}"),
+        (true, None, true) => "re-planning…".to_owned(),
+        (true, None, false) => "follows every edit".to_owned(),
+    };
+    let ms = job.elapsed(Instant::now()).as_secs_f64() * 1e3;
+    Line::styled(
+        format!(
+            "{} · {} · {ms:.0} ms · {warm} · {state}",
+            crate::tui::live::label(job.id),
+            job.pipeline.name()
+        ),
+        Style::default().cyan(),
+    )
+}
+
+/// A distributed fleet's agents alive, of how many (red once one is lost).
+fn agents_span(job: &Job) -> Option<Span<'static>> {
+    job.distributed?;
+    let lost = job
+        .outcome
+        .as_ref()
+        .and_then(|o| o.fleet())
+        .map(|o| (o.agents.len() - o.lost.len(), o.agents.len()));
+    let (alive, total) = lost.or(job.agents)?;
+    let style = if alive < total {
+        Style::default().red().bold()
+    } else {
+        Style::default().green()
+    };
+    Some(Span::styled(format!(" ⇄{alive}/{total}"), style))
+}
+
 fn state_span(job: &Job) -> Span<'static> {
     match &job.state {
         JobState::Running => Span::styled(job.stage.clone(), Style::default().cyan()),
@@ -82,7 +126,9 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         ]));
     let inner = block.inner(area);
     frame.render_widget(block, area);
-    if app.jobs().is_empty() {
+    // The newest live plan, when the map shows it, is what the panel details.
+    let live = app.shown().filter(|j| crate::tui::live::Live::owns(j.id));
+    if app.jobs().is_empty() && live.is_none() {
         // The Run keys of the key table, each with its help up to any
         // parenthesis.
         let mut text = vec![Line::raw("No runs yet.")];
@@ -106,7 +152,9 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         frame.render_widget(Paragraph::new(text), inner);
         return;
     }
-    let list_height = (app.jobs().len() as u16).min(inner.height / 3).max(1);
+    let list_height = (app.jobs().len().max(1) as u16)
+        .min(inner.height / 3)
+        .max(1);
     let [list, detail] =
         Layout::vertical([Constraint::Length(list_height), Constraint::Min(0)]).areas(inner);
 
@@ -141,7 +189,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
             let cost = job
                 .best_cost()
                 .map_or(String::new(), |c| format!("J {c:.1} "));
-            Line::from(vec![
+            let mut spans = vec![
                 Span::styled(head, style),
                 Span::styled(
                     bar(job.progress, bar_width),
@@ -149,15 +197,20 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
                 ),
                 Span::raw(format!(" {:>5.1}s {cost}", job.elapsed(now).as_secs_f64())),
                 state_span(job),
-            ])
+            ];
+            spans.extend(agents_span(job));
+            Line::from(spans)
         })
         .collect();
     frame.render_widget(Paragraph::new(lines), list);
 
-    let Some(job) = app.jobs().get(app.board().cursor()) else {
+    let Some(job) = live.or_else(|| app.jobs().get(app.board().cursor())) else {
         return;
     };
     let mut facts: Vec<Line> = Vec::new();
+    if let Some(job) = live {
+        facts.push(live_line(app, job));
+    }
     if let JobState::Failed(e) = &job.state {
         facts.push(Line::styled(format!("error: {e}"), Style::default().red()));
     }
@@ -169,11 +222,26 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         return;
     } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.flatlo()) {
         // FLATLO's verification table fills the panel (no convergence chart).
-        let lines = flatlo_table(o, app.is_stale(job));
+        let lines: Vec<Line> = std::mem::take(&mut facts)
+            .into_iter()
+            .chain(flatlo_table(o, app.is_stale(job)))
+            .collect();
         frame.render_widget(Paragraph::new(lines), detail);
         return;
     } else if let Some(w) = &job.last_warning {
         facts.push(Line::styled(w.clone(), Style::default().yellow()));
+    }
+    if job.is_running()
+        && let Some(d) = job.distributed
+    {
+        let alive = job.agents.map_or_else(
+            || "starting".to_owned(),
+            |(alive, total)| format!("{alive} of {total} agents alive"),
+        );
+        facts.push(Line::raw(format!(
+            "{} agent process(es) over Zenoh: {alive}",
+            d.processes
+        )));
     }
     // The verdict and the table first, from the top: the chart takes what
     // they leave, when that is enough to read.
@@ -342,6 +410,29 @@ fn fleet_table(o: &crate::pipelines::fleet::FleetOutcome, stale: bool) -> Vec<Li
             d.values.last().copied().unwrap_or(f64::NAN),
             d.desired
         )));
+    }
+    if let Some(d) = &o.distributed {
+        lines.push(Line::raw(format!(
+            "{} agent process(es) over Zenoh, {}{}",
+            d.processes,
+            d.clock,
+            if d.round_mean > 0.0 {
+                format!(" · round {:.2} ms", 1e3 * d.round_mean)
+            } else {
+                String::new()
+            }
+        )));
+    }
+    for l in &o.lost {
+        lines.push(Line::styled(
+            format!(
+                "agent {} LOST at {:.1} s: {}",
+                l.agent + 1,
+                l.time,
+                l.reason
+            ),
+            Style::default().red().bold(),
+        ));
     }
     let evaluations: usize = o.agents.iter().map(|a| a.evaluations).sum();
     lines.push(Line::raw(format!(

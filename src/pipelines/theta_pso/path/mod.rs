@@ -308,6 +308,18 @@ impl PathBuilder {
             .collect()
     }
 
+    /// The pass angles of a particle, decoded (radians round each
+    /// inspected obstacle's axis, in [-π, π]).
+    pub fn pass_angles(&self, angles: &[f64]) -> Vec<f64> {
+        let free_angles = &angles[(3 * self.free).min(angles.len())..];
+        (0..self.inspections.len())
+            .map(|i| {
+                let theta = free_angles.get(i).copied().unwrap_or(0.0);
+                decode_angle(theta, -std::f64::consts::PI, std::f64::consts::PI)
+            })
+            .collect()
+    }
+
     /// The particle that stands for these waypoints (the inverse of eq. 1),
     /// each inspection pass placed at `pass_angles` (radians round the axis).
     pub fn encode(&self, waypoints: &[Point3<f64>], pass_angles: &[f64]) -> Vec<f64> {

@@ -33,12 +33,16 @@
 mod blocked;
 pub mod field;
 mod guide;
+mod reuse;
 mod search;
 
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
 
 use nalgebra::Point2;
+use serde::{Deserialize, Serialize};
+
+pub use reuse::reuse;
 
 use self::field::{Disc, Field};
 use self::guide::Guide;
@@ -59,7 +63,8 @@ const MAX_STATES: f64 = 2_000_000.0;
 const SQUEEZE_SPACING_MARGIN: f64 = 0.05;
 
 /// A leg of the corridor.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Leg {
     /// Flown in layer 0 (nominal), 1 (shrunk) or 2 (column).
     Free { layer: usize },
@@ -70,7 +75,7 @@ pub enum Leg {
 }
 
 /// The route found: start, corners, crossings and passes, goal.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Corridor {
     pub points: Vec<Point2<f64>>,
     /// `legs[i]` joins `points[i]` and `points[i + 1]`.
@@ -78,8 +83,21 @@ pub struct Corridor {
     /// Per inspection (builder order): the angle round the axis and the side.
     pub passes: Vec<(f64, bool)>,
     pub length: f64,
-    /// Where the formation flies squeezed, for every path the swarm tries.
+    /// Where the formation flies squeezed, for every path the swarm tries
+    /// (worked out from the site for each run, never written).
+    #[serde(skip)]
     pub squeeze: Option<Arc<SqueezeMap>>,
+}
+
+/// Two corridors are the same route (the squeeze map is the site's reading
+/// of it, not part of it).
+impl PartialEq for Corridor {
+    fn eq(&self, other: &Self) -> bool {
+        self.points == other.points
+            && self.legs == other.legs
+            && self.passes == other.passes
+            && self.length == other.length
+    }
 }
 
 /// Why no corridor exists.
@@ -170,6 +188,121 @@ fn blocking(mission: &Mission) -> Vec<(usize, Disc)> {
         .collect()
 }
 
+/// The grid the route stage searches and what it knows of every cell: the
+/// clearance field, and in which layers each cell may be entered.
+pub(crate) struct Site {
+    shape: Shape,
+    /// The clearance the centroid needs in each layer.
+    need: [f64; LAYERS],
+    /// The obstacles in the way (mission index, disc) and their discs alone.
+    obstacles: Vec<(usize, Disc)>,
+    discs: Vec<Disc>,
+    field: Field,
+    /// Per cell, one bit per layer it may be entered in.
+    open: Vec<u8>,
+}
+
+impl Site {
+    /// The squeezed regions `corridor` passes, as the paths the swarm tries
+    /// read them (`None` when it never squeezes).
+    fn squeeze_of(&self, corridor: &Corridor, mission: &Mission) -> Option<Arc<SqueezeMap>> {
+        squeeze_map(
+            &self.field,
+            &self.open,
+            corridor,
+            &self.shape,
+            mission,
+            &self.discs,
+        )
+        .map(|mut map| {
+            map.obstacle_of = self.obstacles.iter().map(|(k, d)| (*k, d.center)).collect();
+            Arc::new(map)
+        })
+    }
+
+    fn new(mission: &Mission, builder: &PathBuilder, margin: f64) -> Self {
+        let shape = Shape::new(mission, margin);
+        let need = shape.need();
+        let b = &mission.bounds;
+        let area = (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]);
+        // The search holds a state per cell, layer and stage: the grid shares
+        // MAX_STATES among the stages (a stop per pass and requested crossing),
+        // never finer than 0.2 m. A large site gets coarse cells rather than
+        // gigabytes (the refusal then speaks for that resolution).
+        let stops = builder.inspections().len() + builder.crossing_iwps().len();
+        let cells = (MAX_STATES / (LAYERS * (stops + 1)) as f64).min(MAX_CELLS);
+        let cell = (area / cells).sqrt().max(FINEST_CELL);
+        let obstacles = blocking(mission);
+        let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| *d).collect();
+        let field = Field::new([b.x, b.y], &discs, cell, need[0] + 2.0 * cell);
+        let boxes = [
+            [dx_dy(builder)[0], dx_dy(builder)[1]],
+            [
+                shrink(b.x, shape.smallest * shape.reach),
+                shrink(b.y, shape.smallest * shape.reach),
+            ],
+            [b.x, b.y],
+        ];
+
+        let inside = |p: Point2<f64>, [x, y]: [[f64; 2]; 2]| {
+            x[0] <= p.x && p.x <= x[1] && y[0] <= p.y && p.y <= y[1]
+        };
+        let (start, goal) = (mission.route.start.xy(), mission.route.goal.xy());
+        let mut open: Vec<u8> = (0..field.len())
+            .map(|i| {
+                let (c, p) = (field.clearance(i), field.center(i));
+                // Half a cell's diagonal of slack: a straight between two open
+                // cell centres stays clear in between.
+                let slack = cell * std::f64::consts::FRAC_1_SQRT_2;
+                (0..LAYERS)
+                    .filter(|&l| c >= need[l] + slack && inside(p, boxes[l]))
+                    .fold(0, |bits, l| bits | bit(l))
+            })
+            .collect();
+        // Round the start and the goal the disc model is too strict: validation
+        // has checked the formation fits there; let the centroid leave them
+        // wherever it is itself clear.
+        for end in [start, goal] {
+            let around = shape.reach + cell;
+            for i in field.cells_within(end, around) {
+                let p = field.center(i);
+                if (p - end).norm() <= around
+                    && field.clearance(i) >= shape.r_q + margin
+                    && b.contains_xy(&p)
+                {
+                    open[i] |= bit(0) | bit(1) | bit(2);
+                }
+            }
+        }
+        Site {
+            shape,
+            need,
+            obstacles,
+            discs,
+            field,
+            open,
+        }
+    }
+}
+
+/// Whether a pass along the straight `ends` round obstacle `k` (mission
+/// index) is open: every cell on it open in the nominal layer, or nearest to
+/// `k` itself and clear of it by r_Q (the pass flies close to its obstacle
+/// on purpose), and both ends open.
+fn pass_clear(
+    field: &Field,
+    open: &[u8],
+    obstacles: &[(usize, Disc)],
+    r_q: f64,
+    k: usize,
+    ends: [Point2<f64>; 2],
+) -> bool {
+    let obstacle = obstacles.iter().position(|(o, _)| *o == k);
+    field.cells_along(ends[0], ends[1]).all(|c| {
+        open[c] & bit(0) != 0 || (field.nearest_disc(c) == obstacle && field.clearance(c) > r_q)
+    }) && ends.iter().all(|p| open[field.index_of(*p)] & bit(0) != 0)
+}
+
 /// The route stage for `mission`: the cheapest corridor, or why none exists.
 ///
 /// Long (~170 lines): the stage in order (grid, open layers, stops, jumps, search, corridor, squeeze map), each step reading the one before.
@@ -179,59 +312,16 @@ pub fn find(
     iwps: &[Iwp],
     margin: f64,
 ) -> Result<Corridor, Blocked> {
-    let shape = Shape::new(mission, margin);
-    let need = shape.need();
-    let b = &mission.bounds;
-    let area = (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]);
-    // The search holds a state per cell, layer and stage: the grid shares
-    // MAX_STATES among the stages (a stop per pass and requested crossing),
-    // never finer than 0.2 m. A large site gets coarse cells rather than
-    // gigabytes (the refusal then speaks for that resolution).
-    let stops = builder.inspections().len() + builder.crossing_iwps().len();
-    let cells = (MAX_STATES / (LAYERS * (stops + 1)) as f64).min(MAX_CELLS);
-    let cell = (area / cells).sqrt().max(FINEST_CELL);
-    let obstacles = blocking(mission);
-    let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| *d).collect();
-    let field = Field::new([b.x, b.y], &discs, cell, need[0] + 2.0 * cell);
-    let boxes = [
-        [dx_dy(builder)[0], dx_dy(builder)[1]],
-        [
-            shrink(b.x, shape.smallest * shape.reach),
-            shrink(b.y, shape.smallest * shape.reach),
-        ],
-        [b.x, b.y],
-    ];
-
-    let inside = |p: Point2<f64>, [x, y]: [[f64; 2]; 2]| {
-        x[0] <= p.x && p.x <= x[1] && y[0] <= p.y && p.y <= y[1]
-    };
+    let Site {
+        shape,
+        need,
+        obstacles,
+        discs,
+        field,
+        open,
+        ..
+    } = Site::new(mission, builder, margin);
     let (start, goal) = (mission.route.start.xy(), mission.route.goal.xy());
-    let mut open: Vec<u8> = (0..field.len())
-        .map(|i| {
-            let (c, p) = (field.clearance(i), field.center(i));
-            // Half a cell's diagonal of slack: a straight between two open
-            // cell centres stays clear in between.
-            let slack = cell * std::f64::consts::FRAC_1_SQRT_2;
-            (0..LAYERS)
-                .filter(|&l| c >= need[l] + slack && inside(p, boxes[l]))
-                .fold(0, |bits, l| bits | bit(l))
-        })
-        .collect();
-    // Round the start and the goal the disc model is too strict: validation
-    // has checked the formation fits there; let the centroid leave them
-    // wherever it is itself clear.
-    for end in [start, goal] {
-        let around = shape.reach + cell;
-        for i in field.cells_within(end, around) {
-            let p = field.center(i);
-            if (p - end).norm() <= around
-                && field.clearance(i) >= shape.r_q + margin
-                && b.contains_xy(&p)
-            {
-                open[i] |= bit(0) | bit(1) | bit(2);
-            }
-        }
-    }
 
     // The stops, in order along start → goal: every inspection pass, and
     // every crossing the user asked for by name (a `[[reconfiguration.
@@ -268,14 +358,7 @@ pub fn find(
             let phi = TAU * j as f64 / PASS_ANGLES as f64 - PI;
             for on_left in [true, false] {
                 let ends = builder.pass_ends(i, phi, on_left);
-                let obstacle = obstacles.iter().position(|(o, _)| *o == k);
-                let clear = field.cells_along(ends[0], ends[1]).all(|c| {
-                    open[c] & bit(0) != 0
-                        || (field.nearest_disc(c) == obstacle && field.clearance(c) > shape.r_q)
-                }) && [ends[0], ends[1]]
-                    .iter()
-                    .all(|p| open[field.index_of(*p)] & bit(0) != 0);
-                if clear {
+                if pass_clear(&field, &open, &obstacles, shape.r_q, k, ends) {
                     jumps.push(Jump {
                         from: field.index_of(ends[0]),
                         to: field.index_of(ends[1]),
@@ -352,11 +435,15 @@ pub fn find(
         &candidates,
         builder.inspections().len(),
     );
-    corridor.squeeze =
-        squeeze_map(&field, &open, &corridor, &shape, mission, &discs).map(|mut map| {
-            map.obstacle_of = obstacles.iter().map(|(k, d)| (*k, d.center)).collect();
-            Arc::new(map)
-        });
+    corridor.squeeze = Site {
+        shape,
+        need,
+        obstacles,
+        discs,
+        field,
+        open,
+    }
+    .squeeze_of(&corridor, mission);
     Ok(corridor)
 }
 

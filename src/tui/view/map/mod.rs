@@ -112,6 +112,53 @@ fn pane_block(title: TextLine<'static>, focused: bool) -> Block<'static> {
         .title(title)
 }
 
+/// The map title of a live plan: its verdict and first failing check, or,
+/// once the mission changed, "re-planning…" (a run under way or due) or why
+/// live planning waits; the long and the short form, and their style.
+fn live_title(
+    o: &crate::pipelines::theta_pso::ThetaPsoOutcome,
+    stale: bool,
+    job: &crate::tui::jobs::Job,
+    live: &crate::tui::live::Live,
+) -> (String, String, Style) {
+    let name = crate::tui::live::label(job.id);
+    if stale {
+        return match live.paused() {
+            Some(why) if live.is_on() => (
+                format!(" {name}: live paused: {why} "),
+                " live paused ".into(),
+                Style::default().black().on_yellow(),
+            ),
+            _ if live.replanning() => (
+                format!(" {name}: re-planning… "),
+                " re-planning… ".into(),
+                Style::default().fg(Color::Gray),
+            ),
+            _ => (
+                format!(" STALE {name} (mission edited) "),
+                format!(" STALE {name} "),
+                Style::default().black().on_yellow(),
+            ),
+        };
+    }
+    let warm = if o.warm_start.is_some() { "warm, " } else { "" };
+    let seconds = job.elapsed(std::time::Instant::now()).as_secs_f64() * 1e3;
+    if o.feasible() {
+        (
+            format!(" {name} ({warm}{seconds:.0} ms): feasible "),
+            format!(" {name} ✓ "),
+            Style::default().green(),
+        )
+    } else {
+        let why = o.verification.first_failure().unwrap_or_default();
+        (
+            format!(" {name}: INFEASIBLE: {why} "),
+            format!(" {name} INFEASIBLE "),
+            Style::default().red().bold(),
+        )
+    }
+}
+
 /// The shown job's outcome of one pipeline (`pick`), and whether it is stale.
 fn shown_outcome<'a, T>(
     app: &'a App,
@@ -207,7 +254,13 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     let result = result_of(app);
     // The shown result's state, and its short form for a narrow map.
     let mut short = None;
+    let live = app.board().live();
     match (&result, app.shown()) {
+        (Some((o, stale)), Some(job)) if crate::tui::live::Live::owns(job.id) => {
+            let (long, brief, style) = live_title(o, *stale, job, live);
+            title.push(Span::styled(long, style));
+            short = Some(Span::styled(brief, style));
+        }
         (Some((o, stale)), Some(job)) => {
             let verdict = if o.feasible() {
                 "feasible"
@@ -237,7 +290,19 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
                 Style::default().cyan(),
             ));
         }
+        (None, _) if live.replanning() => {
+            title.push(Span::styled(" live: planning… ", Style::default().cyan()));
+        }
         _ => {}
+    }
+    if live.is_on()
+        && result.is_none()
+        && let Some(why) = live.paused()
+    {
+        title.push(Span::styled(
+            format!(" live paused: {why} "),
+            Style::default().black().on_yellow(),
+        ));
     }
     if let Some(ground) = super::terrain::legend(m) {
         title.push(ground);
@@ -410,6 +475,29 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
                 v.location.position.x,
                 v.location.position.y,
                 Span::styled("✗", Style::default().red().bold()),
+            );
+        }
+        // A live plan says at once where it fails: the first violation named.
+        if let (false, Some(v), Some(job)) = (stale, o.verification.violations.first(), app.shown())
+            && crate::tui::live::Live::owns(job.id)
+        {
+            let with = v
+                .location
+                .other
+                .as_ref()
+                .map_or_else(String::new, |other| format!(" vs {other}"));
+            ctx.print(
+                v.location.position.x,
+                v.location.position.y,
+                Span::styled(
+                    format!(
+                        "✗ UAV {} {} {:.2}{with}",
+                        v.location.uav + 1,
+                        v.check,
+                        v.value
+                    ),
+                    Style::default().red().bold(),
+                ),
             );
         }
     }
