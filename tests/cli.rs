@@ -265,3 +265,72 @@ fn new_writes_the_minimal_mission_or_a_copy_on_purpose() {
     assert_eq!(bad.status.code(), Some(1));
     assert!(text(&bad.stderr).contains("bridge-inspection.toml"));
 }
+
+/// `--warm-from`: a run warm-started from an earlier outcome records what
+/// it started from (so the JSON says it was warm) and settles early; its
+/// `warm_start` record given back repeats it exactly; a file that is not a
+/// plan is an error naming it.
+#[test]
+fn a_warm_started_run_is_recorded_and_can_be_repeated() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).display().to_string();
+    let bridge = "missions/bridge-inspection.toml";
+    let out = skyform(&["run", "theta-pso", bridge, "--json", &path("cold.json")]);
+    assert_eq!(out.status.code(), Some(0));
+    let out = skyform(&[
+        "run",
+        "theta-pso",
+        bridge,
+        "--warm-from",
+        &path("cold.json"),
+        "--json",
+        &path("warm.json"),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let read = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(path(name)).unwrap()).unwrap()
+    };
+    let (cold, warm) = (read("cold.json"), read("warm.json"));
+    assert!(
+        cold.get("warm_start").is_none(),
+        "a cold run says nothing of a warm start"
+    );
+    let from = warm["warm_start"]["from"].as_str().unwrap_or_default();
+    assert!(from.contains("cold.json"), "{from}");
+    assert!(warm["iterations"].as_u64().unwrap() < 150);
+    assert_eq!(warm["verification"]["feasible"], true);
+    std::fs::write(path("record.json"), warm["warm_start"].to_string()).unwrap();
+    let out = skyform(&[
+        "run",
+        "theta-pso",
+        bridge,
+        "--warm-from",
+        &path("record.json"),
+        "--json",
+        &path("again.json"),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let again = read("again.json");
+    assert_eq!(again["cost"], warm["cost"], "repeated from its record");
+    assert_eq!(again["waypoints"], warm["waypoints"]);
+
+    std::fs::write(path("junk.json"), "{\"nothing\": 1}").unwrap();
+    let out = skyform(&[
+        "run",
+        "theta-pso",
+        bridge,
+        "--warm-from",
+        &path("junk.json"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("junk.json") && err.contains("waypoints"),
+        "{err}"
+    );
+}

@@ -1086,3 +1086,121 @@ fn eq8_pass_geometry_centres_the_facing_uav_in_the_band() {
     let long = skyform::pipelines::theta_pso::PassGeometry::new(&f.slots, 2.5, [1.0, 1.5], 30.0);
     assert!(long.is_err_and(|e| e.contains("shorten formation.inspection_pass")));
 }
+
+/// A warm start (issue 27): a cold run is `plan_warm` without one, bit for
+/// bit; warm from the cold plan after pier 3 moved 1 m, the swarm reuses the
+/// corridor (it still holds), settles within a fraction of the paper's 150
+/// iterations, stays feasible and within 0.5 % of a cold run's J, and
+/// records what it started from; the same warm start gives the same plan.
+#[test]
+fn a_warm_start_settles_fast_and_is_recorded_and_repeatable() {
+    use skyform::pipelines::theta_pso::{PlanOptions, WarmStart, plan_warm};
+    let m = mission::default_mission().mission;
+    let cold = run(&m, 7);
+    let again = plan_warm(
+        &m,
+        7,
+        PlanOptions { parallel: false },
+        None,
+        &mut Silent,
+        &CancelToken::new(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(again, cold, "no warm start: the cold run");
+    assert!(cold.warm_start.is_none());
+
+    let mut moved = m.clone();
+    let k = moved
+        .obstacles
+        .iter()
+        .position(|o| o.name == "pier 3")
+        .unwrap_or(0);
+    moved.obstacles[k].center.x += 1.0;
+    let warm = WarmStart {
+        from: "the cold plan".into(),
+        waypoints: cold.waypoints.clone(),
+        pass_angles: cold.pass_angles.clone(),
+        corridor: Some(cold.corridor.clone()),
+    };
+    let mut logs = Vec::new();
+    let mut observer = |e: Event<'_>| {
+        if let Event::Log(_, text) = e {
+            logs.push(text.to_owned());
+        }
+    };
+    let plan = |o: &mut dyn skyform::pipelines::Observer| {
+        plan_warm(
+            &moved,
+            7,
+            PlanOptions { parallel: false },
+            Some(&warm),
+            o,
+            &CancelToken::new(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let warmed = plan(&mut observer);
+    assert!(
+        logs.iter().any(|l| l.contains("corridor still holds")),
+        "{logs:?}"
+    );
+    assert!(warmed.feasible());
+    assert!(warmed.iterations < 50, "{} iterations", warmed.iterations);
+    assert_eq!(warmed.warm_start.as_ref(), Some(&warm));
+    let cold_moved = run(&moved, 7);
+    assert!(
+        warmed.cost.total <= cold_moved.cost.total * 1.005,
+        "warm J {} vs cold {}",
+        warmed.cost.total,
+        cold_moved.cost.total
+    );
+    assert_eq!(
+        plan(&mut Silent),
+        warmed,
+        "the same warm start, the same plan"
+    );
+}
+
+/// The corridor of an earlier run is reused only while it holds: on the
+/// same site it is the same route; with a post standing on one of its free
+/// legs, or with the goal moved, the search must run.
+#[test]
+fn an_earlier_corridor_is_reused_only_while_it_holds() {
+    use skyform::pipelines::theta_pso::{Problem, route};
+    let m = mission::default_mission().mission;
+    let Ok(problem) = Problem::new(&m) else {
+        panic!("the bridge")
+    };
+    let margin = problem.cost.margin();
+    let corridor = route::find(&m, &problem.builder, &problem.iwps, margin)
+        .unwrap_or_else(|b| panic!("{}", b.reason));
+    let again = route::reuse(&m, &problem.builder, &problem.iwps, margin, &corridor);
+    assert_eq!(again.as_ref(), Some(&corridor));
+    // A post in the middle of the first free leg.
+    let (a, b) = (corridor.points[0], corridor.points[1]);
+    let mid = nalgebra::center(&a, &b);
+    let mut blocked = m.clone();
+    blocked.obstacles.push(pole("blocker", mid.x, mid.y, 1.0));
+    let Ok(p2) = Problem::new(&blocked) else {
+        panic!("with a blocker")
+    };
+    assert_eq!(
+        route::reuse(&blocked, &p2.builder, &p2.iwps, p2.cost.margin(), &corridor),
+        None
+    );
+    let mut elsewhere = m.clone();
+    elsewhere.route.goal.y += 2.0;
+    let Ok(p3) = Problem::new(&elsewhere) else {
+        panic!("goal moved")
+    };
+    assert_eq!(
+        route::reuse(
+            &elsewhere,
+            &p3.builder,
+            &p3.iwps,
+            p3.cost.margin(),
+            &corridor
+        ),
+        None
+    );
+}

@@ -92,6 +92,17 @@ fn launch(file: &std::path::Path, state: &std::path::Path) -> Session {
 }
 
 fn launch_sized(file: &std::path::Path, state: &std::path::Path, rows: u16, cols: u16) -> Session {
+    launch_with(file, state, rows, cols, &[])
+}
+
+/// `launch_sized` with more arguments after the file.
+fn launch_with(
+    file: &std::path::Path,
+    state: &std::path::Path,
+    rows: u16,
+    cols: u16,
+    args: &[&str],
+) -> Session {
     let pair = native_pty_system()
         .openpty(PtySize {
             rows,
@@ -102,6 +113,7 @@ fn launch_sized(file: &std::path::Path, state: &std::path::Path, rows: u16, cols
         .unwrap();
     let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_skyform"));
     cmd.arg(file);
+    cmd.args(args);
     if let Some(dir) = file.parent() {
         cmd.cwd(dir);
     }
@@ -517,4 +529,86 @@ fn z_runs_the_fleet_over_agent_processes() {
         thread::sleep(Duration::from_millis(50));
     }
     assert_eq!(agent_processes(), Vec::<u32>::new(), "agent processes left");
+}
+
+/// The process's CPU time so far (user + system), in clock ticks.
+fn cpu_ticks(pid: u32) -> u64 {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();
+    let rest = stat.rsplit_once(") ").map(|(_, r)| r).unwrap();
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    // utime and stime are fields 14 and 15 of stat, 12 and 13 after ") ".
+    fields[11].parse::<u64>().unwrap() + fields[12].parse::<u64>().unwrap()
+}
+
+/// The live plan's J as the jobs panel shows it ("J 172.65 · …").
+fn shown_cost(s: &Session) -> Option<String> {
+    s.contents().lines().find_map(|l| {
+        l.split("││")
+            .nth(1)?
+            .trim_start()
+            .strip_prefix("J ")
+            .map(|r| r.split_whitespace().next().unwrap_or("").to_owned())
+    })
+}
+
+/// Live planning in a real terminal: the bridge is planned as it opens;
+/// tree 9 moved onto the route bends the plan (another J), which stays
+/// feasible; once nothing changes the designer uses no CPU; with --no-live
+/// nothing runs until asked.
+#[test]
+fn the_plan_follows_an_obstacle_moved_across_it_and_idles_after() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = bridge_copy(dir.path());
+    let mut s = launch(&file, &dir.path().join("state"));
+    s.wait_for("live 1", Duration::from_secs(30));
+    s.wait_for("feasible", Duration::from_secs(30));
+    s.wait_for("FEASIBLE", Duration::from_secs(10));
+    let before = shown_cost(&s).expect("the live plan's J");
+    // Tree 9 is the twelfth item (mission, bounds, start, goal, 8 obstacles).
+    for _ in 0..11 {
+        s.send("n");
+    }
+    s.wait_for("'tree 9'", Duration::from_secs(5));
+    for _ in 0..6 {
+        s.send("\x1b[B"); // Down: 1 m south, onto the route
+        thread::sleep(Duration::from_millis(30));
+    }
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while (s.contents().contains("re-planning") || shown_cost(&s).as_deref() == Some(&before))
+        && Instant::now() < deadline
+    {
+        thread::sleep(Duration::from_millis(50));
+    }
+    let after = shown_cost(&s).expect("the new plan's J");
+    assert_ne!(
+        after,
+        before,
+        "the plan changed; the screen:\n{}",
+        s.contents()
+    );
+    assert!(s.contents().contains("✓ FEASIBLE"), "{}", s.contents());
+    // Idle: nothing changes, nothing runs, no CPU.
+    let pid = s.child.process_id().unwrap();
+    let used = cpu_ticks(pid);
+    thread::sleep(Duration::from_secs(3));
+    let idle = cpu_ticks(pid) - used;
+    assert!(idle <= 2, "{idle} ticks of CPU in 3 s idle");
+    s.send("q");
+    s.wait_for("unsaved", Duration::from_secs(5));
+    s.send("y");
+    assert_eq!(s.wait_exit(Duration::from_secs(10)), 0);
+
+    // --no-live: the designer as before, nothing planned until r.
+    let mut s = launch_with(
+        &file,
+        &dir.path().join("state2"),
+        ROWS,
+        COLS,
+        &["--no-live"],
+    );
+    s.wait_for("No runs yet", Duration::from_secs(20));
+    thread::sleep(Duration::from_millis(500));
+    assert!(!s.contents().contains("live 1"), "{}", s.contents());
+    s.send("q");
+    assert_eq!(s.wait_exit(Duration::from_secs(10)), 0);
 }

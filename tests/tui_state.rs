@@ -1564,3 +1564,79 @@ fn presets_grow_valid_for_the_mission_with_their_spacing_as_a_field() {
         "{status:?}"
     );
 }
+
+/// Live planning: the bridge is planned as live mode starts (cold), each
+/// edit re-plans it warm from the last plan (outside the jobs list, shown
+/// at once), a mission with an error pauses it naming the error and an edit
+/// that mends it resumes it, and off it plans nothing.
+#[test]
+fn live_planning_follows_edits_pauses_on_errors_and_stops_when_off() {
+    let wait = Duration::from_secs(120);
+    let mut app = App::new(
+        Document::new(default_mission().mission, None),
+        std::env::temp_dir(),
+    );
+    assert!(app.start_live(skyform::pipelines::Kind::ThetaPso).is_ok());
+    assert!(app.settle_live(wait));
+    let first = app
+        .board()
+        .live()
+        .latest()
+        .map(|j| j.id)
+        .expect("a live plan");
+    assert_eq!(app.shown().map(|j| j.id), Some(first), "shown at once");
+    assert!(app.jobs().is_empty(), "live runs stay out of the list");
+    let o = app
+        .shown()
+        .and_then(|j| j.outcome.as_ref())
+        .and_then(|o| o.theta_pso())
+        .unwrap();
+    assert!(
+        o.feasible() && o.warm_start.is_none(),
+        "the first live plan is cold"
+    );
+
+    // An edit: tree 9 one metre south.
+    app.update(Action::Select(Item::Obstacle(7)));
+    app.update(Action::Nudge(0.0, -1.0));
+    assert!(app.board().live().replanning());
+    assert!(app.settle_live(wait));
+    assert_eq!(app.board().live().revision(), 2);
+    let job = app.shown().unwrap();
+    assert_eq!(
+        &job.mission,
+        app.mission(),
+        "the plan is of the mission as edited"
+    );
+    assert!(!app.is_stale(job));
+    let o = job.outcome.as_ref().and_then(|o| o.theta_pso()).unwrap();
+    let warm = o.warm_start.as_ref().expect("warm-started");
+    assert!(warm.from.contains("live 1"), "{}", warm.from);
+    assert!(o.iterations < 150, "settled in {} iterations", o.iterations);
+
+    // An error pauses live planning, naming it; mending it resumes.
+    type_into(&mut app, "radius (m)", "-1");
+    let paused = app.board().live().paused().map(str::to_owned);
+    assert!(
+        paused.as_deref().is_some_and(|p| p.contains("radius")),
+        "{paused:?}"
+    );
+    assert!(app.settle_live(wait));
+    assert_eq!(
+        app.board().live().revision(),
+        2,
+        "nothing planned while invalid"
+    );
+    type_into(&mut app, "radius (m)", "3");
+    assert!(app.board().live().paused().is_none());
+    assert!(app.settle_live(wait));
+    assert_eq!(app.board().live().revision(), 3);
+
+    // Off: an edit plans nothing; the last live plan turns stale.
+    app.update(Action::ToggleLive);
+    assert!(!app.board().live().is_on());
+    app.update(Action::Nudge(0.0, 1.0));
+    assert!(app.settle_live(wait));
+    assert_eq!(app.board().live().revision(), 3);
+    assert!(app.shown().is_some_and(|j| app.is_stale(j)));
+}

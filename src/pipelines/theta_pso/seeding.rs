@@ -253,6 +253,31 @@ mod tests {
         assert_eq!(fit_corners(s, g, corners.clone(), all, 3), corners);
     }
 
+    /// A warm start's waypoints refitted to another count keep the points
+    /// they can (with their heights) and add midpoints at their legs'
+    /// heights.
+    #[test]
+    fn warm_waypoints_are_refitted_keeping_their_heights() {
+        let (s, g) = (Point3::new(0.0, 0.0, 10.0), Point3::new(10.0, 0.0, 10.0));
+        let w = vec![
+            Point3::new(2.0, 0.1, 11.0),
+            Point3::new(5.0, 5.0, 12.0),
+            Point3::new(8.0, 0.1, 13.0),
+        ];
+        assert_eq!(fit_waypoints(s, g, &w, 3), w);
+        let one = fit_waypoints(s, g, &w, 1);
+        assert_eq!(one, vec![Point3::new(5.0, 5.0, 12.0)]);
+        let five = fit_waypoints(s, g, &w, 5);
+        assert_eq!(five.len(), 5);
+        for p in &w {
+            assert!(five.contains(p), "{p} kept");
+        }
+        assert!(
+            five.iter().all(|p| (10.0..=13.0).contains(&p.z)),
+            "{five:?}"
+        );
+    }
+
     #[test]
     fn a_crossing_leg_is_never_split() {
         // start → A, A → B a long crossing, B → goal: the extra points go on
