@@ -60,6 +60,7 @@ fn a_late_lossy_network_is_reproducible_and_counted() {
         range: None,
         latency,
         loss: 0.3,
+        links: Vec::new(),
     };
     let (a, b) = (run(&m, 1), run(&m, 1));
     assert_eq!(a, b, "the same mission and seed fly the same");
@@ -101,4 +102,52 @@ fn an_impossible_network_is_refused_naming_the_field() {
     assert!(loss.contains("[0, 1)"), "{loss}");
     let late = at("fleet.network.latency").unwrap_or_default();
     assert!(late.contains("longer than the whole run"), "{late}");
+}
+
+/// A link of its own (agents 1 and 3, 60 steps: 0.3 s) is written in the
+/// mission and flies differently from the default latency; a link naming an
+/// agent the fleet does not have, or given twice, is refused naming it.
+#[test]
+fn a_link_with_a_latency_of_its_own_is_read_checked_and_flown() {
+    let base = include_str!("../missions/fleet-triangle.toml");
+    let text = format!(
+        "{base}\n[fleet.network]\nlatency = 1\nlinks = [{{ between = [1, 3], latency = 60 }}]\n"
+    );
+    let mut m = skyform::mission::parse_str(&text, "links.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    assert_eq!(m.fleet.network.links[0].between, [1, 3]);
+    m.fleet.duration = 20.0;
+    let linked = run(&m, 2);
+    m.fleet.network.links.clear();
+    let plain = run(&m, 2);
+    assert_ne!(linked.agents[0].samples, plain.agents[0].samples);
+    // Agent 1 heard agent 3 0.3 s late at worst, agent 2 (the default link) 5 ms.
+    assert!(
+        linked.agents[0].network.worst_age >= 0.3 - 1e-9,
+        "{:?}",
+        linked.agents[0].network
+    );
+    assert!(
+        linked.agents[1].network.worst_age < 0.1,
+        "{:?}",
+        linked.agents[1].network
+    );
+    for (links, wanted) in [
+        ("[{ between = [1, 4], latency = 2 }]", "from 1 to 3"),
+        (
+            "[{ between = [1, 2], latency = 2 }, { between = [2, 1], latency = 3 }]",
+            "twice",
+        ),
+    ] {
+        let text = format!("{base}\n[fleet.network]\nlinks = {links}\n");
+        let err = match skyform::mission::parse_str(&text, "links.toml") {
+            Ok(_) => panic!("{links} accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            err.contains("fleet.network.links") && err.contains(wanted),
+            "{err}"
+        );
+    }
 }

@@ -513,3 +513,63 @@ fn a_fleet_recording_shows_the_links_and_the_lost_agents() {
         "{texts:?}"
     );
 }
+
+/// The designer's live plans in a recording: each a `revision` of the same
+/// plan entities (the view follows the edit, the timeline keeps them all),
+/// with its verdict on the live events.
+#[test]
+fn live_plans_are_revisions_of_one_recording() {
+    use skyform::outcome::Outcome;
+    use skyform::pipelines::theta_pso::{PlanOptions, plan};
+    use skyform::pipelines::{CancelToken, Silent};
+    use skyform::record::{Recorder, Sinks};
+    let m = skyform::mission::default_mission().mission;
+    let o = plan(
+        &m,
+        7,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let rrd = dir.path().join("live.rrd");
+    let sinks = Sinks {
+        rrd: Some(rrd.clone()),
+        connect: None,
+        spawn: false,
+    };
+    let mut warnings = Vec::new();
+    let mut recorder = Recorder::start(
+        &m.name,
+        Some(skyform::pipelines::Kind::ThetaPso),
+        &sinks,
+        &mut warnings,
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+    .unwrap_or_else(|| panic!("no recorder"));
+    recorder.log_mission(&m);
+    let outcome = Outcome::ThetaPso(Box::new(o));
+    for revision in 1..=3 {
+        recorder.log_live(revision, &outcome);
+    }
+    recorder.finish();
+    let chunks = chunks(&rrd);
+    let paths = entity_paths(&chunks);
+    for entity in [
+        "/live/plan/centroid",
+        "/live/plan/vehicle_1",
+        "/live/plan/vehicle_3",
+        "/live/events",
+    ] {
+        assert!(
+            paths.contains(&entity.to_owned()),
+            "{entity} missing from {paths:?}"
+        );
+    }
+    assert_eq!(
+        last_time(&chunks, "/live/plan/centroid", "revision"),
+        Some(3)
+    );
+    assert_eq!(last_time(&chunks, "/live/events", "revision"), Some(3));
+}

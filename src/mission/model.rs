@@ -642,13 +642,27 @@ pub struct FleetNetwork {
     pub latency: usize,
     /// Probability that one message to one receiver is lost, in [0, 1).
     pub loss: f64,
+    /// Links with a latency of their own (both ways), in place of `latency`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub links: Vec<FleetLink>,
+}
+
+/// One link of the fleet's network with its own latency:
+/// `links = [{ between = [1, 3], latency = 20 }]` (agents from 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FleetLink {
+    /// The two agents, numbered from 1.
+    pub between: [usize; 2],
+    /// Whole simulation steps from sending to hearing, both ways.
+    pub latency: usize,
 }
 
 impl FleetNetwork {
     /// No latency, no loss, the range of the neighbourhood: the fleet as
     /// the paper simulates it.
     pub fn is_ideal(&self) -> bool {
-        self.range.is_none() && self.latency == 0 && self.loss == 0.0
+        self.range.is_none() && self.latency == 0 && self.loss == 0.0 && self.links.is_empty()
     }
 }
 

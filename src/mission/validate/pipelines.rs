@@ -347,16 +347,41 @@ impl Checker {
             );
         }
         let steps = (p.duration / p.sim_step).round();
-        if p.sim_step > 0.0 && p.duration > 0.0 && steps.is_finite() && n.latency as f64 > steps {
-            self.error(
-                path.key("latency"),
-                format!(
-                    "{} steps of {} s is longer than the whole run ({} s): no message would arrive",
-                    n.latency,
-                    compact(p.sim_step),
-                    compact(p.duration)
-                ),
-            );
+        let too_late = |latency: usize| {
+            p.sim_step > 0.0 && p.duration > 0.0 && steps.is_finite() && latency as f64 > steps
+        };
+        let late = |latency: usize| {
+            format!(
+                "{} steps of {} s is longer than the whole run ({} s): no message would arrive",
+                latency,
+                compact(p.sim_step),
+                compact(p.duration)
+            )
+        };
+        if too_late(n.latency) {
+            self.error(path.key("latency"), late(n.latency));
+        }
+        let mut seen = std::collections::HashSet::new();
+        for (i, link) in n.links.iter().enumerate() {
+            let at = path.key("links").index(i);
+            let [a, b] = link.between;
+            if a == 0 || b == 0 || a > p.agents || b > p.agents || a == b {
+                self.error(
+                    at.key("between"),
+                    format!(
+                        "must name two different agents from 1 to {} (the fleet's agents), got [{a}, {b}]",
+                        p.agents
+                    ),
+                );
+            } else if !seen.insert((a.min(b), a.max(b))) {
+                self.error(
+                    at.key("between"),
+                    format!("the link between agents {a} and {b} is given twice"),
+                );
+            }
+            if too_late(link.latency) {
+                self.error(at.key("latency"), late(link.latency));
+            }
         }
     }
 }

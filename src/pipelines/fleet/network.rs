@@ -55,6 +55,10 @@ pub struct LinkStats {
 pub struct Network {
     range: f64,
     latency: usize,
+    /// Per receiver × sender, the link's own latency where it has one.
+    link_latency: std::collections::HashMap<(usize, usize), usize>,
+    /// The longest latency of any link: the steps of broadcasts kept.
+    longest: usize,
     loss: f64,
     seed: u64,
     agents: usize,
@@ -76,14 +80,26 @@ impl Network {
         seed: u64,
         dt: f64,
     ) -> Self {
+        let mut link_latency = std::collections::HashMap::new();
+        for link in &model.links {
+            let [a, b] = link.between.map(|k| k.saturating_sub(1));
+            link_latency.insert((a, b), link.latency);
+            link_latency.insert((b, a), link.latency);
+        }
+        let longest = link_latency
+            .values()
+            .copied()
+            .fold(model.latency, usize::max);
         Network {
             range: model.range.unwrap_or(neighbourhood),
             latency: model.latency,
+            link_latency,
+            longest,
             loss: model.loss,
             seed,
             agents,
             dt,
-            sent: std::collections::VecDeque::with_capacity(model.latency + 1),
+            sent: std::collections::VecDeque::with_capacity(longest + 1),
             heard: vec![None; agents * agents],
             stats: vec![LinkStats::default(); agents],
         }
@@ -108,21 +124,30 @@ impl Network {
             s.sent += 1;
         }
         self.sent.push_back(broadcasts);
-        if self.sent.len() > self.latency + 1 {
+        if self.sent.len() > self.longest + 1 {
             self.sent.pop_front();
         }
-        let Some(arriving) = step.checked_sub(self.latency).and(self.sent.front()) else {
-            return; // nothing sent long enough ago yet
+        // The broadcasts of `latency` steps ago, if sent yet.
+        let sent = &self.sent;
+        let of = |latency: usize| {
+            step.checked_sub(latency)?;
+            sent.get(sent.len().checked_sub(latency + 1)?)
         };
         for (receiver, senders) in watched.iter().enumerate() {
-            // Where the receiver was when they were sent.
-            let Some(at) = arriving[receiver].map(|m| m.position) else {
-                continue;
-            };
             for &sender in senders {
-                let Some(message) = arriving[sender] else {
+                let latency = self
+                    .link_latency
+                    .get(&(receiver, sender))
+                    .copied()
+                    .unwrap_or(self.latency);
+                let Some(arriving) = of(latency) else {
+                    continue; // nothing sent long enough ago yet
+                };
+                // Where the receiver was when it was sent.
+                let (Some(at), Some(message)) = (arriving[receiver], arriving[sender]) else {
                     continue;
                 };
+                let at = at.position;
                 if (message.position - at).norm() > self.range {
                     continue;
                 }
@@ -215,6 +240,7 @@ mod tests {
             range: Some(5.0),
             latency: 2,
             loss: 0.0,
+            links: Vec::new(),
         };
         let mut net = Network::new(&model, 5.0, 3, 7, 0.01);
         let watched = vec![vec![1, 2], vec![0], vec![0]];
@@ -239,5 +265,29 @@ mod tests {
         let s = net.stats()[0];
         assert_eq!((s.sent, s.received, s.lost), (4, 2, 0));
         assert!((s.worst_age - 0.02).abs() < 1e-12 && (s.mean_age - 0.02).abs() < 1e-12);
+    }
+
+    /// A link with a latency of its own: 1 and 2 hear each other 4 steps
+    /// late, 1 hears 3 at the default 1 step.
+    #[test]
+    fn a_link_can_have_a_latency_of_its_own() {
+        let model = FleetNetwork {
+            range: None,
+            latency: 1,
+            loss: 0.0,
+            links: vec![crate::mission::FleetLink {
+                between: [1, 2],
+                latency: 4,
+            }],
+        };
+        let mut net = Network::new(&model, 50.0, 3, 7, 0.01);
+        let watched = vec![vec![1, 2], vec![0], vec![0]];
+        for k in 0..6 {
+            let out = (0..3).map(|i| Some(message(i, k, i as f64))).collect();
+            net.exchange(k, out, &watched);
+        }
+        assert_eq!(net.heard(0, 2).map(|m| m.step), Some(4), "5 − 1");
+        assert_eq!(net.heard(0, 1).map(|m| m.step), Some(1), "5 − 4");
+        assert_eq!(net.heard(1, 0).map(|m| m.step), Some(1), "both ways");
     }
 }
