@@ -4,38 +4,19 @@
 //! decisions every τ = 0.1 s). Target (issue 7): 300 agents simulate a
 //! minute at least 10× faster than real time, i.e. in under 6 s.
 
+#[path = "common/fleets.rs"]
+mod fleets;
+
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Point2;
-use skyform::mission::{self, FleetParams, Mission};
+use skyform::mission::{FleetParams, Mission};
 use skyform::pipelines::fleet::{self, agent::Planner, cost};
 use skyform::pipelines::{CancelToken, Silent};
 
-/// `n` agents in a square room sized for them, one target, a regular polygon
-/// whose sides are the paper's 1.732 m.
 fn fleet_of(n: usize) -> Mission {
-    let text = include_str!("../missions/fleet-triangle.toml");
-    let mut m = mission::parse_str(text, "fleet-triangle.toml")
-        .map(|l| l.mission)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let radius = if n > 3 {
-        1.732 / (2.0 * (std::f64::consts::PI / n as f64).sin())
-    } else {
-        1.0
-    };
-    let half = (radius * 1.5).max(5.0);
-    m.bounds.x = [-half, half];
-    m.bounds.y = [-half, half];
-    m.route.start = nalgebra::Point3::new(-half + 0.5, -half + 0.5, 1.0);
-    m.route.goal = nalgebra::Point3::new(half - 0.5, half - 0.5, 1.0);
-    m.obstacles.clear();
-    m.fleet.agents = n;
-    m.fleet.target_distance = radius;
-    m.fleet.duration = 60.0;
-    m.fleet.targets.truncate(1);
-    m.fleet.targets[0].position = Point2::origin();
-    m
+    fleets::fleet_of(n, 60.0)
 }
 
 fn decision(c: &mut Criterion) {

@@ -11,44 +11,24 @@
 //! Needs the `skyform` binary (default features): `cargo bench --bench
 //! fleet_distributed`.
 
+#[path = "common/fleets.rs"]
+mod fleets;
+
 use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nalgebra::Point2;
 use skyform::distributed::{self, Options};
-use skyform::mission::{self, Mission};
+use skyform::mission::Mission;
 use skyform::pipelines::fleet;
 use skyform::pipelines::{CancelToken, Silent};
 
 /// Seconds each measured run flies.
 const FLIGHT: f64 = 2.0;
 
-/// `n` agents in a room sized for them round one target (as the fleet
-/// bench's fleets), flying `FLIGHT` seconds.
 fn fleet_of(n: usize) -> Mission {
-    let text = include_str!("../missions/fleet-triangle.toml");
-    let mut m = mission::parse_str(text, "fleet-triangle.toml")
-        .map(|l| l.mission)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let radius = if n > 3 {
-        1.732 / (2.0 * (std::f64::consts::PI / n as f64).sin())
-    } else {
-        1.0
-    };
-    let half = (radius * 1.5).max(5.0);
-    m.bounds.x = [-half, half];
-    m.bounds.y = [-half, half];
-    m.route.start = nalgebra::Point3::new(-half + 0.5, -half + 0.5, 1.0);
-    m.route.goal = nalgebra::Point3::new(half - 0.5, half - 0.5, 1.0);
-    m.obstacles.clear();
-    m.fleet.agents = n;
-    m.fleet.target_distance = radius;
-    m.fleet.duration = FLIGHT;
-    m.fleet.targets.truncate(1);
-    m.fleet.targets[0].position = Point2::origin();
-    m
+    fleets::fleet_of(n, FLIGHT)
 }
 
 fn options(processes: usize) -> Options {

@@ -19,7 +19,6 @@
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nalgebra::Point2;
 use skyform::mission;
 use skyform::pipelines::Kind;
 use skyform::tui::action::Action;
@@ -157,7 +156,6 @@ fn bridge(c: &mut Criterion) {
         "live/bridge_drag_20_steps: at most {most} live run(s) at once (one at work, any other winding down)"
     );
     assert!(most <= 2, "{most} live runs at once");
-    let _ = Point2::<f64>::origin();
     group.finish();
 }
 

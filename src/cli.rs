@@ -344,16 +344,17 @@ pub fn main() -> ExitCode {
                     return ExitCode::from(exit::ERROR);
                 }
             };
-            ExitCode::from(run_pipeline_with(
-                Kind::ThetaPso,
+            ExitCode::from(run_pipeline(
                 &mission,
                 seed,
                 json.as_deref(),
                 &record.sinks(),
-                options,
                 verbose,
-                None,
-                warm,
+                |seed| Run {
+                    options,
+                    warm,
+                    ..Run::new(Kind::ThetaPso, seed)
+                },
             ))
         }
         Command::Run(RunCommand::Fleet(a)) => {
@@ -364,16 +365,16 @@ pub fn main() -> ExitCode {
             });
             #[cfg(not(feature = "zenoh"))]
             let distributed = None;
-            ExitCode::from(run_pipeline_with(
-                Kind::Fleet,
+            ExitCode::from(run_pipeline(
                 &a.mission,
                 a.seed,
                 a.json.as_deref(),
                 &a.record.sinks(),
-                PlanOptions::default(),
                 false,
-                distributed,
-                None,
+                |seed| Run {
+                    distributed,
+                    ..Run::new(Kind::Fleet, seed)
+                },
             ))
         }
         Command::Run(RunCommand::Flatlo {
@@ -382,13 +383,12 @@ pub fn main() -> ExitCode {
             json,
             record,
         }) => ExitCode::from(run_pipeline(
-            Kind::Flatlo,
             &mission,
             seed,
             json.as_deref(),
             &record.sinks(),
-            PlanOptions::default(),
             false,
+            |seed| Run::new(Kind::Flatlo, seed),
         )),
         Command::Record { mission, record } => {
             ExitCode::from(record_mission(&mission, &record.sinks()))
@@ -670,20 +670,6 @@ impl Observer for StderrProgress {
     }
 }
 
-/// `skyform run PIPELINE`: load, record, run with progress and Ctrl-C,
-/// summarise, write JSON, choose the exit status.
-fn run_pipeline(
-    kind: Kind,
-    path: &std::path::Path,
-    seed: Option<u64>,
-    json: Option<&std::path::Path>,
-    sinks: &Sinks,
-    options: PlanOptions,
-    verbose: bool,
-) -> u8 {
-    run_pipeline_with(kind, path, seed, json, sinks, options, verbose, None, None)
-}
-
 /// The plan in `path` to warm-start from: a JSON object with `waypoints`
 /// (and `pass_angles`), as a θ-PSO outcome and its `warm_start` record have.
 fn read_warm_start(
@@ -710,29 +696,22 @@ fn read_warm_start(
     Ok(warm)
 }
 
-/// [`run_pipeline`], a fleet's agents flown where `distributed` says.
-#[allow(clippy::too_many_arguments)]
-fn run_pipeline_with(
-    kind: Kind,
+/// `skyform run PIPELINE`: load, record, run (`run` of the seed: the given
+/// one, else the mission's) with progress and Ctrl-C, summarise, write JSON,
+/// choose the exit status.
+fn run_pipeline(
     path: &std::path::Path,
     seed: Option<u64>,
     json: Option<&std::path::Path>,
     sinks: &Sinks,
-    options: PlanOptions,
     verbose: bool,
-    distributed: Option<crate::run::Distribution>,
-    warm: Option<std::sync::Arc<crate::pipelines::theta_pso::WarmStart>>,
+    run: impl FnOnce(u64) -> Run,
 ) -> u8 {
     let Some(mission) = load_reporting(path) else {
         return exit::ERROR;
     };
-    let run = Run {
-        kind,
-        seed: seed.unwrap_or(mission.seed),
-        options,
-        distributed,
-        warm,
-    };
+    let run = run(seed.unwrap_or(mission.seed));
+    let kind = run.kind;
     let mut warnings = Vec::new();
     let recorder = match Recorder::start(&mission.name, Some(kind), sinks, &mut warnings) {
         Ok(r) => r,

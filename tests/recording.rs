@@ -430,7 +430,6 @@ fn a_fleet_recording_shows_the_links_and_the_lost_agents() {
     use skyform::outcome::Outcome;
     use skyform::pipelines::fleet::{self, simulation::LostAgent};
     use skyform::pipelines::{CancelToken, Silent};
-    use skyform::record::{Recorder, Sinks};
     let mut m = skyform::mission::load(Path::new("missions/fleet-triangle.toml"))
         .unwrap_or_else(|e| panic!("{e}"))
         .mission;
@@ -450,25 +449,9 @@ fn a_fleet_recording_shows_the_links_and_the_lost_agents() {
         time: 2.0,
         reason: "its process went away".into(),
     });
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let rrd = dir.path().join("fleet.rrd");
-    let sinks = Sinks {
-        rrd: Some(rrd.clone()),
-        connect: None,
-        spawn: false,
-    };
-    let mut warnings = Vec::new();
-    let mut recorder = Recorder::start(
-        &m.name,
-        Some(skyform::pipelines::Kind::Fleet),
-        &sinks,
-        &mut warnings,
-    )
-    .unwrap_or_else(|e| panic!("{e}"))
-    .unwrap_or_else(|| panic!("no recorder"));
-    recorder.log_outcome(&Outcome::Fleet(Box::new(o.clone())));
-    recorder.finish();
-    let chunks = chunks(&rrd);
+    let chunks = recorded(&m.name, skyform::pipelines::Kind::Fleet, |r| {
+        r.log_outcome(&Outcome::Fleet(Box::new(o.clone())));
+    });
     let paths = entity_paths(&chunks);
     for entity in [
         "/fleet/links",
@@ -522,7 +505,6 @@ fn live_plans_are_revisions_of_one_recording() {
     use skyform::outcome::Outcome;
     use skyform::pipelines::theta_pso::{PlanOptions, plan};
     use skyform::pipelines::{CancelToken, Silent};
-    use skyform::record::{Recorder, Sinks};
     let m = skyform::mission::default_mission().mission;
     let o = plan(
         &m,
@@ -532,29 +514,13 @@ fn live_plans_are_revisions_of_one_recording() {
         &CancelToken::new(),
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let rrd = dir.path().join("live.rrd");
-    let sinks = Sinks {
-        rrd: Some(rrd.clone()),
-        connect: None,
-        spawn: false,
-    };
-    let mut warnings = Vec::new();
-    let mut recorder = Recorder::start(
-        &m.name,
-        Some(skyform::pipelines::Kind::ThetaPso),
-        &sinks,
-        &mut warnings,
-    )
-    .unwrap_or_else(|e| panic!("{e}"))
-    .unwrap_or_else(|| panic!("no recorder"));
-    recorder.log_mission(&m);
     let outcome = Outcome::ThetaPso(Box::new(o));
-    for revision in 1..=3 {
-        recorder.log_live(revision, &outcome);
-    }
-    recorder.finish();
-    let chunks = chunks(&rrd);
+    let chunks = recorded(&m.name, skyform::pipelines::Kind::ThetaPso, |r| {
+        r.log_mission(&m);
+        for revision in 1..=3 {
+            r.log_live(revision, &outcome);
+        }
+    });
     let paths = entity_paths(&chunks);
     for entity in [
         "/live/plan/centroid",
@@ -572,4 +538,27 @@ fn live_plans_are_revisions_of_one_recording() {
         Some(3)
     );
     assert_eq!(last_time(&chunks, "/live/events", "revision"), Some(3));
+}
+
+/// The chunks of a recording of a `kind` run of `name` to an `.rrd`, what
+/// `log` logs to its recorder.
+fn recorded(
+    name: &str,
+    kind: skyform::pipelines::Kind,
+    log: impl FnOnce(&mut skyform::record::Recorder),
+) -> Vec<Chunk> {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let rrd = dir.path().join("run.rrd");
+    let sinks = skyform::record::Sinks {
+        rrd: Some(rrd.clone()),
+        connect: None,
+        spawn: false,
+    };
+    let mut warnings = Vec::new();
+    let mut recorder = skyform::record::Recorder::start(name, Some(kind), &sinks, &mut warnings)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .unwrap_or_else(|| panic!("no recorder"));
+    log(&mut recorder);
+    recorder.finish();
+    chunks(&rrd)
 }

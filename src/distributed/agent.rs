@@ -10,7 +10,6 @@
 //! run ends, when the coordinator's token goes, or when a wait times out
 //! (naming the step and the agents it waited for).
 
-use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use zenoh::Wait;
@@ -19,8 +18,9 @@ use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
 use zenoh::sample::{Sample, SampleKind};
 
+use super::inbox::{Inbox, publish};
 use super::session;
-use super::wire::{Clock, Control, Hello, Keys, Report, States, fingerprint, ids_text};
+use super::wire::{Clock, Control, Hello, Keys, Report, fingerprint, ids_text};
 use crate::mission::Mission;
 use crate::pipelines::fleet::network::Message;
 use crate::pipelines::fleet::simulation::{Delivery, Link, LinkError, Simulation};
@@ -110,21 +110,18 @@ pub fn fly(mission: &Mission, ids: Vec<usize>, options: &AgentOptions) -> Result
             simulation.clock().dt,
         );
         let flown = simulation.run(&mut link, &mut Silent, &CancelToken::new());
-        (flown, link.received)
+        (flown, link.inbox.received)
     } else {
         let mut link = Lockstep {
             publisher: &publisher,
-            states: &states,
+            inbox: Inbox::new(&states, mission.fleet.agents),
             clock: &clock,
             watch: &mut watch,
-            agents: mission.fleet.agents,
             alive: vec![true; mission.fleet.agents],
-            pending: BTreeMap::new(),
             timeout: options.timeout,
-            received: 0,
         };
         let flown = simulation.run(&mut link, &mut Silent, &CancelToken::new());
-        (flown, link.received)
+        (flown, link.inbox.received)
     };
     let ended_early = match flown {
         Ok(Completion::Finished) => None,
@@ -253,15 +250,11 @@ fn wait_for_start(
 /// the step's states.
 struct Lockstep<'a, 'w> {
     publisher: &'a Publisher<'a>,
-    states: &'a Subscriber<FifoChannelHandler<Sample>>,
+    inbox: Inbox<'a>,
     clock: &'a Subscriber<FifoChannelHandler<Sample>>,
     watch: &'a mut Watch<'w>,
-    agents: usize,
     alive: Vec<bool>,
-    /// States that came ahead of their step.
-    pending: BTreeMap<usize, Vec<Message>>,
     timeout: Duration,
-    received: usize,
 }
 
 impl Lockstep<'_, '_> {
@@ -272,44 +265,12 @@ impl Lockstep<'_, '_> {
             reason,
         }
     }
-
-    /// Takes every state that arrived, filing those of `step` into `into`.
-    fn take(&mut self, step: usize, into: &mut [Option<Message>], wait: Duration) {
-        let first = match self.states.recv_timeout(wait) {
-            Ok(Some(s)) => s,
-            _ => return,
-        };
-        let mut next = Some(first);
-        while let Some(sample) = next {
-            if let Ok(batch) = States::decode(&sample.payload().to_bytes()) {
-                self.received += batch.messages.len();
-                for m in batch.messages {
-                    if m.step == step && m.sender < into.len() {
-                        into[m.sender] = Some(m);
-                    } else if m.step > step {
-                        self.pending.entry(m.step).or_default().push(m);
-                    }
-                }
-            }
-            next = self.states.try_recv().ok().flatten();
-        }
-    }
 }
 
 impl Link for Lockstep<'_, '_> {
     fn exchange(&mut self, step: usize, local: &[Message]) -> Result<Delivery, LinkError> {
-        let batch = States {
-            step,
-            messages: local.to_vec(),
-        };
-        self.publisher
-            .put(batch.encode())
-            .wait()
-            .map_err(|e| self.error(step, format!("cannot publish the states: {e}")))?;
-        let mut messages = vec![None; self.agents];
-        for m in self.pending.remove(&step).unwrap_or_default() {
-            messages[m.sender] = Some(m);
-        }
+        publish(self.publisher, step, local).map_err(|e| self.error(step, e))?;
+        let mut messages = self.inbox.open(step);
         // The round: every state of the step reached the coordinator.
         let deadline = Instant::now() + self.timeout;
         let lost = loop {
@@ -349,7 +310,7 @@ impl Link for Lockstep<'_, '_> {
             messages[m.sender] = Some(*m);
         }
         loop {
-            let missing: Vec<usize> = (0..self.agents)
+            let missing: Vec<usize> = (0..messages.len())
                 .filter(|&i| self.alive[i] && messages[i].is_none())
                 .collect();
             if missing.is_empty() {
@@ -361,7 +322,8 @@ impl Link for Lockstep<'_, '_> {
                     format!("the states of agents {} never came", ids_text(&missing)),
                 ));
             }
-            self.take(step, &mut messages, Duration::from_millis(20));
+            self.inbox
+                .take(step, &mut messages, Duration::from_millis(20));
         }
         for (i, m) in messages.iter_mut().enumerate() {
             if !self.alive[i] {

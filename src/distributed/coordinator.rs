@@ -11,7 +11,6 @@
 //! end it asks for the agents' reports and waits for every process to exit;
 //! any left after a grace period is killed, so no process outlives a run.
 
-use std::collections::BTreeMap;
 use std::io::BufRead;
 use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
@@ -24,9 +23,10 @@ use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
 use zenoh::sample::{Sample, SampleKind};
 
-use super::realtime::{pace, take_newest};
+use super::inbox::Inbox;
+use super::realtime::pace;
 use super::session;
-use super::wire::{Clock, Control, Hello, Keys, Report, States, chunk, fingerprint, ids_text};
+use super::wire::{Clock, Control, Hello, Keys, Report, chunk, fingerprint, ids_text};
 use crate::mission::Mission;
 use crate::pipelines::fleet::network::Message;
 use crate::pipelines::fleet::simulation::{Delivery, Effort, Link, LinkError, Simulation};
@@ -330,23 +330,19 @@ pub fn coordinate(
     let mut simulation = Simulation::flying(mission, seed, Vec::new(), true);
     let agents = mission.fleet.agents;
     let mut link = Hub {
-        states: &states,
+        inbox: Inbox::new(&states, agents),
         alive: &alive,
         clock: &clock,
         keys: &keys,
-        agents,
         live: vec![true; agents],
-        pending: BTreeMap::new(),
-        newest: vec![None; agents],
         timeout: options.timeout,
         realtime: options.realtime,
         start: Instant::now(),
         dt: simulation.clock().dt,
         rounds: Vec::new(),
-        received: 0,
     };
     let flown = simulation.run(&mut link, observer, cancel);
-    let (rounds, received) = (std::mem::take(&mut link.rounds), link.received);
+    let (rounds, received) = (std::mem::take(&mut link.rounds), link.inbox.received);
     let reason = match &flown {
         Ok(Completion::Finished) => "finished".to_owned(),
         Ok(Completion::Cancelled) => "cancelled".to_owned(),
@@ -527,21 +523,17 @@ fn collect_reports(
 /// The coordinator's link: every live agent's state of the step in, the
 /// round announced (lockstep); or, on the wall clock, the newest states.
 struct Hub<'a> {
-    states: &'a Subscriber<FifoChannelHandler<Sample>>,
+    inbox: Inbox<'a>,
     alive: &'a Subscriber<FifoChannelHandler<Sample>>,
     clock: &'a Publisher<'a>,
     keys: &'a Keys,
-    agents: usize,
     live: Vec<bool>,
-    pending: BTreeMap<usize, Vec<Message>>,
-    newest: Vec<Option<usize>>,
     timeout: Duration,
     realtime: bool,
     start: Instant,
     dt: f64,
     /// Seconds per round.
     rounds: Vec<f64>,
-    received: usize,
 }
 
 impl Hub<'_> {
@@ -562,26 +554,6 @@ impl Hub<'_> {
         }
         out
     }
-
-    fn take(&mut self, step: usize, into: &mut [Option<Message>], wait: Duration) {
-        let mut next = match self.states.recv_timeout(wait) {
-            Ok(Some(s)) => Some(s),
-            _ => None,
-        };
-        while let Some(sample) = next {
-            if let Ok(batch) = States::decode(&sample.payload().to_bytes()) {
-                self.received += batch.messages.len();
-                for m in batch.messages {
-                    if m.step == step && m.sender < into.len() {
-                        into[m.sender] = Some(m);
-                    } else if m.step > step {
-                        self.pending.entry(m.step).or_default().push(m);
-                    }
-                }
-            }
-            next = self.states.try_recv().ok().flatten();
-        }
-    }
 }
 
 impl Link for Hub<'_> {
@@ -590,20 +562,17 @@ impl Link for Hub<'_> {
         if self.realtime {
             pace(self.start, step, self.dt);
             let lost = self.gone();
-            let mut messages = vec![None; self.agents];
-            self.received += take_newest(self.states, &mut messages, &mut self.newest);
+            let mut messages = self.inbox.open(step);
+            self.inbox.take_newest(&mut messages);
             return Ok(Delivery { messages, lost });
         }
         let began = Instant::now();
         let deadline = began + self.timeout;
-        let mut messages = vec![None; self.agents];
-        for m in self.pending.remove(&step).unwrap_or_default() {
-            messages[m.sender] = Some(m);
-        }
+        let mut messages = self.inbox.open(step);
         let mut lost = Vec::new();
         loop {
             lost.extend(self.gone());
-            let missing: Vec<usize> = (0..self.agents)
+            let missing: Vec<usize> = (0..messages.len())
                 .filter(|&i| self.live[i] && messages[i].is_none())
                 .collect();
             if missing.is_empty() {
@@ -620,7 +589,8 @@ impl Link for Hub<'_> {
                     ),
                 });
             }
-            self.take(step, &mut messages, Duration::from_millis(20));
+            self.inbox
+                .take(step, &mut messages, Duration::from_millis(20));
         }
         for (i, m) in messages.iter_mut().enumerate() {
             if !self.live[i] {

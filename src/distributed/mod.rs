@@ -20,6 +20,7 @@
 
 pub mod agent;
 pub mod coordinator;
+pub mod inbox;
 pub mod realtime;
 pub mod session;
 pub mod wire;

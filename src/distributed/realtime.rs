@@ -7,13 +7,13 @@
 
 use std::time::{Duration, Instant};
 
-use zenoh::Wait;
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::sample::Sample;
 
 use super::agent::{ENDED, Watch};
-use super::wire::{Clock, Control, States};
+use super::inbox::{Inbox, publish};
+use super::wire::{Clock, Control};
 use crate::pipelines::fleet::network::Message;
 use crate::pipelines::fleet::simulation::{Delivery, Link, LinkError};
 
@@ -27,43 +27,14 @@ pub fn pace(start: Instant, step: usize, dt: f64) {
     }
 }
 
-/// The newest state of each agent among those that arrived, into `into`
-/// (only states newer than what `into` holds, and than `newest`).
-pub fn take_newest(
-    states: &Subscriber<FifoChannelHandler<Sample>>,
-    into: &mut [Option<Message>],
-    newest: &mut [Option<usize>],
-) -> usize {
-    let mut count = 0;
-    while let Ok(Some(sample)) = states.try_recv() {
-        let Ok(batch) = States::decode(&sample.payload().to_bytes()) else {
-            continue;
-        };
-        for m in batch.messages {
-            count += 1;
-            let Some(slot) = newest.get_mut(m.sender) else {
-                continue;
-            };
-            if slot.is_none_or(|s| m.step > s) {
-                *slot = Some(m.step);
-                into[m.sender] = Some(m);
-            }
-        }
-    }
-    count
-}
-
 /// An agent process's link on the wall clock.
 pub struct AgentClock<'a, 'w> {
     publisher: &'a Publisher<'a>,
-    states: &'a Subscriber<FifoChannelHandler<Sample>>,
+    pub inbox: Inbox<'a>,
     clock: &'a Subscriber<FifoChannelHandler<Sample>>,
     watch: &'a mut Watch<'w>,
-    agents: usize,
-    newest: Vec<Option<usize>>,
     start: Instant,
     dt: f64,
-    pub received: usize,
 }
 
 impl<'a, 'w> AgentClock<'a, 'w> {
@@ -78,14 +49,11 @@ impl<'a, 'w> AgentClock<'a, 'w> {
     ) -> Self {
         AgentClock {
             publisher,
-            states,
+            inbox: Inbox::new(states, agents),
             clock,
             watch,
-            agents,
-            newest: vec![None; agents],
             start: Instant::now(),
             dt,
-            received: 0,
         }
     }
 }
@@ -108,19 +76,12 @@ impl Link for AgentClock<'_, '_> {
                 return Err(error(format!("{ENDED}: {reason}")));
             }
         }
-        let batch = States {
-            step,
-            messages: local.to_vec(),
-        };
-        self.publisher
-            .put(batch.encode())
-            .wait()
-            .map_err(|e| error(format!("cannot publish the states: {e}")))?;
-        let mut messages = vec![None; self.agents];
-        self.received += take_newest(self.states, &mut messages, &mut self.newest);
+        publish(self.publisher, step, local).map_err(error)?;
+        let mut messages = self.inbox.open(step);
+        self.inbox.take_newest(&mut messages);
         for m in local {
             messages[m.sender] = Some(*m);
-            self.newest[m.sender] = Some(m.step);
+            self.inbox.own(m);
         }
         Ok(Delivery {
             messages,

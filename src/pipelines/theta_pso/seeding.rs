@@ -53,17 +53,24 @@ pub fn particles(
     }
     let (waypoints, pass_angles) = waypoints(problem, corridor);
     let exact = problem.builder.encode(&waypoints, &pass_angles);
+    about(&exact, count, 0.1, seed, u64::MAX)
+}
+
+/// `exact`, then `count − 1` copies jittered by normal noise of a spread
+/// growing to `widest` radians (each angle kept in [-π/2, π/2]), drawn from
+/// stream `stream` of `seed`.
+fn about(exact: &[f64], count: usize, widest: f64, seed: u64, stream: u64) -> Vec<Vec<f64>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(u64::MAX);
+    rng.set_stream(stream);
     (0..count)
         .map(|j| {
-            let spread = 0.1 * j as f64 / count as f64;
+            let spread = widest * j as f64 / count as f64;
             match Normal::new(0.0, spread) {
                 Ok(noise) if j > 0 => exact
                     .iter()
                     .map(|theta| (theta + noise.sample(&mut rng)).clamp(-FRAC_PI_2, FRAC_PI_2))
                     .collect(),
-                _ => exact.clone(),
+                _ => exact.to_vec(),
             }
         })
         .collect()
@@ -82,20 +89,7 @@ pub fn warm(problem: &Problem, warm: &super::WarmStart, seed: u64) -> Vec<Vec<f6
     let count = builder.free_waypoints();
     let points = fit_waypoints(builder.start(), builder.goal(), &warm.waypoints, count);
     let exact = builder.encode(&points, &warm.pass_angles);
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(u64::MAX - 1);
-    (0..WARM_PARTICLES)
-        .map(|j| {
-            let spread = 0.02 * j as f64 / WARM_PARTICLES as f64;
-            match Normal::new(0.0, spread) {
-                Ok(noise) if j > 0 => exact
-                    .iter()
-                    .map(|theta| (theta + noise.sample(&mut rng)).clamp(-FRAC_PI_2, FRAC_PI_2))
-                    .collect(),
-                _ => exact.clone(),
-            }
-        })
-        .collect()
+    about(&exact, WARM_PARTICLES, 0.02, seed, u64::MAX - 1)
 }
 
 /// Exactly `count` waypoints from `waypoints` (between `start` and `goal`):

@@ -312,15 +312,15 @@ pub fn find(
     iwps: &[Iwp],
     margin: f64,
 ) -> Result<Corridor, Blocked> {
+    let site = Site::new(mission, builder, margin);
     let Site {
         shape,
         need,
         obstacles,
-        discs,
         field,
         open,
         ..
-    } = Site::new(mission, builder, margin);
+    } = &site;
     let (start, goal) = (mission.route.start.xy(), mission.route.goal.xy());
 
     // The stops, in order along start → goal: every inspection pass, and
@@ -358,7 +358,7 @@ pub fn find(
             let phi = TAU * j as f64 / PASS_ANGLES as f64 - PI;
             for on_left in [true, false] {
                 let ends = builder.pass_ends(i, phi, on_left);
-                if pass_clear(&field, &open, &obstacles, shape.r_q, k, ends) {
+                if pass_clear(field, open, obstacles, shape.r_q, k, ends) {
                     jumps.push(Jump {
                         from: field.index_of(ends[0]),
                         to: field.index_of(ends[1]),
@@ -374,8 +374,8 @@ pub fn find(
     }
 
     let graph = Graph {
-        field: &field,
-        open: &open,
+        field,
+        open,
         jumps: &jumps,
         stages: order.len(),
         switch_cost: mission
@@ -405,8 +405,8 @@ pub fn find(
             return Err(blocked::explain(
                 mission,
                 iwps,
-                &field,
-                &obstacles,
+                field,
+                obstacles,
                 &reached,
                 &order,
                 builder,
@@ -426,8 +426,8 @@ pub fn find(
     };
 
     let mut corridor = assemble(
-        &field,
-        &open,
+        field,
+        open,
         &steps,
         start,
         goal,
@@ -435,15 +435,7 @@ pub fn find(
         &candidates,
         builder.inspections().len(),
     );
-    corridor.squeeze = Site {
-        shape,
-        need,
-        obstacles,
-        discs,
-        field,
-        open,
-    }
-    .squeeze_of(&corridor, mission);
+    corridor.squeeze = site.squeeze_of(&corridor, mission);
     Ok(corridor)
 }
 
