@@ -120,13 +120,20 @@ fn in_process(m: &Mission, seed: u64) -> FleetOutcome {
 
 /// Lockstep over Zenoh, three agents in three processes, flies the
 /// in-process fleet bit for bit: every sample, decision, closest approach
-/// and message count; with the ideal network and with a late, lossy one.
+/// and message count; with the ideal network and with a late, lossy one
+/// where agent 2 decides on a clock of its own.
 #[test]
 fn lockstep_over_zenoh_is_the_in_process_run_bit_for_bit() {
     let ideal = triangle(6.0);
     let mut lossy = ideal.clone();
     lossy.fleet.network.latency = 3;
     lossy.fleet.network.loss = 0.2;
+    // An agent on a clock of its own: every process reads it from the mission.
+    lossy.fleet.network.updates = vec![skyform::mission::FleetUpdate {
+        agent: 2,
+        period: 30,
+        phase: 7,
+    }];
     for (m, seed) in [(ideal, 3), (lossy, 5)] {
         let here = in_process(&m, seed);
         let (mut there, _) = distributed_run(&m, seed, 3);

@@ -2,7 +2,7 @@
 //! decides from the messages it heard, with latency and loss reproducible
 //! from the seed, and the ideal network flies the fleet the paper simulates.
 
-use skyform::mission::{self, FleetNetwork, Mission, Severity};
+use skyform::mission::{self, FleetNetwork, FleetUpdate, Mission, Severity};
 use skyform::pipelines::fleet::{self, FleetOutcome};
 use skyform::pipelines::{CancelToken, Silent};
 
@@ -61,6 +61,7 @@ fn a_late_lossy_network_is_reproducible_and_counted() {
         latency,
         loss: 0.3,
         links: Vec::new(),
+        updates: Vec::new(),
     };
     let (a, b) = (run(&m, 1), run(&m, 1));
     assert_eq!(a, b, "the same mission and seed fly the same");
@@ -147,6 +148,78 @@ fn a_link_with_a_latency_of_its_own_is_read_checked_and_flown() {
         };
         assert!(
             err.contains("fleet.network.links") && err.contains(wanted),
+            "{err}"
+        );
+    }
+}
+
+/// Asynchronous agents (`[fleet.network] updates`): agent 2 on a clock of
+/// its own (every 60 steps from step 7, three rounds of τ) decides at its own
+/// steps, well under half as often as the others; the same seed repeats; on
+/// τ's own period and phase 0 it is the fleet's run bit for bit; a clock
+/// that names no agent, never ticks or starts past its period is refused
+/// naming the field.
+#[test]
+fn agents_on_their_own_clocks_decide_on_them_and_repeat() {
+    let base = include_str!("../missions/fleet-triangle.toml");
+    let text =
+        format!("{base}\n[fleet.network]\nupdates = [{{ agent = 2, period = 60, phase = 7 }}]\n");
+    let mut m = skyform::mission::parse_str(&text, "clocks.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    assert_eq!(
+        m.fleet.network.updates,
+        vec![FleetUpdate {
+            agent: 2,
+            period: 60,
+            phase: 7
+        }]
+    );
+    m.fleet.duration = 20.0;
+    let own = run(&m, 4);
+    assert_eq!(own, run(&m, 4), "the same mission and seed fly the same");
+    let steps = (m.fleet.duration / m.fleet.sim_step).round() as usize;
+    // Its own steps 7, 67, …: each one a decision (the first target is out
+    // from t = 0); a neighbour closer than c may add some.
+    let ticks = (steps - 7) / 60 + 1;
+    let (first, second) = (own.agents[0].decisions, own.agents[1].decisions);
+    assert!(
+        second >= ticks && 2 * second < first,
+        "agent 2 decided {second} times on {ticks} ticks, agent 1 {first} times"
+    );
+    let mut plain = m.clone();
+    plain.fleet.network.updates.clear();
+    let plain_run = run(&plain, 4);
+    assert_ne!(own.agents[1].samples, plain_run.agents[1].samples);
+    let round = (m.fleet.replan_period / m.fleet.sim_step).round() as usize;
+    m.fleet.network.updates[0] = FleetUpdate {
+        agent: 2,
+        period: round,
+        phase: 0,
+    };
+    assert_eq!(run(&m, 4), plain_run, "τ's own clock is the fleet's");
+
+    for (updates, field, wanted) in [
+        ("[{ agent = 4, period = 20 }]", "agent", "from 1 to 3"),
+        ("[{ agent = 1, period = 0 }]", "period", "at least 1 step"),
+        (
+            "[{ agent = 1, period = 20, phase = 20 }]",
+            "phase",
+            "below the period",
+        ),
+        (
+            "[{ agent = 1, period = 20 }, { agent = 1, period = 30 }]",
+            "agent",
+            "twice",
+        ),
+    ] {
+        let text = format!("{base}\n[fleet.network]\nupdates = {updates}\n");
+        let err = match skyform::mission::parse_str(&text, "clocks.toml") {
+            Ok(_) => panic!("{updates} accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            err.contains("fleet.network.updates") && err.contains(field) && err.contains(wanted),
             "{err}"
         );
     }

@@ -645,6 +645,26 @@ pub struct FleetNetwork {
     /// Links with a latency of their own (both ways), in place of `latency`.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub links: Vec<FleetLink>,
+    /// Agents deciding on a clock of their own (asynchronous agents), in
+    /// place of the fleet's rounds every τ.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub updates: Vec<FleetUpdate>,
+}
+
+/// One agent's own update clock: `updates = [{ agent = 2, period = 30,
+/// phase = 7 }]` (agents from 1) has agent 2 decide at steps 7, 37, 67, …
+/// instead of at the fleet's rounds (it still decides at once when a
+/// neighbour comes closer than c, and still broadcasts every step).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FleetUpdate {
+    /// The agent, numbered from 1.
+    pub agent: usize,
+    /// Whole simulation steps between its decisions.
+    pub period: usize,
+    /// The step of its first decision, below `period`.
+    #[serde(default)]
+    pub phase: usize,
 }
 
 /// One link of the fleet's network with its own latency:
@@ -662,7 +682,11 @@ impl FleetNetwork {
     /// No latency, no loss, the range of the neighbourhood: the fleet as
     /// the paper simulates it.
     pub fn is_ideal(&self) -> bool {
-        self.range.is_none() && self.latency == 0 && self.loss == 0.0 && self.links.is_empty()
+        self.range.is_none()
+            && self.latency == 0
+            && self.loss == 0.0
+            && self.links.is_empty()
+            && self.updates.is_empty()
     }
 }
 

@@ -331,7 +331,7 @@ impl Checker {
     }
 
     /// `[fleet.network]`: a range that carries, a latency within the run, a
-    /// loss that leaves some messages.
+    /// loss that leaves some messages, links and own clocks of real agents.
     pub(super) fn fleet_network(&mut self, path: &FieldPath, p: &FleetParams) {
         let n = &p.network;
         if let Some(range) = n.range {
@@ -381,6 +381,49 @@ impl Checker {
             }
             if too_late(link.latency) {
                 self.error(at.key("latency"), late(link.latency));
+            }
+        }
+        let mut clocked = std::collections::HashSet::new();
+        for (i, update) in n.updates.iter().enumerate() {
+            let at = path.key("updates").index(i);
+            let agent = update.agent;
+            if agent == 0 || agent > p.agents {
+                self.error(
+                    at.key("agent"),
+                    format!(
+                        "must name an agent from 1 to {} (the fleet's agents), got {agent}",
+                        p.agents
+                    ),
+                );
+            } else if !clocked.insert(agent) {
+                self.error(
+                    at.key("agent"),
+                    format!("agent {agent} is given a clock of its own twice"),
+                );
+            }
+            if update.period == 0 {
+                self.error(
+                    at.key("period"),
+                    "must be at least 1 step (the agent would never decide)",
+                );
+            } else if too_late(update.period) {
+                self.error(
+                    at.key("period"),
+                    format!(
+                        "{} steps of {} s is longer than the whole run ({} s): the agent would decide once at most",
+                        update.period,
+                        compact(p.sim_step),
+                        compact(p.duration)
+                    ),
+                );
+            } else if update.phase >= update.period {
+                self.error(
+                    at.key("phase"),
+                    format!(
+                        "must be below the period ({} steps), got {}",
+                        update.period, update.phase
+                    ),
+                );
             }
         }
     }

@@ -241,6 +241,7 @@ mod tests {
             latency: 2,
             loss: 0.0,
             links: Vec::new(),
+            updates: Vec::new(),
         };
         let mut net = Network::new(&model, 5.0, 3, 7, 0.01);
         let watched = vec![vec![1, 2], vec![0], vec![0]];
@@ -279,6 +280,7 @@ mod tests {
                 between: [1, 2],
                 latency: 4,
             }],
+            updates: Vec::new(),
         };
         let mut net = Network::new(&model, 50.0, 3, 7, 0.01);
         let watched = vec![vec![1, 2], vec![0], vec![0]];

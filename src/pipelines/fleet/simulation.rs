@@ -158,6 +158,19 @@ struct Log {
     links: Vec<Vec<(usize, usize)>>,
 }
 
+/// Each agent's own update clock, (period, phase) in steps, from
+/// `[fleet.network] updates` (agents from 1; validation keeps the period
+/// positive and the agents real).
+fn own_clocks(p: &FleetParams) -> Vec<Option<(usize, usize)>> {
+    let mut clocks = vec![None; p.agents];
+    for u in &p.network.updates {
+        if let Some(slot) = u.agent.checked_sub(1).and_then(|i| clocks.get_mut(i)) {
+            *slot = Some((u.period.max(1), u.phase));
+        }
+    }
+    clocks
+}
+
 /// The fleet in flight, with everything the round loop needs.
 pub struct Simulation<'m> {
     mission: &'m Mission,
@@ -184,6 +197,9 @@ pub struct Simulation<'m> {
     watch_radius: f64,
     /// What each agent has heard of the others (`network`).
     network: Network,
+    /// Per agent, its own update clock (period, phase) in steps, if it has
+    /// one (`[fleet.network] updates`); else it decides at the rounds.
+    own_clock: Vec<Option<(usize, usize)>>,
     /// Records samples (off in a process that only flies its agents).
     recording: bool,
     log: Log,
@@ -292,6 +308,7 @@ impl<'m> Simulation<'m> {
                 .neighbourhood
                 .max(p.safety_distance + 2.0 * std::f64::consts::SQRT_2 * p.step_max + 1.0),
             network: Network::new(&p.network, p.neighbourhood, n, seed, clock.dt),
+            own_clock: own_clocks(p),
             recording,
             log,
         }
@@ -543,15 +560,22 @@ impl<'m> Simulation<'m> {
             .collect()
     }
 
-    /// Who decides now: everyone at a scheduled round; an agent with a
-    /// neighbour closer than c at once (every agent's, from the replicated
-    /// network: the round's number depends on it).
+    /// Who decides now: everyone at a scheduled round (an agent with a
+    /// clock of its own at its own steps instead); an agent with a neighbour
+    /// closer than c at once (every agent's, from the replicated network:
+    /// the round's number depends on it).
     fn due(&self, now: &Snapshot) -> Vec<bool> {
         let positions = &now.positions;
         (0..positions.len())
             .map(|i| {
+                let scheduled = match self.own_clock[i] {
+                    Some((period, phase)) => {
+                        now.step >= phase && (now.step - phase).is_multiple_of(period)
+                    }
+                    None => now.scheduled,
+                };
                 self.alive[i]
-                    && (now.scheduled
+                    && (scheduled
                         || self
                             .heard_neighbours(i)
                             .any(|m| (m.position - positions[i]).norm() < self.p.safety_distance))
