@@ -187,6 +187,15 @@ fn agents_on_their_own_clocks_decide_on_them_and_repeat() {
         second >= ticks && 2 * second < first,
         "agent 2 decided {second} times on {ticks} ticks, agent 1 {first} times"
     );
+    // The summary says who decided how often.
+    let summary = skyform::outcome::Outcome::Fleet(Box::new(own.clone())).summary();
+    assert!(
+        summary.contains(&format!(
+            "({first} / {second} / {} by agent)",
+            own.agents[2].decisions
+        )),
+        "{summary}"
+    );
     let mut plain = m.clone();
     plain.fleet.network.updates.clear();
     let plain_run = run(&plain, 4);

@@ -425,7 +425,8 @@ pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
     let evaluations: usize = o.agents.iter().map(|a| a.evaluations).sum();
     let _ = writeln!(
         s,
-        "  PSO effort   {decisions} decisions, {evaluations} cost evaluations ({:.0} per agent per second)",
+        "  PSO effort   {decisions} decisions{}, {evaluations} cost evaluations ({:.0} per agent per second)",
+        decisions_by_agent(o),
         evaluations as f64 / (o.agents.len().max(1) as f64 * o.duration.max(1e-9))
     );
     // The pass rule is `Outcome::verdict`'s, written once.
@@ -436,4 +437,22 @@ pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
     };
     let _ = writeln!(s, "  result       {verdict}");
     s
+}
+
+/// The decisions of each agent, when they differ (an agent on a clock of its
+/// own, or deciding at once near a neighbour): ` (201 / 67 / 201 by agent)`,
+/// the least and the most for a fleet of more than twelve.
+fn decisions_by_agent(o: &FleetOutcome) -> String {
+    let counts: Vec<usize> = o.agents.iter().map(|a| a.decisions).collect();
+    let (Some(least), Some(most)) = (counts.iter().min(), counts.iter().max()) else {
+        return String::new();
+    };
+    if least == most {
+        String::new()
+    } else if counts.len() <= 12 {
+        let each: Vec<String> = counts.iter().map(|d| d.to_string()).collect();
+        format!(" ({} by agent)", each.join(" / "))
+    } else {
+        format!(" ({least} to {most} by agent)")
+    }
 }
