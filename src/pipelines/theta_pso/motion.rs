@@ -117,7 +117,13 @@ impl<'a> Motion<'a> {
             ),
             _ => None,
         };
-        let (from, to) = (column(state.from), column(state.to));
+        // A shape held is read once: both ends are the same point.
+        let from = column(state.from);
+        let to = if state.to == state.from {
+            from
+        } else {
+            column(state.to)
+        };
         match (from, to) {
             (None, None) => frame.place(&state.offset(self.slots, n)),
             (from, to) => {
