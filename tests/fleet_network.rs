@@ -13,6 +13,16 @@ fn triangle_mission() -> Mission {
         .mission
 }
 
+/// The error loading the fleet triangle with `line` under `[fleet.network]`.
+fn refusal(line: &str) -> String {
+    let base = include_str!("../missions/fleet-triangle.toml");
+    let text = format!("{base}\n[fleet.network]\n{line}\n");
+    match mission::parse_str(&text, "network.toml") {
+        Ok(_) => panic!("{line} accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
 fn run(m: &Mission, seed: u64) -> FleetOutcome {
     let report = mission::validate(m);
     assert!(report.iter().all(|d| !d.is_error()), "{report:?}");
@@ -141,11 +151,7 @@ fn a_link_with_a_latency_of_its_own_is_read_checked_and_flown() {
             "twice",
         ),
     ] {
-        let text = format!("{base}\n[fleet.network]\nlinks = {links}\n");
-        let err = match skyform::mission::parse_str(&text, "links.toml") {
-            Ok(_) => panic!("{links} accepted"),
-            Err(e) => e.to_string(),
-        };
+        let err = refusal(&format!("links = {links}"));
         assert!(
             err.contains("fleet.network.links") && err.contains(wanted),
             "{err}"
@@ -222,11 +228,7 @@ fn agents_on_their_own_clocks_decide_on_them_and_repeat() {
             "twice",
         ),
     ] {
-        let text = format!("{base}\n[fleet.network]\nupdates = {updates}\n");
-        let err = match skyform::mission::parse_str(&text, "clocks.toml") {
-            Ok(_) => panic!("{updates} accepted"),
-            Err(e) => e.to_string(),
-        };
+        let err = refusal(&format!("updates = {updates}"));
         assert!(
             err.contains("fleet.network.updates") && err.contains(field) && err.contains(wanted),
             "{err}"
