@@ -679,8 +679,8 @@ pub struct FleetLink {
 }
 
 impl FleetNetwork {
-    /// No latency, no loss, the range of the neighbourhood: the fleet as
-    /// the paper simulates it.
+    /// No latency, no loss, the range of the neighbourhood, every agent on
+    /// the fleet's rounds: the fleet as the paper simulates it.
     pub fn is_ideal(&self) -> bool {
         self.range.is_none()
             && self.latency == 0
