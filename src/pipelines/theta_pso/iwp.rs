@@ -132,8 +132,14 @@ impl Shape {
 /// How far ahead of the centroid (negative: behind) slot `n` flies in the
 /// column, metres along the path.
 pub fn column_place(nominal: &[Vector3<f64>], n: usize, spacing: f64) -> f64 {
+    column_rank_from_middle(nominal, n) * spacing
+}
+
+/// Slot `n`'s place in the column counted in spacings from its middle:
+/// [`column_place`] is this times the spacing.
+pub fn column_rank_from_middle(nominal: &[Vector3<f64>], n: usize) -> f64 {
     let count = nominal.len() as f64;
-    (column_rank(nominal, n) as f64 - (count - 1.0) / 2.0) * spacing
+    column_rank(nominal, n) as f64 - (count - 1.0) / 2.0
 }
 
 /// Place of slot `n` in the column, front to back by forward offset (ties by

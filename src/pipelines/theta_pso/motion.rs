@@ -16,7 +16,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::iwp::{Shape, column_place};
+use super::iwp::{Shape, column_rank_from_middle};
 use super::path::{ArcWalker, CentroidPath, Hint, ShapeState, Zone};
 
 /// The formation frame at one arc length.
@@ -43,6 +43,9 @@ pub struct Motion<'a> {
     zones: &'a [Zone],
     slots: &'a [Vector3<f64>],
     span: f64,
+    /// Each slot's place in a column, in spacings from its middle (worked
+    /// out once: every read of a column needs it for every UAV).
+    ranks: Vec<f64>,
 }
 
 impl<'a> Motion<'a> {
@@ -53,7 +56,16 @@ impl<'a> Motion<'a> {
             zones: &path.zones,
             slots,
             span,
+            ranks: (0..slots.len())
+                .map(|n| column_rank_from_middle(slots, n))
+                .collect(),
         }
+    }
+
+    /// How far ahead of the centroid slot `n` flies in a column of
+    /// `spacing` (`iwp::column_place`), metres along the path.
+    pub fn column_place(&self, n: usize, spacing: f64) -> f64 {
+        self.ranks[n] * spacing
     }
 
     pub fn walker(&self) -> &ArcWalker<'a> {
@@ -113,7 +125,7 @@ impl<'a> Motion<'a> {
         let mut column = |shape: Option<Shape>| match shape {
             Some(Shape::Alignment { spacing }) => Some(
                 self.walker
-                    .at_extended_from(s + column_place(self.slots, n, spacing), hint),
+                    .at_extended_from(s + self.column_place(n, spacing), hint),
             ),
             _ => None,
         };

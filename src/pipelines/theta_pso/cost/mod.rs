@@ -34,7 +34,7 @@
 
 use nalgebra::{Point2, Point3, Vector3};
 
-use super::iwp::{Iwp, Shape, column_place};
+use super::iwp::{Iwp, Shape};
 use super::motion::{Motion, Reader};
 use super::path::Hint;
 use super::path::{CentroidPath, heading_span};
@@ -572,7 +572,7 @@ impl CostModel {
                 if let Some(Shape::Alignment { spacing }) = column {
                     for &a in motion.walker().arcs() {
                         for n in 0..self.slots.len() {
-                            let s = a - column_place(&self.slots, n, spacing);
+                            let s = a - motion.column_place(n, spacing);
                             if w0 < s && s < w1 && z0 <= s && s <= z3 {
                                 knots.push(s);
                             }
