@@ -18,7 +18,7 @@ use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
 use zenoh::sample::{Sample, SampleKind};
 
-use super::inbox::{Inbox, publish};
+use super::inbox::{Inbox, drop_lost, missing, publish};
 use super::session;
 use super::wire::{Clock, Control, Hello, Keys, Report, fingerprint, ids_text};
 use crate::mission::Mission;
@@ -89,12 +89,7 @@ pub fn fly(mission: &Mission, ids: Vec<usize>, options: &AgentOptions) -> Result
         seed: options.seed,
         pid: std::process::id(),
     };
-    let text = serde_json::to_vec(&hello).map_err(|e| e.to_string())?;
-    session
-        .put(keys.hello(), text)
-        .congestion_control(CongestionControl::Block)
-        .wait()
-        .map_err(|e| zenoh_error("saying hello", e))?;
+    say(&session, keys.hello(), &hello, "saying hello")?;
 
     let mut watch = Watch::new(&coordinator);
     wait_for_start(&clock, &mut watch, &ids, options.timeout)?;
@@ -133,12 +128,7 @@ pub fn fly(mission: &Mission, ids: Vec<usize>, options: &AgentOptions) -> Result
         effort: simulation.effort(),
         received,
     };
-    let text = serde_json::to_vec(&report).map_err(|e| e.to_string())?;
-    session
-        .put(keys.report(), text)
-        .congestion_control(CongestionControl::Block)
-        .wait()
-        .map_err(|e| zenoh_error("reporting", e))?;
+    say(&session, keys.report(), &report, "reporting")?;
     if ended_early.is_none() {
         // The coordinator ends the run once every report is in.
         let deadline = Instant::now() + options.timeout;
@@ -159,6 +149,22 @@ pub fn fly(mission: &Mission, ids: Vec<usize>, options: &AgentOptions) -> Result
     Ok(())
 }
 
+/// Puts `value` as JSON on `key`, blocking rather than dropping it (the
+/// coordinator waits for the hello and the report); `what` names the step
+/// in the error.
+fn say(
+    session: &zenoh::Session,
+    key: String,
+    value: &impl serde::Serialize,
+    what: &str,
+) -> Result<(), String> {
+    let text = serde_json::to_vec(value).map_err(|e| format!("{what}: {e}"))?;
+    session
+        .put(key, text)
+        .congestion_control(CongestionControl::Block)
+        .wait()
+        .map_err(|e| format!("{what}: {e}"))
+}
 /// The start of a [`LinkError`]'s reason when the coordinator ended the run.
 pub const ENDED: &str = "ended by the coordinator";
 
@@ -310,9 +316,7 @@ impl Link for Lockstep<'_, '_> {
             messages[m.sender] = Some(*m);
         }
         loop {
-            let missing: Vec<usize> = (0..messages.len())
-                .filter(|&i| self.alive[i] && messages[i].is_none())
-                .collect();
+            let missing = missing(&messages, &self.alive);
             if missing.is_empty() {
                 break;
             }
@@ -325,11 +329,7 @@ impl Link for Lockstep<'_, '_> {
             self.inbox
                 .take(step, &mut messages, Duration::from_millis(20));
         }
-        for (i, m) in messages.iter_mut().enumerate() {
-            if !self.alive[i] {
-                *m = None;
-            }
-        }
+        drop_lost(&mut messages, &self.alive);
         Ok(Delivery { messages, lost })
     }
 }

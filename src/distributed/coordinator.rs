@@ -23,7 +23,7 @@ use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
 use zenoh::sample::{Sample, SampleKind};
 
-use super::inbox::Inbox;
+use super::inbox::{Inbox, drop_lost, missing};
 use super::realtime::pace;
 use super::session;
 use super::wire::{Clock, Control, Hello, Keys, Report, chunk, fingerprint, ids_text};
@@ -572,9 +572,7 @@ impl Link for Hub<'_> {
         let mut lost = Vec::new();
         loop {
             lost.extend(self.gone());
-            let missing: Vec<usize> = (0..messages.len())
-                .filter(|&i| self.live[i] && messages[i].is_none())
-                .collect();
+            let missing = missing(&messages, &self.live);
             if missing.is_empty() {
                 break;
             }
@@ -592,11 +590,7 @@ impl Link for Hub<'_> {
             self.inbox
                 .take(step, &mut messages, Duration::from_millis(20));
         }
-        for (i, m) in messages.iter_mut().enumerate() {
-            if !self.live[i] {
-                *m = None;
-            }
-        }
+        drop_lost(&mut messages, &self.live);
         let round = Clock::Round {
             step,
             lost: lost.clone(),

@@ -92,6 +92,20 @@ impl<'a> Inbox<'a> {
     }
 }
 
+/// The agents still flying (`alive`) whose state of the step is not in.
+pub fn missing(messages: &[Option<Message>], alive: &[bool]) -> Vec<usize> {
+    (0..messages.len())
+        .filter(|&i| alive[i] && messages[i].is_none())
+        .collect()
+}
+
+/// Forgets the states of agents no longer flying: nobody hears them.
+pub fn drop_lost(messages: &mut [Option<Message>], alive: &[bool]) {
+    for (m, _) in messages.iter_mut().zip(alive).filter(|(_, a)| !**a) {
+        *m = None;
+    }
+}
+
 /// Publishes this process's agents' states of `step`.
 pub fn publish(publisher: &Publisher<'_>, step: usize, local: &[Message]) -> Result<(), String> {
     let batch = States {

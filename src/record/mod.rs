@@ -478,12 +478,7 @@ fn log_live(
         )?;
     }
     if let Some(o) = outcome.theta_pso() {
-        stream.log(
-            paths::LIVE_CENTROID,
-            &rerun::LineStrips3D::new([o.centroid_path.iter().map(f32x3).collect::<Vec<_>>()])
-                .with_colors([rerun::Color::from_rgb(255, 255, 255)])
-                .with_labels(["centroid"]),
-        )?;
+        stream.log(paths::LIVE_CENTROID, &theta_pso::centroid_strip(o))?;
     }
     let warm = outcome
         .theta_pso()

@@ -82,6 +82,14 @@ fn log_clearances(
     Ok(())
 }
 
+/// The plan's centroid path, white and labelled: the outcome's and each
+/// live revision's.
+pub fn centroid_strip(o: &ThetaPsoOutcome) -> rerun::LineStrips3D {
+    rerun::LineStrips3D::new([o.centroid_path.iter().map(f32x3).collect::<Vec<_>>()])
+        .with_colors([rerun::Color::from_rgb(255, 255, 255)])
+        .with_labels(["centroid"])
+}
+
 /// A θ-PSO outcome: planned paths, UAVs moving on `sim_time`, events, violations.
 pub fn log_outcome(
     stream: &RecordingStream,
@@ -109,12 +117,7 @@ pub fn log_outcome(
             env!("CARGO_PKG_VERSION")
         )),
     )?;
-    stream.log_static(
-        at::CENTROID,
-        &rerun::LineStrips3D::new([o.centroid_path.iter().map(f32x3).collect::<Vec<_>>()])
-            .with_colors([rerun::Color::from_rgb(255, 255, 255)])
-            .with_labels(["centroid"]),
-    )?;
+    stream.log_static(at::CENTROID, &centroid_strip(o))?;
     log_trajectories(stream, o)?;
     log_reconfigurations(stream, o, &events)?;
     log_passes(stream, o, &events)?;
