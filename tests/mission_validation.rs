@@ -314,6 +314,42 @@ fn a_shrink_that_brings_uavs_too_close_is_an_error() {
 }
 
 #[test]
+fn a_tight_formation_is_valid_until_a_shrink_by_the_default_scale_is_asked_for() {
+    // A 2 × 2 box 1.6 m apart: the default scale 0.5 would bring its UAVs
+    // 0.8 m apart (< 2 r_Q = 1 m), but auto shrinks by a scale of its own,
+    // so nothing flies 0.5 and the mission is valid.
+    let tight = "[formation]\nslots = [[0.8, 0.8, 0.0], [0.8, -0.8, 0.0], [-0.8, 0.8, 0.0], \
+                 [-0.8, -0.8, 0.0]]\n";
+    let text = mission_with(tight);
+    let shrink_errors = |text: &str| {
+        diagnostics(text)
+            .into_iter()
+            .filter(|d| d.severity == Severity::Error && d.path.to_string().contains("shrink"))
+            .count()
+    };
+    assert_eq!(shrink_errors(&text), 0, "{:?}", diagnostics(&text));
+    assert!(parse_str(&text, FILE).is_ok());
+    // Shrink as the default shape flies the scale: each pair too close is named.
+    let text = mission_with(&format!(
+        "{tight}[reconfiguration]\ndefault_shape = \"shrink\"\n"
+    ));
+    assert_eq!(shrink_errors(&text), 4);
+    let d = error_at(&text, "reconfiguration.shrink_scale");
+    assert!(d.message.contains("0.800 m apart"), "{d}");
+    // So does one IWP set to shrink without a scale of its own; with its own
+    // scale (0.7 → 1.12 m apart) it is valid again.
+    let iwp = |scale: &str| {
+        mission_with(&format!(
+            "{tight}[[reconfiguration.waypoints]]\nbetween = [\"a\", \"b\"]\nshape = \"shrink\"\n{scale}\
+             [[obstacles]]\nname = \"a\"\ncenter = [50.0, 45.0]\nradius = 1.0\nheight = 5.0\n\
+             [[obstacles]]\nname = \"b\"\ncenter = [50.0, 55.0]\nradius = 1.0\nheight = 5.0\n"
+        ))
+    };
+    assert_eq!(shrink_errors(&iwp("")), 4);
+    assert_eq!(shrink_errors(&iwp("scale = 0.7\n")), 0);
+}
+
+#[test]
 fn duplicate_obstacle_names_are_errors() {
     let text = mission_with(
         "[[obstacles]]\nname = \"a\"\ncenter = [50.0, 50.0]\nradius = 1.0\nheight = 5.0\n\

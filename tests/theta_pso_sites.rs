@@ -18,12 +18,18 @@ use skyform::pipelines::{CancelToken, Silent};
 /// Sites 400-423 (a range the planner was never tuned on), one seed each.
 const SHARE: std::ops::Range<u64> = 400..424;
 
-#[test]
-fn every_site_of_the_share_is_planned_feasible() {
-    let runs: Vec<(sites::Site, Result<bool, String>, String)> = SHARE
+/// Sites 400-415 of the wide variant (more shapes, r_Q 0.3-0.7 m, sites
+/// mirrored and transposed), one seed each.
+const WIDE_SHARE: std::ops::Range<u64> = 400..416;
+
+type Run = (sites::Site, Result<bool, String>, String);
+
+/// Plans each site of `share` with the paper's swarm on one core.
+fn plan_share(share: std::ops::Range<u64>, generate: fn(u64) -> sites::Site) -> Vec<Run> {
+    share
         .into_par_iter()
         .map(|i| {
-            let site = sites::generated(i);
+            let site = generate(i);
             let seed = i % 3;
             let result = plan(
                 &site.mission,
@@ -41,7 +47,23 @@ fn every_site_of_the_share_is_planned_feasible() {
             };
             (site, feasible, why)
         })
-        .collect();
+        .collect()
+}
+
+/// Every run that was refused or infeasible, with why.
+fn failures(runs: &[Run]) -> Vec<String> {
+    runs.iter()
+        .filter(|(_, feasible, _)| !matches!(feasible, Ok(true)))
+        .map(|(site, feasible, why)| match feasible {
+            Err(e) => format!("{}: refused: {e}", site.mission.name),
+            _ => format!("{}: infeasible: {why}", site.mission.name),
+        })
+        .collect()
+}
+
+#[test]
+fn every_site_of_the_share_is_planned_feasible() {
+    let runs = plan_share(SHARE, sites::generated);
 
     // The share covers the family's dimensions, so a pass means something.
     let walls: BTreeSet<usize> = runs.iter().map(|r| r.0.walls).collect();
@@ -55,13 +77,34 @@ fn every_site_of_the_share_is_planned_feasible() {
     assert!(largest >= 9, "largest formation {largest}");
     assert!(close_walls >= 2, "walls closer than 22 m: {close_walls}");
 
-    let failures: Vec<String> = runs
+    let failures = failures(&runs);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn every_site_of_the_wide_share_is_planned_feasible() {
+    let runs = plan_share(WIDE_SHARE, sites::generated_wide);
+    let wide_shapes = runs
         .iter()
-        .filter(|(_, feasible, _)| !matches!(feasible, Ok(true)))
-        .map(|(site, feasible, why)| match feasible {
-            Err(e) => format!("{}: refused: {e}", site.mission.name),
-            _ => format!("{}: infeasible: {why}", site.mission.name),
-        })
+        .filter(|r| sites::WIDE_SHAPES.contains(&r.0.shape))
+        .count();
+    let radii: Vec<f64> = runs
+        .iter()
+        .map(|r| r.0.mission.formation.uav_radius)
         .collect();
+    let northward = runs
+        .iter()
+        .filter(|r| {
+            let route = r.0.mission.route.goal - r.0.mission.route.start;
+            route.y.abs() > route.x.abs()
+        })
+        .count();
+    assert!(wide_shapes >= 3, "shapes beyond the family: {wide_shapes}");
+    assert!(
+        radii.iter().any(|&r| r < 0.45) && radii.iter().any(|&r| r > 0.55),
+        "r_Q varies: {radii:?}"
+    );
+    assert!(northward >= 3, "routes across the other axis: {northward}");
+    let failures = failures(&runs);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -9,6 +9,15 @@
 //! inspect one or two free-standing obstacles (eq. 8). The swarm is the
 //! paper's (100 particles, 150 iterations, 7 waypoints).
 //!
+//! The wide variant (`generated_wide`) reaches past the family the planner
+//! was built against: six more shapes (an echelon of 5, a column of 4, a
+//! ring of 8, a V of 5 stacked in two altitudes, a 2 × 2 × 2 box, a 2 × 2
+//! grid 1.6 m apart), r_Q from 0.3 to 0.7 m, and the site mirrored and/or
+//! transposed, so the route runs east to west or south to north. A tower
+//! whose pass cannot hold eq. 8 for the shape (an echelon's facing UAV
+//! changes along a pass; `check` refuses it, naming the band) is not
+//! inspected.
+//!
 //! A plan exists by construction: the clutter keeps off the corridor
 //! start → gap 1 → … → gap n → goal by the formation's safe radius, and off
 //! each gap's crossing, so every site is one a correct planner must plan.
@@ -22,6 +31,7 @@ use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 use skyform::base::geometry::segment_point_distance;
 use skyform::mission::{self, Mission, Obstacle};
+use skyform::pipelines::theta_pso::PassGeometry;
 
 /// The formation shapes of the family: name and slots (x forward, y left).
 pub const SHAPES: [&str; 9] = [
@@ -34,6 +44,16 @@ pub const SHAPES: [&str; 9] = [
     "grid 3x3",
     "line 6",
     "grid 4x3",
+];
+
+/// The wide variant's further shapes, after [`SHAPES`] (index 9 on).
+pub const WIDE_SHAPES: [&str; 6] = [
+    "echelon 5",
+    "column 4",
+    "ring 8",
+    "V 5 in two altitudes",
+    "box 2x2x2",
+    "grid 2x2 tight",
 ];
 
 /// Slots of shape `index` of [`SHAPES`].
@@ -75,7 +95,7 @@ pub fn slots(index: usize) -> Vec<Vector3<f64>> {
         }
         centred(s)
     };
-    match index % SHAPES.len() {
+    match index % (SHAPES.len() + WIDE_SHAPES.len()) {
         0 => vec![
             Vector3::new(0.0, 2.0, 0.0),
             Vector3::new(-2.0, -1.0, 0.0),
@@ -93,7 +113,40 @@ pub fn slots(index: usize) -> Vec<Vector3<f64>> {
         5 => vee(7, 2.5),
         6 => grid(3, 3, 3.0),
         7 => line(6, 2.5),
-        _ => grid(4, 3, 3.0),
+        8 => grid(4, 3, 3.0),
+        9 => centred(
+            (0..5)
+                .map(|k| Vector3::new(-2.0 * k as f64, 2.0 * k as f64, 0.0))
+                .collect(),
+        ),
+        10 => centred(
+            (0..4)
+                .map(|k| Vector3::new(-2.5 * k as f64, 0.0, 0.0))
+                .collect(),
+        ),
+        11 => (0..8)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / 8.0;
+                Vector3::new(4.0 * a.cos(), 4.0 * a.sin(), 0.0)
+            })
+            .collect(),
+        12 => {
+            let mut s = vee(5, 3.0);
+            for (i, o) in s.iter_mut().enumerate() {
+                o.z = if i % 2 == 0 { 1.0 } else { -1.0 };
+            }
+            centred(s)
+        }
+        13 => {
+            let mut s = Vec::new();
+            for z in [-1.5, 1.5] {
+                for (x, y) in [(1.5, 1.5), (1.5, -1.5), (-1.5, 1.5), (-1.5, -1.5)] {
+                    s.push(Vector3::new(x, y, z));
+                }
+            }
+            s
+        }
+        _ => grid(2, 2, 1.6),
     }
 }
 
@@ -120,9 +173,25 @@ pub struct Site {
 
 /// Site `index` of the family.
 pub fn generated(index: u64) -> Site {
-    let mut rng = ChaCha8Rng::seed_from_u64(0x51_7e5 ^ index.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-    let shape_index = rng.random_range(0..SHAPES.len());
-    let shape = SHAPES[shape_index];
+    generate(index, false)
+}
+
+/// Site `index` of the wide variant (the module's doc).
+pub fn generated_wide(index: u64) -> Site {
+    generate(index, true)
+}
+
+fn generate(index: u64, wide: bool) -> Site {
+    let salt = if wide { 0x3a1d_e000 } else { 0 };
+    let mut rng =
+        ChaCha8Rng::seed_from_u64(0x51_7e5 ^ salt ^ index.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    let shapes = SHAPES.len() + if wide { WIDE_SHAPES.len() } else { 0 };
+    let shape_index = rng.random_range(0..shapes);
+    let shape = SHAPES
+        .get(shape_index)
+        .or_else(|| WIDE_SHAPES.get(shape_index - SHAPES.len()))
+        .copied()
+        .unwrap_or("?");
     let formation_slots = slots(shape_index);
     let walls = rng.random_range(1..=3usize);
     let width: f64 = rng.random_range(60.0..100.0);
@@ -156,6 +225,10 @@ pub fn generated(index: u64) -> Site {
         .map(|l| l.mission)
         .unwrap_or_else(|e| panic!("{e}"));
     m.formation.slots = formation_slots;
+    if wide && shape_index != 14 {
+        // The tight grid keeps r_Q = 0.5 m (1.6 m ≥ 2 r_Q + 0.6 m of room).
+        m.formation.uav_radius = rng.random_range(0.3..0.7);
+    }
     let r_q = m.formation.uav_radius;
     let r_f = m.formation.radius();
     let safe = r_f + r_q;
@@ -344,14 +417,55 @@ pub fn generated(index: u64) -> Site {
             stand_off: None,
         });
     }
+    let mut towers = inspect_placed;
+    if wide {
+        let f = &m.formation;
+        for o in m.obstacles.iter_mut().filter(|o| o.inspect) {
+            let band = o.stand_off_band(f);
+            if PassGeometry::new(&f.slots, o.radius, band, f.inspection_pass).is_err() {
+                o.inspect = false;
+                towers -= 1;
+            }
+        }
+        transform(&mut m, rng.random_range(0..4u32));
+    }
     let uavs = m.formation.slots.len();
     Site {
         walls,
         narrow,
         shape,
         uavs,
-        inspected: inspect_placed,
+        inspected: towers,
         closest_walls: spacing.iter().copied().fold(f64::INFINITY, f64::min),
         mission: m,
+    }
+}
+
+/// The site mirrored east to west (`turn` bit 0) and/or transposed, x and y
+/// swapped (bit 1): the same site, flown in another direction.
+fn transform(m: &mut Mission, turn: u32) {
+    let (length, width) = (m.bounds.x[1], m.bounds.y[1]);
+    let map = |p: Point2<f64>| {
+        let p = if turn & 1 == 1 {
+            Point2::new(length - p.x, p.y)
+        } else {
+            p
+        };
+        if turn & 2 == 2 {
+            Point2::new(p.y, p.x)
+        } else {
+            p
+        }
+    };
+    for o in &mut m.obstacles {
+        o.center = map(o.center);
+    }
+    for q in [&mut m.route.start, &mut m.route.goal] {
+        let xy = map(q.xy());
+        (q.x, q.y) = (xy.x, xy.y);
+    }
+    if turn & 2 == 2 {
+        m.bounds.x = [0.0, width];
+        m.bounds.y = [0.0, length];
     }
 }

@@ -2,6 +2,7 @@
 //! reconfigurations (alignment, rotation, shrink) it may fly.
 
 use super::*;
+use crate::mission::model::ShapeChoice;
 
 impl Checker {
     pub(super) fn formation(&mut self, path: &FieldPath, f: &Formation) {
@@ -89,7 +90,16 @@ impl Checker {
         mission: &Mission,
     ) {
         self.in_half_open(path.key("shrink_scale"), r.shrink_scale, 0.0, 1.0);
-        if r.shrink_scale > 0.0 && r.shrink_scale < 1.0 {
+        // Eq. 7 binds the scale only where a shrink flies it: the default
+        // shape, or an IWP set to shrink without a scale of its own. Auto
+        // picks its own scale (the largest that fits the gap and keeps 2 r_Q),
+        // so a formation too tight for the default 0.5 is not refused for a
+        // shrink nobody asked for.
+        let used = r.default_shape == ShapeChoice::Shrink
+            || r.waypoints
+                .iter()
+                .any(|w| w.shape == ShapeChoice::Shrink && w.scale.is_none());
+        if used && r.shrink_scale > 0.0 && r.shrink_scale < 1.0 {
             self.slot_spacing(
                 &path.key("shrink_scale"),
                 &mission.formation,

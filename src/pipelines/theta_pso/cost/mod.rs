@@ -43,6 +43,7 @@ use crate::mission::{Bounds, Mission, ThetaPsoParams};
 use serde::Serialize;
 
 mod pairs;
+mod passes;
 
 /// How far a UAV's path may stray from the chord of a piece where the heading
 /// turns, metres: a fifth of the default clearance margin.
@@ -75,6 +76,8 @@ pub struct CostModel {
     /// The same in the nominal shape, outside the reconfiguration zones.
     nominal_reach: f64,
     nominal_rise: f64,
+    /// Eq. 8's stand-off band of each obstacle (used for the inspected).
+    bands: Vec<[f64; 2]>,
     /// C_j of the enabled IWPs.
     iwp_points: Vec<Point2<f64>>,
     band: [f64; 2],
@@ -149,11 +152,24 @@ struct Sums {
     /// Σ arc length × metres closer than 2 r_Q + `PAIR_FLOOR`, over the
     /// pairs of UAVs where they can change (eq. 7).
     spacing: f64,
+    /// Σ step × metres the facing UAV is outside eq. 8's band, along the
+    /// inspection passes a change of shape reaches into.
+    passes: f64,
 }
 
 impl Sums {
     fn violated(&self) -> bool {
-        self.obstacle > 0.0 || self.altitude > 0.0 || self.bounds > 0.0 || self.spacing > 0.0
+        self.obstacle > 0.0
+            || self.altitude > 0.0
+            || self.bounds > 0.0
+            || self.spacing > 0.0
+            || self.passes > 0.0
+    }
+
+    /// The violations measured in metres of path, undiluted (the swarm's
+    /// penalty beyond the step).
+    fn undiluted(&self) -> f64 {
+        self.obstacle + self.spacing + self.passes
     }
 }
 
@@ -200,6 +216,11 @@ impl CostModel {
                 .obstacles
                 .iter()
                 .map(|o| mission.cylinder(o))
+                .collect(),
+            bands: mission
+                .obstacles
+                .iter()
+                .map(|o| o.stand_off_band(f))
                 .collect(),
             slots: f.slots.clone(),
             uav_radius: f.uav_radius,
@@ -395,8 +416,7 @@ impl CostModel {
                 + p.weight_obstacle * sums.obstacle * obstacle_scale
                 + (p.weight_altitude * sums.altitude + p.weight_bounds * sums.bounds) * share;
             if sums.violated() {
-                so_far += INFEASIBLE_STEP
-                    + p.weight_obstacle * (sums.obstacle + sums.spacing) * undiluted;
+                so_far += INFEASIBLE_STEP + p.weight_obstacle * sums.undiluted() * undiluted;
             }
             if so_far >= bound {
                 reached_bound = true;
@@ -405,6 +425,7 @@ impl CostModel {
         }
         if !reached_bound {
             sums.spacing = self.pair_deficit(&motion, path, &mut scratch.current);
+            sums.passes = self.pass_deficit(&motion, path, &mut scratch.current);
         }
         terms.obstacle = sums.obstacle * obstacle_scale;
         terms.altitude = sums.altitude * share;
@@ -415,7 +436,7 @@ impl CostModel {
             + p.weight_bounds * terms.bounds;
         let violation = if sums.violated() {
             // Positive even for a band or bounds violation alone.
-            ((sums.obstacle + sums.spacing) * undiluted).max(f64::MIN_POSITIVE)
+            (sums.undiluted() * undiluted).max(f64::MIN_POSITIVE)
         } else {
             0.0
         };

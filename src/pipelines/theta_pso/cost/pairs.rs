@@ -55,10 +55,12 @@ impl CostModel {
     }
 
     /// The same over a column's hold [t2, t3], from the path alone: UAV n is
-    /// at the path's point its place ahead of the centroid, so two UAVs are
-    /// the chord between two points of the path a whole number of spacings
-    /// apart. The path is sampled at a quarter spacing, so every such pair
-    /// falls on two samples.
+    /// at the path's point its place ahead of the centroid, so two UAVs `p`
+    /// places apart are the chord between the path's points at u and
+    /// u + p × spacing. Between the path's vertices (and the vertices one
+    /// chord behind them) both ends move straight, so the chord is linear in
+    /// u: its closest approach on each piece is exact, not sampled, and a
+    /// hairpin that brings two UAVs together between samples is seen.
     pub(super) fn column_deficit(
         &self,
         walker: &crate::pipelines::theta_pso::path::ArcWalker<'_>,
@@ -70,27 +72,76 @@ impl CostModel {
         if spacing <= 0.0 || t3 <= t2 {
             return 0.0;
         }
-        let step = spacing / 4.0;
         let half = (n - 1) as f64 * spacing / 2.0;
         let (from, to) = (t2 - half, t3 + half);
-        let samples = (((to - from) / step).ceil() as usize).max(1);
-        let mut hint = crate::pipelines::theta_pso::path::Hint::default();
-        let points: Vec<Point3<f64>> = (0..=samples)
-            .map(|k| walker.at_extended_from(from + k as f64 * step, &mut hint))
-            .collect();
+        let arcs = walker.arcs();
+        let inner = &arcs[1..arcs.len().saturating_sub(1)];
+        let mut breaks: Vec<f64> = Vec::with_capacity(2 * inner.len() + 2);
         let mut deficit = 0.0;
-        for i in 0..points.len() {
-            for places in 1..n {
-                let j = i + 4 * places;
-                if j >= points.len() {
-                    break;
+        for places in 1..n {
+            let chord = places as f64 * spacing;
+            let end = to - chord;
+            if end <= from {
+                break;
+            }
+            breaks.clear();
+            breaks.push(from);
+            breaks.push(end);
+            for &a in inner {
+                for u in [a, a - chord] {
+                    if from < u && u < end {
+                        breaks.push(u);
+                    }
                 }
-                let gap = floor - (points[j] - points[i]).norm();
-                if gap > 0.0 {
-                    deficit += gap * step;
-                }
+            }
+            breaks.sort_by(f64::total_cmp);
+            let (mut behind, mut ahead) = (Hint::default(), Hint::default());
+            let mut chord_at = |u: f64| {
+                walker.at_extended_from(u + chord, &mut ahead)
+                    - walker.at_extended_from(u, &mut behind)
+            };
+            let mut d0 = chord_at(breaks[0]);
+            for w in breaks.windows(2) {
+                let d1 = chord_at(w[1]);
+                deficit += linear_deficit(d0, d1, floor) * (w[1] - w[0]);
+                d0 = d1;
             }
         }
         deficit
     }
+}
+
+/// ∫₀¹ (floor − |d0 + t (d1 − d0)|)⁺ dt, in closed form: the chord is
+/// closer than `floor` between the roots of a quadratic in t, and there
+/// |d0 + t e| = |e| √((t + b)² + k²) with ∫ √(x² + k²) dx =
+/// ½ (x √(x² + k²) + k² asinh(x / k)).
+fn linear_deficit(d0: Vector3<f64>, d1: Vector3<f64>, floor: f64) -> f64 {
+    let e = d1 - d0;
+    let (qa, qb, qc) = (
+        e.norm_squared(),
+        2.0 * d0.dot(&e),
+        d0.norm_squared() - floor * floor,
+    );
+    if qa < 1e-18 {
+        return (floor - d0.norm()).max(0.0);
+    }
+    let disc = qb * qb - 4.0 * qa * qc;
+    if disc <= 0.0 {
+        return 0.0;
+    }
+    let root = disc.sqrt();
+    let lo = ((-qb - root) / (2.0 * qa)).max(0.0);
+    let hi = ((-qb + root) / (2.0 * qa)).min(1.0);
+    if hi <= lo {
+        return 0.0;
+    }
+    let b = d0.dot(&e) / qa;
+    let k2 = (d0.norm_squared() / qa - b * b).max(0.0);
+    let k = k2.sqrt();
+    let antiderivative = |x: f64| {
+        let r = (x * x + k2).sqrt();
+        0.5 * (x * r + if k > 0.0 { k2 * (x / k).asinh() } else { 0.0 })
+    };
+    let under = qa.sqrt() * (antiderivative(hi + b) - antiderivative(lo + b));
+    (floor * (hi - lo) - under).max(0.0)
 }

@@ -64,3 +64,120 @@ fn among_infeasible_paths_the_smaller_violation_ranks_first() {
     assert!(edge.terms.obstacle < centre.terms.obstacle);
     assert!(edge.objective < centre.objective);
 }
+
+/// The column's pair check (eq. 7 along a column's hold) is the integral of
+/// (floor − chord)⁺ over where the column's places sit, exact between the
+/// path's vertices: through a sharp corner, where two UAVs 2.5 m apart along
+/// the path come within 1.2 m of each other, it matches a 400-times finer
+/// sampling of the same integral to 0.1 %, and a straight path has none.
+#[test]
+fn a_columns_pairs_are_judged_exactly_through_a_sharp_corner() {
+    let mut m = one_post();
+    m.formation.slots = (0..5)
+        .map(|k| Vector3::new(5.0 - 2.5 * k as f64, 0.0, 0.0))
+        .collect();
+    let model = CostModel::new(&m, &[]);
+    let floor = 2.0 * m.formation.uav_radius + PAIR_FLOOR;
+    let spacing = 2.5;
+    let sampled = |points: &[Point3<f64>], [t2, t3]: [f64; 2]| {
+        let walker = crate::pipelines::theta_pso::path::ArcWalker::new(points);
+        let half = 2.0 * spacing;
+        let mut sum = 0.0;
+        for places in 1..5 {
+            let chord = places as f64 * spacing;
+            let (from, to) = (t2 - half, t3 + half - chord);
+            let steps = ((to - from) / (spacing / 400.0)).ceil() as usize;
+            let h = (to - from) / steps as f64;
+            for k in 0..steps {
+                let u = from + (k as f64 + 0.5) * h;
+                let d = (walker.at_extended(u + chord) - walker.at_extended(u)).norm();
+                sum += (floor - d).max(0.0) * h;
+            }
+        }
+        sum
+    };
+    // A 150° turn: the chord of 2.5 m of path round the corner is ~0.65 m.
+    let turn = 150f64.to_radians();
+    let corner = Point3::new(30.0, 20.0, 10.0);
+    let points = vec![
+        Point3::new(10.0, 20.0, 10.0),
+        corner,
+        corner + Vector3::new(turn.cos(), turn.sin(), 0.0) * 20.0,
+    ];
+    let walker = crate::pipelines::theta_pso::path::ArcWalker::new(&points);
+    let hold = [12.0, 28.0];
+    let exact = model.column_deficit(&walker, hold, spacing, floor);
+    let reference = sampled(&points, hold);
+    assert!(reference > 0.1, "the corner must bring places together");
+    assert!(
+        (exact - reference).abs() <= 1e-3 * reference,
+        "exact {exact} against sampled {reference}"
+    );
+    let straight = vec![Point3::new(10.0, 20.0, 10.0), Point3::new(50.0, 20.0, 10.0)];
+    let walker = crate::pipelines::theta_pso::path::ArcWalker::new(&straight);
+    assert_eq!(model.column_deficit(&walker, hold, spacing, floor), 0.0);
+}
+
+/// Eq. 8 where a change of shape reaches into an inspection pass: the pass
+/// is laid out for the nominal shape, so a column held over it moves the
+/// facing UAV out to the centroid's line and out of a tight band. The cost
+/// then finds the path infeasible (verification would fail the inspection);
+/// the same column held clear of the pass, or the pass flown in the nominal
+/// shape, costs nothing.
+#[test]
+fn an_inspection_pass_flown_in_a_changed_shape_is_judged_on_the_facing_uav() {
+    use crate::pipelines::theta_pso::inspection::PassGeometry;
+    use crate::pipelines::theta_pso::path::{Pass, Zone, ZoneCause};
+    let mut m = one_post();
+    // A line abreast, 3 m apart: its outer UAV faces the post.
+    m.formation.slots = vec![
+        Vector3::new(0.0, 3.0, 0.0),
+        Vector3::zeros(),
+        Vector3::new(0.0, -3.0, 0.0),
+    ];
+    let band = [2.0, 4.0];
+    m.obstacles[0].inspect = true;
+    m.obstacles[0].stand_off = Some(band);
+    let model = CostModel::new(&m, &[]);
+    let geometry = match PassGeometry::new(&m.formation.slots, 3.0, band, 6.0) {
+        Ok(g) => g,
+        Err(e) => panic!("{e}"),
+    };
+    // Eastward past the post with the post on the right, the pass centred
+    // abeam it (x = 30, arc 25 from x = 5).
+    let y = 20.0 + geometry.radius_right;
+    let path = |zone: Option<[f64; 2]>| CentroidPath {
+        points: vec![Point3::new(5.0, y, 10.0), Point3::new(55.0, y, 10.0)],
+        zones: zone
+            .map(|hold| Zone {
+                causes: vec![ZoneCause::Squeeze {
+                    region: 1,
+                    pair: [0, 0],
+                }],
+                shape: Shape::Alignment { spacing: 2.5 },
+                arc: (hold[0] + hold[1]) / 2.0,
+                hold,
+                transition_in: 6.0,
+                transition_out: 6.0,
+                from: None,
+                into: None,
+            })
+            .into_iter()
+            .collect(),
+        passes: vec![Pass {
+            obstacle: 0,
+            arcs: [22.0, 28.0],
+            on_left: false,
+        }],
+        crossed: Vec::new(),
+    };
+    // In the column every UAV is on the centroid's line: its surface
+    // distance abeam is the line's, beyond the band's top.
+    assert!(geometry.radius_right - 3.0 > band[1]);
+    let over = model.evaluate_below(&path(Some([18.0, 32.0])), f64::INFINITY);
+    assert!(over.objective >= INFEASIBLE_STEP, "{over:?}");
+    for clear in [None, Some([36.0, 44.0])] {
+        let e = model.evaluate_below(&path(clear), f64::INFINITY);
+        assert_eq!(e.objective, e.terms.total, "{clear:?}: {e:?}");
+    }
+}
