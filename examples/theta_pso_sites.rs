@@ -163,6 +163,17 @@ fn detail(m: &skyform::mission::Mission, seed: u64) {
     }
 }
 
+/// Which way the route runs, start to goal, by its larger component.
+fn heading(m: &skyform::mission::Mission) -> &'static str {
+    let d = m.route.goal - m.route.start;
+    match (d.x.abs() >= d.y.abs(), d.x >= 0.0, d.y >= 0.0) {
+        (true, true, _) => "eastward",
+        (true, false, _) => "westward",
+        (false, _, true) => "northward",
+        (false, _, false) => "southward",
+    }
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut raw: Vec<String> = std::env::args().skip(1).collect();
     let wide = raw.iter().any(|a| a == "--wide");
@@ -222,6 +233,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ("shape", site.shape.to_owned()),
                 ("UAVs", site.uavs.to_string()),
                 ("inspected", site.inspected.to_string()),
+                ("route", heading(&site.mission).to_owned()),
                 (
                     "closest walls",
                     if site.closest_walls < 22.0 {
