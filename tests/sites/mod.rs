@@ -225,7 +225,7 @@ fn generate(index: u64, wide: bool) -> Site {
         .map(|l| l.mission)
         .unwrap_or_else(|e| panic!("{e}"));
     m.formation.slots = formation_slots;
-    if wide && shape_index != 14 {
+    if wide && shape != "grid 2x2 tight" {
         // The tight grid keeps r_Q = 0.5 m (1.6 m ≥ 2 r_Q + 0.6 m of room).
         m.formation.uav_radius = rng.random_range(0.3..0.7);
     }

@@ -32,7 +32,7 @@
 //! path's vertices ± the heading's span, the zones' t1..t4) except where the
 //! heading turns or the shape blends; those stretches are split finely.
 
-use nalgebra::{Point2, Point3, Vector3};
+use nalgebra::{Point2, Point3, SVector, Vector3};
 
 use super::iwp::{Iwp, Shape};
 use super::motion::{Motion, Reader};
@@ -496,23 +496,8 @@ impl CostModel {
             // Entirely above the top by more than the safe distance.
             return None;
         }
-        // |a + t (b − a) − c|² < safe² in the plane: a quadratic in t.
-        let d = b.xy() - a.xy();
-        let f = a.xy() - c.center;
-        let qa = d.norm_squared();
-        let qb = 2.0 * f.dot(&d);
-        let qc = f.norm_squared() - safe * safe;
-        if qa < 1e-18 {
-            return (qc < 0.0).then_some((0.0, 1.0));
-        }
-        let disc = qb * qb - 4.0 * qa * qc;
-        if disc <= 0.0 {
-            return None;
-        }
-        let root = disc.sqrt();
-        let t0 = ((-qb - root) / (2.0 * qa)).max(0.0);
-        let t1 = ((-qb + root) / (2.0 * qa)).min(1.0);
-        (t0 < t1).then_some((t0, t1))
+        // |a + t (b − a) − c| < safe in the plane.
+        closer_than(&(a.xy() - c.center), &(b.xy() - a.xy()), safe)
     }
 
     /// Follows every UAV along the leg [s0, s1] of the centroid path: the
@@ -738,6 +723,50 @@ impl Piece<'_, '_> {
             .heading_from(mid, self.motion.span(), chord);
         self.split(a, mid, heading_a, heading_mid, depth - 1, samples, chord);
         self.split(mid, b, heading_mid, heading_b, depth - 1, samples, chord);
+    }
+}
+
+/// Where along f + t d, t ∈ [0, 1], the point is closer than `radius` to
+/// the origin: between the roots of |f + t d|² = radius², a quadratic in t;
+/// all of [0, 1] when d is nil and f is inside. The broad phase's windows
+/// (`touch_window`) and the column's chords (`pairs::linear_deficit`).
+fn closer_than<const D: usize>(
+    f: &SVector<f64, D>,
+    d: &SVector<f64, D>,
+    radius: f64,
+) -> Option<(f64, f64)> {
+    let qa = d.norm_squared();
+    let qb = 2.0 * f.dot(d);
+    let qc = f.norm_squared() - radius * radius;
+    if qa < 1e-18 {
+        return (qc < 0.0).then_some((0.0, 1.0));
+    }
+    let disc = qb * qb - 4.0 * qa * qc;
+    if disc <= 0.0 {
+        return None;
+    }
+    let root = disc.sqrt();
+    let t0 = ((-qb - root) / (2.0 * qa)).max(0.0);
+    let t1 = ((-qb + root) / (2.0 * qa)).min(1.0);
+    (t0 < t1).then_some((t0, t1))
+}
+
+/// Every UAV's position at evenly spaced arc lengths from `from` to `to`,
+/// both included, at most `most` apart: `at(positions, spacing)` at each.
+/// The changes of shape' pairs and the passes' facing UAV are sampled so.
+fn each_sample(
+    motion: &Motion<'_>,
+    [from, to]: [f64; 2],
+    most: f64,
+    scratch: &mut Vec<Point3<f64>>,
+    reader: &mut Reader,
+    mut at: impl FnMut(&[Point3<f64>], f64),
+) {
+    let samples = (((to - from) / most).ceil() as usize).max(1);
+    let step = (to - from) / samples as f64;
+    for k in 0..=samples {
+        motion.read_into(from + k as f64 * step, scratch, reader);
+        at(scratch, step);
     }
 }
 

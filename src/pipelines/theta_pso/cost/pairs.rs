@@ -24,20 +24,24 @@ impl CostModel {
         let floor = 2.0 * self.uav_radius + PAIR_FLOOR;
         let mut deficit = 0.0;
         let mut follow = |from: f64, to: f64, deficit: &mut f64| {
-            let samples = (((to - from) / PAIR_STEP).ceil() as usize).max(1);
-            let step = (to - from) / samples as f64;
-            let mut reader = crate::pipelines::theta_pso::motion::Reader::default();
-            for k in 0..=samples {
-                motion.read_into(from + k as f64 * step, scratch, &mut reader);
-                for i in 0..n {
-                    for j in (i + 1)..n {
-                        let gap = floor - (scratch[i] - scratch[j]).norm();
-                        if gap > 0.0 {
-                            *deficit += gap * step;
+            let mut reader = Reader::default();
+            each_sample(
+                motion,
+                [from, to],
+                PAIR_STEP,
+                scratch,
+                &mut reader,
+                |at, step| {
+                    for i in 0..n {
+                        for j in (i + 1)..n {
+                            let gap = floor - (at[i] - at[j]).norm();
+                            if gap > 0.0 {
+                                *deficit += gap * step;
+                            }
                         }
                     }
-                }
-            }
+                },
+            );
         };
         for zone in &path.zones {
             let [t1, t2, t3, t4] = zone.arcs();
@@ -117,23 +121,12 @@ impl CostModel {
 /// ½ (x √(x² + k²) + k² asinh(x / k)).
 fn linear_deficit(d0: Vector3<f64>, d1: Vector3<f64>, floor: f64) -> f64 {
     let e = d1 - d0;
-    let (qa, qb, qc) = (
-        e.norm_squared(),
-        2.0 * d0.dot(&e),
-        d0.norm_squared() - floor * floor,
-    );
+    let Some((lo, hi)) = closer_than(&d0, &e, floor) else {
+        return 0.0;
+    };
+    let qa = e.norm_squared();
     if qa < 1e-18 {
         return (floor - d0.norm()).max(0.0);
-    }
-    let disc = qb * qb - 4.0 * qa * qc;
-    if disc <= 0.0 {
-        return 0.0;
-    }
-    let root = disc.sqrt();
-    let lo = ((-qb - root) / (2.0 * qa)).max(0.0);
-    let hi = ((-qb + root) / (2.0 * qa)).min(1.0);
-    if hi <= lo {
-        return 0.0;
     }
     let b = d0.dot(&e) / qa;
     let k2 = (d0.norm_squared() / qa - b * b).max(0.0);

@@ -38,16 +38,20 @@ impl CostModel {
                 if to <= from {
                     continue;
                 }
-                let samples = (((to - from) / PASS_STEP).ceil() as usize).max(1);
-                let step = (to - from) / samples as f64;
-                for k in 0..=samples {
-                    motion.read_into(from + k as f64 * step, scratch, &mut reader);
-                    let facing = scratch
-                        .iter()
-                        .map(|p| cylinder.clearance(p))
-                        .fold(f64::INFINITY, f64::min);
-                    deficit += (band[0] - facing).max(facing - band[1]).max(0.0) * step;
-                }
+                each_sample(
+                    motion,
+                    [from, to],
+                    PASS_STEP,
+                    scratch,
+                    &mut reader,
+                    |at, step| {
+                        let facing = at
+                            .iter()
+                            .map(|p| cylinder.clearance(p))
+                            .fold(f64::INFINITY, f64::min);
+                        deficit += (band[0] - facing).max(facing - band[1]).max(0.0) * step;
+                    },
+                );
             }
         }
         deficit
