@@ -207,6 +207,7 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                 bounds,
                 route,
                 formation: Formation::default(),
+                vehicle: Default::default(),
                 reconfiguration: Default::default(),
                 theta_pso: Default::default(),
                 flatlo: Default::default(),

@@ -1491,10 +1491,12 @@ fn slot_errors(app: &App) -> Vec<String> {
 }
 
 /// Issue 24, items 4 and 11: growing a formation keeps its shape and stays
-/// valid for the mission's d_com and r_Q: a diamond of 4 typed to 20 UAVs
-/// is a diamond of 20 without an error (it had 32), `a` grows a preset as
-/// itself, P skips a preset that cannot fit (the line abreast of 20: 141
-/// errors) and says why, the spacing is a field, slots are millimetres.
+/// valid for the mission's d_com and r_Q: a diamond of 4 typed to 16 UAVs
+/// is a diamond of 16 without an error (with the safety margin of issue 36
+/// a diamond of 20 no longer fits d_com = 20 m at the spacing a shrink to
+/// 0.5 needs), `a` grows a preset as itself, P skips a preset that cannot
+/// fit (the line abreast of 16) and says why, the spacing is a field, slots
+/// are millimetres.
 #[test]
 fn presets_grow_valid_for_the_mission_with_their_spacing_as_a_field() {
     let dir = tempfile::tempdir().unwrap();
@@ -1510,8 +1512,8 @@ fn presets_grow_valid_for_the_mission_with_their_spacing_as_a_field() {
     assert_eq!(app.mission().formation.slots.len(), 4);
     assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
 
-    type_into(&mut app, "UAVs", "20");
-    assert_eq!(app.mission().formation.slots.len(), 20);
+    type_into(&mut app, "UAVs", "16");
+    assert_eq!(app.mission().formation.slots.len(), 16);
     assert_eq!(
         app.current_preset(),
         Some(skyform::mission::Preset::Diamond)
@@ -1552,9 +1554,9 @@ fn presets_grow_valid_for_the_mission_with_their_spacing_as_a_field() {
         Some(skyform::mission::Preset::Diamond)
     );
     assert!(slot_errors(&app).is_empty(), "{:?}", slot_errors(&app));
-    // A line abreast of 20 does not fit d_com = 20 m: refused, said why.
+    // A line abreast of 16 does not fit d_com = 20 m: refused, said why.
     app.update(Action::Select(Item::Formation));
-    type_into(&mut app, "UAVs", "20");
+    type_into(&mut app, "UAVs", "16");
     let before = app.mission().clone();
     type_into(&mut app, "preset", "line abreast");
     assert_eq!(app.mission(), &before);

@@ -29,6 +29,9 @@ pub struct Mission {
     pub route: Route,
     #[serde(default)]
     pub formation: Formation,
+    /// What each multicopter of the formation can fly (`[vehicle]`).
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub vehicle: Vehicle,
     #[serde(default)]
     pub reconfiguration: Reconfiguration,
     #[serde(default)]
@@ -246,6 +249,12 @@ pub struct Formation {
     /// [d_min^s, d_max^s]: distance band to the inspected surface, metres
     /// (eq. 8); the default stand-off of every inspected obstacle.
     pub surface_distance: [f64; 2],
+    /// The room a plan must keep beyond r_Q from every obstacle and beyond
+    /// 2 r_Q between two UAVs, metres: verification holds every flight to
+    /// it, the automatic shapes keep it. Not in the paper, whose margins are
+    /// zero by construction: 0.1 m by default, room for a tracking autopilot
+    /// that a zero margin never leaves.
+    pub safety_margin: f64,
     /// Length of the straight inspection pass along an inspected obstacle,
     /// metres of centroid path over which eq. 8 must hold. Not in the paper:
     /// 6 m is 2 s of video at 3 m/s past a pier of the bridge.
@@ -262,6 +271,7 @@ impl Default for Formation {
             uav_radius: 0.5,
             comm_range: 20.0,
             ground_speed: 3.0,
+            safety_margin: 0.1,
             surface_distance: [1.0, 5.0],
             inspection_pass: 6.0,
             slots: vec![
@@ -269,6 +279,116 @@ impl Default for Formation {
                 Vector3::new(-2.0, -1.0, 0.0),
                 Vector3::new(2.0, -1.0, 0.0),
             ],
+        }
+    }
+}
+
+/// `[vehicle]`: what one multicopter of the formation can fly, as its
+/// autopilot limits it. Every UAV's trajectory is timed within these limits
+/// (`theta_pso::timing`) and verification holds every flight to them. The
+/// defaults are PX4's multicopter position-controller parameters
+/// (MPC_XY_VEL_MAX, MPC_Z_VEL_MAX_UP, MPC_Z_VEL_MAX_DN, MPC_ACC_HOR_MAX,
+/// MPC_ACC_UP_MAX, MPC_ACC_DOWN_MAX; see docs/theta-pso.md). Metres, seconds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Vehicle {
+    /// Largest horizontal speed, m/s (PX4 MPC_XY_VEL_MAX: 12).
+    pub max_speed: f64,
+    /// Largest climb rate, m/s (PX4 MPC_Z_VEL_MAX_UP: 3).
+    pub max_climb_rate: f64,
+    /// Largest descent rate, m/s (PX4 MPC_Z_VEL_MAX_DN: 1.5).
+    pub max_descent_rate: f64,
+    /// Largest horizontal acceleration, m/s² (PX4 MPC_ACC_HOR_MAX: 5).
+    pub max_acceleration: f64,
+    /// Largest upward acceleration, m/s² (PX4 MPC_ACC_UP_MAX: 4).
+    pub max_acceleration_up: f64,
+    /// Largest downward acceleration, m/s² (PX4 MPC_ACC_DOWN_MAX: 3).
+    pub max_acceleration_down: f64,
+    /// UAVs with limits of their own (a heavier camera ship, say):
+    /// `uavs = [{ uav = 2, max_speed = 8.0 }]`, UAVs numbered from 1; a
+    /// limit not given is the formation's.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub uavs: Vec<VehicleOverride>,
+}
+
+impl Default for Vehicle {
+    fn default() -> Self {
+        Vehicle {
+            max_speed: 12.0,
+            max_climb_rate: 3.0,
+            max_descent_rate: 1.5,
+            max_acceleration: 5.0,
+            max_acceleration_up: 4.0,
+            max_acceleration_down: 3.0,
+            uavs: Vec::new(),
+        }
+    }
+}
+
+/// One UAV's own limits in `[vehicle]` (`uavs = [{ uav = 2, … }]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VehicleOverride {
+    /// The UAV, numbered from 1 (its slot).
+    pub uav: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_speed: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_climb_rate: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_descent_rate: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_acceleration: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_acceleration_up: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_acceleration_down: Option<f64>,
+}
+
+/// The limits one UAV flies within: `[vehicle]` with its own entry applied.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct VehicleLimits {
+    /// Horizontal speed, m/s.
+    pub speed: f64,
+    /// Climb and descent rates, m/s.
+    pub climb: f64,
+    pub descent: f64,
+    /// Horizontal acceleration, m/s².
+    pub acceleration: f64,
+    /// Upward and downward acceleration, m/s².
+    pub up: f64,
+    pub down: f64,
+}
+
+impl VehicleLimits {
+    /// Every limit times `factor` (the timing plans a little inside them).
+    pub fn scaled(self, factor: f64) -> Self {
+        VehicleLimits {
+            speed: self.speed * factor,
+            climb: self.climb * factor,
+            descent: self.descent * factor,
+            acceleration: self.acceleration * factor,
+            up: self.up * factor,
+            down: self.down * factor,
+        }
+    }
+}
+
+impl Vehicle {
+    /// The limits of UAV `uav` (0-based).
+    pub fn limits(&self, uav: usize) -> VehicleLimits {
+        let own = self.uavs.iter().find(|o| o.uav == uav + 1);
+        let pick = |base: f64, mine: Option<Option<f64>>| mine.flatten().unwrap_or(base);
+        VehicleLimits {
+            speed: pick(self.max_speed, own.map(|o| o.max_speed)),
+            climb: pick(self.max_climb_rate, own.map(|o| o.max_climb_rate)),
+            descent: pick(self.max_descent_rate, own.map(|o| o.max_descent_rate)),
+            acceleration: pick(self.max_acceleration, own.map(|o| o.max_acceleration)),
+            up: pick(self.max_acceleration_up, own.map(|o| o.max_acceleration_up)),
+            down: pick(
+                self.max_acceleration_down,
+                own.map(|o| o.max_acceleration_down),
+            ),
         }
     }
 }
@@ -746,6 +866,18 @@ impl Formation {
     /// r_F = max_n ‖ΔT_n‖: distance of the farthest UAV from the centroid (eq. 6).
     pub fn radius(&self) -> f64 {
         crate::base::geometry::farthest_offset(&self.slots)
+    }
+
+    /// The least distance a plan keeps between two UAVs: 2 r_Q + the safety
+    /// margin (eq. 7's lower bound with the margin verification holds).
+    pub fn closest_pair(&self) -> f64 {
+        2.0 * self.uav_radius + self.safety_margin
+    }
+
+    /// The least clearance a plan keeps from every obstacle's surface:
+    /// r_Q + the safety margin.
+    pub fn least_clearance(&self) -> f64 {
+        self.uav_radius + self.safety_margin
     }
 
     /// Safe radius of the whole formation around its centroid, r_F + r_Q.

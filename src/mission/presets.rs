@@ -98,7 +98,7 @@ impl Preset {
     }
 
     /// The spacings for which this preset of `n` UAVs is a valid formation
-    /// of `f` (eq. 7: every pair at least 2 r_Q apart in the closest shape
+    /// of `f` (eq. 7: every pair at least 2 r_Q + the safety margin apart in the closest shape
     /// the formation takes, `smallest_scale` of a shrink, and at most d_com
     /// apart), with a 2 % margin and to the millimetre; `None` when no
     /// spacing is (the line abreast of 20 is longer than d_com allows).
@@ -106,7 +106,7 @@ impl Preset {
         let cells = self.unit_cells(n);
         let widest = max_pair_distance(&cells);
         let scale = smallest_scale.clamp(1e-6, 1.0);
-        let low = ((2.0 * f.uav_radius / scale) * 1.02 * 1000.0).ceil() / 1000.0;
+        let low = ((f.closest_pair() / scale) * 1.02 * 1000.0).ceil() / 1000.0;
         let high = if widest > 0.0 {
             (f.comm_range / widest * 0.98 * 1000.0).floor() / 1000.0
         } else {
@@ -184,10 +184,10 @@ pub fn reshape(
 
 /// Why `preset` of `n` fits no spacing.
 fn misfit(preset: Preset, n: usize, f: &Formation, scale: f64) -> String {
-    let closest = 2.0 * f.uav_radius / scale.clamp(1e-6, 1.0);
+    let closest = f.closest_pair() / scale.clamp(1e-6, 1.0);
     let far = max_pair_distance(&preset.slots(n, closest));
     format!(
-        "a {} of {n} does not fit: at the {} m spacing that keeps 2 r_Q apart{}, its farthest \
+        "a {} of {n} does not fit: at the {} m spacing that keeps 2 r_Q + the safety margin apart{}, its farthest \
          UAVs are {} m apart, beyond d_com = {} m",
         preset.name(),
         round_mm(closest),
@@ -373,7 +373,8 @@ mod tests {
     }
 
     /// Issue 24, item 11: a preset's spacing range keeps every pair within
-    /// [2 r_Q / shrink, d_com]; a line abreast of 20 does not fit d_com = 20 m.
+    /// [(2 r_Q + the safety margin) / shrink, d_com]; a line abreast of 20
+    /// does not fit d_com = 20 m.
     #[test]
     fn the_spacing_range_keeps_every_pair_within_eq_7() {
         let f = Formation::default();
@@ -385,13 +386,13 @@ mod tests {
                 for spacing in [lo, hi] {
                     let slots = preset.slots(n, spacing);
                     let (near, far) = (min_pair_distance(&slots), max_pair_distance(&slots));
-                    assert!(near * 0.5 >= 2.0 * f.uav_radius, "{} of {n}", preset.name());
+                    assert!(near * 0.5 >= f.closest_pair(), "{} of {n}", preset.name());
                     assert!(far <= f.comm_range, "{} of {n}: {far}", preset.name());
                 }
             }
         }
         assert!(Preset::LineAbreast.spacing_range(20, &f, 0.5).is_none());
-        assert!(Preset::Diamond.spacing_range(20, &f, 0.5).is_some());
+        assert!(Preset::Diamond.spacing_range(16, &f, 0.5).is_some());
     }
 
     #[test]

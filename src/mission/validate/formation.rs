@@ -13,6 +13,14 @@ impl Checker {
             self.non_negative(path.key("surface_distance"), f.surface_distance[0], " m");
         }
         self.positive(path.key("inspection_pass"), f.inspection_pass, " m");
+        self.non_negative(path.key("safety_margin"), f.safety_margin, " m");
+        self.at_most(
+            path.key("safety_margin"),
+            f.safety_margin,
+            physical::UAV_RADIUS,
+            " m",
+            "a margin is room for tracking; no site leaves so much",
+        );
         if f.comm_range.is_finite() && f.comm_range < 2.0 * f.uav_radius {
             self.error(
                 path.key("comm_range"),
@@ -43,7 +51,115 @@ impl Checker {
         }
     }
 
-    /// Eq. 7 on every pair of slots scaled by `scale`: 2 r_Q ≤ d ≤ d_com.
+    /// `[vehicle]`: every limit positive and physical, every UAV's own entry
+    /// naming a UAV of the formation once.
+    pub(super) fn vehicle(&mut self, path: &FieldPath, v: &Vehicle, f: &Formation) {
+        let speeds = [
+            ("max_speed", v.max_speed),
+            ("max_climb_rate", v.max_climb_rate),
+            ("max_descent_rate", v.max_descent_rate),
+        ];
+        let accelerations = [
+            ("max_acceleration", v.max_acceleration),
+            ("max_acceleration_up", v.max_acceleration_up),
+            ("max_acceleration_down", v.max_acceleration_down),
+        ];
+        self.vehicle_limits(path, &speeds, &accelerations);
+        for (i, own) in v.uavs.iter().enumerate() {
+            let at = path.key("uavs").index(i);
+            if own.uav == 0 || own.uav > f.slots.len() {
+                self.error(
+                    at.key("uav"),
+                    format!(
+                        "there is no UAV {} (UAVs are numbered from 1; the formation has {})",
+                        own.uav,
+                        f.slots.len()
+                    ),
+                );
+            } else if v.uavs[..i].iter().any(|o| o.uav == own.uav) {
+                self.error(
+                    at.key("uav"),
+                    format!(
+                        "UAV {} has limits of its own already (an earlier entry)",
+                        own.uav
+                    ),
+                );
+            }
+            let speeds: Vec<(&str, f64)> = [
+                ("max_speed", own.max_speed),
+                ("max_climb_rate", own.max_climb_rate),
+                ("max_descent_rate", own.max_descent_rate),
+            ]
+            .into_iter()
+            .filter_map(|(k, x)| x.map(|x| (k, x)))
+            .collect();
+            let accelerations: Vec<(&str, f64)> = [
+                ("max_acceleration", own.max_acceleration),
+                ("max_acceleration_up", own.max_acceleration_up),
+                ("max_acceleration_down", own.max_acceleration_down),
+            ]
+            .into_iter()
+            .filter_map(|(k, x)| x.map(|x| (k, x)))
+            .collect();
+            self.vehicle_limits(&at, &speeds, &accelerations);
+        }
+        // The formation's pace is its slowest UAV's: a ground speed above a
+        // UAV's speed limit is flown at that limit.
+        let slowest = (0..f.slots.len())
+            .map(|n| (n, v.limits(n).speed))
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((n, speed)) = slowest
+            && speed.is_finite()
+            && speed > 0.0
+            && f.ground_speed.is_finite()
+            && f.ground_speed > speed
+        {
+            self.warning(
+                FieldPath::root().key("formation").key("ground_speed"),
+                format!(
+                    "{} m/s is faster than UAV {}'s max_speed of {} m/s ([vehicle]): the \
+                     formation flies at {} m/s at most",
+                    compact(f.ground_speed),
+                    n + 1,
+                    compact(speed),
+                    compact(speed)
+                ),
+            );
+        }
+    }
+
+    /// Speeds positive and below the speed of sound; accelerations positive
+    /// and below 10 g (no multicopter autopilot commands more).
+    fn vehicle_limits(
+        &mut self,
+        path: &FieldPath,
+        speeds: &[(&str, f64)],
+        accelerations: &[(&str, f64)],
+    ) {
+        for &(key, value) in speeds {
+            self.positive(path.key(key), value, " m/s");
+            self.at_most(
+                path.key(key),
+                value,
+                physical::SPEED,
+                " m/s",
+                "faster than sound; no multicopter flies so",
+            );
+        }
+        for &(key, value) in accelerations {
+            self.positive(path.key(key), value, " m/s²");
+            self.at_most(
+                path.key(key),
+                value,
+                physical::ACCELERATION,
+                " m/s²",
+                "above 10 g; no multicopter autopilot commands so much",
+            );
+        }
+    }
+
+    /// Eq. 7 on every pair of slots scaled by `scale`: 2 r_Q + the safety
+    /// margin ≤ d ≤ d_com.
     pub(super) fn slot_spacing(&mut self, path: &FieldPath, f: &Formation, scale: f64, what: &str) {
         for i in 0..f.slots.len() {
             for j in (i + 1)..f.slots.len() {
@@ -56,15 +172,15 @@ impl Checker {
                 } else {
                     path.clone()
                 };
-                if d < 2.0 * f.uav_radius {
+                if d < f.closest_pair() {
                     self.error(
                         at,
                         format!(
                             "{what}: slots {} and {} are {d:.3} m apart, closer than \
-                             2 r_Q = {:.3} m (eq. 7)",
+                             2 r_Q + the safety margin = {:.3} m (eq. 7)",
                             i + 1,
                             j + 1,
-                            2.0 * f.uav_radius
+                            f.closest_pair()
                         ),
                     );
                 } else if d > f.comm_range {

@@ -11,7 +11,7 @@ use super::diagnostic::Diagnostic;
 use super::source::FieldPath;
 use crate::mission::model::{
     Bounds, FlatloParams, FleetParams, Formation, GeoOrigin, Mission, Reconfiguration, Route,
-    ThetaPsoParams,
+    ThetaPsoParams, Vehicle,
 };
 
 use crate::mission::model::GRAVITY as G;
@@ -34,6 +34,7 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
     c.bounds(&root.key("bounds"), &mission.bounds);
     c.route(&root.key("route"), mission);
     c.formation(&root.key("formation"), &mission.formation);
+    c.vehicle(&root.key("vehicle"), &mission.vehicle, &mission.formation);
     c.reconfiguration(
         &root.key("reconfiguration"),
         &mission.reconfiguration,
@@ -61,6 +62,8 @@ mod physical {
     pub const SPEED: f64 = 343.0;
     /// m/s above which a multirotor formation speed gets a warning.
     pub const FORMATION_SPEED_WARNING: f64 = 50.0;
+    /// m/s²: 10 g, beyond any multicopter autopilot's acceleration limit.
+    pub const ACCELERATION: f64 = 98.0665;
     /// Metres: a "UAV" bigger than this is not one.
     pub const UAV_RADIUS: f64 = 50.0;
 }
