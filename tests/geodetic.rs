@@ -130,7 +130,9 @@ fn a_latitude_longitude_mission_plans_the_same_as_its_enu_twin() {
     }
     eprintln!("{samples} samples, largest difference {worst:e} m");
     assert!(samples > 100);
-    assert!(worst < 1e-6, "{worst} m");
+    // Micrometres: the conversion's last bits, carried through the time
+    // law's bisections (each grid point's speed to a part in 10⁹).
+    assert!(worst < 1e-5, "{worst} m");
     assert!((a.cost.total - b.cost.total).abs() < 1e-6);
 }
 

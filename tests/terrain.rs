@@ -4,9 +4,7 @@
 
 use nalgebra::Point3;
 use skyform::mission;
-use skyform::pipelines::theta_pso::{
-    CostModel, path::CentroidPath, path::heading_span, trajectory, verify,
-};
+use skyform::pipelines::theta_pso::{CostModel, flight, path::CentroidPath};
 
 /// Writes a 101 × 21 float map (1 m pixels from (0, 0), rows northward):
 /// flat at 0, or with a 20 m hill over x ∈ [40, 60].
@@ -68,8 +66,7 @@ fn judge(hill: bool) -> (f64, bool) {
         .collect();
     let path = CentroidPath::bare(points);
     let terms = CostModel::new(&m, &[]).terms(&path);
-    let (trajectories, _) = trajectory::generate(&path, &[], &[], &m.formation, heading_span(&m));
-    let v = verify::verify(&m, &trajectories);
+    let (_, v) = flight::fly(&m, &path, &[], &[]);
     (terms.altitude, v.feasible)
 }
 

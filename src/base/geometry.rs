@@ -48,6 +48,18 @@ pub fn segment_point_distance(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>)
     segment_projection(a, b, p).1
 }
 
+/// Distance from `p` to the segment a-b in three dimensions.
+pub fn segment_point_distance_3d(a: &Point3<f64>, b: &Point3<f64>, p: &Point3<f64>) -> f64 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * t)).norm()
+}
+
 /// Where `p` projects onto the segment a-b: the fraction t ∈ [0, 1] along
 /// it, and the distance from `p` to that point.
 pub fn segment_projection(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>) -> (f64, f64) {

@@ -142,7 +142,12 @@ impl Planned {
             pipeline: Kind::ThetaPso,
             seed: outcome.seed,
             tracks: tracks::theta_pso(outcome),
-            limits: Limits::theta_pso(mission),
+            // The written legs are flown by the autopilot's own trajectory
+            // generator: its speeds are checked, not its accelerations.
+            limits: Limits {
+                dynamics: false,
+                ..Limits::theta_pso(mission)
+            },
             margin: mission.theta_pso.clearance_margin,
             margin_source: "theta_pso.clearance_margin".into(),
             loiter_radius: 0.0,
@@ -172,6 +177,7 @@ impl Planned {
                 closest: p.min_separation,
                 farthest: None,
                 inspections: false,
+                dynamics: false,
             },
             margin: tracking,
             margin_source: "the simulated squadron's largest tracking error".into(),
@@ -194,6 +200,7 @@ impl Planned {
                 closest: p.safety_distance,
                 farthest: None,
                 inspections: false,
+                dynamics: false,
             },
             margin: p.tolerance * p.safety_distance / 2.0,
             margin_source: "fleet.tolerance × fleet.safety_distance / 2".into(),

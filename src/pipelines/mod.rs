@@ -75,6 +75,10 @@ pub struct Limits {
     pub farthest: Option<f64>,
     /// Check eq. 8 over each inspected obstacle's pass.
     pub inspections: bool,
+    /// Hold every vehicle's speeds and accelerations, sample to sample, to
+    /// the mission's `[vehicle]` limits (θ-PSO's timed trajectories; not
+    /// an export's straight legs, whose autopilot shapes its own).
+    pub dynamics: bool,
 }
 
 /// Severity of a log event.

@@ -46,8 +46,9 @@ pub fn flush_iterations(
 }
 
 /// Each UAV's clearance over `sim_time`: the distance from its sphere of
-/// radius r_Q to the nearest obstacle (terrain-raised), 0 = touching. The
-/// plot beside the scene on the timeline the flight plays on.
+/// radius r_Q + the safety margin to the nearest obstacle (terrain-raised),
+/// 0 = the least verification accepts. The plot beside the scene on the
+/// timeline the flight plays on.
 fn log_clearances(
     stream: &RecordingStream,
     o: &ThetaPsoOutcome,
@@ -74,7 +75,7 @@ fn log_clearances(
                     .iter()
                     .map(|c| c.clearance(&s.position))
                     .fold(f64::INFINITY, f64::min)
-                    - m.formation.uav_radius
+                    - m.formation.least_clearance()
             })
             .collect();
         log_series(stream, &entity, &times, values)?;
@@ -215,13 +216,11 @@ fn log_passes(
     o: &ThetaPsoOutcome,
     events: &str,
 ) -> rerun::RecordingStreamResult<()> {
-    let speed = o.path_length / o.duration.max(1e-9);
-    let walker = crate::pipelines::theta_pso::path::ArcWalker::new(&o.centroid_path);
     for (pass, result) in o.passes.iter().zip(&o.verification.inspections) {
         let [t0, t1] = pass.time;
         let steps = 20;
         let stretch: Vec<[f32; 3]> = (0..=steps)
-            .map(|k| f32x3(&walker.at((t0 + (t1 - t0) * k as f64 / steps as f64) * speed)))
+            .map(|k| f32x3(&o.centroid_at(t0 + (t1 - t0) * k as f64 / steps as f64)))
             .collect();
         stream.log_static(
             at::pass(&pass.obstacle).as_str(),

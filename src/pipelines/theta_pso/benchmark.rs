@@ -12,7 +12,7 @@
 use std::ops::ControlFlow;
 
 use super::CostTerms;
-use super::{ThetaPsoOutcome, path, trajectory, verify};
+use super::{ThetaPsoOutcome, path, trajectory};
 use crate::mission::Mission;
 use crate::pipelines::theta_pso::spso::{self, Decoder};
 use crate::pipelines::{CancelToken, Completion, Event, Level, Observer, PipelineError};
@@ -111,11 +111,8 @@ pub fn plan(
             crate::pipelines::figure(crate::pipelines::limits::TRAJECTORY_SAMPLES)
         )));
     }
-    let span = path::heading_span(mission);
-    let (trajectories, reconfigurations) =
-        trajectory::generate(&centroid, &[], &[], &mission.formation, span);
     observer.on_event(Event::Stage("verification"));
-    let verification = verify::verify(mission, &trajectories);
+    let (flight, verification) = super::flight::fly(mission, &centroid, &[], &[]);
     observer.on_event(Event::Progress(1.0));
     let n = model.nodes;
     let waypoints = (0..n)
@@ -136,12 +133,14 @@ pub fn plan(
         pass_angles: Vec::new(),
         warm_start: None,
         path_length: length,
-        duration: length / speed,
+        duration: flight.duration(),
         reference_length: None,
         length_ratio: None,
         passes: Vec::new(),
         centroid_path: centroid.points,
-        reconfigurations,
+        flown_path: flight.rounded.path.points,
+        flown_arcs: flight.progress,
+        reconfigurations: flight.reconfigurations,
         bypassed: Vec::new(),
         source: super::PlanSource::Swarm,
         route_length: length,
@@ -152,7 +151,7 @@ pub fn plan(
             length: 0.0,
             squeeze: None,
         },
-        trajectories,
+        trajectories: flight.trajectories,
         verification,
     })
 }

@@ -3,9 +3,12 @@
 //! Reading of eq. 9: for two obstacles p, q the gap d_pq is the distance
 //! between their circles along the line C_p C_q (centre distance minus both
 //! radii). An IWP sits at the midpoint of that gap when the gap is at least
-//! one UAV wide (2 r_Q) but narrower than the formation (2 (r_F + r_Q)):
-//! one UAV fits, the nominal formation does not. Two refinements a flight
-//! engineer needs and the paper leaves implicit:
+//! one UAV wide (2 r_Q, with the safety margin each side) but narrower than
+//! the formation (2 (r_F + r_Q), the same): one UAV fits, the nominal
+//! formation does not. Every "r_Q" of the planner is r_Q plus
+//! `formation.safety_margin` (r_Q + m from an obstacle, 2 r_Q + m between two
+//! UAVs): the room verification holds every flight to. Two refinements a
+//! flight engineer needs and the paper leaves implicit:
 //! - a gap blocked by a third obstacle (the segment P_p P_q passes within
 //!   r_Q of it) is not a passage and gets no IWP;
 //! - both obstacles must reach into the altitude band; over a lower one the
@@ -176,10 +179,11 @@ pub fn min_pair_distance(offsets: &[Vector3<f64>]) -> f64 {
     best
 }
 
-/// The spacing of the alignment column: the closest nominal pair, at least 2 r_Q.
+/// The spacing of the alignment column: the closest nominal pair, at
+/// least 2 r_Q + the safety margin.
 pub fn column_spacing(formation: &Formation) -> f64 {
     let nominal = min_pair_distance(&formation.slots);
-    let floor = 2.0 * formation.uav_radius + COLUMN_SPARE;
+    let floor = formation.closest_pair() + COLUMN_SPARE;
     let spacing = if nominal.is_finite() {
         nominal.max(floor)
     } else {
@@ -224,8 +228,8 @@ const FIT_EPS: f64 = 1e-9;
 /// `Auto` is the least change that fits: among the shapes that make the
 /// lateral width fit, the one that moves the UAVs least (largest slot
 /// displacement). Shrink is tried at the largest scale that leaves `margin`
-/// beside the outermost UAVs (never below the spacing 2 r_Q allows), which
-/// often beats a full alignment.
+/// beside the outermost UAVs (never below the spacing 2 r_Q + the safety
+/// margin allows), which often beats a full alignment.
 pub fn resolve_shape(
     choice: ShapeChoice,
     gap: f64,
@@ -234,7 +238,7 @@ pub fn resolve_shape(
     margin: f64,
 ) -> Result<Option<Shape>, String> {
     let slots = &formation.slots;
-    let r_q = formation.uav_radius;
+    let r_q = formation.least_clearance();
     let fits =
         |shape: &Shape| lateral_half_width(&shape.offsets(slots, 1.0), r_q) <= gap / 2.0 + FIT_EPS;
     let width = |shape: &Shape| 2.0 * lateral_half_width(&shape.offsets(slots, 1.0), r_q);
@@ -246,9 +250,10 @@ pub fn resolve_shape(
     let explicit = |shape: Shape| {
         if matches!(shape, Shape::Alignment { .. }) && !column_ok {
             Err(format!(
-                "a column of {} UAVs at least 2 r_Q = {:.2} m apart is longer than d_com = {} m (eq. 7)",
+                "a column of {} UAVs at least 2 r_Q + the safety margin = {:.2} m apart is longer \
+                 than d_com = {} m (eq. 7)",
                 slots.len(),
-                2.0 * r_q,
+                formation.closest_pair(),
                 formation.comm_range
             ))
         } else if fits(&shape) {
@@ -283,7 +288,7 @@ pub fn resolve_shape(
                 let fit = (gap / 2.0 - r_q - margin.max(0.0)) / widest;
                 let closest = min_pair_distance(slots);
                 let floor = if closest.is_finite() {
-                    2.0 * r_q / closest
+                    formation.closest_pair() / closest
                 } else {
                     0.0
                 };
@@ -345,7 +350,7 @@ fn crossing_hold(
     shape: Option<Shape>,
 ) -> Result<(f64, f64), String> {
     let f = &mission.formation;
-    let r_q = f.uav_radius;
+    let r_q = f.least_clearance();
     let margin = mission.theta_pso.clearance_margin.max(0.0);
     let obstacles = &mission.obstacles;
     let deepest = obstacles[pair[0]].radius.max(obstacles[pair[1]].radius);
@@ -429,7 +434,7 @@ fn crossing_hold(
 /// Every IWP of the mission by eq. 9, with the operator's choices applied.
 pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
     let f = &mission.formation;
-    let r_q = f.uav_radius;
+    let r_q = f.least_clearance();
     let too_narrow = 2.0 * r_q;
     let fits_formation = 2.0 * (f.radius() + r_q);
     let obstacles = &mission.obstacles;

@@ -6,6 +6,7 @@
 
 pub mod benchmark;
 pub mod cost;
+pub mod flight;
 pub mod inspection;
 pub mod iwp;
 pub mod motion;
@@ -17,6 +18,7 @@ pub mod seeding;
 pub mod spso;
 pub mod trajectory;
 pub mod unusable;
+pub mod timing;
 pub mod verify;
 
 use std::f64::consts::FRAC_PI_2;
@@ -106,6 +108,13 @@ pub struct ThetaPsoOutcome {
     pub warm_start: Option<WarmStart>,
     /// P_F*: start, waypoints, IWP crossings and inspection passes, goal.
     pub centroid_path: Vec<Point3<f64>>,
+    /// The centroid's path as flown: P_F* simplified and its corners
+    /// rounded (`path::rounding`), metres ENU.
+    pub flown_path: Vec<Point3<f64>>,
+    /// Where the centroid is along `flown_path` at each trajectory sample,
+    /// metres (the flight's time law: from rest, slowed by the vehicle's
+    /// limits, to rest).
+    pub flown_arcs: Vec<f64>,
     /// Metres.
     pub path_length: f64,
     /// Seconds at the formation's ground speed.
@@ -145,6 +154,27 @@ pub struct PlannedPass {
 impl ThetaPsoOutcome {
     pub fn feasible(&self) -> bool {
         self.verification.feasible
+    }
+
+    /// Where the centroid is along `flown_path` at `t` seconds, metres
+    /// (between samples, as the samples' straight line has it).
+    pub fn arc_at(&self, t: f64) -> f64 {
+        let times = self.trajectories.first().map(|tr| &tr.samples[..]).unwrap_or(&[]);
+        let k = times.partition_point(|s| s.t <= t);
+        match (k.checked_sub(1), times.get(k)) {
+            (Some(a), Some(b)) if b.t > times[a].t => {
+                let u = (t - times[a].t) / (b.t - times[a].t);
+                let (sa, sb) = (self.flown_arcs[a], self.flown_arcs[k]);
+                sa + (sb - sa) * u
+            }
+            (Some(a), _) => self.flown_arcs.get(a).copied().unwrap_or(0.0),
+            (None, _) => 0.0,
+        }
+    }
+
+    /// Where the centroid is at `t` seconds, metres ENU.
+    pub fn centroid_at(&self, t: f64) -> Point3<f64> {
+        path::ArcWalker::new(&self.flown_path).at(self.arc_at(t))
     }
 }
 
@@ -350,8 +380,7 @@ struct Attempt {
     convergence: Vec<f64>,
     path: CentroidPath,
     cost: CostTerms,
-    trajectories: Vec<Trajectory>,
-    reconfigurations: Vec<Reconfiguration>,
+    flight: trajectory::Flight,
     verification: Verification,
     source: PlanSource,
 }
@@ -395,21 +424,26 @@ impl Attempt {
             )));
         }
         let names: Vec<String> = mission.obstacles.iter().map(|o| o.name.clone()).collect();
-        let (trajectories, reconfigurations) = trajectory::generate(
-            &path,
-            &problem.iwps,
-            &names,
-            &mission.formation,
-            path::heading_span(mission),
-        );
-        let verification = verify::verify(mission, &trajectories);
+        let (flight, verification) = flight::fly(mission, &path, &problem.iwps, &names);
+        // Slowing through the turns makes the flight longer than the path
+        // over the ground speed: its samples are checked again.
+        let samples = trajectory_samples(flight.duration(), mission.formation.slots.len());
+        if crate::pipelines::exceeds(samples, crate::pipelines::limits::TRAJECTORY_SAMPLES) {
+            return Err(PipelineError::OverBudget(format!(
+                "vehicle: the planned flight ({:.1} m in {:.1} s within the [vehicle] limits) \
+                 needs {} trajectory samples (limit {})",
+                cost.length,
+                flight.duration(),
+                crate::pipelines::figure(samples),
+                crate::pipelines::figure(crate::pipelines::limits::TRAJECTORY_SAMPLES)
+            )));
+        }
         Ok(Attempt {
             position,
             convergence,
             path,
             cost,
-            trajectories,
-            reconfigurations,
+            flight,
             verification,
             source,
         })
@@ -689,7 +723,10 @@ pub fn plan_warm(
         .iter()
         .map(|pass| PlannedPass {
             obstacle: mission.obstacles[pass.obstacle].name.clone(),
-            time: [pass.arcs[0] / speed, pass.arcs[1] / speed],
+            time: [
+                best.flight.time_at_planned(pass.arcs[0]),
+                best.flight.time_at_planned(pass.arcs[1]),
+            ],
             on_left: pass.on_left,
         })
         .collect();
@@ -709,19 +746,21 @@ pub fn plan_warm(
         pass_angles,
         warm_start: warm.cloned(),
         path_length: best.cost.length,
-        duration: best.cost.length / speed,
+        duration: best.flight.duration(),
         reference_length,
         length_ratio: reference_length
             .filter(|r| *r > 0.0)
             .map(|r| best.cost.length / r),
         passes,
         centroid_path: best.path.points,
-        reconfigurations: best.reconfigurations,
+        flown_path: best.flight.rounded.path.points,
+        flown_arcs: best.flight.progress,
+        reconfigurations: best.flight.reconfigurations,
         bypassed,
         source: best.source,
         route_length: corridor.length,
         corridor,
-        trajectories: best.trajectories,
+        trajectories: best.flight.trajectories,
         verification: best.verification,
     })
 }

@@ -95,9 +95,9 @@ pub fn lower_bound(mission: &Mission, iwps: &[Iwp], resolution: f64) -> Option<R
     let discs: Vec<Disc> = mission
         .obstacles
         .iter()
-        .filter(|o| o.height + f.uav_radius > mission.bounds.z[1])
+        .filter(|o| o.height + f.least_clearance() > mission.bounds.z[1])
         .map(|o| {
-            let reach = o.radius + f.uav_radius;
+            let reach = o.radius + f.least_clearance();
             let rho = shapes
                 .iter()
                 .map(|s| closest_centroid(s, reach))

@@ -16,8 +16,6 @@ use nalgebra::{Point3, Vector3};
 use super::Problem;
 use super::cost::INFEASIBLE_STEP;
 use super::path::ArcWalker;
-use super::trajectory;
-use super::verify;
 use crate::mission::Mission;
 
 /// Rounds of verify-and-move at most.
@@ -42,15 +40,12 @@ pub fn repair(mission: &Mission, problem: &Problem, position: &[f64]) -> Option<
         p
     };
     let objective = |w: &[Point3<f64>]| problem.objective_below(&encode(w), f64::INFINITY);
-    let span = super::path::heading_span(mission);
     let names: Vec<String> = mission.obstacles.iter().map(|o| o.name.clone()).collect();
     let mut current = objective(&waypoints);
     for _ in 0..ROUNDS {
         let particle = encode(&waypoints);
         let path = problem.path(&particle);
-        let (trajectories, _) =
-            trajectory::generate(&path, &problem.iwps, &names, &mission.formation, span);
-        let verification = verify::verify(mission, &trajectories);
+        let (_, verification) = super::flight::fly(mission, &path, &problem.iwps, &names);
         if verification.feasible {
             return Some(particle);
         }

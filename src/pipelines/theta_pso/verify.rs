@@ -1,10 +1,15 @@
 //! Checks the flown result against the hard constraints, sample by sample.
 //!
 //! The cost only penalises; this decides. For every UAV and every sample:
-//! clearance to every obstacle ≥ r_Q, every pair within [2 r_Q, d_com]
-//! (eq. 7), altitude inside the band (eq. 5), position inside the bounds;
-//! and for every inspected obstacle, eq. 8 over its pass (`verify_inspections`, with the pass geometry of `inspection`).
-//! A plan that fails any of them is infeasible.
+//! clearance to every obstacle ≥ r_Q + the safety margin, every pair within
+//! [2 r_Q + the safety margin, d_com] (eq. 7 with the margin), altitude
+//! inside the band (eq. 5), position inside the bounds; every UAV's
+//! horizontal and vertical speed and acceleration within its `[vehicle]`
+//! limits (accelerations from one sample's velocity to the next); and for
+//! every inspected obstacle, eq. 8 over its pass (`verify_inspections`, with
+//! the pass geometry of `inspection`). A plan that fails any of them is
+//! infeasible, and the first failure is named: the check, the UAV, the time,
+//! the figure and the limit.
 
 use nalgebra::Point3;
 use serde::Serialize;
@@ -145,14 +150,16 @@ impl Tracker {
 
 /// θ-PSO's own thresholds, in the shared vocabulary of the checks.
 impl Limits {
-    /// θ-PSO's hard constraints: r_Q, [2 r_Q, d_com] (eq. 7), eq. 8.
+    /// θ-PSO's hard constraints: r_Q and 2 r_Q with the safety margin,
+    /// d_com (eq. 7), eq. 8, the vehicle's limits.
     pub fn theta_pso(mission: &Mission) -> Self {
         let f = &mission.formation;
         Limits {
-            clearance: f.uav_radius,
-            closest: 2.0 * f.uav_radius,
+            clearance: f.least_clearance(),
+            closest: f.closest_pair(),
             farthest: Some(f.comm_range),
             inspections: true,
+            dynamics: true,
         }
     }
 }
@@ -244,11 +251,18 @@ pub fn verify_within(
             }
         }
     }
-    let checks: Vec<Check> = [clearance, closest, farthest, low, high, inside]
+    let mut checks: Vec<Check> = [clearance, closest, farthest, low, high, inside]
         .into_iter()
         .map(|t| t.check)
         .filter(|c| c.limit.is_finite())
         .collect();
+    if limits.dynamics {
+        let dynamics = Dynamics::measure(mission, trajectories, samples);
+        for v in &dynamics.violations {
+            note(v.check, v.value, v.location.clone());
+        }
+        checks.extend(dynamics.checks);
+    }
     let inspections = if limits.inspections {
         verify_inspections(mission, trajectories)
     } else {
@@ -260,6 +274,134 @@ pub fn verify_within(
         violations,
         violation_count: count,
         inspections,
+    }
+}
+
+/// The vehicle's limits as flown: one row each for the horizontal speed,
+/// the vertical speed (climb and descent), the horizontal and the vertical
+/// acceleration. UAVs may have limits of their own, so each row keeps the
+/// value nearest its limit (the largest share of it) with that UAV's limit.
+struct Dynamics {
+    checks: Vec<Check>,
+    violations: Vec<Violation>,
+}
+
+/// The rows of [`Dynamics`], by name.
+pub const DYNAMICS_ROWS: [&str; 4] = [
+    "horizontal speed (m/s)",
+    "vertical speed (m/s)",
+    "horizontal acceleration (m/s²)",
+    "vertical acceleration (m/s²)",
+];
+
+/// Whether a check (or a violation's check) is one of the vehicle's
+/// limits, not a constraint on where the UAVs are.
+pub fn is_dynamics(check: &str) -> bool {
+    DYNAMICS_ROWS.contains(&check)
+}
+
+/// One row of [`Dynamics`]: the largest share of the limit seen.
+struct Share {
+    check: Check,
+    share: f64,
+}
+
+impl Share {
+    fn new(name: &'static str) -> Self {
+        Share {
+            check: Check {
+                name,
+                relation: "≤",
+                limit: 0.0,
+                worst: None,
+                ok: true,
+                at: None,
+            },
+            share: f64::NEG_INFINITY,
+        }
+    }
+
+    /// Records `value` against `limit`; returns whether it breaks it (a
+    /// part in a million over, for the rounding of the samples).
+    fn observe(&mut self, value: f64, limit: f64, at: impl FnOnce() -> Location) -> bool {
+        let share = value / limit;
+        if share > self.share {
+            self.share = share;
+            self.check.worst = Some(value);
+            self.check.limit = limit;
+            self.check.at = Some(at());
+        }
+        let bad = share > 1.0 + 1e-6;
+        if bad {
+            self.check.ok = false;
+        }
+        bad
+    }
+}
+
+impl Dynamics {
+    fn measure(mission: &Mission, trajectories: &[Trajectory], samples: usize) -> Self {
+        let [speed, vertical, acceleration, vertical_acceleration] = DYNAMICS_ROWS;
+        let mut speed = Share::new(speed);
+        let mut vertical = Share::new(vertical);
+        let mut acceleration = Share::new(acceleration);
+        let mut vertical_acceleration = Share::new(vertical_acceleration);
+        let mut violations = Vec::new();
+        for (n, traj) in trajectories.iter().enumerate() {
+            let limit = mission.vehicle.limits(n);
+            for k in 0..samples.min(traj.samples.len()) {
+                let s = &traj.samples[k];
+                let here = || Location {
+                    time: s.t,
+                    uav: n,
+                    other: None,
+                    position: s.position,
+                };
+                let mut note = |row: &Share, value: f64| {
+                    if violations.len() < MAX_VIOLATIONS {
+                        violations.push(Violation {
+                            check: row.check.name,
+                            value,
+                            location: here(),
+                        });
+                    }
+                };
+                let v = s.velocity;
+                let horizontal = v.xy().norm();
+                if speed.observe(horizontal, limit.speed, here) {
+                    note(&speed, horizontal);
+                }
+                let rate = if v.z >= 0.0 { limit.climb } else { limit.descent };
+                if vertical.observe(v.z.abs(), rate, here) {
+                    note(&vertical, v.z.abs());
+                }
+                if k == 0 {
+                    continue;
+                }
+                let before = &traj.samples[k - 1];
+                let dt = s.t - before.t;
+                if dt <= 1e-9 {
+                    continue;
+                }
+                let a = (v - before.velocity) / dt;
+                let across = a.xy().norm();
+                if acceleration.observe(across, limit.acceleration, here) {
+                    note(&acceleration, across);
+                }
+                let up_or_down = if a.z >= 0.0 { limit.up } else { limit.down };
+                if vertical_acceleration.observe(a.z.abs(), up_or_down, here) {
+                    note(&vertical_acceleration, a.z.abs());
+                }
+            }
+        }
+        Dynamics {
+            checks: [speed, vertical, acceleration, vertical_acceleration]
+                .into_iter()
+                .filter(|r| r.check.worst.is_some())
+                .map(|r| r.check)
+                .collect(),
+            violations,
+        }
     }
 }
 
@@ -287,7 +429,10 @@ pub struct InspectionResult {
 
 /// Checks eq. 8 on the flown trajectories for every inspected obstacle:
 /// the longest run of samples where the nearest UAV is within the band must
-/// cover the pass (less one sample's travel, the resolution of the check).
+/// cover the pass, measured as the distance the formation's centre (the
+/// mean of its UAVs) travels over the run, less one sample's travel there
+/// (the resolution of the check). The pace varies along a timed flight, so
+/// the distance is travelled, not time times a speed.
 pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec<InspectionResult> {
     let f = &mission.formation;
     let samples = trajectories
@@ -295,11 +440,23 @@ pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec
         .map(|t| t.samples.len())
         .min()
         .unwrap_or(0);
-    let step = trajectories
-        .first()
-        .and_then(|t| t.samples.get(1).map(|s| s.t - t.samples[0].t))
-        .unwrap_or(0.0);
-    let resolution = step * f.ground_speed;
+    // Distance travelled by the formation's centre up to each sample.
+    let centre = |k: usize| {
+        let sum: nalgebra::Vector3<f64> = trajectories
+            .iter()
+            .map(|t| t.samples[k].position.coords)
+            .sum();
+        sum / trajectories.len().max(1) as f64
+    };
+    let mut travelled = Vec::with_capacity(samples);
+    for k in 0..samples {
+        let step = if k == 0 {
+            0.0
+        } else {
+            (centre(k) - centre(k - 1)).norm()
+        };
+        travelled.push(travelled.last().copied().unwrap_or(0.0) + step);
+    }
     mission
         .obstacles
         .iter()
@@ -333,7 +490,18 @@ pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec
                 }
             }
             let time = |k: usize| trajectories[0].samples[k].t;
-            let achieved = best.map_or(0.0, |(a, b)| (time(b) - time(a)) * f.ground_speed);
+            let achieved = best.map_or(0.0, |(a, b)| travelled[b] - travelled[a]);
+            // One sample's travel at either end of the run: where the band
+            // was entered and left between samples.
+            let resolution = best.map_or(0.0, |(a, b)| {
+                let before = if a > 0 {
+                    travelled[a] - travelled[a - 1]
+                } else {
+                    0.0
+                };
+                let after = travelled.get(b + 1).map_or(0.0, |next| next - travelled[b]);
+                before.max(after)
+            });
             let distance = best.map(|(a, b)| {
                 (a..=b).fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], k| {
                     let d = facing(k).map_or(f64::NAN, |(_, d)| d);

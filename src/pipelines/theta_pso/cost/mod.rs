@@ -50,9 +50,9 @@ mod passes;
 const CHORD_TOLERANCE: f64 = 0.02;
 /// Longest piece where the shape blends, metres.
 const BLEND_STEP: f64 = 2.0;
-/// Room the cost asks between two UAVs beyond 2 r_Q, metres (eq. 7 as
-/// verified is ≥ 2 r_Q); below the room the smallest shrink and the column
-/// leave (`route::SQUEEZE_SPACING_MARGIN`).
+/// Room the cost asks between two UAVs beyond 2 r_Q + the safety margin,
+/// metres (eq. 7 as verified is ≥ 2 r_Q + the margin); below the room the
+/// smallest shrink and the column leave (`route::SQUEEZE_SPACING_MARGIN`).
 pub const PAIR_FLOOR: f64 = 0.02;
 /// Step of the pair check along the changes of shape, metres.
 const PAIR_STEP: f64 = 0.5;
@@ -65,7 +65,12 @@ pub struct CostModel {
     params: ThetaPsoParams,
     obstacles: Vec<Cylinder>,
     slots: Vec<Vector3<f64>>,
+    /// r_Q + the safety margin: what every UAV keeps from an obstacle and
+    /// a bound before the cost's own margin.
     uav_radius: f64,
+    /// 2 r_Q + the safety margin + [`PAIR_FLOOR`]: the closest two UAVs
+    /// may come before the pairs' term counts (eq. 7).
+    pair_floor: f64,
     /// The clearance margin in use (the mission's, reduced where a gap is tight).
     margin: f64,
     span: f64,
@@ -149,7 +154,7 @@ struct Sums {
     altitude: f64,
     /// Σ arc length × metres outside the bounds over UAVs, pieces.
     bounds: f64,
-    /// Σ arc length × metres closer than 2 r_Q + `PAIR_FLOOR`, over the
+    /// Σ arc length × metres closer than 2 r_Q + the margin + `PAIR_FLOOR`, over the
     /// pairs of UAVs where they can change (eq. 7).
     spacing: f64,
     /// Σ step × metres the facing UAV is outside eq. 8's band, along the
@@ -203,7 +208,7 @@ impl CostModel {
                 let offsets = i
                     .shape
                     .map_or_else(|| f.slots.clone(), |s| s.offsets(&f.slots, 1.0));
-                i.gap / 2.0 - super::iwp::lateral_half_width(&offsets, f.uav_radius)
+                i.gap / 2.0 - super::iwp::lateral_half_width(&offsets, f.least_clearance())
             })
             .fold(f64::INFINITY, f64::min);
         let margin = mission
@@ -223,7 +228,8 @@ impl CostModel {
                 .map(|o| o.stand_off_band(f))
                 .collect(),
             slots: f.slots.clone(),
-            uav_radius: f.uav_radius,
+            uav_radius: f.least_clearance(),
+            pair_floor: f.closest_pair() + PAIR_FLOOR,
             margin,
             span: heading_span(mission),
             reach,
@@ -275,7 +281,7 @@ impl CostModel {
             .last()
             .copied()
             .unwrap_or(0.0);
-        let turning = turning_excess(points);
+        let turning = turning_excess(points, TURN_WINDOW);
         let (segments, waypoints) = self.waypoint_term(points, length);
         Lead {
             length,
@@ -770,27 +776,68 @@ fn each_sample(
     }
 }
 
-/// J_T: Σ over the path's corners of the horizontal turn beyond 90°,
-/// radians. A sharper corner whips the formation round (its outer UAVs speed
-/// up with the turn rate times their offset) and doubles back on the route.
-pub fn turning_excess(points: &[Point3<f64>]) -> f64 {
-    let mut excess = 0.0;
+/// Half the stretch of path over which J_T sums the corners' turns into
+/// one, metres: corners within a metre turn as one (issue 36's 200° turn
+/// "within 1 m of path").
+pub const TURN_WINDOW: f64 = 0.5;
+
+/// J_T: the path's horizontal turns beyond 90°, radians. A sharper turn
+/// whips the formation round (its outer UAVs speed up with the turn rate
+/// times their offset) and doubles back on the route.
+///
+/// A turn is what the path turns within `window` either side of a point
+/// ([`TURN_WINDOW`]: the formation turns through close corners as through
+/// one): the sum of the signed turns of the corners there. J_T is
+/// the mean over the path's points of that turn's excess beyond 90°, each
+/// point's window 2 `window` long, so an isolated corner of θ costs
+/// θ − 90° (as a corner did before issue 36), a 200° turn made of three
+/// corners 30 cm apart costs 110° instead of nothing, corners far apart
+/// cost what each does alone, and a zigzag's corners cancel. The mean is
+/// continuous in the corners' positions (no step where a leg grows past
+/// the window), which the swarm needs.
+pub fn turning_excess(points: &[Point3<f64>], window: f64) -> f64 {
+    // (arc length, signed turn) of every corner.
+    let mut corners: Vec<(f64, f64)> = Vec::new();
     let mut incoming: Option<nalgebra::Vector2<f64>> = None;
+    let mut s = 0.0;
     for w in points.windows(2) {
         let d = w[1].xy() - w[0].xy();
-        if d.norm_squared() < 1e-18 {
-            continue;
-        }
-        if let Some(a) = incoming {
-            // Only a turn past 90° (dot < 0) counts: atan2 only then.
-            let dot = a.dot(&d);
-            if dot < 0.0 {
-                excess += a.perp(&d).abs().atan2(dot) - std::f64::consts::FRAC_PI_2;
+        let length = (w[1] - w[0]).norm();
+        if d.norm() > 1e-9 {
+            if let Some(a) = incoming {
+                let signed = a.perp(&d).atan2(a.dot(&d));
+                if signed.abs() > 1e-12 {
+                    corners.push((s, signed));
+                }
             }
+            incoming = Some(d);
         }
-        incoming = Some(d);
+        s += length;
     }
-    excess
+    let right_angle = std::f64::consts::FRAC_PI_2;
+    if window <= 0.0 {
+        return corners
+            .iter()
+            .map(|c| (c.1.abs() - right_angle).max(0.0))
+            .sum();
+    }
+    // Sweep the window's centre along the path: the sum of the turns in it
+    // changes only where a corner enters (centre at its arc − window) or
+    // leaves (+ window).
+    let mut events: Vec<(f64, f64)> = corners
+        .iter()
+        .flat_map(|&(at, turn)| [(at - window, turn), (at + window, -turn)])
+        .collect();
+    events.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (mut sum, mut excess) = (0.0f64, 0.0);
+    for pair in events.windows(2) {
+        sum += pair[0].1;
+        let span = pair[1].0 - pair[0].0;
+        if span > 0.0 {
+            excess += span * (sum.abs() - right_angle).max(0.0);
+        }
+    }
+    excess / (2.0 * window)
 }
 
 /// A leg a UAV may break a constraint on: its index, whether it is followed

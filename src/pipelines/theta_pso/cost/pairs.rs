@@ -21,7 +21,7 @@ impl CostModel {
         if n < 2 {
             return 0.0;
         }
-        let floor = 2.0 * self.uav_radius + PAIR_FLOOR;
+        let floor = self.pair_floor;
         let mut deficit = 0.0;
         let mut follow = |from: f64, to: f64, deficit: &mut f64| {
             let mut reader = Reader::default();

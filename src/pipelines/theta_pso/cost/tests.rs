@@ -77,7 +77,7 @@ fn a_columns_pairs_are_judged_exactly_through_a_sharp_corner() {
         .map(|k| Vector3::new(5.0 - 2.5 * k as f64, 0.0, 0.0))
         .collect();
     let model = CostModel::new(&m, &[]);
-    let floor = 2.0 * m.formation.uav_radius + PAIR_FLOOR;
+    let floor = m.formation.closest_pair() + PAIR_FLOOR;
     let spacing = 2.5;
     let sampled = |points: &[Point3<f64>], [t2, t3]: [f64; 2]| {
         let walker = crate::pipelines::theta_pso::path::ArcWalker::new(points);
@@ -180,4 +180,34 @@ fn an_inspection_pass_flown_in_a_changed_shape_is_judged_on_the_facing_uav() {
         let e = model.evaluate_below(&path(clear), f64::INFINITY);
         assert_eq!(e.objective, e.terms.total, "{clear:?}: {e:?}");
     }
+}
+
+/// Issue 36: a 200° turn made of three corners within a metre of path
+/// costs J_T as the turn it is, not as three of 67° that cost nothing: the
+/// mean over the window's positions (1 m either side) of the excess beyond
+/// 90°, here (44° × 0.4 + 110° × 1.2 + 43° × 0.4) / 2 = 83.4°; the same
+/// corners 5 m apart are three gentle turns; a zigzag's corners cancel; an
+/// isolated hairpin costs its 90° beyond 90°.
+#[test]
+fn a_sharp_turn_spread_over_close_corners_is_never_free() {
+    let deg = std::f64::consts::PI / 180.0;
+    let path = |leg: f64, turns: &[f64]| {
+        let mut points = vec![Point3::new(0.0, 0.0, 10.0), Point3::new(20.0, 0.0, 10.0)];
+        let mut heading: f64 = 0.0;
+        for (k, t) in turns.iter().enumerate() {
+            heading += t * deg;
+            let length = if k + 1 == turns.len() { 20.0 } else { leg };
+            let last = *points.last().unwrap();
+            points.push(last + Vector3::new(heading.cos(), heading.sin(), 0.0) * length);
+        }
+        points
+    };
+    let tight = turning_excess(&path(0.4, &[67.0, 67.0, 66.0]), 1.0);
+    assert!((tight - 83.4 * deg).abs() < 1e-9, "{}", tight / deg);
+    let spread = turning_excess(&path(5.0, &[67.0, 67.0, 66.0]), 1.0);
+    assert_eq!(spread, 0.0);
+    let zigzag = turning_excess(&path(0.4, &[80.0, -80.0, 80.0, -80.0]), 1.0);
+    assert_eq!(zigzag, 0.0);
+    let hairpin = turning_excess(&path(0.4, &[180.0]), 1.0);
+    assert!((hairpin - 90.0 * deg).abs() < 1e-9);
 }

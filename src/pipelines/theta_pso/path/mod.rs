@@ -24,6 +24,7 @@ use super::iwp::{Iwp, Shape, vertical_half_height};
 pub use crate::base::swarm::{decode_angle, encode_angle};
 use crate::mission::Mission;
 
+pub mod rounding;
 mod squeeze;
 mod walker;
 mod zone;
@@ -214,7 +215,7 @@ impl PathBuilder {
             inspections,
             ground: mission.ground_model(),
             slots: f.slots.clone(),
-            uav_radius: f.uav_radius,
+            uav_radius: f.least_clearance(),
             hold_distance: mission.reconfiguration.hold_distance,
             transition: mission.reconfiguration.transition_distance,
             squeeze: None,

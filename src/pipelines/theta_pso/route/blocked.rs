@@ -160,11 +160,14 @@ pub fn explain(
         .map(|(i, j)| (i, j, gap_of(&obstacles[i].1, &obstacles[j].1)))
         .filter(|(_, _, g)| *g < 2.0 * need)
         .max_by(|a, b| a.2.total_cmp(&b.2));
-    let r_q = mission.formation.uav_radius;
+    let r_q = mission.formation.least_clearance();
     let gap_text = widest.map_or_else(String::new, |(i, j, gap)| {
         let (p, q) = (obstacles[i].0, obstacles[j].0);
         let why = if gap < 2.0 * r_q {
-            format!("narrower than one UAV (2 r_Q = {:.2} m)", 2.0 * r_q)
+            format!(
+                "narrower than one UAV (2 (r_Q + the safety margin) = {:.2} m)",
+                2.0 * r_q
+            )
         } else if let Some(iwp) = iwps
             .iter()
             .find(|w| (w.obstacles == [p, q]) || (w.obstacles == [q, p]))

@@ -127,7 +127,7 @@ impl Shape {
         let reach = f.slots.iter().map(|o| o.xy().norm()).fold(0.0, f64::max);
         let closest = min_pair_distance(&f.slots);
         let smallest = if closest.is_finite() && closest > 0.0 {
-            ((2.0 * f.uav_radius + SQUEEZE_SPACING_MARGIN) / closest).min(1.0)
+            ((f.closest_pair() + SQUEEZE_SPACING_MARGIN) / closest).min(1.0)
         } else {
             0.0
         };
@@ -138,7 +138,7 @@ impl Shape {
         Shape {
             reach,
             smallest,
-            r_q: f.uav_radius,
+            r_q: f.least_clearance(),
             margin,
             column,
         }

@@ -10,7 +10,7 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
     let m = app.mission();
     let result = result_of(app);
     let centroid: Vec<Point3<f64>> = match &result {
-        Some((o, _)) => o.centroid_path.clone(),
+        Some((o, _)) => o.flown_path.clone(),
         None => vec![m.route.start, m.route.goal],
     };
     let along = cumulative(&centroid);
@@ -104,9 +104,12 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
             if let Some((o, _)) = &result {
                 for (k, t) in o.trajectories.iter().enumerate() {
                     let color = if stale { Color::DarkGray } else { uav_color(k) };
-                    let speed = m.formation.ground_speed;
+                    // Each sample where the centroid is along the flown path.
                     let pts = decimate(
-                        t.samples.iter().map(|s| (s.t * speed, s.position.z)),
+                        t.samples
+                            .iter()
+                            .zip(&o.flown_arcs)
+                            .map(|(s, along)| (*along, s.position.z)),
                         length / 400.0,
                     );
                     ctx.draw(&Polyline {
