@@ -455,8 +455,12 @@ fn the_jobs_panel_groups_unusable_iwps_and_names_the_nearest_at_80_by_24() {
     let screen = render_at(&app, app.jobs()[0].started, (80, 24));
     let panel = jobs_panel(&screen).join(" ");
     assert!(panel.contains("12 unusable"), "{screen}");
+    // The posts in the way named (issue 36: it said '…'), the one nearest
+    // the route first.
     assert!(
-        panel.contains("12 held through the gap, the alignment would pass within r_Q of '…'"),
+        panel.contains(
+            "12 held through the gap, the alignment would pass within r_Q of 'post 4b' or 11 others"
+        ),
         "{screen}"
     );
     // The two nearest the route are named, the other ten are not.
