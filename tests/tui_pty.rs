@@ -318,7 +318,8 @@ fn at_80_by_24_help_scrolls_to_the_run_keys_and_a_cancel_shows_its_share() {
     let state = tempfile::tempdir().unwrap();
     let file = long_bridge_copy(dir.path());
     let mut s = launch_sized(&file, state.path(), 24, 80);
-    s.wait_for("Inspector", Duration::from_secs(30));
+    // The map has the width: the inspector is folded away.
+    s.wait_for("Tab: inspector and jobs", Duration::from_secs(30));
 
     s.send("?");
     s.wait_for("Keys", Duration::from_secs(5));
@@ -344,6 +345,10 @@ fn at_80_by_24_help_scrolls_to_the_run_keys_and_a_cancel_shows_its_share() {
     thread::sleep(Duration::from_millis(1500));
     s.send("x");
     s.wait_for("cancelled", Duration::from_secs(30));
+    // The jobs panel folds away while the map has the focus at 80 columns:
+    // Tab, Tab unfolds it and focuses it.
+    s.send("\t\t");
+    s.wait_for("Jobs", Duration::from_secs(5));
     let screen = s.contents();
     assert!(screen.contains("job 1 cancelled"), "{screen}");
     let line = screen
@@ -611,4 +616,51 @@ fn the_plan_follows_an_obstacle_moved_across_it_and_idles_after() {
     assert!(!s.contents().contains("live 1"), "{}", s.contents());
     s.send("q");
     assert_eq!(s.wait_exit(Duration::from_secs(10)), 0);
+}
+
+/// Issue 36, item 7, in a real terminal at 80 × 24: a 126-obstacle site
+/// opens with live planning off and says why (the obstacles over live
+/// planning's 60) and that `L` turns it on; `/` finds a mast by name,
+/// selects it and the map draws its name; `L` plans live anyway.
+#[test]
+fn a_126_obstacle_site_says_why_live_is_off_and_finds_a_mast_at_80_by_24() {
+    let dir = tempfile::tempdir().unwrap();
+    let state = tempfile::tempdir().unwrap();
+    let file = dir.path().join("site.toml");
+    let mut m = skyform::tui::fixtures::bridge_with_oaks();
+    m.theta_pso.swarm_size = 20;
+    m.theta_pso.iterations = 10;
+    std::fs::write(&file, mission::to_toml_string(&m).unwrap()).unwrap();
+    let mut s = launch_sized(&file, state.path(), 24, 80);
+    s.wait_for(
+        "live planning off: 126 obstacles (live up to 60); L turns it on",
+        Duration::from_secs(30),
+    );
+    assert!(!s.contents().contains("live 1"), "{}", s.contents());
+    step(&mut s, "/", "type part of an obstacle");
+    step(&mut s, "mast 2", "1 of 1: Obstacle 125 'mast 2'");
+    step(
+        &mut s,
+        "\r",
+        "Obstacle 125 'mast 2': the one match for 'mast 2'",
+    );
+    // Its name on the map's canvas (not only on the status line and the
+    // map's bottom line).
+    let screen = s.contents();
+    assert!(
+        screen
+            .lines()
+            .skip(1)
+            .take(21)
+            .any(|l| l.contains("mast 2")),
+        "{screen}"
+    );
+    step(
+        &mut s,
+        "L",
+        "live planning on: 126 obstacles (live up to 60)",
+    );
+    s.wait_for("live 1", Duration::from_secs(300));
+    s.send("q");
+    assert_eq!(s.wait_exit(Duration::from_secs(20)), 0);
 }

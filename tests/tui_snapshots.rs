@@ -12,7 +12,9 @@ use ratatui::backend::TestBackend;
 use skyform::mission::default_mission;
 use skyform::tui::app::Focus;
 use skyform::tui::fields::Item;
-use skyform::tui::fixtures::{app_with_flatlo_result, app_with_result};
+use skyform::tui::fixtures::{
+    app_with_flatlo_result, app_with_result, bridge_with_oaks, type_into,
+};
 use skyform::tui::jobs::{Job, JobMsg, Kind};
 use skyform::tui::{Action, App, Document, view};
 
@@ -226,16 +228,13 @@ fn rows_of(screen: &str) -> Vec<String> {
         .collect()
 }
 
-/// At 80×24 the bridge's piers are a cell or two apart: each name drawn is
+/// At 80×24 the bridge's piers are a few cells apart: each name drawn is
 /// whole, with a cell free on either side (none written over another).
 #[test]
 fn map_labels_do_not_cover_each_other_at_80_by_24() {
     let app = default_app();
     let screen = render_at(&app, Instant::now(), (80, 24));
-    let map: Vec<String> = rows_of(&screen)
-        .iter()
-        .map(|r| r.chars().take(36).collect())
-        .collect();
+    let map = map_rows(&screen, 80);
     let mut drawn = 0;
     for o in &app.mission().obstacles {
         for row in &map {
@@ -262,6 +261,8 @@ fn map_labels_do_not_cover_each_other_at_80_by_24() {
 #[test]
 fn the_selected_obstacles_label_wins() {
     let mut app = default_app();
+    // Beside the inspector, where the map has 36 columns.
+    app.update(Action::FocusOn(Focus::Inspector));
     let i = app
         .mission()
         .obstacles
@@ -288,13 +289,19 @@ fn the_selected_obstacles_label_wins() {
 fn the_iwp_table_stays_readable_at_80_by_24() {
     let mut app = default_app();
     app.update(Action::ShowFormation);
+    // The formation editor focused has the width: the table's five columns.
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    assert!(screen.contains("IWP between"), "{screen}");
+    assert!(screen.contains("light pole 4 ↔ pier 5"), "{screen}");
+    insta::assert_snapshot!(screen);
+    // Beside the inspector, two lines an IWP.
+    app.update(Action::FocusOn(Focus::Inspector));
     let screen = render_at(&app, Instant::now(), (80, 24));
     assert!(screen.contains("◆ light pole 4 ↔ pier 5"), "{screen}");
     assert!(
         screen.contains("gap 1.50 m · alignment (chosen)"),
         "{screen}"
     );
-    insta::assert_snapshot!(screen);
 }
 
 /// The row after the one holding `text` continues it: blank up to the
@@ -448,8 +455,12 @@ fn the_jobs_panel_groups_unusable_iwps_and_names_the_nearest_at_80_by_24() {
     let screen = render_at(&app, app.jobs()[0].started, (80, 24));
     let panel = jobs_panel(&screen).join(" ");
     assert!(panel.contains("12 unusable"), "{screen}");
+    // The posts in the way named (issue 36: it said '…'), the one nearest
+    // the route first.
     assert!(
-        panel.contains("12 held through the gap, the alignment would pass within r_Q of '…'"),
+        panel.contains(
+            "12 held through the gap, the alignment would pass within r_Q of 'post 4b' or 11 others"
+        ),
         "{screen}"
     );
     // The two nearest the route are named, the other ten are not.
@@ -558,10 +569,455 @@ fn a_stale_result_is_marked_on_the_map_at_80_by_24() {
     app.update(Action::Select(Item::Goal));
     app.update(Action::FocusOn(Focus::Map));
     let fresh = render_at(&app, app.jobs()[0].started, (80, 24));
-    let title = fresh.lines().next().unwrap_or_default().to_owned();
-    assert!(title.contains("Map  job 1 ✓ "), "{title}");
+    let title = map_title(&fresh);
+    assert!(title.ends_with("  job 1 seed 7: feasible "), "{title}");
     app.update(Action::Nudge(-1.0, 0.0));
     let screen = render_at(&app, app.jobs()[0].started, (80, 24));
-    let title = screen.lines().next().unwrap_or_default().to_owned();
-    assert!(title.contains("Map  STALE job 1 "), "{title}");
+    let title = map_title(&screen);
+    assert!(
+        title.ends_with("  STALE job 1 seed 7: feasible (mission edited) "),
+        "{title}"
+    );
+}
+
+/// The rows of the map's canvas (inside its border: neither its title nor
+/// its bottom line), the map being `columns` wide from the left edge.
+fn map_rows(screen: &str, columns: usize) -> Vec<String> {
+    let rows = rows_of(screen);
+    rows[1..rows.len() - 2]
+        .iter()
+        .map(|r| r.chars().take(columns).collect())
+        .collect()
+}
+
+/// The bridge among 114 oaks and three masts, quick to plan (the
+/// obstacles alone are over live planning's sizes).
+fn oak_site() -> skyform::mission::Mission {
+    let mut m = bridge_with_oaks();
+    m.theta_pso.swarm_size = 20;
+    m.theta_pso.iterations = 10;
+    m
+}
+
+fn obstacle_named(app: &App, name: &str) -> usize {
+    app.mission()
+        .obstacles
+        .iter()
+        .position(|o| o.name == name)
+        .unwrap_or_else(|| panic!("no obstacle '{name}'"))
+}
+
+/// Issue 36, item 7: a 126-obstacle site opens with live planning off and
+/// says why (the size over `outcome::interactive`'s limit, with its
+/// figure) and that `L` turns it on, on the status line and in the empty
+/// jobs panel; `L` does, and a live plan comes in.
+#[test]
+fn a_126_obstacle_site_says_why_live_planning_is_off_and_l_turns_it_on() {
+    let m = oak_site();
+    assert_eq!(m.obstacles.len(), 126);
+    assert_eq!(
+        skyform::outcome::over_live_limits(Kind::ThetaPso, &m),
+        ["126 obstacles (live up to 60)"]
+    );
+    let mut app = App::new(
+        Document::new(m, Some(PathBuf::from("site.toml"))),
+        PathBuf::from("."),
+    );
+    app.enable_live();
+    assert!(!app.board().live().is_on());
+    let why = "live planning off: 126 obstacles (live up to 60); L turns it on";
+    let screen = render(&app, Instant::now());
+    assert!(
+        rows_of(&screen).last().is_some_and(|r| r.contains(why)),
+        "{screen}"
+    );
+    let panel = jobs_panel(&screen).join(" ");
+    assert!(
+        panel.contains(why),
+        "the empty jobs panel says it too: {screen}"
+    );
+    let small = render_at(&app, Instant::now(), (80, 24));
+    assert!(
+        rows_of(&small).last().is_some_and(|r| r.contains(why)),
+        "{small}"
+    );
+
+    app.update(Action::ToggleLive);
+    assert!(app.board().live().is_on(), "L turns it on anyway");
+    assert_eq!(
+        app.status().map(|s| s.text.as_str()),
+        Some("live planning on: 126 obstacles (live up to 60), re-plans may take seconds")
+    );
+    assert!(app.board().live().held_off().is_none());
+    assert!(app.settle_live(Duration::from_secs(600)));
+    let plan = app.shown().expect("a live plan");
+    assert!(skyform::tui::live::Live::owns(plan.id));
+    assert!(plan.outcome.as_ref().and_then(|o| o.theta_pso()).is_some());
+}
+
+/// Issue 36, item 7: on a site of more than 40 obstacles the map leaves
+/// their names out, but the selected obstacle's is drawn (it was not).
+#[test]
+fn the_selected_obstacles_name_is_drawn_on_a_126_obstacle_site() {
+    let mut app = App::new(
+        Document::new(oak_site(), Some(PathBuf::from("site.toml"))),
+        PathBuf::from("."),
+    );
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    let map = map_rows(&screen, 80).join("\n");
+    assert!(!map.contains("mast 2"), "{screen}");
+    app.update(Action::Select(Item::Obstacle(obstacle_named(
+        &app, "mast 2",
+    ))));
+    // The map is the whole width at 80 × 24, 84 of 140 columns beside
+    // the inspector.
+    for (size, columns) in [((80, 24), 80), ((WIDTH, HEIGHT), 84)] {
+        let screen = render_at(&app, Instant::now(), size);
+        let map = map_rows(&screen, columns).join("\n");
+        assert!(map.contains("mast 2"), "{screen}");
+        for other in ["mast 1", "mast 3", "oak 7", "pier 5"] {
+            assert!(!map.contains(other), "'{other}' drawn:\n{screen}");
+        }
+    }
+    insta::assert_snapshot!(render_at(&app, Instant::now(), (80, 24)));
+}
+
+/// Issue 36, item 7: `/` finds an obstacle by name on a 126-obstacle site
+/// (one mast took 79 presses of `n`): the matches narrow as the name is
+/// typed, the first is selected and the map pans to it; Enter keeps it,
+/// `n` / `N` step through the matches until Esc, and Esc while typing goes
+/// back to what was selected.
+#[test]
+fn find_by_name_narrows_as_typed_selects_pans_and_steps_with_n() {
+    use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    use skyform::tui::input::key_action;
+    let key = |c: char| {
+        let shift = if c.is_ascii_uppercase() {
+            KeyModifiers::SHIFT
+        } else {
+            KeyModifiers::NONE
+        };
+        KeyEvent::new(KeyCode::Char(c), shift)
+    };
+    let mut app = App::new(
+        Document::new(oak_site(), Some(PathBuf::from("site.toml"))),
+        PathBuf::from("."),
+    );
+    app.update(Action::Zoom(4.0, None));
+    assert_eq!(key_action(&app, key('/')), Some(Action::Find));
+    app.update(Action::Find);
+    assert!(app.finder().is_typing());
+    let (mut counts, mut obstacles) = (Vec::new(), Vec::new());
+    for c in "oak 11".chars() {
+        let typed = key_action(&app, key(c)).expect("typed into the prompt");
+        assert_eq!(typed, Action::FindInput(c));
+        app.update(typed);
+        let found = app.finder().matches();
+        counts.push(found.len());
+        obstacles.push(
+            found
+                .iter()
+                .filter(|i| matches!(i, Item::Obstacle(_)))
+                .count(),
+        );
+    }
+    // o (every name with an o), oa, oak, "oak " (the oaks, and the IWPs
+    // an oak is one side of), oak 1, oak 11.
+    assert!(counts.windows(2).all(|w| w[1] <= w[0]), "{counts:?}");
+    assert!(counts[0] > counts[1], "{counts:?}");
+    assert_eq!(&obstacles[1..], [114, 114, 114, 26, 6], "{obstacles:?}");
+    assert_eq!(counts[5], 6, "{counts:?}");
+    let oak_11 = obstacle_named(&app, "oak 11");
+    assert_eq!(
+        app.selected(),
+        &Item::Obstacle(oak_11),
+        "the name itself first"
+    );
+    let at = app.mission().obstacles[oak_11].center;
+    assert_eq!(
+        app.camera().panned_center(),
+        Some(at),
+        "the map looks at it"
+    );
+    let screen = render_at(&app, Instant::now(), (80, 24));
+    assert!(screen.contains("/oak 11▏"), "{screen}");
+    assert!(screen.contains("1 of 6: Obstacle 20 'oak 11'"), "{screen}");
+    assert!(screen.contains("6 matches"), "{screen}");
+    assert!(screen.contains("▶ Obstacle 20 'oak 11'"), "{screen}");
+    assert!(screen.contains("Obstacle 123 'oak 114'"), "{screen}");
+    insta::assert_snapshot!(screen);
+
+    app.update(Action::FindKeep);
+    assert!(!app.finder().is_typing() && app.finder().is_stepping());
+    assert_eq!(
+        app.status().map(|s| s.text.as_str()),
+        Some(
+            "Obstacle 20 'oak 11': 1 of 6 matches for 'oak 11' (n / N next / previous, Esc ends the find)"
+        )
+    );
+    assert_eq!(key_action(&app, key('n')), Some(Action::FindStep(1)));
+    assert_eq!(key_action(&app, key('N')), Some(Action::FindStep(-1)));
+    app.update(Action::FindStep(1));
+    let oak_110 = obstacle_named(&app, "oak 110");
+    assert_eq!(app.selected(), &Item::Obstacle(oak_110));
+    assert_eq!(
+        app.camera().panned_center(),
+        Some(app.mission().obstacles[oak_110].center)
+    );
+    app.update(Action::FindStep(-1));
+    app.update(Action::FindStep(-1));
+    assert_eq!(
+        app.selected(),
+        &Item::Obstacle(obstacle_named(&app, "oak 114")),
+        "round the ends"
+    );
+    app.update(Action::Dismiss);
+    assert!(!app.finder().is_stepping());
+    assert_eq!(key_action(&app, key('n')), Some(Action::SelectNext));
+    assert_eq!(key_action(&app, key('N')), Some(Action::RunNewSeed));
+
+    // Esc while typing: back to the selection and the view before.
+    let (selected, center) = (app.selected().clone(), app.camera().panned_center());
+    app.update(Action::Find);
+    for c in "mast".chars() {
+        app.update(Action::FindInput(c));
+    }
+    assert_eq!(
+        app.selected(),
+        &Item::Obstacle(obstacle_named(&app, "mast 1"))
+    );
+    app.update(Action::FindCancel);
+    assert_eq!(app.selected(), &selected);
+    assert_eq!(app.camera().panned_center(), center);
+    // A name nothing has: said, and nothing selected.
+    app.update(Action::Find);
+    for c in "zzz".chars() {
+        app.update(Action::FindInput(c));
+    }
+    app.update(Action::FindKeep);
+    assert_eq!(app.selected(), &selected);
+    let status = app.status().expect("a message");
+    assert!(status.error, "{status:?}");
+    assert_eq!(status.text, "no obstacle or IWP has 'zzz' in its name");
+}
+
+/// An IWP is found by either obstacle's name and drawn selected on the
+/// map, named.
+#[test]
+fn find_selects_an_iwp_and_the_map_names_it() {
+    let mut app = default_app();
+    app.update(Action::Find);
+    for c in "pier 5".chars() {
+        app.update(Action::FindInput(c));
+    }
+    assert_eq!(app.finder().matches().len(), 2, "the pier, then its IWP");
+    app.update(Action::FindStep(1));
+    app.update(Action::FindKeep);
+    let iwp = Item::Waypoint(["light pole 4".into(), "pier 5".into()]);
+    assert_eq!(app.selected(), &iwp);
+    let screen = render(&app, Instant::now());
+    let map = map_rows(&screen, 84).join("\n");
+    assert!(map.contains("light pole 4 ↔ pier 5"), "{screen}");
+    assert!(
+        screen.contains("Inspector · IWP light pole 4 ↔ pier 5"),
+        "{screen}"
+    );
+}
+
+/// The map's title row, up to its first run of border.
+fn map_title(screen: &str) -> String {
+    let top = rows_of(screen).into_iter().next().unwrap_or_default();
+    let inner = top.trim_start_matches('╭');
+    inner.split("──").next().unwrap_or_default().to_owned()
+}
+
+/// Issue 36, item 7: a FLATLO result turns STALE after an edit, on the map
+/// (whose title names it) and under the verdict in the jobs panel; undo
+/// makes it fresh again. At 80 × 24 too.
+#[test]
+fn a_flatlo_result_turns_stale_after_an_edit() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/flatlo-squadron.toml");
+    let m = skyform::mission::load(std::path::Path::new(path))
+        .unwrap()
+        .mission;
+    let mut app = app_with_flatlo_result(m, 3);
+    let started = app.jobs()[0].started;
+    let fresh = render(&app, started);
+    assert!(
+        map_title(&fresh).contains("job 1 FLATLO seed 3: pass"),
+        "{fresh}"
+    );
+    assert!(!fresh.contains("STALE"), "{fresh}");
+    app.update(Action::Select(Item::Squadron));
+    type_into(&mut app, "airspeed (m/s)", "21");
+    app.update(Action::FocusOn(Focus::Jobs));
+    let stale = render(&app, started);
+    assert!(
+        map_title(&stale).contains("STALE job 1 FLATLO seed 3: pass (mission edited)"),
+        "{stale}"
+    );
+    let panel = jobs_panel(&stale);
+    assert!(panel[1].contains("✓ separation kept"), "{stale}");
+    assert!(
+        panel[2].contains("STALE: the mission changed since this run"),
+        "{stale}"
+    );
+    app.update(Action::FocusOn(Focus::Map));
+    let small = render_at(&app, started, (80, 24));
+    assert!(map_title(&small).contains("STALE job 1 "), "{small}");
+    insta::assert_snapshot!(small);
+    app.update(Action::Undo);
+    assert!(!render(&app, started).contains("STALE"));
+}
+
+/// The fleet's result turns STALE after an edit, as the others do.
+#[test]
+fn a_fleet_result_turns_stale_after_an_edit() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/fleet-triangle.toml");
+    let mut m = skyform::mission::load(std::path::Path::new(path))
+        .unwrap()
+        .mission;
+    m.fleet.duration = 6.0;
+    let mut app = skyform::tui::fixtures::app_with_fleet_result(m, 1);
+    let started = app.jobs()[0].started;
+    let fresh = map_title(&render(&app, started));
+    assert!(fresh.contains("job 1 fleet seed 1: "), "{fresh}");
+    assert!(!fresh.contains("STALE"), "{fresh}");
+    app.update(Action::Select(Item::FleetTarget(0)));
+    app.update(Action::FocusOn(Focus::Map));
+    app.update(Action::Nudge(1.0, 0.0));
+    app.update(Action::FocusOn(Focus::Jobs));
+    let screen = render(&app, started);
+    assert!(map_title(&screen).contains("STALE job 1 fleet"), "{screen}");
+    let panel = jobs_panel(&screen);
+    assert!(
+        panel[2].contains("STALE: the mission changed since this run"),
+        "{screen}"
+    );
+}
+
+/// Issue 36, item 7: at 80 × 24 the map has the width while it has the
+/// focus (78 columns, not 34: the inspector and the jobs fold away, its
+/// bottom line names the selection and says Tab); Tab brings them back
+/// beside a narrower map. No title is cut mid-word: the map's drops its
+/// step, then its scale, then shortens the result; a job's row keeps its
+/// verdict whole.
+#[test]
+fn at_80_by_24_the_map_has_the_width_and_no_title_is_cut_mid_word() {
+    let mut app = app_with_result(default_mission().mission, 7, 20);
+    app.update(Action::FocusOn(Focus::Map));
+    let started = app.jobs()[0].started;
+    let screen = render_at(&app, started, (80, 24));
+    let rows = rows_of(&screen);
+    assert!(
+        !screen.contains("Inspector") && !screen.contains("Jobs"),
+        "{screen}"
+    );
+    assert!(
+        rows[0].starts_with("╭ Map · ") && rows[0].ends_with('╮'),
+        "{screen}"
+    );
+    let title = map_title(&screen);
+    let scale: f64 = title
+        .split("· ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no scale in {title:?}"));
+    // 4.4 m/cell on 34 columns beside the inspector before.
+    assert!(scale < 3.0, "{scale} m/cell: {title}");
+    assert_eq!(
+        title,
+        " Map · 2.6 m/cell · step 1 m  job 1 seed 7: feasible "
+    );
+    assert!(
+        rows[22].contains("Mission · Tab: inspector and jobs"),
+        "{screen}"
+    );
+    insta::assert_snapshot!(screen);
+
+    // Tab: the inspector and the jobs beside a 36-column map, whose title
+    // drops the step and the scale, whole.
+    app.update(Action::FocusNext);
+    let screen = render_at(&app, started, (80, 24));
+    assert!(screen.contains("Inspector · Mission"), "{screen}");
+    assert_eq!(map_title(&screen), " Map  job 1 seed 7: feasible ");
+    app.update(Action::FocusNext);
+    let screen = render_at(&app, started, (80, 24));
+    let row = jobs_panel(&screen).into_iter().next().unwrap_or_default();
+    assert!(
+        row.starts_with("▶◉ 1 θ-PSO s7") && row.ends_with("feasible"),
+        "{screen}"
+    );
+    insta::assert_snapshot!("at_80_by_24_the_jobs_focus_unfolds_the_panels", screen);
+
+    // A stale result on the narrow map: STALE and the job, whole.
+    app.update(Action::Select(Item::Goal));
+    app.update(Action::Nudge(-1.0, 0.0));
+    let screen = render_at(&app, started, (80, 24));
+    assert_eq!(map_title(&screen), " Map  STALE job 1 ");
+}
+
+/// Issue 36, item 7: `s` on an IWP says the shape and that the route must
+/// now cross there (the choice it writes in `reconfiguration.waypoints`
+/// makes the IWP a stop of the route stage: `route::find`'s requested
+/// crossings); Space off says the route need not; Del gives the route its
+/// choice back.
+#[test]
+fn the_shape_and_the_crossing_the_route_must_make_are_said() {
+    let mut m = default_mission().mission;
+    m.reconfiguration.waypoints.clear();
+    let mut app = App::new(Document::new(m, None), PathBuf::from("."));
+    app.update(Action::ShowFormation);
+    let iwp = Item::Waypoint(["light pole 4".into(), "pier 5".into()]);
+    app.update(Action::Select(iwp.clone()));
+    let said = |app: &App| app.status().map(|s| s.text.clone()).unwrap_or_default();
+    let chosen = |app: &App| {
+        app.mission()
+            .reconfiguration
+            .choice("light pole 4", "pier 5")
+            .cloned()
+    };
+    assert_eq!(chosen(&app), None, "no choice yet: the route may go round");
+    app.update(Action::CycleShape);
+    assert_eq!(
+        said(&app),
+        "alignment (chosen): the route must cross between 'light pole 4' and 'pier 5'"
+    );
+    assert!(
+        chosen(&app).is_some_and(|c| c.enabled),
+        "a choice in the file"
+    );
+    // Rotation keeps the formation's width: no shape passes, and it says why.
+    app.update(Action::CycleShape);
+    assert!(
+        said(&app).starts_with(
+            "rotation (chosen): no shape passes between 'light pole 4' and 'pier 5': "
+        ),
+        "{}",
+        said(&app)
+    );
+    app.update(Action::CycleShape);
+    assert!(
+        said(&app).starts_with("shrink (chosen): "),
+        "{}",
+        said(&app)
+    );
+    app.update(Action::CycleShape);
+    assert!(
+        said(&app).starts_with("auto → ")
+            && said(&app).ends_with(": the route must cross between 'light pole 4' and 'pier 5'"),
+        "auto, but still a choice: {}",
+        said(&app)
+    );
+    app.update(Action::ToggleWaypoint);
+    assert!(
+        said(&app).starts_with("IWP off (")
+            && said(&app).contains("the route need not cross between 'light pole 4' and 'pier 5'"),
+        "{}",
+        said(&app)
+    );
+    app.update(Action::Delete);
+    assert_eq!(chosen(&app), None);
+    assert!(said(&app).contains("the route may cross between 'light pole 4' and 'pier 5' or not"));
 }

@@ -1220,7 +1220,7 @@ fn every_binding_dispatches_and_every_key_that_acts_is_in_the_table() {
     use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
     use skyform::tui::app::Pane;
     use skyform::tui::input::key_action;
-    use skyform::tui::keys::{KEYS, Key, lookup};
+    use skyform::tui::keys::{Context, KEYS, Key, lookup};
 
     let dir = tempfile::tempdir().unwrap();
     let mut app = app_in(dir.path());
@@ -1235,25 +1235,39 @@ fn every_binding_dispatches_and_every_key_that_acts_is_in_the_table() {
         Key::Shift(code) => KeyEvent::new(code, KeyModifiers::SHIFT),
     };
     let mut states = Vec::new();
-    for pane in [Pane::Map, Pane::Formation] {
-        for focus in [Focus::Map, Focus::Inspector, Focus::Jobs] {
-            states.push((focus, pane));
+    for found in [false, true] {
+        for pane in [Pane::Map, Pane::Formation] {
+            for focus in [Focus::Map, Focus::Inspector, Focus::Jobs] {
+                states.push(Context { focus, pane, found });
+            }
         }
     }
-    let enter = |app: &mut App, (focus, pane): (Focus, Pane)| {
-        app.update(match pane {
+    let enter = |app: &mut App, at: Context| {
+        // A find kept (its matches stepped through with n / N), or none.
+        app.update(Action::Dismiss);
+        if at.found {
+            app.update(Action::Find);
+            for c in "pier".chars() {
+                app.update(Action::FindInput(c));
+            }
+            app.update(Action::FindKeep);
+        }
+        app.update(match at.pane {
             Pane::Map => Action::ShowMap,
             Pane::Formation => Action::ShowFormation,
         });
-        app.update(Action::FocusOn(focus));
-        assert_eq!((app.focus(), app.pane()), (focus, pane));
+        app.update(Action::FocusOn(at.focus));
+        assert_eq!(
+            (app.focus(), app.pane(), app.finder().is_stepping()),
+            (at.focus, at.pane, at.found)
+        );
     };
     let mut bindings = 0;
     for row in KEYS {
         for b in row.bindings {
             let Some(&state) = states
                 .iter()
-                .find(|(f, p)| b.when.holds(*f, *p) && lookup(b.key, *f, *p) == Some(b))
+                .find(|at| b.when.holds(**at) && lookup(b.key, **at) == Some(b))
             else {
                 panic!(
                     "{b:?} ('{}') is shadowed by an earlier binding everywhere",
@@ -1307,7 +1321,7 @@ fn every_binding_dispatches_and_every_key_that_acts_is_in_the_table() {
         for press in &presses {
             if let Some(action) = key_action(&app, *press) {
                 let typing =
-                    matches!(action, Action::EditStart(Some(_))) && state.0 == Focus::Inspector;
+                    matches!(action, Action::EditStart(Some(_))) && state.focus == Focus::Inspector;
                 assert!(
                     typing || in_table(&action),
                     "{press:?} in {state:?} gives {action:?}, which no row of the key table lists"

@@ -53,28 +53,54 @@ pub fn figure_name(kind: Kind) -> &'static str {
 }
 
 /// Whether a run of `kind` on `mission` is small enough to plan live, after
-/// every edit, in the designer: θ-PSO up to 20,000 cost evaluations per run
-/// (the paper's 100 × 150 is 15,000), 6 UAVs, 60 obstacles and a site of
-/// 40,000 m² (the bridge plans in about 0.2 s cold on two cores); FLATLO up
-/// to 8 aircraft and 200,000 integration steps (the paper's case takes
-/// about 30 ms); never the fleet, which simulates for seconds.
+/// every edit, in the designer: none of [`over_live_limits`].
 pub fn interactive(kind: Kind, mission: &Mission) -> bool {
+    over_live_limits(kind, mission).is_empty()
+}
+
+/// The sizes that keep a run of `kind` on `mission` from being planned live
+/// (each with its figure and the limit), none when it is small enough:
+/// θ-PSO up to 20,000 cost evaluations per run (the paper's 100 × 150 is
+/// 15,000), 6 UAVs, 60 obstacles and a site of 40,000 m² (the bridge plans
+/// in about 0.2 s cold on two cores); FLATLO up to 8 aircraft and 200,000
+/// integration steps (the paper's case takes about 30 ms); never the fleet,
+/// which simulates for seconds. The designer says these when it opens with
+/// live planning off.
+pub fn over_live_limits(kind: Kind, mission: &Mission) -> Vec<String> {
+    use crate::pipelines::{exceeds, figure};
+    let mut over = Vec::new();
+    // "126 obstacles (live up to 60)".
+    let mut check = |value: f64, limit: f64, what: &str| {
+        if exceeds(value, limit) {
+            let (value, limit) = (figure(value), figure(limit));
+            over.push(format!(
+                "{} (live up to {limit})",
+                what.replace('#', &value)
+            ));
+        }
+    };
     match kind {
         Kind::ThetaPso => {
             let p = &mission.theta_pso;
             let b = &mission.bounds;
-            p.swarm_size.saturating_mul(p.iterations) <= 20_000
-                && mission.formation.slots.len() <= 6
-                && mission.obstacles.len() <= 60
-                && (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]) <= 40_000.0
+            let evaluations = p.swarm_size.saturating_mul(p.iterations) as f64;
+            check(evaluations, 20_000.0, "# cost evaluations per run");
+            check(mission.formation.slots.len() as f64, 6.0, "# UAVs");
+            check(mission.obstacles.len() as f64, 60.0, "# obstacles");
+            let area = (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]);
+            check(area, 40_000.0, "a site of # m²");
         }
         Kind::Flatlo => {
             let p = &mission.flatlo;
-            p.aircraft <= 8
-                && p.aircraft as f64 * flatlo::references(p).duration / p.sim_step <= 200_000.0
+            check(p.aircraft as f64, 8.0, "# aircraft");
+            if p.aircraft <= 8 {
+                let steps = p.aircraft as f64 * flatlo::references(p).duration / p.sim_step;
+                check(steps, 200_000.0, "# integration steps");
+            }
         }
-        Kind::Fleet => false,
+        Kind::Fleet => over.push("the fleet simulates for seconds: never live".to_owned()),
     }
+    over
 }
 
 /// What `kind` predicts of a run on `mission` against the documented

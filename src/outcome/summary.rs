@@ -72,10 +72,9 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
         };
         let _ = writeln!(
             s,
-            "  reconfig     {} {why} between '{}' and '{}': t1 {:.1} s, t2 {:.1} s, t3 {:.1} s, t4 {:.1} s",
+            "  reconfig     {} {why} {}: t1 {:.1} s, t2 {:.1} s, t3 {:.1} s, t4 {:.1} s",
             r.shape.name(),
-            r.between[0],
-            r.between[1],
+            r.obstacles(),
             r.t1,
             r.t2,
             r.t3,

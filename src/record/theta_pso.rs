@@ -197,13 +197,8 @@ fn log_reconfigurations(
             stream.set_duration_secs("sim_time", t);
             stream.log(
                 events,
-                &rerun::TextLog::new(format!(
-                    "{} between '{}' and '{}': {label}",
-                    r.shape.name(),
-                    r.between[0],
-                    r.between[1]
-                ))
-                .with_level(rerun::TextLogLevel::INFO),
+                &rerun::TextLog::new(format!("{} {}: {label}", r.shape.name(), r.obstacles()))
+                    .with_level(rerun::TextLogLevel::INFO),
             )?;
         }
     }

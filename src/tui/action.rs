@@ -59,6 +59,20 @@ pub enum Action {
     /// Fit the bounds (or the slots) to the view.
     Fit,
 
+    /// Open the find prompt (`/`): obstacles and IWPs by name.
+    Find,
+    /// Text typed into the find prompt.
+    FindInput(char),
+    FindBackspace,
+    /// Clear the find prompt's text (Ctrl-u).
+    FindClear,
+    /// Select the match this many after the one selected (round the ends).
+    FindStep(i32),
+    /// Keep the match selected (Enter): the prompt closes, `n` / `N` step on.
+    FindKeep,
+    /// Close the prompt and go back to what was selected before (Esc).
+    FindCancel,
+
     /// A new obstacle at the point, or at the view's centre.
     AddObstacle(Option<Point2<f64>>),
     ToggleAddTool,

@@ -26,6 +26,7 @@ use super::camera::Camera;
 use super::document::{Document, slug};
 use super::editor::{Editor, Request, Surroundings};
 use super::fields::{Field, Item};
+use super::find::{Before, Find};
 use super::jobs::{Job, JobMsg};
 pub use super::overlay::{AfterSave, Entry, Overlay};
 use super::overlay::{Loaded, Overlays, load};
@@ -48,6 +49,8 @@ pub struct App {
     camera: Camera,
     /// The fleet replay.
     replay: Replay,
+    /// Find by name (`/`).
+    find: Find,
     /// The recovery copy of unsaved edits; `None` unless enabled.
     recovery: Option<Recovery>,
     focus: Focus,
@@ -67,6 +70,7 @@ impl App {
             overlays: Overlays::default(),
             camera: Camera::default(),
             replay: Replay::default(),
+            find: Find::default(),
             recovery: None,
             focus: Focus::Map,
             pane: Pane::Map,
@@ -85,6 +89,11 @@ impl App {
     /// The runs of this session.
     pub fn board(&self) -> &JobBoard {
         &self.board
+    }
+
+    /// Find by name: the prompt, or the matches being stepped through.
+    pub fn finder(&self) -> &Find {
+        &self.find
     }
 
     /// How the map and the formation editor are looked at.
@@ -317,6 +326,8 @@ impl App {
             | PickerMove(_) => self.overlays.update(action, &self.cwd),
             Save | SaveAs | Open | Confirm | Import => self.update_files(action),
             ChangeStep(_) | Zoom(..) | Pan(..) | Fit => self.update_camera(action),
+            Find | FindInput(_) | FindBackspace | FindClear | FindStep(_) | FindKeep
+            | FindCancel => self.update_find(action),
             Scrub(_) | TogglePlay => self.update_replay(action),
             Run(_) | RunDistributed | RunNewSeed | Cancel | JobUp | JobDown | ToggleRecording
             | CycleViewer => {
@@ -325,6 +336,16 @@ impl App {
             }
             ToggleLive => {
                 self.board.toggle_live(Instant::now(), &mut self.status);
+                let live = self.board.live();
+                if live.is_on() {
+                    let over = crate::outcome::over_live_limits(live.pipeline(), self.mission());
+                    if !over.is_empty() {
+                        self.status.say(format!(
+                            "live planning on: {}, re-plans may take seconds",
+                            over.join(", ")
+                        ));
+                    }
+                }
                 self.poll_live(Instant::now());
             }
             ShowJob => {
@@ -351,17 +372,34 @@ impl App {
     }
 
     /// Live planning on, for θ-PSO, when the mission is of a size planned
-    /// in well under a second (the designer's start; tests leave it off).
+    /// in well under a second (the designer's start; tests leave it off);
+    /// else off, and the status line says which size keeps it off.
     pub fn enable_live(&mut self) {
+        let over =
+            crate::outcome::over_live_limits(crate::pipelines::Kind::ThetaPso, self.mission());
+        if !over.is_empty() {
+            self.hold_live_off(format!("{}; L turns it on", over.join(", ")));
+            return;
+        }
         let now = Instant::now();
-        if crate::outcome::interactive(crate::pipelines::Kind::ThetaPso, self.mission())
-            && self
-                .board
-                .start_live(crate::pipelines::Kind::ThetaPso, now)
-                .is_ok()
+        if self
+            .board
+            .start_live(crate::pipelines::Kind::ThetaPso, now)
+            .is_ok()
         {
             self.board.follow(self.editor.doc(), now);
         }
+    }
+
+    /// Leaves live planning off for `why` (the designer's start: the
+    /// mission's size, `--no-live`); the status line says so unless it
+    /// already has something to say, and the empty jobs panel says so too.
+    pub fn hold_live_off(&mut self, why: String) {
+        let text = format!("live planning off: {why}");
+        if self.status.get().is_none() {
+            self.status.say(text.clone());
+        }
+        self.board.hold_live_off(text);
     }
 
     /// Live planning on for `pipeline` (θ-PSO or FLATLO), whatever the size.
@@ -432,10 +470,16 @@ impl App {
                 self.status.say("the recovery copy was discarded");
             }
             Action::Dismiss => {
-                // The innermost first: the line typed, the window, the add tool.
+                // The innermost first: the line typed, the window, a find,
+                // the add tool.
                 let closed = self.editor.cancel_edit() || self.overlays.close();
                 if !closed {
-                    self.editor.stop_add_tool();
+                    if self.find.end() {
+                        self.status
+                            .say("find ended: n / p step through every item again");
+                    } else {
+                        self.editor.stop_add_tool();
+                    }
                 }
             }
             Action::FocusNext | Action::FocusPrevious => {
@@ -497,6 +541,138 @@ impl App {
             },
             _ => {}
         }
+    }
+
+    /// The find prompt and its matches: typing narrows them and selects
+    /// the first (the map pans to it), Enter keeps it, Esc goes back.
+    fn update_find(&mut self, action: Action) {
+        match action {
+            Action::Find => {
+                self.editor.cancel_edit();
+                self.find.start(Before {
+                    selected: self.selected().clone(),
+                    center: self.camera.panned_center(),
+                    pane: self.pane,
+                });
+            }
+            Action::FindInput(c) => self.find_query(format!("{}{c}", self.find.query())),
+            Action::FindBackspace => {
+                let mut query = self.find.query().to_owned();
+                query.pop();
+                self.find_query(query);
+            }
+            Action::FindClear => self.find_query(String::new()),
+            Action::FindStep(by) => {
+                if !self.find.is_typing() {
+                    let (m, iwps) = (self.editor.mission(), self.editor.iwps());
+                    self.find.refresh(m, iwps, self.editor.selected());
+                }
+                match self.find.step(by).cloned() {
+                    Some(item) => {
+                        self.go_to(item);
+                        if !self.find.is_typing() {
+                            self.say_match();
+                        }
+                    }
+                    None if !self.find.is_typing() => {
+                        self.find.end();
+                        self.status.say("no match left: the find ended");
+                    }
+                    None => {}
+                }
+            }
+            Action::FindKeep => {
+                let query = self.find.query().trim().to_owned();
+                if self.find.current().is_none() {
+                    self.find_cancel();
+                    if !query.is_empty() {
+                        self.status
+                            .error(format!("no obstacle or IWP has '{query}' in its name"));
+                    }
+                    return;
+                }
+                self.find.keep();
+                self.say_match();
+                // One match: nothing to step through, n and p select as ever.
+                if self.find.matches().len() == 1 {
+                    self.find.end();
+                }
+            }
+            Action::FindCancel => self.find_cancel(),
+            _ => {}
+        }
+    }
+
+    /// The find's query is now `query`: its first match is selected, or,
+    /// with none, what was before the find.
+    fn find_query(&mut self, query: String) {
+        let (m, iwps) = (self.editor.mission(), self.editor.iwps());
+        self.find.set_query(query, m, iwps);
+        match self.find.current().cloned() {
+            Some(item) => self.go_to(item),
+            None => {
+                if let Some(before) = self.find.before().cloned() {
+                    self.restore(before);
+                }
+            }
+        }
+    }
+
+    fn find_cancel(&mut self) {
+        if let Some(before) = self.find.cancel() {
+            self.restore(before);
+        }
+    }
+
+    /// Back to what was on screen before a find.
+    fn restore(&mut self, before: Before) {
+        self.update_editor(Action::Select(before.selected));
+        self.camera.look_at(before.center);
+        self.pane = before.pane;
+    }
+
+    /// Selects `item` and shows it: an obstacle on the map, panned to
+    /// unless the whole map is in view; an IWP where it is (the map or the
+    /// formation editor's table).
+    fn go_to(&mut self, item: Item) {
+        let at = match &item {
+            Item::Obstacle(i) => self.mission().obstacles.get(*i).map(|o| o.center),
+            Item::Waypoint(between) => self
+                .iwps()
+                .iter()
+                .find(|w| w.between == *between)
+                .map(|w| w.position),
+            _ => None,
+        };
+        if matches!(item, Item::Obstacle(_)) {
+            self.pane = Pane::Map;
+        }
+        self.update_editor(Action::Select(item));
+        if self.pane == Pane::Map
+            && !self.camera.shows_everything()
+            && let Some(p) = at
+        {
+            self.camera.look_at(Some(p));
+        }
+    }
+
+    /// The status line names the match selected, which of how many, and
+    /// the keys that step on.
+    fn say_match(&mut self) {
+        let Some(item) = self.find.current() else {
+            return;
+        };
+        let n = self.find.matches().len();
+        let title = item.title(self.mission());
+        let query = self.find.query().trim();
+        self.status.say(if n == 1 {
+            format!("{title}: the one match for '{query}'")
+        } else {
+            format!(
+                "{title}: {} of {n} matches for '{query}' (n / N next / previous, Esc ends the find)",
+                self.find.cursor() + 1
+            )
+        });
     }
 
     fn update_replay(&mut self, action: Action) {
@@ -768,8 +944,10 @@ impl App {
             Entry::Builtin(name) => doc.with_builtin(name),
             Entry::File(_) | Entry::New(_) => doc.with_label(entry.label()),
         };
-        // The jobs were of the other mission: not "stale", gone.
+        // The jobs were of the other mission: not "stale", gone; so are
+        // the matches of a find.
         self.board.clear();
+        self.find.end();
         self.editor.replace(doc);
         if let Some(r) = &mut self.recovery {
             // Opening another mission drops this one's unsaved edits

@@ -108,6 +108,11 @@ impl JobBoard {
         }
     }
 
+    /// Leaves live planning off for `why` (the designer's start).
+    pub fn hold_live_off(&mut self, why: String) {
+        self.live.hold_off(why);
+    }
+
     /// Turns live planning on for `pipeline` (the designer's start).
     pub fn start_live(&mut self, pipeline: Kind, now: Instant) -> Result<(), String> {
         self.live.start(pipeline, now)

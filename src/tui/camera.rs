@@ -91,6 +91,16 @@ impl Camera {
         ));
     }
 
+    /// Looks at `center` (None: the extent's middle), at the same zoom.
+    pub fn look_at(&mut self, center: Option<Point2<f64>>) {
+        self.center = center;
+    }
+
+    /// Whether the whole extent is surely in view (zoom 1 or less, not panned).
+    pub fn shows_everything(&self) -> bool {
+        self.zoom <= 1.0 && self.center.is_none()
+    }
+
     /// The whole extent in view again.
     pub fn fit_map(&mut self) {
         self.zoom = 1.0;

@@ -17,7 +17,9 @@ use super::action::{Action, Pane};
 use super::document::Document;
 use super::fields::{self, Field, Item};
 use super::status::StatusLine;
-use crate::mission::{self, FleetTarget, Mission, MissionError, PathSegment, Preset, Severity};
+use crate::mission::{
+    self, FleetTarget, Mission, MissionError, PathSegment, Preset, Severity, ShapeChoice,
+};
 use crate::pipelines::theta_pso::{Iwp, find_iwps};
 
 /// A line of text being typed into an inspector field.
@@ -206,13 +208,14 @@ impl Editor {
             CyclePreset => self.cycle_preset(status),
             CycleShape => self.cycle_shape(status),
             ToggleWaypoint => {
-                if let Item::Waypoint(_) = &self.selected {
-                    let item = self.selected.clone();
+                if let Item::Waypoint(between) = &self.selected {
+                    let (item, between) = (self.selected.clone(), between.clone());
                     self.edit(status, |m| {
                         if let Ok(choice) = fields::waypoint_choice(m, &item) {
                             choice.enabled = !choice.enabled;
                         }
                     });
+                    status.say(self.iwp_said(&between));
                 }
             }
             FieldUp => {
@@ -436,14 +439,18 @@ impl Editor {
         }
     }
 
+    /// The next shape for the selected IWP, said on the status line with
+    /// what it makes of the route: a choice in the file is a crossing the
+    /// route must make (`route::find`'s requested stops).
     fn cycle_shape(&mut self, status: &mut StatusLine) {
-        if let Item::Waypoint(_) = &self.selected {
-            let item = self.selected.clone();
+        if let Item::Waypoint(between) = &self.selected {
+            let (item, between) = (self.selected.clone(), between.clone());
             self.edit(status, |m| {
                 if let Ok(choice) = fields::waypoint_choice(m, &item) {
                     choice.shape = fields::next_shape(choice.shape);
                 }
             });
+            status.say(self.iwp_said(&between));
         } else {
             // Say what `s` needs rather than do nothing.
             let iwps = self.iwps.len();
@@ -455,6 +462,35 @@ impl Editor {
                      first (2 formation editor, then n)"
                 )
             });
+        }
+    }
+
+    /// What the IWP between `between` is now, for the status line: its
+    /// shape (chosen, or auto and the one that fits), and whether the route
+    /// must cross it: an IWP with a choice in the file (`s` and `Space`
+    /// write one) is a stop of the route, as an inspection is.
+    fn iwp_said(&self, between: &[String; 2]) -> String {
+        let [a, b] = between;
+        let choice = self.mission().reconfiguration.choice(a, b);
+        let Some(iwp) = self.iwps.iter().find(|w| w.between == *between) else {
+            // Not an IWP of the mission as it is (a choice naming a gap
+            // that is not one): the choice alone.
+            let shape = choice.map_or("auto", |c| fields::shape_name(c.shape));
+            return format!("{shape} chosen for '{a}' ↔ '{b}', which is no IWP now");
+        };
+        let shape = match choice.map(|c| c.shape) {
+            None | Some(ShapeChoice::Auto) => format!("auto → {}", iwp.shape_name()),
+            Some(chosen) => format!("{} (chosen)", fields::shape_name(chosen)),
+        };
+        if let Some(why) = &iwp.unusable {
+            return format!("{shape}: no shape passes between '{a}' and '{b}': {why}");
+        }
+        match (iwp.enabled, choice.is_some()) {
+            (false, _) => format!(
+                "IWP off ({shape}): the route need not cross between '{a}' and '{b}' (Space: on)"
+            ),
+            (true, true) => format!("{shape}: the route must cross between '{a}' and '{b}'"),
+            (true, false) => format!("{shape}: the route may cross between '{a}' and '{b}' or not"),
         }
     }
 
@@ -587,7 +623,10 @@ impl Editor {
                         .waypoints
                         .retain(|w| !w.is_between(&between[0], &between[1]))
                 });
-                status.say("IWP back to the mission's default shape");
+                let [a, b] = &between;
+                status.say(format!(
+                    "IWP back to the mission's default shape: the route may cross between '{a}' and '{b}' or not"
+                ));
             }
             _ => status.say("only obstacles, slots and IWP choices can be deleted"),
         }

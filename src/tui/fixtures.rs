@@ -47,6 +47,50 @@ pub fn crowded_mission(n: usize) -> Mission {
     m
 }
 
+/// The bridge with 114 oaks in six rows north of the route (7 m apart: no
+/// gap among them is an IWP) and three masts south of it: a survey's
+/// 126 obstacles, over live planning's 60 (issue 36).
+pub fn bridge_with_oaks() -> Mission {
+    let mut m = mission::default_mission().mission;
+    m.name = "Bridge among oaks".into();
+    let tree = |name: String, x: f64, y: f64, kind: &str| Obstacle {
+        name,
+        center: Point2::new(x, y),
+        radius: 0.5,
+        height: 12.0,
+        kind: Some(kind.into()),
+        inspect: false,
+        stand_off: None,
+    };
+    for k in 0..114 {
+        let (column, row) = (k % 19, k / 19);
+        let (x, y) = (5.0 + 7.0 * column as f64, 62.0 + 7.0 * row as f64);
+        m.obstacles
+            .push(tree(format!("oak {}", k + 1), x, y, "tree"));
+    }
+    for (k, x) in [30.0, 60.0, 100.0].into_iter().enumerate() {
+        m.obstacles
+            .push(tree(format!("mast {}", k + 1), x, 10.0, "mast"));
+    }
+    m
+}
+
+/// An app on `mission` whose map shows a finished fleet run with `seed`.
+pub fn app_with_fleet_result(mission: Mission, seed: u64) -> App {
+    let outcome = crate::pipelines::fleet::plan(&mission, seed, &mut Silent, &CancelToken::new());
+    let mut app = App::new(
+        Document::new(mission.clone(), Some(PathBuf::from("fleet.toml"))),
+        PathBuf::from("."),
+    );
+    let started = Instant::now();
+    app.adopt_job(Job::new(1, Kind::Fleet, seed, mission, started));
+    let result = outcome
+        .map(|o| Outcome::Fleet(Box::new(o)))
+        .map_err(JobError::from);
+    app.on_job_msg(JobMsg::Done(1, result), started);
+    app
+}
+
 /// An app on `mission` whose map shows a finished θ-PSO run (`iterations`
 /// swarm iterations, seed `seed`), planned synchronously.
 pub fn app_with_result(mut mission: Mission, seed: u64, iterations: usize) -> App {

@@ -39,6 +39,9 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
             _ => None,
         };
     }
+    if app.finder().is_typing() {
+        return find_key(key, ctrl);
+    }
     let pressed = match key.code {
         KeyCode::Char(c) if ctrl => Key::Ctrl(c),
         KeyCode::Char(c) => Key::Char(c),
@@ -47,7 +50,12 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
         }
         code => Key::Code(code),
     };
-    if let Some(binding) = keys::lookup(pressed, app.focus(), app.pane()) {
+    let at = keys::Context {
+        focus: app.focus(),
+        pane: app.pane(),
+        found: app.finder().is_stepping(),
+    };
+    if let Some(binding) = keys::lookup(pressed, at) {
         return Some(binding.action.clone());
     }
     // In the inspector a number typed over a field replaces it.
@@ -57,6 +65,23 @@ pub fn key_action(app: &App, key: KeyEvent) -> Option<Action> {
         {
             Some(Action::EditStart(Some(c)))
         }
+        _ => None,
+    }
+}
+
+/// The find prompt's keys: letters type, the arrows choose among the
+/// matches, Enter keeps the one chosen, Esc goes back.
+fn find_key(key: KeyEvent, ctrl: bool) -> Option<Action> {
+    match key.code {
+        KeyCode::Enter => Some(Action::FindKeep),
+        KeyCode::Esc => Some(Action::FindCancel),
+        KeyCode::Backspace => Some(Action::FindBackspace),
+        KeyCode::Down | KeyCode::Tab => Some(Action::FindStep(1)),
+        KeyCode::Up | KeyCode::BackTab => Some(Action::FindStep(-1)),
+        KeyCode::Char('u') if ctrl => Some(Action::FindClear),
+        KeyCode::Char('n') if ctrl => Some(Action::FindStep(1)),
+        KeyCode::Char('p') if ctrl => Some(Action::FindStep(-1)),
+        KeyCode::Char(c) if !ctrl => Some(Action::FindInput(c)),
         _ => None,
     }
 }

@@ -32,15 +32,27 @@ pub enum When {
     Focus(Focus),
     NotFocus(Focus),
     Pane(Pane),
+    /// A find was kept (`/`, then Enter): its matches are stepped through.
+    Found,
+}
+
+/// What a binding's condition reads of the screen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Context {
+    pub focus: Focus,
+    pub pane: Pane,
+    /// A kept find's matches are being stepped through.
+    pub found: bool,
 }
 
 impl When {
-    pub fn holds(self, focus: Focus, pane: Pane) -> bool {
+    pub fn holds(self, at: Context) -> bool {
         match self {
             When::Always => true,
-            When::Focus(f) => focus == f,
-            When::NotFocus(f) => focus != f,
-            When::Pane(p) => pane == p,
+            When::Focus(f) => at.focus == f,
+            When::NotFocus(f) => at.focus != f,
+            When::Pane(p) => at.pane == p,
+            When::Found => at.found,
         }
     }
 }
@@ -67,13 +79,13 @@ pub struct KeyRow {
     pub bindings: &'static [Binding],
 }
 
-/// The first binding for `key` that holds with this focus and pane; a
-/// Shift-arrow nothing binds acts as the plain arrow.
-pub fn lookup(key: Key, focus: Focus, pane: Pane) -> Option<&'static Binding> {
+/// The first binding for `key` that holds in `at`; a Shift-arrow nothing
+/// binds acts as the plain arrow.
+pub fn lookup(key: Key, at: Context) -> Option<&'static Binding> {
     let find = |key: Key| {
         KEYS.iter()
             .flat_map(|row| row.bindings)
-            .find(|b| b.key == key && b.when.holds(focus, pane))
+            .find(|b| b.key == key && b.when.holds(at))
     };
     find(key).or_else(|| match key {
         Key::Shift(code) => find(Key::Code(code)),
@@ -175,6 +187,22 @@ pub static KEYS: &[KeyRow] = &[
         keys: "I",
         help: "import obstacles from a site survey (GeoJSON, KML, KMZ): one undo step",
         bindings: &[bind(Key::Char('I'), When::Always, Action::Import)],
+    },
+    KeyRow {
+        group: "Select & move",
+        keys: "/",
+        help: "find an obstacle or IWP by name: type part of it, ↑ ↓ choose, Enter selects it (the map pans to it), Esc cancels",
+        bindings: &[bind(Key::Char('/'), When::Always, Action::Find)],
+    },
+    KeyRow {
+        group: "Select & move",
+        keys: "n  N  p",
+        help: "after a find: next / previous match (Esc ends the find)",
+        bindings: &[
+            bind(Key::Char('n'), When::Found, Action::FindStep(1)),
+            bind(Key::Char('N'), When::Found, Action::FindStep(-1)),
+            bind(Key::Char('p'), When::Found, Action::FindStep(-1)),
+        ],
     },
     KeyRow {
         group: "Select & move",
@@ -345,7 +373,7 @@ pub static KEYS: &[KeyRow] = &[
     KeyRow {
         group: "Edit",
         keys: "Esc",
-        help: "cancel typing, close a window, leave the add tool",
+        help: "cancel typing, close a window, end a find, leave the add tool",
         bindings: &[bind(Key::Code(KeyCode::Esc), When::Always, Action::Dismiss)],
     },
     KeyRow {

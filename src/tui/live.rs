@@ -53,6 +53,9 @@ pub struct Live {
     latest: Option<Job>,
     /// Why live planning waits, when the mission has errors.
     paused: Option<String>,
+    /// Why live planning was left off when the designer opened (the
+    /// mission's size, `--no-live`), until it is turned on.
+    held_off: Option<String>,
 
     next_id: JobId,
     /// Live plans that came in.
@@ -72,6 +75,7 @@ impl Default for Live {
             running: Vec::new(),
             latest: None,
             paused: None,
+            held_off: None,
             next_id: FIRST_ID,
             revision: 0,
             most_running: 0,
@@ -97,6 +101,18 @@ impl Live {
     /// Why live planning waits, if it does (the mission's first error).
     pub fn paused(&self) -> Option<&str> {
         self.paused.as_deref()
+    }
+
+    /// Why live planning was left off when the designer opened, while it
+    /// still is.
+    pub fn held_off(&self) -> Option<&str> {
+        self.held_off.as_deref().filter(|_| !self.on)
+    }
+
+    /// Leaves live planning off for `why` (said until it is turned on).
+    pub fn hold_off(&mut self, why: String) {
+        self.stop();
+        self.held_off = Some(why);
     }
 
     /// A run is under way or due: the plan shown is being replaced.
@@ -132,6 +148,7 @@ impl Live {
             );
         }
         self.on = true;
+        self.held_off = None;
         self.pipeline = pipeline;
         self.target = None;
         self.due = Some(now);

@@ -18,6 +18,7 @@ pub mod document;
 pub mod editor;
 pub mod export;
 pub mod fields;
+pub mod find;
 #[doc(hidden)]
 pub mod fixtures;
 mod import;
@@ -136,6 +137,8 @@ pub fn run(path: Option<PathBuf>, live: bool) -> Result<u8, String> {
     });
     if live {
         app.enable_live();
+    } else {
+        app.hold_live_off("--no-live; L turns it on".to_owned());
     }
     let signals = spawn_signals();
 

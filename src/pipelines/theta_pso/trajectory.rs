@@ -40,7 +40,8 @@ pub struct Reconfiguration {
     /// where the site is narrower than the formation but no IWP says so.
     pub iwp: Option<usize>,
     /// The obstacles of the IWP, or the nearest on either side of the
-    /// squeezed stretch where it is narrowest.
+    /// squeezed stretch where it is narrowest; one name twice for a stretch
+    /// squeezed beside one obstacle, the other side open (names are unique).
     pub between: [String; 2],
     pub shape: super::iwp::Shape,
     /// Centroid position at the IWP.
@@ -51,6 +52,20 @@ pub struct Reconfiguration {
     pub t2: f64,
     pub t3: f64,
     pub t4: f64,
+}
+
+impl Reconfiguration {
+    /// Where it is, as a reader is told: "between 'a' and 'b'", or "beside
+    /// 'a'" for a stretch squeezed by one obstacle (not "between 'oak' and
+    /// 'oak'").
+    pub fn obstacles(&self) -> String {
+        let [a, b] = &self.between;
+        if a == b {
+            format!("beside '{a}'")
+        } else {
+            format!("between '{a}' and '{b}'")
+        }
+    }
 }
 
 /// Samples per second of the trajectories.

@@ -12,7 +12,8 @@ use crate::base::geometry::segment_point_distance;
 /// Unusable IWPs that share a reason.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UnusableGroup {
-    /// The reason without the names and figures of any one IWP.
+    /// The reason without the figures of any one IWP; the obstacles it
+    /// names, by name (those of the IWPs nearest the route first).
     pub reason: String,
     pub count: usize,
     /// The IWPs of the group nearest the route, nearest first (at most the
@@ -20,9 +21,9 @@ pub struct UnusableGroup {
     pub nearest: Vec<[String; 2]>,
 }
 
-/// An IWP of a group: its distance to the route and the obstacles it is
-/// between.
-type Member = (f64, [String; 2]);
+/// An IWP of a group: its distance to the route, the obstacles it is
+/// between and the names its reason quotes.
+type Member = (f64, [String; 2], Vec<String>);
 
 /// The enabled, unusable IWPs of `iwps` grouped by reason, the largest
 /// group first, each naming its `named` IWPs nearest `route` (x-y).
@@ -33,7 +34,11 @@ pub fn unusable_groups(iwps: &[Iwp], route: &[Point3<f64>], named: usize) -> Vec
             continue;
         };
         let key = reason_kind(reason);
-        let entry = (distance_to(route, &iwp.position), iwp.between.clone());
+        let entry = (
+            distance_to(route, &iwp.position),
+            iwp.between.clone(),
+            quoted(reason),
+        );
         match groups.iter_mut().find(|(k, _)| *k == key) {
             Some((_, members)) => members.push(entry),
             None => groups.push((key, vec![entry])),
@@ -41,12 +46,12 @@ pub fn unusable_groups(iwps: &[Iwp], route: &[Point3<f64>], named: usize) -> Vec
     }
     let mut out: Vec<UnusableGroup> = groups
         .into_iter()
-        .map(|(reason, mut members)| {
+        .map(|(kind, mut members)| {
             members.sort_by(|a, b| a.0.total_cmp(&b.0));
             UnusableGroup {
-                reason,
+                reason: with_names(&kind, &members),
                 count: members.len(),
-                nearest: members.into_iter().take(named).map(|(_, b)| b).collect(),
+                nearest: members.into_iter().take(named).map(|(_, b, _)| b).collect(),
             }
         })
         .collect();
@@ -84,6 +89,44 @@ fn reason_kind(reason: &str) -> String {
         out.push(c);
     }
     out.trim().to_owned()
+}
+
+/// The names `reason` quotes before its colon, in order.
+fn quoted(reason: &str) -> Vec<String> {
+    let head = reason.split(':').next().unwrap_or(reason);
+    head.split('\'')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_owned)
+        .collect()
+}
+
+/// A group's reason (`kind`, its quoted names taken out as `'…'`) with the
+/// names put back: at each place the one name every member quotes there,
+/// else the one of the IWP nearest the route and how many others ("'post
+/// 4c' or 3 others"): never a literal `'…'`.
+fn with_names(kind: &str, members: &[Member]) -> String {
+    let mut out = String::new();
+    for (slot, piece) in kind.split("'…'").enumerate() {
+        if slot > 0 {
+            let mut names: Vec<&str> = Vec::new();
+            for (.., quoted) in members {
+                if let Some(name) = quoted.get(slot - 1)
+                    && !names.contains(&name.as_str())
+                {
+                    names.push(name);
+                }
+            }
+            out.push_str(&match names.as_slice() {
+                [] => "an obstacle".to_owned(),
+                [one] => format!("'{one}'"),
+                [nearest, other] => format!("'{nearest}' or '{other}'"),
+                [nearest, others @ ..] => format!("'{nearest}' or {} others", others.len()),
+            });
+        }
+        out.push_str(piece);
+    }
+    out
 }
 
 /// The x-y distance from `p` to the polyline `route` (∞ without one).
@@ -148,17 +191,27 @@ mod tests {
             ));
         }
         iwps.push(iwp("gate a", "gate b", 5.0, None));
+        let why = "held through the gap, the shrink would pass within r_Q of 'mast'";
+        iwps.push(iwp("mast", "wall", 60.0, Some(why)));
+        iwps.push(iwp("mast", "fence", 61.0, Some(why)));
         let route = [Point3::new(0.0, 12.0, 10.0), Point3::new(100.0, 12.0, 10.0)];
         let groups = unusable_groups(&iwps, &route, 3);
-        assert_eq!(groups.len(), 2, "{groups:?}");
+        assert_eq!(groups.len(), 3, "{groups:?}");
         assert_eq!(groups[0].reason, "no shape fits");
         assert_eq!(groups[0].count, 30);
         let nearest: Vec<&str> = groups[0].nearest.iter().map(|b| b[0].as_str()).collect();
         assert_eq!(nearest, ["tree 12", "tree 11", "tree 13"]);
+        // The names of the obstacles in the way, not '…' (issue 36): the
+        // one nearest the route, and how many more.
         assert_eq!(
             groups[1].reason,
-            "held through the gap, the alignment would pass within r_Q of '…'"
+            "held through the gap, the alignment would pass within r_Q of 'post 0' or 9 others"
         );
         assert_eq!(groups[1].count, 10);
+        // One name throughout the group: that name.
+        assert_eq!(
+            groups[2].reason,
+            "held through the gap, the shrink would pass within r_Q of 'mast'"
+        );
     }
 }

@@ -144,10 +144,13 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
         .borders(Borders::ALL)
         .border_type(BorderType::Rounded)
         .border_style(Style::default().fg(border))
-        .title(Line::from(vec![
-            Span::styled(" Inspector ", Style::default().bold()),
-            Span::raw(format!("· {} ", app.selected().title(m))),
-        ]));
+        .title(super::title::fit(
+            vec![
+                super::title::Part::keep(Span::styled(" Inspector ", Style::default().bold())),
+                super::title::Part::keep(Span::raw(format!("· {} ", app.selected().title(m)))),
+            ],
+            area.width.saturating_sub(2),
+        ));
     // Keep the cursor visible in a long list.
     let inner_height = area.height.saturating_sub(2) as usize;
     let scroll = cursor_line.saturating_sub(inner_height.saturating_sub(3)) as u16;

@@ -17,6 +17,7 @@ use crate::tui::action::Action;
 use crate::tui::app::{App, Focus};
 use crate::tui::jobs::{Job, JobState};
 use crate::tui::keys::KEYS;
+use crate::tui::view::title::{Part, fit};
 
 /// `██████░░░░ 60%` in `width` cells.
 fn bar(progress: f64, width: usize) -> String {
@@ -120,10 +121,13 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         .borders(Borders::ALL)
         .border_type(BorderType::Rounded)
         .border_style(Style::default().fg(border))
-        .title(Line::from(vec![
-            Span::styled(" Jobs ", Style::default().bold()),
-            Span::styled(rec, Style::default().red()),
-        ]));
+        .title(fit(
+            vec![
+                Part::keep(Span::styled(" Jobs ", Style::default().bold())),
+                Part::optional(1, Span::styled(rec, Style::default().red())),
+            ],
+            area.width.saturating_sub(2),
+        ));
     let inner = block.inner(area);
     frame.render_widget(block, area);
     // The newest live plan, when the map shows it, is what the panel details.
@@ -132,6 +136,9 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         // The Run keys of the key table, each with its help up to any
         // parenthesis.
         let mut text = vec![Line::raw("No runs yet.")];
+        if let Some(why) = app.board().live().held_off() {
+            text.push(Line::styled(why.to_owned(), Style::default().yellow()));
+        }
         for row in KEYS.iter().filter(|row| {
             row.bindings.iter().any(|b| {
                 matches!(
@@ -149,7 +156,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
                 Span::raw(format!(" {help}")),
             ]));
         }
-        frame.render_widget(Paragraph::new(text), inner);
+        frame.render_widget(Paragraph::new(text).wrap(Wrap { trim: false }), inner);
         return;
     }
     let list_height = (app.jobs().len().max(1) as u16)
@@ -189,17 +196,27 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
             let cost = job
                 .best_cost()
                 .map_or(String::new(), |c| format!("J {c:.1} "));
-            let mut spans = vec![
-                Span::styled(head, style),
-                Span::styled(
-                    bar(job.progress, bar_width),
-                    Style::default().fg(Color::LightBlue),
+            // A row too long for the panel drops its elapsed time, then
+            // its cost, then its bar: never its verdict ("J 280.2 f" at 80
+            // columns).
+            let mut parts = vec![
+                Part::keep(Span::styled(head, style)),
+                Part::optional(
+                    2,
+                    Span::styled(
+                        format!("{} ", bar(job.progress, bar_width)),
+                        Style::default().fg(Color::LightBlue),
+                    ),
                 ),
-                Span::raw(format!(" {:>5.1}s {cost}", job.elapsed(now).as_secs_f64())),
-                state_span(job),
+                Part::optional(
+                    4,
+                    Span::raw(format!("{:>5.1}s ", job.elapsed(now).as_secs_f64())),
+                ),
+                Part::optional(3, Span::raw(cost)),
+                Part::keep(state_span(job)),
             ];
-            spans.extend(agents_span(job));
-            Line::from(spans)
+            parts.extend(agents_span(job).map(Part::keep));
+            fit(parts, inner.width)
         })
         .collect();
     frame.render_widget(Paragraph::new(lines), list);
@@ -215,7 +232,12 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         facts.push(Line::styled(format!("error: {e}"), Style::default().red()));
     }
     if let Some(o) = job.outcome.as_ref().and_then(|o| o.theta_pso()) {
-        facts.extend(theta_pso_table(o, &job.state, app.is_stale(job)));
+        facts.extend(theta_pso_table(
+            o,
+            &job.state,
+            app.is_stale(job),
+            detail.width,
+        ));
     } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.fleet()) {
         let lines = fleet_table(o, app.is_stale(job));
         frame.render_widget(Paragraph::new(lines), detail);
@@ -257,6 +279,14 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
     draw_chart(frame, job, chart_area);
 }
 
+/// Under a result's verdict once the mission changed after its run.
+fn stale_line() -> Line<'static> {
+    Line::styled(
+        "STALE: the mission changed since this run",
+        Style::default().black().on_yellow(),
+    )
+}
+
 /// Rows `lines` take once wrapped at `width` cells.
 fn wrapped_rows(lines: &[Line], width: u16) -> u16 {
     let width = usize::from(width.max(1));
@@ -272,12 +302,14 @@ fn collapsed(text: &str) -> String {
 }
 
 /// θ-PSO's result as the CLI prints it: the verdict and its first failing
-/// check on top, the figures, the unusable IWPs grouped by reason, then the
-/// whole verification table (`outcome::summary::verification_rows`).
+/// check on top, the figures (on one row of `width`), the unusable IWPs
+/// grouped by reason, then the whole verification table
+/// (`outcome::summary::verification_rows`).
 fn theta_pso_table(
     o: &crate::pipelines::theta_pso::ThetaPsoOutcome,
     state: &JobState,
     stale: bool,
+    width: u16,
 ) -> Vec<Line<'static>> {
     let v = &o.verification;
     let rows = crate::outcome::summary::verification_rows(o);
@@ -301,18 +333,24 @@ fn theta_pso_table(
     };
     lines.push(verdict);
     if stale {
-        lines.push(Line::styled(
-            "stale: the mission changed since this run",
-            Style::default().yellow(),
-        ));
+        lines.push(stale_line());
     }
-    lines.push(Line::raw(format!(
-        "J {:.2} · {:.1} m · {:.1} s · {} reconfiguration(s)",
-        o.cost.total,
-        o.path_length,
-        o.duration,
-        o.reconfigurations.len()
-    )));
+    // On one row of a narrow panel: the reconfigurations' word shortens.
+    let n = o.reconfigurations.len();
+    lines.push(fit(
+        vec![
+            Part::keep(Span::raw(format!(
+                "J {:.2} · {:.1} m · {:.1} s",
+                o.cost.total, o.path_length, o.duration
+            ))),
+            Part::shortened(
+                1,
+                Span::raw(format!(" · {n} reconfiguration(s)")),
+                Span::raw(format!(" · {n} reconfig.")),
+            ),
+        ],
+        width,
+    ));
     let enabled = o.iwps.iter().filter(|i| i.enabled).count();
     let groups =
         crate::pipelines::theta_pso::unusable::unusable_groups(&o.iwps, &o.centroid_path, 2);
@@ -440,10 +478,8 @@ fn fleet_table(o: &crate::pipelines::fleet::FleetOutcome, stale: bool) -> Vec<Li
         evaluations
     )));
     if stale {
-        lines.push(Line::styled(
-            "stale: the mission changed since this run",
-            Style::default().yellow(),
-        ));
+        // Second, under the verdict, where a short panel still shows it.
+        lines.insert(1, stale_line());
     }
     lines
 }
@@ -514,10 +550,8 @@ fn flatlo_table(o: &crate::pipelines::flatlo::FlatloOutcome, stale: bool) -> Vec
         )));
     }
     if stale {
-        lines.push(Line::styled(
-            "stale: the mission changed since this run",
-            Style::default().yellow(),
-        ));
+        // Second, under the verdict, where a short panel still shows it.
+        lines.insert(1, stale_line());
     }
     lines
 }

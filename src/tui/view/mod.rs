@@ -5,6 +5,7 @@ pub mod inspector;
 pub mod jobs;
 pub mod map;
 pub mod terrain;
+pub mod title;
 pub mod viewport;
 
 use std::time::Instant;
@@ -17,27 +18,56 @@ use ratatui::widgets::{Block, BorderType, Borders, Clear, Paragraph, Wrap};
 
 use super::app::{App, Focus, Overlay, Pane};
 use super::keys::KEYS;
+use title::Part;
 
 /// Below this the layout cannot show a usable map and inspector.
 pub const MIN_WIDTH: u16 = 80;
 pub const MIN_HEIGHT: u16 = 24;
+
+/// Narrower than this, the inspector and the jobs fold away while the map
+/// (or the formation editor) has the focus, so it has the whole width: at
+/// 80 columns beside them it had 34, at 5.7 m a cell on the bridge. `Tab`
+/// unfolds them.
+pub const FOLD_BELOW: u16 = 100;
 
 /// Where each panel goes on a screen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Areas {
     /// Map, side view or formation editor.
     pub left: Rect,
+    /// Empty (and so are the jobs) while folded.
     pub inspector: Rect,
     pub jobs: Rect,
     pub status: Rect,
+    /// The inspector and the jobs are folded away: the left pane has the
+    /// whole width.
+    pub folded: bool,
 }
 
-/// The panels for a screen of `area`; None when it is too small.
+/// The panels for a screen of `area`, the inspector and the jobs shown;
+/// None when it is too small.
 pub fn layout(area: Rect) -> Option<Areas> {
+    layout_for(area, Focus::Inspector)
+}
+
+/// The panels for a screen of `area` with `focus` on one of them; None
+/// when it is too small. Under [`FOLD_BELOW`] columns, the map's focus
+/// folds the inspector and the jobs away.
+pub fn layout_for(area: Rect, focus: Focus) -> Option<Areas> {
     if area.width < MIN_WIDTH || area.height < MIN_HEIGHT {
         return None;
     }
     let [body, status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
+    if area.width < FOLD_BELOW && focus == Focus::Map {
+        let none = Rect::new(body.right(), body.y, 0, 0);
+        return Some(Areas {
+            left: body,
+            inspector: none,
+            jobs: none,
+            status,
+            folded: true,
+        });
+    }
     let side = (area.width * 2 / 5).clamp(44, 64);
     let [left, right] =
         Layout::horizontal([Constraint::Min(0), Constraint::Length(side)]).areas(body);
@@ -48,6 +78,7 @@ pub fn layout(area: Rect) -> Option<Areas> {
         inspector,
         jobs,
         status,
+        folded: false,
     })
 }
 
@@ -66,7 +97,7 @@ impl Drawn {
     /// What `draw` shows of `app` on a screen of `screen`; None when the
     /// screen is too small for the designer.
     pub fn of(app: &App, screen: Rect) -> Option<Drawn> {
-        let areas = layout(screen)?;
+        let areas = layout_for(screen, app.focus())?;
         let canvas = match app.pane() {
             Pane::Map => map::Viewport::map(app, areas.left),
             Pane::Formation => {
@@ -98,12 +129,20 @@ pub fn draw(frame: &mut Frame, app: &App, now: Instant) -> Option<Drawn> {
     };
     let areas = drawn.areas;
     match app.pane() {
-        Pane::Map => map::draw_map(frame, app, areas.left, &drawn.canvas),
-        Pane::Formation => map::draw_formation(frame, app, areas.left, &drawn.canvas),
+        Pane::Map => map::draw_map(frame, app, areas.left, &drawn.canvas, areas.folded),
+        Pane::Formation => {
+            map::draw_formation(frame, app, areas.left, &drawn.canvas, areas.folded);
+        }
     }
-    inspector::draw(frame, app, areas.inspector);
-    jobs::draw(frame, app, areas.jobs, now);
-    draw_status(frame, app, areas.status);
+    if !areas.folded {
+        inspector::draw(frame, app, areas.inspector);
+        jobs::draw(frame, app, areas.jobs, now);
+    }
+    if app.finder().is_typing() {
+        draw_find(frame, app, areas);
+    } else {
+        draw_status(frame, app, areas.status);
+    }
     if let Some(overlay) = app.overlay() {
         draw_overlay(frame, app, overlay, area);
     }
@@ -111,37 +150,48 @@ pub fn draw(frame: &mut Frame, app: &App, now: Instant) -> Option<Drawn> {
 }
 
 fn draw_status(frame: &mut Frame, app: &App, area: Rect) {
-    let modified = app.doc().is_modified();
-    let mut spans = vec![
+    // The message matters most: on a narrow screen the file's name and the
+    // badges give way to it.
+    let mut parts = vec![Part::optional(
+        2,
         Span::styled(
             format!(" {} ", app.doc().title()),
             Style::default().black().on_gray(),
         ),
-        if modified {
-            Span::styled(" ● modified ", Style::default().black().on_yellow())
-        } else {
-            Span::raw(" ")
-        },
-    ];
+    )];
+    let modified = Style::default().black().on_yellow();
+    parts.push(if app.doc().is_modified() {
+        Part::shortened(
+            1,
+            Span::styled(" ● modified ", modified),
+            Span::styled(" ● ", modified),
+        )
+    } else {
+        Part::keep(Span::raw(" "))
+    });
     let errors = app.doc().error_count();
     if errors > 0 {
-        spans.push(Span::styled(
-            format!(" {errors} error(s) "),
-            Style::default().white().on_red(),
+        let style = Style::default().white().on_red();
+        parts.push(Part::shortened(
+            1,
+            Span::styled(format!(" {errors} error(s) "), style),
+            Span::styled(format!(" {errors}✗ "), style),
         ));
     }
-    spans.push(Span::raw(" "));
+    parts.push(Part::keep(Span::raw(" ")));
     if let Some(status) = app.status() {
         let style = if status.error {
             Style::default().light_red().bold()
         } else {
             Style::default()
         };
-        spans.push(Span::styled(status.text.clone(), style));
+        parts.push(Part::keep(Span::styled(status.text.clone(), style)));
     }
+    let mut spans = title::fit(parts, area.width).spans;
     let hints = match (app.focus(), app.pane()) {
         _ if app.editor().editing().is_some() => "Enter apply · Esc cancel · Ctrl-u clear",
-        (Focus::Map, Pane::Map) => "n/p select · arrows move · a add · r run · ? help",
+        _ if app.finder().is_stepping() => "n/N next/previous match · Esc end the find · ? help",
+        (Focus::Map, Pane::Map) => "/ find · n/p select · arrows move · r run · ? help",
         (Focus::Map, Pane::Formation) => "n/p select · arrows move · P preset · s shape · ? help",
         (Focus::Inspector, _) => "↑↓ field · Enter edit · Tab focus · ? help",
         (Focus::Jobs, _) => "↑↓ job · Enter show · x cancel · ? help",
@@ -153,6 +203,97 @@ fn draw_status(frame: &mut Frame, app: &App, area: Rect) {
         spans.push(Span::styled(hints, Style::default().fg(Color::DarkGray)));
     }
     frame.render_widget(Paragraph::new(Line::from(spans)), area);
+}
+
+/// Most matches the find's list shows at once.
+const FIND_ROWS: usize = 8;
+
+/// The find prompt on the status line (what is typed, which match of how
+/// many is selected, the keys), and the matches above it, over the left
+/// pane's lower left, the selected one marked.
+fn draw_find(frame: &mut Frame, app: &App, areas: Areas) {
+    let find = app.finder();
+    let m = app.mission();
+    let matches = find.matches();
+    let mut spans = vec![
+        Span::styled(" find ", Style::default().black().on_gray()),
+        Span::raw(" "),
+        Span::styled(
+            format!("/{}▏", find.query()),
+            Style::default().white().on_blue(),
+        ),
+        Span::raw(" "),
+    ];
+    let said = match (find.query().trim().is_empty(), matches.len()) {
+        (true, _) => "type part of an obstacle's or an IWP's name".to_owned(),
+        (false, 0) => "no obstacle or IWP has that in its name".to_owned(),
+        (false, n) => format!(
+            "{} of {n}: {}",
+            find.cursor() + 1,
+            matches[find.cursor()].title(m)
+        ),
+    };
+    let style = if !find.query().trim().is_empty() && matches.is_empty() {
+        Style::default().light_red()
+    } else {
+        Style::default()
+    };
+    spans.push(Span::styled(said, style));
+    let hints = "↑↓ choose · Enter select · Esc cancel";
+    let used: usize = spans.iter().map(Span::width).sum();
+    let room = usize::from(areas.status.width).saturating_sub(used + 1);
+    if room > hints.chars().count() {
+        spans.push(Span::raw(" ".repeat(room - hints.chars().count())));
+        spans.push(Span::styled(hints, Style::default().fg(Color::DarkGray)));
+    }
+    frame.render_widget(Paragraph::new(Line::from(spans)), areas.status);
+    if matches.is_empty() {
+        return;
+    }
+    // The list: as many rows as fit over the lower half of the left pane.
+    let room = usize::from(areas.left.height.saturating_sub(2) / 2).clamp(1, FIND_ROWS);
+    let shown = matches.len().min(room);
+    let first = (find.cursor() + 1).saturating_sub(shown);
+    let lines: Vec<Line> = matches
+        .iter()
+        .enumerate()
+        .skip(first)
+        .take(shown)
+        .map(|(k, item)| {
+            let title = item.title(m);
+            if k == find.cursor() {
+                Line::styled(format!("▶ {title}"), Style::default().black().on_yellow())
+            } else {
+                Line::raw(format!("  {title}"))
+            }
+        })
+        .collect();
+    let inner_width = lines.iter().map(Line::width).max().unwrap_or(0) as u16;
+    let width = (inner_width + 2)
+        .max(16)
+        .min(areas.left.width.saturating_sub(2));
+    let height = shown as u16 + 2;
+    let r = Rect::new(
+        areas.left.x + 1,
+        areas.left.bottom().saturating_sub(height + 1),
+        width,
+        height,
+    );
+    let title = match matches.len() {
+        1 => " 1 match ".to_owned(),
+        n => format!(" {n} matches "),
+    };
+    frame.render_widget(Clear, r);
+    frame.render_widget(
+        Paragraph::new(lines).block(
+            Block::default()
+                .borders(Borders::ALL)
+                .border_type(BorderType::Rounded)
+                .border_style(Style::default().fg(Color::Cyan))
+                .title(Span::styled(title, Style::default().bold())),
+        ),
+        r,
+    );
 }
 
 /// A centred box of at most `width` × `height` cells.

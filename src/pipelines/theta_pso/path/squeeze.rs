@@ -63,7 +63,8 @@ impl SqueezeMap {
 
     /// The obstacles nearest `p` on the left and on the right of the
     /// direction `along` (mission indices; one twice when the other side is
-    /// open or a bound).
+    /// open or a bound: the stretch is squeezed beside it; with neither
+    /// side's, the obstacle nearest `p` twice).
     pub fn sides(&self, p: Point2<f64>, along: nalgebra::Vector2<f64>) -> [usize; 2] {
         let left = nalgebra::Vector2::new(-along.y, along.x).normalize();
         let probe = |sign: f64| {
@@ -85,7 +86,14 @@ impl SqueezeMap {
         match (probe(1.0), probe(-1.0)) {
             (Some(a), Some(b)) => [a, b],
             (Some(a), None) | (None, Some(a)) => [a, a],
-            (None, None) => [0, 0],
+            (None, None) => {
+                let nearest = self
+                    .field
+                    .nearest_disc(self.field.index_of(p))
+                    .and_then(|k| self.obstacle_of.get(k))
+                    .map_or(0, |&(k, _)| k);
+                [nearest, nearest]
+            }
         }
     }
 }
@@ -244,4 +252,67 @@ pub(super) fn clip(
         }
     }
     (u0 <= u1).then_some([u0, u1])
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector2;
+
+    use super::*;
+    use crate::pipelines::theta_pso::route::field::Disc;
+    use crate::pipelines::theta_pso::trajectory::Reconfiguration;
+
+    /// A squeeze map over 40 m × 40 m with these discs (mission indices 10,
+    /// 11, …), no region marked: only `sides` is asked.
+    fn map(centres: &[(f64, f64)]) -> SqueezeMap {
+        let discs: Vec<Disc> = centres
+            .iter()
+            .map(|&(x, y)| Disc {
+                center: Point2::new(x, y),
+                radius: 3.0,
+            })
+            .collect();
+        let field = Field::new([[0.0, 40.0], [0.0, 40.0]], &discs, 0.5, 20.0);
+        let cells = field.len();
+        SqueezeMap {
+            field,
+            region: vec![0; cells],
+            shapes: Vec::new(),
+            obstacle_of: discs
+                .iter()
+                .enumerate()
+                .map(|(k, d)| (10 + k, d.center))
+                .collect(),
+            free: vec![0; cells],
+            extent: [Point2::new(0.0, 0.0), Point2::new(40.0, 40.0)],
+        }
+    }
+
+    /// Issue 36: a stretch squeezed by one obstacle, the other side open,
+    /// is named by that obstacle once ("beside 'oak'", not "between 'oak'
+    /// and 'oak'"); with none on either side, by the nearest, never by the
+    /// mission's first obstacle.
+    #[test]
+    fn a_squeeze_is_named_by_an_obstacle_on_each_side_or_beside_one() {
+        let (p, east) = (Point2::new(20.0, 20.0), Vector2::new(1.0, 0.0));
+        assert_eq!(map(&[(20.0, 26.0), (20.0, 14.0)]).sides(p, east), [10, 11]);
+        assert_eq!(map(&[(20.0, 26.0)]).sides(p, east), [10, 10]);
+        // Straight ahead, on neither side: the nearest obstacle (it was
+        // [0, 0], whatever the mission's first obstacle is).
+        assert_eq!(map(&[(26.0, 20.0)]).sides(p, east), [10, 10]);
+
+        let mut r = Reconfiguration {
+            iwp: None,
+            between: ["oak 7".into(), "oak 7".into()],
+            shape: Shape::Shrink { scale: 0.5 },
+            position: Point3::origin(),
+            t1: 0.0,
+            t2: 1.0,
+            t3: 2.0,
+            t4: 3.0,
+        };
+        assert_eq!(r.obstacles(), "beside 'oak 7'");
+        r.between[1] = "oak 8".into();
+        assert_eq!(r.obstacles(), "between 'oak 7' and 'oak 8'");
+    }
 }

@@ -32,20 +32,38 @@ pub fn formation_split(app: &App, area: Rect) -> [Rect; 2] {
 /// The formation editor: slots in the formation frame (drawn through `vp`,
 /// the viewport `Drawn` reports), and the IWPs' shapes.
 ///
+/// `folded`: the pane has the whole width (a narrow screen, its focus):
+/// its bottom line names the selection and says Tab.
+///
 /// Long (~135 lines): the formation's slots, their labels and the heading, in drawing order.
-pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
+pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport, folded: bool) {
     let m = app.mission();
     let [top, bottom] = formation_split(app, area);
     let vp = *vp;
-    let title = TextLine::from(vec![
-        Span::styled(" Formation ", Style::default().bold()),
-        Span::raw(format!(
-            "· {} UAVs · r_F {:.2} m · forward ↑ · P preset ({}) · a add · Del remove ",
-            m.formation.slots.len(),
-            m.formation.radius(),
-            app.current_preset().map_or("custom", Preset::name)
-        )),
-    ]);
+    let title = fit(
+        vec![
+            Part::keep(Span::styled(" Formation ", Style::default().bold())),
+            Part::keep(Span::raw(format!("· {} UAVs ", m.formation.slots.len()))),
+            Part::optional(
+                2,
+                Span::raw(format!("· r_F {:.2} m ", m.formation.radius())),
+            ),
+            Part::optional(4, Span::raw("· forward ↑ ")),
+            Part::shortened_optional(
+                1,
+                Span::raw(format!(
+                    "· P preset ({}) ",
+                    app.current_preset().map_or("custom", Preset::name)
+                )),
+                Span::raw(format!(
+                    "· {} ",
+                    app.current_preset().map_or("custom", Preset::name)
+                )),
+            ),
+            Part::optional(3, Span::raw("· a add · Del remove ")),
+        ],
+        top.width.saturating_sub(2),
+    );
     let dot = vp.metres_per_column() / 2.0;
     let canvas = Canvas::default()
         .block(pane_block(title, app.focus() == Focus::Map))
@@ -140,14 +158,35 @@ pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
     // With errors elsewhere the IWPs are not looked for: "none" would say
     // no gap needs one.
     let errors = app.doc().diagnostics().iter().any(|d| d.is_error());
-    let title = match (empty, narrow) {
-        (true, _) if errors => " IWPs (eq. 9): not found until the mission's errors are fixed ",
-        (true, false) => " IWPs (eq. 9): none: no gap narrower than the formation ",
-        (true, true) => " IWPs (eq. 9): none ",
-        (false, false) => " IWPs (eq. 9) · s cycle shape · space on/off ",
-        (false, true) => " IWPs · s shape · Space on/off ",
+    let name = Part::keep(Span::raw(" IWPs (eq. 9)"));
+    let parts = match (empty, errors) {
+        (true, true) => vec![
+            name,
+            Part::shortened(
+                1,
+                Span::raw(": not found until the mission's errors are fixed "),
+                Span::raw(": not found: fix the errors first "),
+            ),
+        ],
+        (true, false) => vec![
+            name,
+            Part::shortened(
+                1,
+                Span::raw(": none: no gap narrower than the formation "),
+                Span::raw(": none "),
+            ),
+        ],
+        (false, _) => vec![
+            name,
+            Part::shortened(1, Span::raw(" · s cycle shape"), Span::raw(" · s shape")),
+            Part::optional(2, Span::raw(" · Space on/off")),
+            Part::keep(Span::raw(" ")),
+        ],
     };
-    let block = pane_block(TextLine::from(title), false);
+    let mut block = pane_block(fit(parts, bottom.width.saturating_sub(2)), false);
+    if folded {
+        block = block.title_bottom(super::folded_hint(app, bottom.width));
+    }
     let table = if narrow {
         Table::new(rows, [ratatui::layout::Constraint::Fill(1)]).block(block)
     } else {

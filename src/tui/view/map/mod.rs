@@ -17,12 +17,15 @@ use ratatui::widgets::{Block, BorderType, Borders, Cell, Row, Table};
 
 use crate::base::geometry::segment_projection;
 use crate::mission::{Mission, Preset, ShapeChoice};
+use crate::outcome::Verdict;
+use crate::pipelines::Kind;
 use crate::pipelines::flatlo::FlatloOutcome;
 use crate::pipelines::fleet::FleetOutcome;
 use crate::pipelines::theta_pso::ThetaPsoOutcome;
 use crate::tui::app::{App, Focus};
 use crate::tui::fields::{Item, shape_name};
-use crate::tui::jobs::Outcome;
+use crate::tui::jobs::{Job, Outcome};
+use crate::tui::live::Live;
 
 mod formation;
 mod side;
@@ -30,6 +33,7 @@ mod side;
 pub use formation::{draw_formation, formation_split};
 use side::draw_side;
 
+use super::title::{Part, fit};
 pub use super::viewport::Viewport;
 
 /// UAV `i`'s colour (0-based), the same as in the Rerun recording.
@@ -112,51 +116,87 @@ fn pane_block(title: TextLine<'static>, focused: bool) -> Block<'static> {
         .title(title)
 }
 
-/// The map title of a live plan: its verdict and first failing check, or,
-/// once the mission changed, "re-planning…" (a run under way or due) or why
-/// live planning waits; the long and the short form, and their style.
-fn live_title(
-    o: &crate::pipelines::theta_pso::ThetaPsoOutcome,
-    stale: bool,
-    job: &crate::tui::jobs::Job,
-    live: &crate::tui::live::Live,
-) -> (String, String, Style) {
+/// The shown result's part of the map's title, for every pipeline: which
+/// run, its verdict (θ-PSO's live plan with its first failing check), and
+/// once the mission changed STALE (a live plan: "re-planning…" while its
+/// successor is under way or due, or why live planning waits); its full and
+/// short forms.
+fn result_part(app: &App, job: &Job, outcome: &Outcome) -> Part<'static> {
+    let stale = app.is_stale(job);
+    let live = app.board().live();
     let name = crate::tui::live::label(job.id);
-    if stale {
-        return match live.paused() {
-            Some(why) if live.is_on() => (
+    // θ-PSO's words are its own: a plan is feasible or not.
+    let word = outcome.verdict_word().unwrap_or("cancelled");
+    let what = match job.pipeline {
+        Kind::ThetaPso => String::new(),
+        other => format!("{} ", other.name()),
+    };
+    let yellow = Style::default().black().on_yellow();
+    let (long, short, style) = if Live::owns(job.id) {
+        match (stale, live.paused()) {
+            (true, Some(why)) if live.is_on() => (
                 format!(" {name}: live paused: {why} "),
-                " live paused ".into(),
-                Style::default().black().on_yellow(),
+                " live paused ".to_owned(),
+                yellow,
             ),
-            _ if live.replanning() => (
+            (true, _) if live.replanning() => (
                 format!(" {name}: re-planning… "),
-                " re-planning… ".into(),
+                " re-planning… ".to_owned(),
                 Style::default().fg(Color::Gray),
             ),
-            _ => (
-                format!(" STALE {name} (mission edited) "),
+            (true, _) => (
+                format!(" STALE {name} {what}(mission edited) "),
                 format!(" STALE {name} "),
-                Style::default().black().on_yellow(),
+                yellow,
             ),
-        };
-    }
-    let warm = if o.warm_start.is_some() { "warm, " } else { "" };
-    let seconds = job.elapsed(std::time::Instant::now()).as_secs_f64() * 1e3;
-    if o.feasible() {
-        (
-            format!(" {name} ({warm}{seconds:.0} ms): feasible "),
-            format!(" {name} ✓ "),
-            Style::default().green(),
-        )
+            (false, _) => {
+                let warm = match outcome.theta_pso() {
+                    Some(o) if o.warm_start.is_some() => "warm, ",
+                    _ => "",
+                };
+                let ms = job.elapsed(std::time::Instant::now()).as_secs_f64() * 1e3;
+                match outcome.verdict() {
+                    Verdict::Passed => (
+                        format!(" {name} {what}({warm}{ms:.0} ms): {word} "),
+                        format!(" {name} ✓ "),
+                        Style::default().green(),
+                    ),
+                    Verdict::Failed(why) => (
+                        format!(" {name} {what}{word}: {why} "),
+                        format!(" {name} {word} "),
+                        Style::default().red().bold(),
+                    ),
+                    Verdict::Cancelled => (
+                        format!(" {name} {what}cancelled "),
+                        format!(" {name} cancelled "),
+                        Style::default().yellow(),
+                    ),
+                }
+            }
+        }
     } else {
-        let why = o.verification.first_failure().unwrap_or_default();
-        (
-            format!(" {name}: INFEASIBLE: {why} "),
-            format!(" {name} INFEASIBLE "),
-            Style::default().red().bold(),
-        )
-    }
+        let text = format!(" job {} {what}seed {}: {word} ", job.id, job.seed);
+        if stale {
+            (
+                format!(" STALE{text}(mission edited) "),
+                format!(" STALE job {} ", job.id),
+                yellow,
+            )
+        } else if outcome.ok() {
+            (
+                text,
+                format!(" job {} ✓ ", job.id),
+                Style::default().green(),
+            )
+        } else if matches!(outcome.verdict(), Verdict::Cancelled) {
+            let short = format!(" job {} cancelled ", job.id);
+            (text, short, Style::default().yellow())
+        } else {
+            let short = format!(" job {} {word} ", job.id);
+            (text, short, Style::default().red().bold())
+        }
+    };
+    Part::shortened(2, Span::styled(long, style), Span::styled(short, style))
 }
 
 /// The shown job's outcome of one pipeline (`pick`), and whether it is stale.
@@ -223,94 +263,100 @@ fn paint_fleet(ctx: &mut Context, app: &App, o: &FleetOutcome, stale: bool, dot:
 
 /// The top-down map (or the side view when toggled).
 /// The map in `area`, drawn through `vp` (the viewport `Drawn` reports).
-pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport) {
+///
+/// `folded`: the map has the whole width (a narrow screen, the map
+/// focused): its bottom line names the selection and says Tab.
+pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport, folded: bool) {
     if app.side_view() {
         return draw_side(frame, app, area);
     }
     let m = app.mission();
     let vp = *vp;
     let scale = vp.metres_per_column();
-    let scale_span = Span::raw(format!(
-        "· {:.1} m/cell · step {} m ",
-        scale,
-        crate::tui::fields::fmt_num(app.step_size())
-    ));
-    let mut title = Vec::new();
+    // The title's parts, the least important giving way first (`title::fit`).
+    let mut title = vec![
+        Part::keep(Span::styled(" Map ", Style::default().bold())),
+        Part::optional(3, Span::raw(format!("· {scale:.1} m/cell "))),
+        Part::optional(
+            5,
+            Span::raw(format!(
+                "· step {} m ",
+                crate::tui::fields::fmt_num(app.step_size())
+            )),
+        ),
+    ];
     if let (Some(t), Some(end)) = (app.replay_time(), app.replay_end()) {
-        title.push(Span::styled(
-            format!(
-                " t = {t:.1} / {end:.1} s {} ",
-                if app.is_playing() { "▶" } else { "‖" }
+        let state = if app.is_playing() { "▶" } else { "‖" };
+        title.push(Part::optional(
+            4,
+            Span::styled(
+                format!(" t = {t:.1} / {end:.1} s {state} "),
+                Style::default().black().on_cyan(),
             ),
-            Style::default().black().on_cyan(),
         ));
     }
     if app.editor().add_tool() {
-        title.push(Span::styled(
-            " ADD: click to place ",
-            Style::default().black().on_green(),
+        let style = Style::default().black().on_green();
+        title.push(Part::shortened(
+            1,
+            Span::styled(" ADD: click to place ", style),
+            Span::styled(" ADD ", style),
         ));
     }
-    let result = result_of(app);
-    // The shown result's state, and its short form for a narrow map.
-    let mut short = None;
     let live = app.board().live();
-    match (&result, app.shown()) {
-        (Some((o, stale)), Some(job)) if crate::tui::live::Live::owns(job.id) => {
-            let (long, brief, style) = live_title(o, *stale, job, live);
-            title.push(Span::styled(long, style));
-            short = Some(Span::styled(brief, style));
+    match app.shown() {
+        Some(job) if job.outcome.is_some() => {
+            if let Some(o) = &job.outcome {
+                title.push(result_part(app, job, o));
+            }
         }
-        (Some((o, stale)), Some(job)) => {
-            let verdict = if o.feasible() {
-                "feasible"
-            } else {
-                "INFEASIBLE"
-            };
-            let text = format!(" job {} seed {}: {verdict} ", job.id, job.seed);
-            let (long, brief, style) = if *stale {
-                (
-                    format!(" STALE{text}(mission edited) "),
-                    format!(" STALE job {} ", job.id),
-                    Style::default().black().on_yellow(),
-                )
-            } else if o.feasible() {
-                let brief = format!(" job {} ✓ ", job.id);
-                (text, brief, Style::default().green())
-            } else {
-                let brief = format!(" job {} INFEASIBLE ", job.id);
-                (text, brief, Style::default().red().bold())
-            };
-            title.push(Span::styled(long, style));
-            short = Some(Span::styled(brief, style));
-        }
-        (None, Some(job)) if job.is_running() => {
-            title.push(Span::styled(
-                format!(" job {} running… ", job.id),
-                Style::default().cyan(),
+        Some(job) if job.is_running() => {
+            title.push(Part::shortened(
+                2,
+                Span::styled(
+                    format!(
+                        " {} {} running… {:.0}% ",
+                        crate::tui::live::label(job.id),
+                        job.pipeline.name(),
+                        job.progress * 100.0
+                    ),
+                    Style::default().cyan(),
+                ),
+                Span::styled(
+                    format!(" {} running… ", crate::tui::live::label(job.id)),
+                    Style::default().cyan(),
+                ),
             ));
         }
-        (None, _) if live.replanning() => {
-            title.push(Span::styled(" live: planning… ", Style::default().cyan()));
+        _ if live.replanning() => {
+            title.push(Part::keep(Span::styled(
+                " live: planning… ",
+                Style::default().cyan(),
+            )));
         }
         _ => {}
     }
     if live.is_on()
-        && result.is_none()
+        && app.shown().and_then(|j| j.outcome.as_ref()).is_none()
         && let Some(why) = live.paused()
     {
-        title.push(Span::styled(
-            format!(" live paused: {why} "),
-            Style::default().black().on_yellow(),
+        let style = Style::default().black().on_yellow();
+        title.push(Part::shortened(
+            1,
+            Span::styled(format!(" live paused: {why} "), style),
+            Span::styled(" live paused ", style),
         ));
     }
     if let Some(ground) = super::terrain::legend(m) {
-        title.push(ground);
+        title.push(Part::optional(4, ground));
     }
-    let block = pane_block(
-        map_title(title, scale_span, short, area.width),
+    let mut block = pane_block(
+        fit(title, area.width.saturating_sub(2)),
         app.focus() == Focus::Map,
     );
+    if folded {
+        block = block.title_bottom(folded_hint(app, area.width));
+    }
     let dot = scale / 2.0;
     let canvas = Canvas::default()
         .block(block)
@@ -571,7 +617,8 @@ impl Labels<'_> {
     }
 
     /// Prints `label` at the first of `spots` where it is in view and free;
-    /// `force` prints it at the first spot even when none is (the selection's).
+    /// `force` prints it even when none is (the selection's): at the first
+    /// spot where it is whole in view, else the first.
     fn place(
         &mut self,
         ctx: &mut Context,
@@ -583,7 +630,14 @@ impl Labels<'_> {
         let spot = spots
             .iter()
             .find(|(x, y)| self.rect(*x, *y, width).is_some_and(|r| self.free(r)))
-            .or(if force { spots.first() } else { None });
+            .or_else(|| {
+                // Forced: where it is whole in view if it can be, not cut at
+                // the map's edge.
+                let whole = spots
+                    .iter()
+                    .find(|(x, y)| self.rect(*x, *y, width).is_some());
+                whole.or(spots.first()).filter(|_| force)
+            });
         if let Some(&(x, y)) = spot {
             if let Some(r) = self.rect(x, y, width) {
                 self.taken.push(r);
@@ -596,64 +650,100 @@ impl Labels<'_> {
 /// The map's text: IWP marks, obstacle names where they fit, start and goal.
 fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
     // A FLATLO result is drawn at kilometre scale: the θ-PSO route, IWPs and
-    // obstacle names would be letters piled on a few cells.
-    if shown_outcome(app, Outcome::flatlo).is_some() {
-        return;
-    }
+    // obstacle names would be letters piled on a few cells (the selected
+    // obstacle's name is still drawn).
+    let kilometres = shown_outcome(app, Outcome::flatlo).is_some();
     let scale = vp.metres_per_column();
     let mut labels = Labels {
         vp,
         taken: Vec::new(),
     };
     let (s, g) = (&m.route.start, &m.route.goal);
-    labels.reserve(s.x, s.y, 1);
-    labels.reserve(g.x, g.y, 1);
-    for t in &m.fleet.targets {
-        labels.reserve(t.position.x, t.position.y, 2);
-    }
-    // IWPs (eq. 9): enabled ones bright, disabled ones dim.
-    for w in app.iwps() {
-        let (glyph, style) = if w.enabled {
-            ("◆", Style::default().fg(Color::LightCyan))
-        } else {
-            ("◇", Style::default().fg(Color::DarkGray))
-        };
-        labels.reserve(w.position.x, w.position.y, 1);
-        ctx.print(w.position.x, w.position.y, Span::styled(glyph, style));
-    }
-    // Obstacle names, right of the obstacle or else left of it, where they
-    // cover no other text; the selected one's first.
-    if m.obstacles.len() <= 40 {
-        let selected = match *app.selected() {
-            Item::Obstacle(i) => Some(i),
-            _ => None,
-        };
-        let order = selected
-            .into_iter()
-            .chain((0..m.obstacles.len()).filter(|i| Some(*i) != selected));
-        for i in order {
-            let Some(o) = m.obstacles.get(i) else {
-                continue;
+    if !kilometres {
+        labels.reserve(s.x, s.y, 1);
+        labels.reserve(g.x, g.y, 1);
+        for t in &m.fleet.targets {
+            labels.reserve(t.position.x, t.position.y, 2);
+        }
+        // IWPs (eq. 9): enabled ones bright, disabled ones dim, the
+        // selected one highlighted and named.
+        for w in app.iwps() {
+            let selected = *app.selected() == Item::Waypoint(w.between.clone());
+            let (glyph, style) = match (selected, w.enabled) {
+                (true, true) => ("◆", Style::default().black().on_yellow()),
+                (true, false) => ("◇", Style::default().black().on_yellow()),
+                (false, true) => ("◆", Style::default().fg(Color::LightCyan)),
+                (false, false) => ("◇", Style::default().fg(Color::DarkGray)),
             };
-            let style = if selected == Some(i) {
-                Style::default().yellow().bold()
-            } else if o.inspect {
-                Style::default().fg(Color::LightMagenta)
-            } else {
-                Style::default().fg(Color::Gray)
-            };
-            let label = if o.inspect {
-                format!("{} ◉", o.name)
-            } else {
-                o.name.clone()
-            };
+            labels.reserve(w.position.x, w.position.y, 1);
+            ctx.print(w.position.x, w.position.y, Span::styled(glyph, style));
+        }
+        if let Some(w) = app
+            .iwps()
+            .iter()
+            .find(|w| *app.selected() == Item::Waypoint(w.between.clone()))
+        {
+            let label = format!("{} ↔ {}", w.between[0], w.between[1]);
             let width = Span::raw(label.as_str()).width() as f64;
             let spots = [
-                (o.center.x + o.radius + scale, o.center.y),
-                (o.center.x - o.radius - scale * (width + 1.0), o.center.y),
+                (w.position.x + 2.0 * scale, w.position.y),
+                (w.position.x - scale * (width + 1.0), w.position.y),
             ];
-            labels.place(ctx, &spots, Span::styled(label, style), selected == Some(i));
+            let style = Style::default().black().on_yellow().bold();
+            labels.place(ctx, &spots, Span::styled(label, style), true);
         }
+    }
+    // Obstacle names, right of the obstacle or else left of it, where they
+    // cover no other text: the selected one's always, first; then a find's
+    // matches; then, on a site of at most 40 obstacles, the others.
+    let selected = match *app.selected() {
+        Item::Obstacle(i) => Some(i),
+        _ => None,
+    };
+    let found: Vec<usize> = app
+        .finder()
+        .matches()
+        .iter()
+        .filter_map(|item| match item {
+            Item::Obstacle(i) if Some(*i) != selected => Some(*i),
+            _ => None,
+        })
+        .collect();
+    let rest = (!kilometres && m.obstacles.len() <= 40)
+        .then(|| (0..m.obstacles.len()).filter(|i| Some(*i) != selected && !found.contains(i)))
+        .into_iter()
+        .flatten();
+    let order = selected
+        .into_iter()
+        .chain(found.iter().copied())
+        .chain(rest);
+    for i in order {
+        let Some(o) = m.obstacles.get(i) else {
+            continue;
+        };
+        let style = if selected == Some(i) {
+            Style::default().black().on_yellow().bold()
+        } else if found.contains(&i) {
+            Style::default().yellow()
+        } else if o.inspect {
+            Style::default().fg(Color::LightMagenta)
+        } else {
+            Style::default().fg(Color::Gray)
+        };
+        let label = if o.inspect {
+            format!("{} ◉", o.name)
+        } else {
+            o.name.clone()
+        };
+        let width = Span::raw(label.as_str()).width() as f64;
+        let spots = [
+            (o.center.x + o.radius + scale, o.center.y),
+            (o.center.x - o.radius - scale * (width + 1.0), o.center.y),
+        ];
+        labels.place(ctx, &spots, Span::styled(label, style), selected == Some(i));
+    }
+    if kilometres {
+        return;
     }
     let marker = |item: Item, glyph: &'static str, color: Color| {
         let style = if *app.selected() == item {
@@ -752,31 +842,24 @@ fn draw_formation_at_start(ctx: &mut Context, app: &App, m: &Mission, dot: f64) 
     }
 }
 
-/// The map's title: " Map ", the scale, then `state` (replay, add tool,
-/// the shown result). When that does not fit in `width` the state comes
-/// first, the result in its `short` form, and the scale last, where the cut
-/// falls: at 80 × 24 "STALE" was cut to "STAL".
-fn map_title<'a>(
-    state: Vec<Span<'a>>,
-    scale: Span<'a>,
-    short: Option<Span<'a>>,
-    width: u16,
-) -> TextLine<'a> {
-    let name = Span::styled(" Map ", Style::default().bold());
-    let full = name.width() + scale.width() + state.iter().map(Span::width).sum::<usize>();
-    if full + 2 <= usize::from(width) {
-        return TextLine::from([vec![name, scale], state].concat());
-    }
-    let mut spans = vec![name];
-    for span in state {
-        // The shown result's span is the one naming its job.
-        match &short {
-            Some(brief) if span.content.contains("job ") => spans.push(brief.clone()),
-            _ => spans.push(span),
-        }
-    }
-    spans.push(scale);
-    TextLine::from(spans)
+/// The bottom line of a pane that has the whole width (a narrow screen,
+/// the map focused): what is selected, and that Tab brings the inspector.
+pub fn folded_hint(app: &App, width: u16) -> TextLine<'static> {
+    let selected = app.selected().title(app.mission());
+    fit(
+        vec![
+            Part::keep(Span::styled(
+                format!(" {selected} "),
+                Style::default().yellow(),
+            )),
+            Part::shortened_optional(
+                1,
+                Span::raw("· Tab: inspector and jobs "),
+                Span::raw("· Tab "),
+            ),
+        ],
+        width.saturating_sub(2),
+    )
 }
 
 #[cfg(test)]

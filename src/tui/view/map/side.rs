@@ -25,12 +25,20 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
         .fold(m.bounds.z[1] + highest, f64::max)
         .max(1.0)
         * 1.15;
-    let title = TextLine::from(vec![
-        Span::styled(" Side view ", Style::default().bold()),
-        Span::raw(format!(
-            "· distance along the path (0-{length:.0} m) vs altitude (0-{top:.0} m) · v: top view "
-        )),
-    ]);
+    let title = fit(
+        vec![
+            Part::keep(Span::styled(" Side view ", Style::default().bold())),
+            Part::shortened(
+                1,
+                Span::raw(format!(
+                    "· distance along the path (0-{length:.0} m) vs altitude (0-{top:.0} m) "
+                )),
+                Span::raw(format!("· 0-{length:.0} m × 0-{top:.0} m ")),
+            ),
+            Part::optional(2, Span::raw("· v: top view ")),
+        ],
+        area.width.saturating_sub(2),
+    );
     let stale = result.as_ref().is_some_and(|(_, s)| *s);
     let canvas = Canvas::default()
         .block(pane_block(title, app.focus() == Focus::Map))
