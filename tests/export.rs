@@ -1066,6 +1066,9 @@ fn a_plan_outside_its_bounds_is_refused_with_advice_about_the_bounds() {
         "{text}"
     );
     assert!(!text.contains("UAV"), "{text}");
+    // A check the plan itself breaks has no slack to share: the tolerance
+    // stays the tracking error (124 m), not 1 cm and 1800 waypoints.
+    assert!(r.tolerance > 100.0, "{}", r.tolerance);
     let advice = r.advice().join("\n");
     assert!(
         advice.starts_with("distance inside the x-y bounds: the FLATLO plan itself"),
@@ -1099,6 +1102,33 @@ fn the_files_are_held_to_the_hard_limits_and_the_margin_is_room_for_the_reductio
         .find(|c| c.name == "inter-UAV distance (closest)")
         .unwrap_or_else(|| panic!("no pair row"));
     assert_eq!(closest.limit, 1.0, "2 r_Q, not 2 r_Q + the margin");
+}
+
+/// The announced tolerance is one the files hold: asked for less than
+/// keeping every sample can give (FLATLO's 2 s legs, speeds to 0.01 m/s),
+/// the export says so with the figure instead of announcing it.
+#[test]
+fn a_tolerance_the_files_cannot_hold_is_refused_with_what_they_can() {
+    let dir = tempdir();
+    let (m, p) = planned("missions/flatlo-squadron.toml", "flatlo");
+    let err = export::export(&m, "flatlo", &p, &options(dir.path(), Some(0.01), false));
+    let Err(e @ ExportError::Unreachable { held, .. }) = err else {
+        panic!("expected Unreachable, got {err:?}");
+    };
+    assert!(held > 0.01, "{held}");
+    let message = e.to_string();
+    assert!(
+        message.contains("cannot hold --tolerance 0.01 m"),
+        "{message}"
+    );
+    assert!(
+        message.contains("a flown aircraft still strays"),
+        "{message}"
+    );
+    // What it says it can hold, it holds.
+    let done = export::export(&m, "flatlo", &p, &options(dir.path(), Some(held), false))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(done.reverification.max_deviation <= held);
 }
 
 #[test]

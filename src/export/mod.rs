@@ -464,6 +464,16 @@ pub enum ExportError {
          coordinates alone may move a waypoint by up to 8.5 mm: 1e-7° of latitude and longitude), got {0}"
     )]
     BadTolerance(f64),
+    #[error(
+        "the files cannot hold --tolerance {tolerance} m: keeping every sample of the track, \
+         a flown {noun} still strays {held:.3} m (speeds to 0.01 m/s, coordinates to 1e-7°); \
+         ask for at least that"
+    )]
+    Unreachable {
+        tolerance: f64,
+        held: f64,
+        noun: &'static str,
+    },
     #[error("the {0} result has no vehicle to export")]
     Empty(&'static str),
     #[error("export refused: the plans as flown break a constraint:\n{}", .0.failure_text())]
@@ -509,12 +519,33 @@ pub fn export(
     if planned.tracks.iter().all(|t| t.samples.is_empty()) {
         return Err(ExportError::Empty(planned.pipeline.slug()));
     }
-    let (tolerance, tolerance_source) = match options.tolerance {
+    let (mut tolerance, mut tolerance_source) = match options.tolerance {
         Some(t) if t.is_finite() && t >= MIN_TOLERANCE => (t, "--tolerance".to_owned()),
         Some(t) => return Err(ExportError::BadTolerance(t)),
         None => planned.default_tolerance(mission),
     };
     let plans = reduce(planned, placement.as_ref(), tolerance);
+    // Keeping every sample may still leave a flight off by more (timing
+    // roundings on many short legs): announce what the files hold, or say
+    // that the tolerance asked for cannot be held.
+    let held = plans
+        .iter()
+        .zip(&planned.tracks)
+        .map(|(p, t)| reverify::deviation(p, t))
+        .fold(0.0, f64::max);
+    if held > tolerance {
+        if options.tolerance.is_some() {
+            return Err(ExportError::Unreachable {
+                tolerance,
+                held,
+                noun: planned.noun(),
+            });
+        }
+        tolerance_source = format!(
+            "{tolerance_source}: {tolerance:.3} m, raised to what the files hold keeping every sample"
+        );
+        tolerance = held;
+    }
     let waypoint_files = options.formats.iter().any(|f| f.waypoints());
     let csv_texts: Vec<String> = if options.formats.contains(&Format::Csv) {
         planned

@@ -749,7 +749,10 @@ fn trajectories_of(tracks: &[Track]) -> Vec<Trajectory> {
 
 /// The plan's own slack against `limits`: the smallest excess of a
 /// clearance, altitude or bounds margin over its limit, or half the excess
-/// of a distance between two vehicles. `None` when nothing was measured.
+/// of a distance between two vehicles. A check the plan itself breaks has
+/// no slack to share (the refusal names it): it is left out, so it does not
+/// shrink the tolerance of the checks it keeps. `None` when nothing was
+/// measured.
 pub fn slack(mission: &Mission, limits: &Limits, tracks: &[Track]) -> Option<(f64, String)> {
     let limits = Limits {
         inspections: false,
@@ -770,7 +773,7 @@ pub fn slack(mission: &Mission, limits: &Limits, tracks: &[Track]) -> Option<(f6
             } else {
                 excess
             };
-            Some((share, c.name.to_owned()))
+            (share >= 0.0).then(|| (share, c.name.to_owned()))
         })
         .min_by(|a, b| a.0.total_cmp(&b.0))
 }
