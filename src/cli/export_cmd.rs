@@ -50,8 +50,8 @@ pub struct ExportArgs {
     #[arg(long)]
     pub seed: Option<u64>,
     /// Largest distance, metres, between where a waypoint plan puts a vehicle
-    /// and where the plan has it at the same instant (default: the plan's
-    /// clearance margin, or less when the plan has less slack).
+    /// and where the plan has it at the same instant, at least 0.01 (default:
+    /// the plan's clearance margin, or less when the plan has less slack).
     #[arg(long, value_name = "METRES")]
     pub tolerance: Option<f64>,
     /// Write the files even when the flown plans break a constraint (warns).
@@ -131,11 +131,11 @@ pub fn export_command(args: &ExportArgs) -> u8 {
             }
             exit::OK
         }
-        Err(e @ ExportError::Refused(_)) => {
-            eprintln!("error: {e}");
-            eprintln!(
-                "(a smaller --tolerance keeps the plans closer to the tracks; --force writes anyway)"
-            );
+        Err(ExportError::Refused(r)) => {
+            eprintln!("error: {}", ExportError::Refused(r.clone()));
+            for line in r.advice() {
+                eprintln!("  advice: {line}");
+            }
             exit::INFEASIBLE
         }
         Err(e) => {
@@ -153,56 +153,85 @@ pub fn stem(path: &Path) -> String {
         .unwrap_or_else(|| "mission".to_owned())
 }
 
-/// What was written, the waypoint counts, the deviation and timing error.
+/// What was written, the waypoint counts, the deviation and timing error,
+/// the flown checks and the written rates.
 pub fn summary(done: &Exported) -> String {
     let r = &done.reverification;
+    let noun = export::noun(done.pipeline);
     let mut out = format!(
         "export {}: tolerance {:.3} m ({})\n",
         done.pipeline.slug(),
         done.tolerance,
         done.tolerance_source
     );
-    let flown = done.files.iter().any(|f| f.format.per_vehicle());
-    if !flown {
-        // Only the KML: the plan itself, no waypoint plans to fly.
-        return out + &files_written(done);
-    }
-    for p in &done.plans {
+    let waypoint_files = done.files.iter().any(|f| f.format.waypoints());
+    if waypoint_files {
+        for p in &done.plans {
+            out.push_str(&format!(
+                "  {noun} {}: {} waypoints\n",
+                p.vehicle + 1,
+                p.waypoints.len()
+            ));
+        }
+        let at = |a: Option<export::reverify::At>| {
+            a.map_or_else(String::new, |a| {
+                format!(
+                    " ({noun} {}, waypoint {}, t = {:.1} s)",
+                    a.vehicle + 1,
+                    a.waypoint,
+                    a.time
+                )
+            })
+        };
         out.push_str(&format!(
-            "  UAV {}: {} waypoints\n",
-            p.vehicle + 1,
-            p.waypoints.len()
+            "as flown (the stored coordinates): largest deviation {:.3} m{}, largest timing \
+             error {:.3} s{}\n",
+            r.max_deviation,
+            at(r.deviation_at),
+            r.max_timing_error,
+            at(r.timing_at)
         ));
+        out.push_str(&checks(&r.verification, noun));
+        for rate in &r.rates {
+            let limit = rate.limit.map_or_else(
+                || "(no limit in the mission)".to_owned(),
+                |l| format!("{} {l} m/s", rate.relation),
+            );
+            out.push_str(&format!(
+                "  {} {:<32} worst {:.3} {limit}\n",
+                if rate.ok { "✓" } else { "✗" },
+                rate.name,
+                rate.worst,
+            ));
+        }
     }
-    let at = |a: Option<export::reverify::At>| {
-        a.map_or_else(String::new, |a| {
-            format!(
-                " (UAV {}, waypoint {}, t = {:.1} s)",
-                a.vehicle + 1,
-                a.waypoint,
-                a.time
-            )
-        })
-    };
-    out.push_str(&format!(
-        "as flown: largest deviation {:.3} m{}, largest timing error {:.3} s{}\n",
-        r.max_deviation,
-        at(r.deviation_at),
-        r.max_timing_error,
-        at(r.timing_at)
-    ));
-    for c in &r.verification.checks {
+    if let Some(csv) = &r.csv {
+        out.push_str(&format!(
+            "CSV as written: largest deviation {:.4} m\n",
+            csv.max_deviation
+        ));
+        if !waypoint_files {
+            out.push_str(&checks(&csv.verification, noun));
+        }
+    }
+    out + &files_written(done)
+}
+
+/// The verification table, in the pipeline's words.
+fn checks(v: &crate::pipelines::theta_pso::verify::Verification, noun: &str) -> String {
+    let mut out = String::new();
+    for c in &v.checks {
         out.push_str(&format!(
             "  {} {:<32} worst {} {} {}\n",
             if c.ok { "✓" } else { "✗" },
-            c.name,
+            export::reverify::worded(c.name, noun),
             c.worst
                 .map_or_else(|| "n/a".to_owned(), |w| format!("{w:.3}")),
             c.relation,
             c.limit
         ));
     }
-    for i in &r.verification.inspections {
+    for i in &v.inspections {
         out.push_str(&format!(
             "  {} inspection of '{}': {:.1} m of {} m in [{}, {}] m (eq. 8)\n",
             if i.ok { "✓" } else { "✗" },
@@ -213,7 +242,7 @@ pub fn summary(done: &Exported) -> String {
             i.band[1]
         ));
     }
-    out + &files_written(done)
+    out
 }
 
 /// One line per file written.
@@ -222,7 +251,7 @@ fn files_written(done: &Exported) -> String {
     for f in &done.files {
         let line = match f.format {
             Format::Kml => format!(
-                "wrote {} ({} tracks, {} placemarks, altitudes relative to the ground)\n",
+                "wrote {} ({} tracks, {} placemarks, absolute altitudes)\n",
                 f.path.display(),
                 f.waypoints,
                 f.items

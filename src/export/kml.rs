@@ -5,12 +5,13 @@
 //! "Mission" with the bounds, the start and goal, every obstacle as an
 //! extruded circle as tall as the obstacle, and each inspected obstacle's
 //! stand-off band (eq. 8) as a ring on the ground; then one folder per
-//! vehicle with its planned track, in the vehicle's colour on the map.
-//! Every altitude is `relativeToGround`: metres above the ground under the
-//! point (the mission's z above its ground), which is how the plan's
-//! heights are meant and how Google Earth draws them over its terrain.
-//! Positions go through the mission's geodesy (`mission::geodesy`), to
-//! 1e-9° (0.1 mm) and 1 mm.
+//! vehicle with its home and its planned track, in the vehicle's colour on
+//! the map. Altitudes are `absolute`, in the export's one convention
+//! (`geodesy`): `[origin].altitude + z`, the altitudes the waypoint files'
+//! homes and relative heights add up to, so the KML shows where the
+//! vehicles fly, not heights above Google Earth's own terrain. The bounds
+//! and the bands are on the ground. Positions go through the mission's
+//! geodesy (`mission::geodesy`), to 1e-9° (0.1 mm) and 1 mm.
 
 use std::collections::HashMap;
 
@@ -21,16 +22,17 @@ use kml::types::{
 use kml::{Kml, KmlDocument, KmlVersion, KmlWriter};
 use nalgebra::{Point2, Point3};
 
-use super::{Frame, Planned};
+use super::{Placement, Planned, VehiclePlan, noun};
 use crate::mission::{Mission, Obstacle};
 use crate::outcome::tracks::vehicle_color;
 
 /// Points on each circle (an obstacle, a band's edge).
 const CIRCLE_POINTS: usize = 48;
 
-/// The folder of vehicle `i` (0-based), as readers find it.
-pub fn vehicle_folder(i: usize) -> String {
-    format!("UAV {}", i + 1)
+/// The folder of vehicle `i` (0-based), as readers find it: "UAV 1",
+/// "aircraft 1", "agent 1".
+pub fn vehicle_folder(noun: &str, i: usize) -> String {
+    format!("{noun} {}", i + 1)
 }
 
 /// KML's `aabbggrr` colour of an RGB colour with alpha `a`.
@@ -38,8 +40,15 @@ pub fn kml_color([r, g, b]: [u8; 3], a: u8) -> String {
     format!("{a:02x}{b:02x}{g:02x}{r:02x}")
 }
 
-/// The KML text of the plan, and its number of placemarks.
-pub fn render(mission: &Mission, planned: &Planned, frame: &Frame) -> (String, usize) {
+/// The KML text of the plan, and its number of placemarks: `plans` give
+/// each vehicle's home (the waypoint files' home).
+pub fn render(
+    mission: &Mission,
+    planned: &Planned,
+    plans: &[VehiclePlan],
+    placement: &Placement,
+) -> (String, usize) {
+    let noun = noun(planned.pipeline);
     let mut placemarks = 0;
     let mut elements = vec![
         text(
@@ -50,44 +59,66 @@ pub fn render(mission: &Mission, planned: &Planned, frame: &Frame) -> (String, u
         text("description", &description(mission, planned)),
     ];
     elements.extend(styles(planned));
-    let mission_folder = mission_folder(mission, frame, &mut placemarks);
+    let mission_folder = mission_folder(mission, placement, &mut placemarks);
     elements.push(mission_folder);
     for track in &planned.tracks {
         let mut coords: Vec<Coord<f64>> = track
             .samples
             .iter()
-            .map(|s| {
-                coord(
-                    frame,
-                    &s.position,
-                    s.position.z - ground(mission, &s.position),
-                )
-            })
+            .map(|s| absolute(placement, &s.position))
             .collect();
         // A vehicle holding still: one vertex (readers drop repeats anyway).
         coords.dedup();
         let line = LineString {
             coords,
-            altitude_mode: AltitudeMode::RelativeToGround,
+            altitude_mode: AltitudeMode::Absolute,
             ..LineString::default()
         };
-        let name = vehicle_folder(track.vehicle);
+        let name = vehicle_folder(noun, track.vehicle);
+        let style = format!("uav{}", track.vehicle + 1);
         let placemark = Placemark {
             name: Some(format!("{name} track")),
             description: Some(format!(
-                "{} samples over {:.1} s, seed {}; altitudes relative to the ground",
+                "{} samples over {:.1} s, seed {}; absolute altitudes ([origin].altitude + z)",
                 track.samples.len(),
                 track.duration(),
                 planned.seed
             )),
             geometry: Some(Geometry::LineString(line)),
-            children: vec![style_url(&format!("uav{}", track.vehicle + 1))],
+            children: vec![style_url(&style)],
             ..Placemark::default()
         };
+        let mut folder_elements = vec![Kml::Placemark(placemark)];
         placemarks += 1;
+        if let Some(home) = plans
+            .iter()
+            .find(|p| p.vehicle == track.vehicle)
+            .and_then(|p| p.home)
+        {
+            folder_elements.push(Kml::Placemark(Placemark {
+                name: Some(format!("{name} home")),
+                description: Some(format!(
+                    "where {name} is armed: the ground under its first waypoint, at {} m \
+                     (the waypoint files' home; their heights are above it)",
+                    home.altitude
+                )),
+                geometry: Some(Geometry::Point(Point {
+                    coord: Coord {
+                        x: home.longitude_deg(),
+                        y: home.latitude_deg(),
+                        z: Some(home.altitude),
+                    },
+                    altitude_mode: AltitudeMode::Absolute,
+                    ..Point::default()
+                })),
+                children: vec![style_url(&style)],
+                ..Placemark::default()
+            }));
+            placemarks += 1;
+        }
         elements.push(Kml::Folder(Folder {
             name: Some(name),
-            elements: vec![Kml::Placemark(placemark)],
+            elements: folder_elements,
             ..Folder::default()
         }));
     }
@@ -116,8 +147,9 @@ pub fn render(mission: &Mission, planned: &Planned, frame: &Frame) -> (String, u
 /// The verdict, what the altitudes mean, and the run.
 fn description(mission: &Mission, planned: &Planned) -> String {
     let mut out = format!(
-        "{} plan, seed {}: {}\n\nAltitudes are relativeToGround: metres above the ground \
-         under each point (the mission's z above its ground).",
+        "{} plan, seed {}: {}\n\nAltitudes are absolute: [origin].altitude plus the \
+         mission's z (its height above the mission's ground), as the exported waypoint \
+         files' homes and relative heights add up to.",
         planned.pipeline.slug(),
         planned.seed,
         planned.verdict
@@ -183,7 +215,7 @@ fn styles(planned: &Planned) -> Vec<Kml<f64>> {
 }
 
 /// The bounds, start and goal, obstacles and inspection bands.
-fn mission_folder(mission: &Mission, frame: &Frame, placemarks: &mut usize) -> Kml<f64> {
+fn mission_folder(mission: &Mission, placement: &Placement, placemarks: &mut usize) -> Kml<f64> {
     let b = &mission.bounds;
     let corners = [
         (b.x[0], b.y[0]),
@@ -194,7 +226,7 @@ fn mission_folder(mission: &Mission, frame: &Frame, placemarks: &mut usize) -> K
     ];
     let ring: Vec<Coord<f64>> = corners
         .iter()
-        .map(|(x, y)| coord(frame, &Point3::new(*x, *y, 0.0), 0.0))
+        .map(|(x, y)| on_ground(placement, &Point2::new(*x, *y)))
         .collect();
     let mut elements = vec![placemark(
         "bounds",
@@ -211,16 +243,15 @@ fn mission_folder(mission: &Mission, frame: &Frame, placemarks: &mut usize) -> K
         "bounds",
     )];
     for (name, p) in [("start", mission.route.start), ("goal", mission.route.goal)] {
-        let at = coord(frame, &p, p.z - ground(mission, &p));
         elements.push(placemark(
             name,
             format!(
                 "formation centroid at {:.1} m above the ground",
-                at.z.unwrap_or(0.0)
+                p.z - mission.ground(p.x, p.y)
             ),
             Geometry::Point(Point {
-                coord: at,
-                altitude_mode: AltitudeMode::RelativeToGround,
+                coord: absolute(placement, &p),
+                altitude_mode: AltitudeMode::Absolute,
                 ..Point::default()
             }),
             "bounds",
@@ -229,13 +260,13 @@ fn mission_folder(mission: &Mission, frame: &Frame, placemarks: &mut usize) -> K
     let obstacles: Vec<Kml<f64>> = mission
         .obstacles
         .iter()
-        .map(|o| obstacle(o, frame))
+        .map(|o| obstacle(mission, o, placement))
         .collect();
     let bands: Vec<Kml<f64>> = mission
         .obstacles
         .iter()
         .filter(|o| o.inspect)
-        .map(|o| band(mission, o, frame))
+        .map(|o| band(mission, o, placement))
         .collect();
     *placemarks += elements.len() + obstacles.len() + bands.len();
     elements.push(folder("Obstacles", obstacles));
@@ -245,9 +276,13 @@ fn mission_folder(mission: &Mission, frame: &Frame, placemarks: &mut usize) -> K
     folder("Mission", elements)
 }
 
-/// An obstacle: its circle at its height, extruded to the ground.
-fn obstacle(o: &Obstacle, frame: &Frame) -> Kml<f64> {
-    let ring = circle(frame, &o.center, o.radius, o.height);
+/// An obstacle: its circle at its top (absolute: [origin].altitude, the
+/// ground under its centre and its height), extruded to the ground.
+fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> {
+    let top = mission.ground(o.center.x, o.center.y) + o.height;
+    let ring = circle(&o.center, o.radius, |p| {
+        absolute(placement, &Point3::new(p.x, p.y, top))
+    });
     let mut text = format!(
         "radius {} m, height {} m above the ground",
         o.radius, o.height
@@ -261,17 +296,19 @@ fn obstacle(o: &Obstacle, frame: &Frame) -> Kml<f64> {
     placemark(
         &o.name,
         text,
-        polygon(ring, Vec::new(), AltitudeMode::RelativeToGround, true),
+        polygon(ring, Vec::new(), AltitudeMode::Absolute, true),
         if o.inspect { "inspected" } else { "obstacle" },
     )
 }
 
 /// An inspected obstacle's stand-off band [d_min, d_max] from its surface,
 /// as a ring on the ground.
-fn band(mission: &Mission, o: &Obstacle, frame: &Frame) -> Kml<f64> {
+fn band(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> {
     let [d_min, d_max] = o.stand_off_band(&mission.formation);
-    let outer = circle(frame, &o.center, o.radius + d_max, 0.0);
-    let inner = circle(frame, &o.center, o.radius + d_min.max(1e-3), 0.0);
+    let outer = circle(&o.center, o.radius + d_max, |p| on_ground(placement, p));
+    let inner = circle(&o.center, o.radius + d_min.max(1e-3), |p| {
+        on_ground(placement, p)
+    });
     placemark(
         &format!("{} band", o.name),
         format!(
@@ -333,38 +370,48 @@ fn polygon(
     })
 }
 
-/// A closed ring of [`CIRCLE_POINTS`] points about `center` at `altitude`
-/// above the ground, counter-clockwise.
-fn circle(frame: &Frame, center: &Point2<f64>, radius: f64, altitude: f64) -> Vec<Coord<f64>> {
+/// A closed ring of [`CIRCLE_POINTS`] points about `center`,
+/// counter-clockwise, each placed by `at`.
+fn circle(
+    center: &Point2<f64>,
+    radius: f64,
+    at: impl Fn(&Point2<f64>) -> Coord<f64>,
+) -> Vec<Coord<f64>> {
     (0..=CIRCLE_POINTS)
         .map(|k| {
             let a = (k % CIRCLE_POINTS) as f64 * std::f64::consts::TAU / CIRCLE_POINTS as f64;
-            let p = Point3::new(
+            at(&Point2::new(
                 center.x + radius * a.cos(),
                 center.y + radius * a.sin(),
-                0.0,
-            );
-            coord(frame, &p, altitude)
+            ))
         })
         .collect()
 }
 
-/// Longitude and latitude of an ENU point (to 1e-9°) and an altitude above
-/// the ground (to 1 mm).
-fn coord(frame: &Frame, p: &Point3<f64>, altitude: f64) -> Coord<f64> {
-    let g = frame.to_geodetic(p);
-    // Through the decimal text, so the file shows the short form.
-    let round = |v: f64, digits: usize| format!("{v:.digits$}").parse().unwrap_or(v);
+/// Through the decimal text, so the file shows the short form.
+fn round(v: f64, digits: usize) -> f64 {
+    format!("{v:.digits$}").parse().unwrap_or(v)
+}
+
+/// Longitude and latitude of an ENU point (to 1e-9°) and its absolute
+/// altitude (to 1 mm), in the export's convention.
+fn absolute(placement: &Placement, p: &Point3<f64>) -> Coord<f64> {
+    let g = placement.absolute(p);
     Coord {
         x: round(g.longitude, 9),
         y: round(g.latitude, 9),
-        z: Some(round(altitude, 3)),
+        z: Some(round(g.altitude, 3)),
     }
 }
 
-/// The mission's ground under a point (0 without terrain).
-fn ground(mission: &Mission, p: &Point3<f64>) -> f64 {
-    mission.ground(p.x, p.y)
+/// A ground point (clamped to the ground: no altitude).
+fn on_ground(placement: &Placement, p: &Point2<f64>) -> Coord<f64> {
+    let g = placement.frame().ground_to_geodetic(p);
+    Coord {
+        x: round(g.longitude, 9),
+        y: round(g.latitude, 9),
+        z: Some(0.0),
+    }
 }
 
 fn text(name: &str, content: &str) -> Kml<f64> {

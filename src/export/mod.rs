@@ -3,19 +3,22 @@
 //!
 //! Each vehicle's timed track ([`crate::outcome::tracks`]) is reduced to waypoints
 //! ([`simplify`]: every sample within the tolerance of where the straight leg
-//! puts the vehicle at the same instant) with a commanded speed per leg, so
-//! that each vehicle reaches each waypoint when the plan says. The reduced
-//! plans are then flown as an autopilot flies them (straight legs at the
-//! commanded speeds, all vehicles starting together) and checked with the
-//! pipeline's own verification ([`reverify`]). Only then are the files
-//! written: QGroundControl `.plan` ([`plan`]), `QGC WPL 110` ([`wpl`]) or CSV
-//! ([`csv`]), atomically. A KML of the whole plan ([`kml`]: the mission, every
-//! vehicle's track, the verdict) is one more file, to look at over imagery.
-//! `docs/export.md` describes the formats.
+//! puts the vehicle at the same instant) at the coordinates the files store
+//! ([`geodesy`]: 1e-7°, float32; one altitude convention for every file)
+//! with a commanded speed per leg ([`legs`]: ground speed for multicopters,
+//! airspeed for fixed wing), so that each vehicle reaches each waypoint
+//! when the plan says. The files are then flown as an autopilot flies them
+//! and checked with the pipeline's own verification against the hard
+//! limits, every written speed against the vehicle's ([`reverify`]). Only
+//! then are they written: QGroundControl `.plan` ([`plan`]), `QGC WPL 110`
+//! ([`wpl`]) or CSV ([`csv`]), atomically. A KML of the whole plan ([`kml`]:
+//! the mission, every vehicle's home and track, the verdict) is one more
+//! file, to look at over imagery. `docs/export.md` describes the formats.
 
 pub mod csv;
 pub mod geodesy;
 pub mod kml;
+pub mod legs;
 pub mod plan;
 pub mod reverify;
 pub mod simplify;
@@ -34,7 +37,8 @@ use crate::pipelines::flatlo::FlatloOutcome;
 use crate::pipelines::fleet::FleetOutcome;
 use crate::pipelines::theta_pso::ThetaPsoOutcome;
 
-pub use geodesy::{Frame, Geodetic};
+pub use geodesy::{Frame, Geodetic, Home, Placement, Stored};
+pub use legs::{HOLD_STEP, LegLimits, MIN_SPEED, SPEED_STEP};
 pub use reverify::Reverification;
 
 /// A file format of the export.
@@ -82,22 +86,35 @@ impl Format {
     pub fn per_vehicle(self) -> bool {
         !matches!(self, Format::Kml)
     }
+
+    /// A waypoint file (`.plan`, `.waypoints`): the reduced plans.
+    pub fn waypoints(self) -> bool {
+        matches!(self, Format::Plan | Format::Wpl)
+    }
 }
 
-/// Slowest commanded speed of a multicopter leg, m/s; a vehicle that must
-/// go slower waits at the leg's start instead.
-pub const MIN_SPEED: f64 = 0.1;
+/// Smallest tolerance, metres: the stored coordinates alone may put a
+/// waypoint [`geodesy::RESOLUTION`] (8.5 mm) from its sample, and 1 cm
+/// leaves the reduction 1.5 mm beyond that.
+pub const MIN_TOLERANCE: f64 = 0.01;
 
-/// Holds are written to this step, seconds (PX4 reads param1 as a float;
-/// ArduCopter keeps whole seconds).
-pub const HOLD_STEP: f64 = 0.01;
+/// How each pipeline names its vehicles: θ-PSO's UAVs, FLATLO's
+/// aircraft, the fleet's agents.
+pub fn noun(pipeline: Kind) -> &'static str {
+    match pipeline {
+        Kind::ThetaPso => "UAV",
+        Kind::Flatlo => "aircraft",
+        Kind::Fleet => "agent",
+    }
+}
 
-/// Commanded speeds are written to this step, m/s.
-pub const SPEED_STEP: f64 = 0.01;
-
-/// Smallest tolerance used, metres (a plan with no slack at all still gets
-/// finite waypoint lists).
-pub const MIN_TOLERANCE: f64 = 1e-3;
+/// FLATLO's airspeed range [min, max], m/s, that every commanded airspeed
+/// must keep: the hook for `flatlo.airspeed_range`, which arrives with the
+/// FLATLO branch of issue 36 (then: `Some(mission.flatlo.airspeed_range)`).
+/// Until then no airspeed is judged (the report says so).
+fn flatlo_airspeed_range(_mission: &Mission) -> Option<[f64; 2]> {
+    None
+}
 
 /// What a pipeline's outcome gives the export: each vehicle's track, the
 /// limits its verification holds, and the deviation it allows.
@@ -106,7 +123,10 @@ pub struct Planned {
     pub pipeline: Kind,
     pub seed: u64,
     pub tracks: Vec<Track>,
+    /// The hard limits the files are re-verified against.
     pub limits: Limits,
+    /// What each vehicle's autopilot lets a leg fly, in track order.
+    pub legs: Vec<LegLimits>,
     /// The most the pipeline lets a vehicle stray from its track, metres,
     /// before the plan's own slack is considered (see [`Planned::default_tolerance`]).
     pub margin: f64,
@@ -134,17 +154,41 @@ impl Planned {
         outcome.headline()
     }
 
-    /// θ-PSO: the UAVs' trajectories, held to r_Q, [2 r_Q, d_com], the band,
-    /// the bounds and eq. 8; the margin is `theta_pso.clearance_margin`, the
-    /// room the cost keeps for a real autopilot.
+    /// How the pipeline names its vehicles ([`noun`]).
+    pub fn noun(&self) -> &'static str {
+        noun(self.pipeline)
+    }
+
+    /// The multicopters' legs: `[vehicle]`'s limits of each track's vehicle.
+    fn multicopters(mission: &Mission, tracks: &[Track]) -> Vec<LegLimits> {
+        tracks
+            .iter()
+            .map(|t| LegLimits::multicopter(mission.vehicle.limits(t.vehicle)))
+            .collect()
+    }
+
+    /// θ-PSO: the UAVs' trajectories, re-verified against the hard limits
+    /// r_Q, [2 r_Q, d_com], the band, the bounds and eq. 8: the
+    /// `formation.safety_margin` the plan keeps beyond r_Q and 2 r_Q is
+    /// room the reduction may use. The margin is
+    /// `theta_pso.clearance_margin`, the room the cost keeps for a real
+    /// autopilot; each UAV's legs are within `[vehicle]`.
     pub fn theta_pso(mission: &Mission, outcome: &ThetaPsoOutcome) -> Self {
+        let f = &mission.formation;
+        let tracks = tracks::theta_pso(outcome);
         Planned {
             pipeline: Kind::ThetaPso,
             seed: outcome.seed,
-            tracks: tracks::theta_pso(outcome),
-            // The written legs are flown by the autopilot's own trajectory
-            // generator: its speeds are checked, not its accelerations.
+            legs: Planned::multicopters(mission, &tracks),
+            tracks,
+            // The files are held to the hard limits r_Q and 2 r_Q: the
+            // safety margin is room the reduction may use. The written legs
+            // are flown by the autopilot's own trajectory generator: their
+            // speeds are checked (`legs`), not their accelerations.
             limits: Limits {
+                clearance: f.uav_radius,
+                closest: 2.0 * f.uav_radius,
+                farthest: Some(f.comm_range),
                 dynamics: false,
                 ..Limits::theta_pso(mission)
             },
@@ -160,7 +204,8 @@ impl Planned {
     /// FLATLO: the aircraft's references, held to `min_separation` (and the
     /// band and bounds, which the geofence enforces); the margin is the
     /// largest tracking error of the simulated autopilot with which the
-    /// squadron was verified.
+    /// squadron was verified; the airspeeds within
+    /// [`flatlo_airspeed_range`].
     pub fn flatlo(mission: &Mission, outcome: &FlatloOutcome) -> Self {
         let p = &mission.flatlo;
         let tracking = outcome
@@ -168,10 +213,12 @@ impl Planned {
             .iter()
             .map(|a| a.tracking_max)
             .fold(0.0, f64::max);
+        let tracks = tracks::flatlo(outcome);
         Planned {
             pipeline: Kind::Flatlo,
             seed: outcome.seed,
-            tracks: tracks::flatlo(outcome),
+            legs: vec![LegLimits::fixed_wing(flatlo_airspeed_range(mission)); tracks.len()],
+            tracks,
             limits: Limits {
                 clearance: 0.0,
                 closest: p.min_separation,
@@ -188,13 +235,18 @@ impl Planned {
 
     /// The fleet: the quadrotors' flights, held to the safety distance c
     /// between agents and from obstacles (and the band and bounds); the
-    /// margin is the convergence tolerance on c, shared by two agents.
+    /// margin is the convergence tolerance on c, shared by two agents. The
+    /// exported files are flown by a real multicopter's autopilot, so its
+    /// legs are within `[vehicle]`, as θ-PSO's are (the fleet's own
+    /// quadrotor parameters model the paper's AR.Drone in the simulation).
     pub fn fleet(mission: &Mission, outcome: &FleetOutcome) -> Self {
         let p = &mission.fleet;
+        let tracks = tracks::fleet(outcome);
         Planned {
             pipeline: Kind::Fleet,
             seed: outcome.seed,
-            tracks: tracks::fleet(outcome),
+            legs: Planned::multicopters(mission, &tracks),
+            tracks,
             limits: Limits {
                 clearance: p.safety_distance,
                 closest: p.safety_distance,
@@ -209,18 +261,37 @@ impl Planned {
         }
     }
 
+    /// The legs of the vehicle of track `i`.
+    pub fn legs_of(&self, i: usize) -> LegLimits {
+        self.legs
+            .get(i)
+            .copied()
+            .unwrap_or_else(|| LegLimits::fixed_wing(None))
+    }
+
     /// The default tolerance: the pipeline's margin, or less when the plan
-    /// itself has less slack against a constraint (a clearance's excess over
+    /// itself has less slack against a hard limit (a clearance's excess over
     /// its limit; half a distance's excess between two vehicles, since both
     /// may stray). Never below [`MIN_TOLERANCE`].
     pub fn default_tolerance(&self, mission: &Mission) -> (f64, String) {
         let slack = reverify::slack(mission, &self.limits, &self.tracks);
-        match slack {
+        let (tolerance, source) = match slack {
             Some((s, what)) if s < self.margin => {
-                (s.max(MIN_TOLERANCE), format!("the plan's slack on {what}"))
+                let what = reverify::worded(&what, self.noun());
+                (s, format!("the plan's slack on {what}"))
             }
-            _ => (self.margin.max(MIN_TOLERANCE), self.margin_source.clone()),
+            _ => (self.margin, self.margin_source.clone()),
+        };
+        if tolerance < MIN_TOLERANCE {
+            return (
+                MIN_TOLERANCE,
+                format!(
+                    "{source} is {tolerance:.4} m, below the stored coordinates' resolution: \
+                     raised to {MIN_TOLERANCE} m"
+                ),
+            );
         }
+        (tolerance, source)
     }
 }
 
@@ -229,9 +300,11 @@ impl Planned {
 pub struct Waypoint {
     /// When the plan has the vehicle here, seconds from the common start.
     pub t: f64,
-    /// Metres ENU.
+    /// Metres ENU: where the file's stored coordinates put the vehicle
+    /// (1e-7° and float32; the track's sample itself without `[origin]`).
     pub position: Point3<f64>,
-    /// Commanded speed of the leg that ends here, m/s (0 for the first).
+    /// Commanded speed of the leg that ends here, m/s (0 for the first):
+    /// ground speed for multicopters, airspeed for fixed wing.
     pub speed: f64,
     /// Seconds the vehicle waits here before the next leg.
     pub hold: f64,
@@ -240,113 +313,112 @@ pub struct Waypoint {
 /// One vehicle's reduced plan.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct VehiclePlan {
-    /// 0-based (file names say `uav<vehicle + 1>`).
+    /// 0-based (file names say `<noun><vehicle + 1>`).
     pub vehicle: usize,
+    /// Where it is armed: the ground under its first waypoint (`None`
+    /// without `[origin]`).
+    #[serde(skip)]
+    pub home: Option<Home>,
+    /// How its autopilot flies the legs.
+    pub legs: LegLimits,
     pub waypoints: Vec<Waypoint>,
 }
 
-impl VehiclePlan {
-    /// Where the vehicle stands before take-off: on the ground (z = 0) below
-    /// its first waypoint.
-    pub fn home(&self) -> Point3<f64> {
-        self.waypoints.first().map_or_else(Point3::origin, |w| {
-            Point3::new(w.position.x, w.position.y, 0.0)
-        })
-    }
-}
-
-/// Reduces every track to waypoints and gives each leg the speed that
-/// arrives on time, rounded to [`SPEED_STEP`]; a rounding early on is made
-/// up on the next leg, so timing errors do not add up. Every sample of a
-/// track stays within `tolerance` of where the plan *as flown* (rounded
-/// speeds, holds) puts the vehicle at the same instant: the SED tolerance
-/// of the reduction is tightened until the flight is within it, down to
-/// keeping every sample.
-pub fn reduce(tracks: &[Track], tolerance: f64, fixed_wing: bool) -> Vec<VehiclePlan> {
-    tracks
+/// Reduces every track to waypoints (see [`reduce_track`]).
+pub fn reduce(
+    planned: &Planned,
+    placement: Option<&Placement>,
+    tolerance: f64,
+) -> Vec<VehiclePlan> {
+    planned
+        .tracks
         .iter()
-        .map(|track| reduce_track(track, tolerance, fixed_wing))
+        .enumerate()
+        .map(|(i, track)| reduce_track(track, planned.legs_of(i), placement, tolerance))
         .collect()
 }
 
-/// One track's plan within `tolerance` as flown (see [`reduce`]).
-fn reduce_track(track: &Track, tolerance: f64, fixed_wing: bool) -> VehiclePlan {
+/// One track's waypoints, each at the position its file stores (with
+/// `placement`), and each leg the speed that arrives on time, rounded to
+/// [`SPEED_STEP`]; a rounding early on is made up on the next leg, so
+/// timing errors do not add up. Every sample of the track stays within
+/// `tolerance` of where the plan *as flown* (stored coordinates, rounded
+/// speeds, holds) puts the vehicle at the same instant: the SED tolerance of
+/// the reduction is tightened until the flight is within it, down to
+/// keeping every sample.
+pub fn reduce_track(
+    track: &Track,
+    legs: LegLimits,
+    placement: Option<&Placement>,
+    tolerance: f64,
+) -> VehiclePlan {
     /// Tightenings tried before every sample is kept.
     const TRIES: usize = 12;
+    let home = placement
+        .zip(track.samples.first())
+        .map(|(p, s)| p.home(&s.position.xy()));
+    let store = |p: &Point3<f64>| match (placement, &home) {
+        (Some(placement), Some(home)) => placement.round_trip(p, home),
+        _ => *p,
+    };
     let mut sed = tolerance;
     for _ in 0..TRIES {
         let kept = simplify::simplify(&track.samples, sed);
-        let plan = plan_through(track, &kept, fixed_wing);
+        let plan = plan_through(track, &kept, legs, home, &store);
         let deviation = reverify::deviation(&plan, track);
         if deviation <= tolerance {
             return plan;
         }
-        // Rounding and holds add what the reduction did not see: ask the
-        // reduction for less, in proportion to the excess.
+        // Stored coordinates, rounding and holds add what the reduction
+        // did not see: ask the reduction for less, in proportion.
         sed *= 0.9 * tolerance / deviation;
     }
     let every: Vec<usize> = (0..track.samples.len()).collect();
-    plan_through(track, &every, fixed_wing)
+    plan_through(track, &every, legs, home, &store)
 }
 
-/// The plan whose waypoints are `track`'s samples `kept`, each leg at the
-/// speed (or hold, then the slowest speed) that reaches it on time.
-fn plan_through(track: &Track, kept: &[usize], fixed_wing: bool) -> VehiclePlan {
+/// The plan whose waypoints are `track`'s samples `kept` (where `store`
+/// puts them), each leg at the speed (or hold, then the slowest speed)
+/// that reaches it on time.
+fn plan_through(
+    track: &Track,
+    kept: &[usize],
+    legs: LegLimits,
+    home: Option<Home>,
+    store: &dyn Fn(&Point3<f64>) -> Point3<f64>,
+) -> VehiclePlan {
     let mut waypoints: Vec<Waypoint> = Vec::with_capacity(kept.len());
     // When the vehicle flown as planned reaches the last waypoint.
     let mut flown = 0.0;
     for &k in kept {
         let s = &track.samples[k];
+        let position = store(&s.position);
         let Some(prev) = waypoints.last_mut() else {
             flown = s.t;
             waypoints.push(Waypoint {
                 t: s.t,
-                position: s.position,
+                position,
                 speed: 0.0,
                 hold: 0.0,
             });
             continue;
         };
-        let length = (s.position - prev.position).norm();
-        let available = s.t - flown;
-        let (hold, speed) = leg_speed(length, available, fixed_wing);
+        let (hold, speed) = legs.command(&prev.position, &position, s.t - prev.t, s.t - flown);
         prev.hold = hold;
-        flown += hold + if speed > 0.0 { length / speed } else { 0.0 };
+        flown += hold + legs.duration(&prev.position, &position, speed);
         waypoints.push(Waypoint {
             t: s.t,
-            position: s.position,
+            position,
             speed,
             hold: 0.0,
         });
     }
     VehiclePlan {
         vehicle: track.vehicle,
+        home,
+        legs,
         waypoints,
     }
-}
-
-/// Hold (seconds, to [`HOLD_STEP`]) and commanded speed for a leg of
-/// `length` metres that has `available` seconds.
-fn leg_speed(length: f64, available: f64, fixed_wing: bool) -> (f64, f64) {
-    let round = |v: f64, step: f64| (v / step).round() * step;
-    let available = available.max(0.0);
-    if length <= 1e-9 {
-        // A vehicle that stays put: a multicopter holds; a fixed wing cannot.
-        let hold = if fixed_wing {
-            0.0
-        } else {
-            round(available, HOLD_STEP)
-        };
-        return (hold, 0.0);
-    }
-    let available = available.max(1e-3);
-    let needed = length / available;
-    if fixed_wing || needed >= MIN_SPEED {
-        return (0.0, round(needed, SPEED_STEP).max(SPEED_STEP));
-    }
-    // Too slow to command: wait, then fly the leg at the slowest speed.
-    let hold = round(available - length / MIN_SPEED, HOLD_STEP).max(0.0);
-    (hold, MIN_SPEED)
 }
 
 /// How to export.
@@ -394,8 +466,21 @@ pub enum ExportError {
          (latitude, longitude, altitude of the ENU origin) to the mission, or export csv"
     )]
     NoOrigin(&'static str),
-    #[error("the tolerance must be a positive number of metres, got {0}")]
+    #[error(
+        "the tolerance must be a number of metres of at least {MIN_TOLERANCE} (the stored \
+         coordinates alone may move a waypoint by up to 8.5 mm: 1e-7° of latitude and longitude), got {0}"
+    )]
     BadTolerance(f64),
+    #[error(
+        "the files cannot hold --tolerance {tolerance} m: keeping every sample of the track, \
+         a flown {noun} still strays {held:.3} m (speeds to 0.01 m/s, coordinates to 1e-7°); \
+         ask for at least that"
+    )]
+    Unreachable {
+        tolerance: f64,
+        held: f64,
+        noun: &'static str,
+    },
     #[error("the {0} result has no vehicle to export")]
     Empty(&'static str),
     #[error("export refused: the plans as flown break a constraint:\n{}", .0.failure_text())]
@@ -407,11 +492,13 @@ pub enum ExportError {
     },
 }
 
-/// File name of one vehicle's export: `<mission-stem>-<pipeline>-uav<N>.<ext>`.
+/// File name of one vehicle's export: `<mission-stem>-<pipeline>-<noun><N>.<ext>`
+/// (`uav`, `aircraft` or `agent`, as the pipeline names its vehicles).
 pub fn file_name(stem: &str, pipeline: Kind, vehicle: usize, format: Format) -> String {
     format!(
-        "{stem}-{}-uav{}.{}",
+        "{stem}-{}-{}{}.{}",
         pipeline.slug(),
+        noun(pipeline).to_lowercase(),
         vehicle + 1,
         format.extension()
     )
@@ -430,8 +517,8 @@ pub fn export(
     planned: &Planned,
     options: &Options,
 ) -> Result<Exported, ExportError> {
-    let frame = mission.origin.as_ref().map(Frame::new);
-    if frame.is_none()
+    let placement = Placement::new(mission);
+    if placement.is_none()
         && let Some(f) = options.formats.iter().find(|f| f.geodetic())
     {
         return Err(ExportError::NoOrigin(f.name()));
@@ -439,17 +526,55 @@ pub fn export(
     if planned.tracks.iter().all(|t| t.samples.is_empty()) {
         return Err(ExportError::Empty(planned.pipeline.slug()));
     }
-    let (tolerance, tolerance_source) = match options.tolerance {
-        Some(t) if t.is_finite() && t > 0.0 => (t, "--tolerance".to_owned()),
+    let (mut tolerance, mut tolerance_source) = match options.tolerance {
+        Some(t) if t.is_finite() && t >= MIN_TOLERANCE => (t, "--tolerance".to_owned()),
         Some(t) => return Err(ExportError::BadTolerance(t)),
         None => planned.default_tolerance(mission),
     };
-    let fixed_wing = planned.pipeline.fixed_wing();
-    let plans = reduce(&planned.tracks, tolerance, fixed_wing);
-    let reverification = reverify::reverify(mission, &planned.limits, &planned.tracks, &plans);
+    let plans = reduce(planned, placement.as_ref(), tolerance);
+    // Keeping every sample may still leave a flight off by more (timing
+    // roundings on many short legs): announce what the files hold, or say
+    // that the tolerance asked for cannot be held.
+    let held = plans
+        .iter()
+        .zip(&planned.tracks)
+        .map(|(p, t)| reverify::deviation(p, t))
+        .fold(0.0, f64::max);
+    if held > tolerance {
+        if options.tolerance.is_some() {
+            return Err(ExportError::Unreachable {
+                tolerance,
+                held,
+                noun: planned.noun(),
+            });
+        }
+        tolerance_source = format!(
+            "{tolerance_source}: {tolerance:.3} m, raised to what the files hold keeping every sample"
+        );
+        tolerance = held;
+    }
+    let waypoint_files = options.formats.iter().any(|f| f.waypoints());
+    let csv_texts: Vec<String> = if options.formats.contains(&Format::Csv) {
+        planned
+            .tracks
+            .iter()
+            .zip(&plans)
+            .map(|(t, p)| csv::render(t, placement.as_ref(), p.home.as_ref()).0)
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let reverification = reverify::reverify(
+        mission,
+        planned,
+        &plans,
+        tolerance,
+        waypoint_files,
+        (!csv_texts.is_empty()).then_some(csv_texts.as_slice()),
+        placement.as_ref(),
+    );
     // The KML shows the plan itself: only the files to fly are refused.
-    let flown = options.formats.iter().any(|f| f.per_vehicle());
-    let forced = flown && !reverification.passed();
+    let forced = !reverification.passed();
     if forced && !options.force {
         return Err(ExportError::Refused(Box::new(reverification)));
     }
@@ -460,9 +585,9 @@ pub fn export(
     })?;
     let mut files = Vec::new();
     for format in &options.formats {
-        if let (Format::Kml, Some(frame)) = (format, &frame) {
+        if let (Format::Kml, Some(placement)) = (format, &placement) {
             let path = options.out_dir.join(kml_file_name(stem, planned.pipeline));
-            let (text, items) = kml::render(mission, planned, frame);
+            let (text, items) = kml::render(mission, planned, &plans, placement);
             write_atomic(&path, text.as_bytes())?;
             files.push(Written {
                 path,
@@ -473,15 +598,18 @@ pub fn export(
             });
             continue;
         }
-        for (plan, track) in plans.iter().zip(&planned.tracks) {
+        for (i, (plan, track)) in plans.iter().zip(&planned.tracks).enumerate() {
             let name = file_name(stem, planned.pipeline, plan.vehicle, *format);
             let path = options.out_dir.join(name);
-            let (text, items) = match (format, &frame) {
-                (Format::Csv, _) => csv::render(track, frame.as_ref()),
-                (Format::Plan, Some(frame)) => {
-                    plan::render(mission, planned, plan, frame, tolerance)
+            let (text, items) = match (format, &placement) {
+                (Format::Csv, _) => (
+                    csv_texts.get(i).cloned().unwrap_or_default(),
+                    track.samples.len(),
+                ),
+                (Format::Plan, Some(placement)) => {
+                    plan::render(mission, planned, plan, placement, tolerance)
                 }
-                (Format::Wpl, Some(frame)) => wpl::render(planned, plan, frame, tolerance),
+                (Format::Wpl, Some(placement)) => wpl::render(planned, plan, placement, tolerance),
                 (f @ (Format::Plan | Format::Wpl | Format::Kml), _) => {
                     return Err(ExportError::NoOrigin(f.name()));
                 }
@@ -526,9 +654,10 @@ pub struct Item {
     pub frame: u8,
     /// param1..param4; NaN where the autopilot should keep its own value.
     pub params: [f64; 4],
-    /// Latitude, longitude (degrees) and altitude relative to home (metres);
-    /// `None` for commands without a position.
-    pub at: Option<[f64; 3]>,
+    /// Latitude and longitude (whole 1e-7°) and altitude relative to home
+    /// (metres, float32) as the files store them; `None` for commands
+    /// without a position.
+    pub at: Option<Stored>,
     /// Index of the waypoint (0-based) when the item is one.
     pub waypoint: Option<usize>,
 }
@@ -542,22 +671,25 @@ pub mod cmd {
     pub const DO_CHANGE_SPEED: u16 = 178;
 }
 
-/// The home position (WGS-84) and the mission items of one vehicle: take-off
-/// to the first waypoint's height, a speed change wherever the commanded
-/// speed changes, the waypoints, then land (multicopters) or loiter without
-/// limit at the last waypoint (fixed wing: ArduPlane would otherwise return
-/// to launch when the mission ends, across the other aircraft's plans).
+/// The home position and the mission items of one vehicle: take-off to the
+/// first waypoint's height, a speed change wherever the commanded speed
+/// changes, the waypoints, then land (multicopters) or loiter without limit
+/// at the last waypoint (fixed wing: ArduPlane would otherwise return to
+/// launch when the mission ends, across the other aircraft's plans).
 pub fn items(
     planned: &Planned,
     plan: &VehiclePlan,
-    frame: &Frame,
+    placement: &Placement,
     tolerance: f64,
-) -> (Geodetic, Vec<Item>) {
-    let home = frame.to_geodetic(&plan.home());
-    let relative = |p: &Point3<f64>| {
-        let g = frame.to_geodetic(p);
-        [g.latitude, g.longitude, g.altitude - home.altitude]
-    };
+) -> (Home, Vec<Item>) {
+    let home = plan.home.unwrap_or_else(|| {
+        let first = plan
+            .waypoints
+            .first()
+            .map_or_else(Point3::origin, |w| w.position);
+        placement.home(&first.xy())
+    });
+    let stored = |p: &Point3<f64>| placement.stored(p, &home);
     let fixed_wing = planned.pipeline.fixed_wing();
     // Ground speed for multicopters, airspeed for fixed wing (still air).
     let speed_type = if fixed_wing { 0.0 } else { 1.0 };
@@ -567,12 +699,15 @@ pub fn items(
         return (home, out);
     };
     let takeoff_pitch = if fixed_wing { 15.0 } else { 0.0 };
-    let f = relative(&first.position);
     out.push(Item {
         command: cmd::NAV_TAKEOFF,
         frame: 3,
         params: [takeoff_pitch, 0.0, 0.0, f64::NAN],
-        at: Some([home.latitude, home.longitude, f[2]]),
+        at: Some(Stored {
+            latitude: home.latitude,
+            longitude: home.longitude,
+            relative: stored(&first.position).relative,
+        }),
         waypoint: None,
     });
     let mut speed = f64::NAN;
@@ -582,7 +717,7 @@ pub fn items(
             command: cmd::NAV_WAYPOINT,
             frame: 3,
             params: [w.hold, accept, 0.0, f64::NAN],
-            at: Some(relative(&w.position)),
+            at: Some(stored(&w.position)),
             waypoint: Some(i),
         });
         let next = plan.waypoints.get(i + 1).map(|n| n.speed);
@@ -594,7 +729,7 @@ pub fn items(
         }
     }
     let last = plan.waypoints.last().unwrap_or(first);
-    let l = relative(&last.position);
+    let l = stored(&last.position);
     out.push(if fixed_wing {
         Item {
             command: cmd::NAV_LOITER_UNLIM,
@@ -608,7 +743,7 @@ pub fn items(
             command: cmd::NAV_LAND,
             frame: 3,
             params: [0.0, 0.0, 0.0, f64::NAN],
-            at: Some([l[0], l[1], 0.0]),
+            at: Some(Stored { relative: 0.0, ..l }),
             waypoint: None,
         }
     });

@@ -7,10 +7,14 @@
 //! Altitude/AltitudeMode/AMSLAltAboveTerrain keys together for positioned
 //! items); a version-2 `geoFence` with `polygons` and `circles`; a version-2
 //! `rallyPoints`. Without `geoFence` or `rallyPoints` MAVSDK refuses the file.
+//!
+//! Latitudes and longitudes are written on MAVLink's 1e-7° grid and
+//! altitudes as the float32 they become: the file says what the autopilot
+//! keeps.
 
 use serde_json::{Value, json};
 
-use super::{Frame, Item, Planned, VehiclePlan, items};
+use super::{Item, Placement, Planned, VehiclePlan, items};
 use crate::mission::Mission;
 
 /// MAV_AUTOPILOT: PX4 for the quadrotor pipelines, ArduPilot for FLATLO's
@@ -27,17 +31,20 @@ pub fn vehicle_type(planned: &Planned) -> u8 {
 fn item_json(item: &Item, jump: usize) -> Value {
     let [p1, p2, p3, p4] = item.params;
     match item.at {
-        Some([lat, lon, alt]) => json!({
-            "type": "SimpleItem",
-            "doJumpId": jump,
-            "autoContinue": true,
-            "command": item.command,
-            "frame": item.frame,
-            "params": [p1, p2, p3, p4, lat, lon, alt],
-            "Altitude": alt,
-            "AltitudeMode": 1,
-            "AMSLAltAboveTerrain": null,
-        }),
+        Some(at) => {
+            let (lat, lon, alt) = (at.latitude_deg(), at.longitude_deg(), at.relative);
+            json!({
+                "type": "SimpleItem",
+                "doJumpId": jump,
+                "autoContinue": true,
+                "command": item.command,
+                "frame": item.frame,
+                "params": [p1, p2, p3, p4, lat, lon, alt],
+                "Altitude": alt,
+                "AltitudeMode": 1,
+                "AMSLAltAboveTerrain": null,
+            })
+        }
         None => json!({
             "type": "SimpleItem",
             "doJumpId": jump,
@@ -54,19 +61,22 @@ pub fn render(
     mission: &Mission,
     planned: &Planned,
     plan: &VehiclePlan,
-    frame: &Frame,
+    placement: &Placement,
     tolerance: f64,
 ) -> (String, usize) {
-    let (home, list) = items(planned, plan, frame, tolerance);
+    let (home, list) = items(planned, plan, placement, tolerance);
     let json_items: Vec<Value> = list
         .iter()
         .enumerate()
         .map(|(i, item)| item_json(item, i + 1))
         .collect();
+    // QGroundControl's estimate of the flight time; every leg's own speed
+    // is a DO_CHANGE_SPEED (all within the vehicle's limits, or refused).
     let cruise = plan.waypoints.iter().map(|w| w.speed).fold(0.0, f64::max);
+    let frame = placement.frame();
     let b = &mission.bounds;
     let corner = |x: f64, y: f64| {
-        let g = frame.to_geodetic(&nalgebra::Point3::new(x, y, 0.0));
+        let g = frame.ground_to_geodetic(&nalgebra::Point2::new(x, y));
         json!([g.latitude, g.longitude])
     };
     // Clockwise from the north-west corner, as QGroundControl draws them.
@@ -78,7 +88,7 @@ pub fn render(
     ]);
     let circles: Vec<Value> = super::fence_obstacles(mission, planned)
         .map(|o| {
-            let g = frame.to_geodetic(&nalgebra::Point3::new(o.center.x, o.center.y, 0.0));
+            let g = frame.ground_to_geodetic(&o.center);
             json!({
                 "circle": {"center": [g.latitude, g.longitude], "radius": o.radius},
                 "inclusion": false,
@@ -96,7 +106,7 @@ pub fn render(
             "vehicleType": vehicle_type(planned),
             "cruiseSpeed": cruise,
             "hoverSpeed": cruise,
-            "plannedHomePosition": [home.latitude, home.longitude, home.altitude],
+            "plannedHomePosition": [home.latitude_deg(), home.longitude_deg(), home.altitude],
             "items": json_items,
         },
         "geoFence": {

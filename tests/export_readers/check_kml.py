@@ -17,9 +17,10 @@ Expectation file (JSON)::
           "verdict": "J = 181.37, 151.0 m, feasible",   # must be in the Document's description
           "vehicles": [                           # one folder each, in this order
             {"folder": "UAV 1", "color": "ffcfbe17",
-             "samples": [[x, y, z, height_above_ground], ...]}   # ENU metres, the plan
+             "home": [lat, lon, alt],                # the waypoint files' home
+             "samples": [[x, y, z, altitude], ...]}  # ENU metres, the plan; its absolute altitude
           ],
-          "obstacles": [{"name": "pier 1", "center": [x, y], "radius": 2.5, "height": 16.0}],
+          "obstacles": [{"name": "pier 1", "center": [x, y], "radius": 2.5, "top": 16.0}],
           "bands": [{"name": "pier 1 band", "center": [x, y], "inner": 3.5, "outer": 7.5}]
         }
       ]
@@ -27,13 +28,14 @@ Expectation file (JSON)::
 
 What is checked, per file: the schema (fastkml parses with validation on), one Document
 whose description holds the verdict, a "Mission" folder then one folder per vehicle in
-order; each vehicle's track is a LineString with altitudeMode relativeToGround, styled
-with the vehicle's colour, whose vertices are the planned samples in order (samples at
-one place, a vehicle holding, share a vertex): every sample's latitude/longitude within
-the tolerance (horizontally, metres) of where pymap3d puts the plan's ENU point, its
-altitude within the tolerance of the plan's height above the ground. Each obstacle
-is an extruded Polygon, relativeToGround, every vertex at its radius from its centre and
-at its height; each band a ring on the ground between its two radii.
+order; each vehicle's track is a LineString with altitudeMode absolute, styled with the
+vehicle's colour, whose vertices are the planned samples in order (samples at one place,
+a vehicle holding, share a vertex): every sample's latitude/longitude within the tolerance
+(horizontally, metres) of where pymap3d puts the ground point (x, y) of the plan's ENU
+frame, its altitude within the tolerance of the expected absolute altitude
+([origin].altitude + z, the export's convention); the vehicle's home Point at the expected
+home. Each obstacle is an extruded Polygon, absolute, every vertex at its radius from its
+centre and at its top; each band a ring on the ground between its two radii.
 """
 
 import argparse
@@ -79,10 +81,10 @@ def coords_of(placemark):
     return list(placemark.geometry.coords)
 
 
-def horizontal_error(lon, lat, x, y, z, origin):
-    """Metres between the read (lon, lat) and the plan's ENU point (x, y, z)."""
+def horizontal_error(lon, lat, x, y, origin):
+    """Metres between the read (lon, lat) and the ground point (x, y) of the plan's ENU frame."""
     lat0, lon0, h0 = origin["latitude"], origin["longitude"], origin.get("altitude", 0.0)
-    want_lat, want_lon, want_h = pymap3d.enu2geodetic(x, y, z, lat0, lon0, h0)
+    want_lat, want_lon, want_h = pymap3d.enu2geodetic(x, y, 0.0, lat0, lon0, h0)
     e, n, _ = pymap3d.geodetic2enu(lat, lon, want_h, want_lat, want_lon, want_h)
     return math.hypot(e, n)
 
@@ -127,16 +129,28 @@ def check_file(entry, tol):
         where = f"{name} {v['folder']}"
         folder = by_name.get(v["folder"])
         marks = placemarks(folder) if folder else []
-        if len(marks) != 1:
-            errors.append(f"{where}: {len(marks)} placemarks, expected 1 track")
+        tracks = [m for m in marks if (m.name or "").endswith(" track")]
+        homes = [m for m in marks if (m.name or "").endswith(" home")]
+        if len(tracks) != 1 or len(marks) != len(tracks) + len(homes):
+            errors.append(f"{where}: placemarks {[m.name for m in marks]}, expected one track (and its home)")
             continue
-        track = marks[0]
+        if v.get("home") is not None:
+            if len(homes) != 1:
+                errors.append(f"{where}: no home placemark")
+            else:
+                c = homes[0].geometry.coords[0]
+                lat, lon, alt = v["home"]
+                if abs(c[1] - lat) > 1e-9 or abs(c[0] - lon) > 1e-9 or abs(c[2] - alt) > tol:
+                    errors.append(f"{where}: home at {c}, expected {v['home']} (lat, lon, alt)")
+                if homes[0].kml_geometry.altitude_mode != AltitudeMode.absolute:
+                    errors.append(f"{where}: the home's altitudeMode is not absolute")
+        track = tracks[0]
         geometry = track.kml_geometry
         if type(geometry).__name__ != "LineString":
             errors.append(f"{where}: the track is a {type(geometry).__name__}, expected LineString")
             continue
-        if geometry.altitude_mode != AltitudeMode.relative_to_ground:
-            errors.append(f"{where}: altitudeMode {geometry.altitude_mode}, expected relativeToGround")
+        if geometry.altitude_mode != AltitudeMode.absolute:
+            errors.append(f"{where}: altitudeMode {geometry.altitude_mode}, expected absolute")
         url = track.style_url.url if track.style_url else None
         color = style_color(doc, url)
         if v.get("color") and color != v["color"]:
@@ -148,11 +162,11 @@ def check_file(entry, tol):
         # vertex at a sample.
         j = 0
         used = set()
-        for k, (x, y, z, above) in enumerate(want):
+        for k, (x, y, z, altitude) in enumerate(want):
             def off(i):
                 g = got[i]
                 alt = g[2] if len(g) > 2 else 0.0
-                return horizontal_error(g[0], g[1], x, y, z, origin), abs(alt - above)
+                return horizontal_error(g[0], g[1], x, y, origin), abs(alt - altitude)
             if not got:
                 break
             h, d = off(j)
@@ -188,13 +202,13 @@ def check_file(entry, tol):
         if type(g).__name__ != "Polygon" or not g.extrude:
             errors.append(f"{where}: expected an extruded Polygon, got {type(g).__name__}")
             continue
-        if g.altitude_mode != AltitudeMode.relative_to_ground:
-            errors.append(f"{where}: altitudeMode {g.altitude_mode}, expected relativeToGround")
+        if g.altitude_mode != AltitudeMode.absolute:
+            errors.append(f"{where}: altitudeMode {g.altitude_mode}, expected absolute")
         for c in coords_of(p):
             e, n = ground_point(c[0], c[1], origin)
             off = abs(math.hypot(e - o["center"][0], n - o["center"][1]) - o["radius"])
             worst_h = max(worst_h, off)
-            if off > tol or abs(c[2] - o["height"]) > tol:
+            if off > tol or abs(c[2] - o["top"]) > tol:
                 errors.append(f"{where}: vertex {c} is {off:.4f} m off its circle or not at its height")
                 break
     for b in entry.get("bands", []):
