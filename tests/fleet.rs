@@ -183,3 +183,141 @@ fn thirty_agents_run_with_their_neighbourhoods() {
         assert_eq!(a.evaluations, a.decisions * 20 * 21);
     }
 }
+
+/// The errors validation gives `m`, as `path: message`.
+fn errors(m: &Mission) -> Vec<String> {
+    mission::validate(m)
+        .into_iter()
+        .filter(|d| d.is_error())
+        .map(|d| format!("{}: {}", d.path, d.message))
+        .collect()
+}
+
+fn with_distances(agents: usize, target_distance: f64, distances: Vec<Vec<f64>>) -> Mission {
+    let mut m = triangle_mission();
+    m.fleet.agents = agents;
+    m.fleet.target_distance = target_distance;
+    m.fleet.distances = distances;
+    m
+}
+
+/// Eq. 4's ∂_d must be a formation: the paper's triangle as written (1.732
+/// for √3), a square round its circle, and the default regular polygons of
+/// 2 to 12 agents written out pass.
+#[test]
+fn a_formation_the_fleet_can_stand_in_passes() {
+    let s = 1.732;
+    let triangle = vec![vec![0.0, s, s], vec![s, 0.0, s], vec![s, s, 0.0]];
+    assert!(errors(&with_distances(3, 1.0, triangle)).is_empty());
+    let (a, d) = (2.0, 2.0 * 2f64.sqrt());
+    let square = vec![
+        vec![0.0, a, d, a],
+        vec![a, 0.0, a, d],
+        vec![d, a, 0.0, a],
+        vec![a, d, a, 0.0],
+    ];
+    assert!(errors(&with_distances(4, 2f64.sqrt(), square)).is_empty());
+    for n in 2..=12 {
+        let polygon = fleet::polygon_distances(n, 3.0);
+        let found = errors(&with_distances(n, 3.0, polygon));
+        assert!(found.is_empty(), "{n} agents: {found:?}");
+    }
+}
+
+/// A triangle that does not close is refused at its longest entry, naming
+/// the three agents and the sum (the triangle inequality); so is a square
+/// whose diagonal does not fit the circle d_ip^d gives it, naming the target.
+#[test]
+fn distances_no_triangle_can_have_are_refused_naming_the_triangle() {
+    let found = errors(&with_distances(
+        3,
+        3.0,
+        vec![
+            vec![0.0, 1.0, 5.0],
+            vec![1.0, 0.0, 2.0],
+            vec![5.0, 2.0, 0.0],
+        ],
+    ));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(
+        found[0]
+            .starts_with("fleet.distances[0][2]: no formation in the plane has these distances:")
+            && found[0].contains("agent 1, agent 2 and agent 3 cannot form a triangle")
+            && found[0].contains("distances[0][2] = 5 m is longer than")
+            && found[0].contains("= 3 m"),
+        "{found:?}"
+    );
+    let (a, d) = (2.0, 2.0 * 2f64.sqrt());
+    let square = vec![
+        vec![0.0, a, d, a],
+        vec![a, 0.0, a, d],
+        vec![d, a, 0.0, a],
+        vec![a, d, a, 0.0],
+    ];
+    // 1 m from the target, two corners 2.83 m apart cannot be.
+    let found = errors(&with_distances(4, 1.0, square));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(
+        found[0].starts_with("fleet.distances[0][2]")
+            && found[0].contains("with the target: agent 1, agent 3 and the target cannot form")
+            && found[0].contains("must lie on a circle of that radius"),
+        "{found:?}"
+    );
+}
+
+/// Four agents all 2 m apart are a tetrahedron's corners: every triangle
+/// closes, but no plane holds them (their Cayley–Menger determinant is not
+/// 0); refused at the entry that misses, naming the agents it was placed
+/// from and the tolerance.
+#[test]
+fn distances_that_need_a_third_dimension_are_refused_naming_the_entry() {
+    let r = 2.0 * (3.0f64 / 8.0).sqrt(); // the tetrahedron's circumradius
+    let all = vec![vec![2.0; 4]; 4];
+    let mut tetrahedron = all.clone();
+    for (i, row) in tetrahedron.iter_mut().enumerate() {
+        row[i] = 0.0;
+    }
+    let found = errors(&with_distances(4, r, tetrahedron));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(
+        found[0].starts_with(
+            "fleet.distances[2][3]: no formation in the plane has these distances: placed from"
+        ) && found[0].contains("come 3.464 m apart, but distances[2][3] = 2 m")
+            && found[0].contains("fleet.tolerance allows ± 0.100 m"),
+        "{found:?}"
+    );
+}
+
+/// `skyform check` refuses the impossible matrix with the file, the line
+/// and the field, and exits non-zero.
+#[test]
+fn check_refuses_an_impossible_matrix_with_its_file_line_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("fleet.toml");
+    let m = with_distances(
+        3,
+        3.0,
+        vec![
+            vec![0.0, 1.0, 5.0],
+            vec![1.0, 0.0, 2.0],
+            vec![5.0, 2.0, 0.0],
+        ],
+    );
+    std::fs::write(&file, mission::to_toml_string(&m).unwrap()).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_skyform"))
+        .arg("check")
+        .arg(&file)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!out.status.success(), "{text}");
+    assert!(
+        text.contains("fleet.toml:") && text.contains("fleet.distances[0][2]"),
+        "{text}"
+    );
+    assert!(text.contains("cannot form a triangle"), "{text}");
+}

@@ -185,6 +185,36 @@ fn a_killed_agent_process_is_reported_lost_and_the_run_finishes() {
     assert!(last(1) <= lost.time + 1e-9);
     assert!((last(0) - 6.0).abs() < 1e-9 && (last(2) - 6.0).abs() < 1e-9);
     assert!(outcome.agents[0].decisions > 0 && outcome.agents[2].decisions > 0);
+    // Its effort is what it did until it was lost (its process never
+    // reported): the rounds' count, one decision per τ at least.
+    let tau = m.fleet.replan_period;
+    let decided = outcome.agents[1].decisions as f64;
+    assert!(
+        decided >= (lost.time / tau).floor() && decided < outcome.agents[0].decisions as f64,
+        "agent 2 decided {decided} times in {} s",
+        lost.time
+    );
+    let per = m.fleet.swarm_size * (m.fleet.iterations + 1);
+    assert_eq!(
+        outcome.agents[1].evaluations,
+        outcome.agents[1].decisions * per
+    );
+    // The survivors kept clear of where it was last heard, and the one
+    // closest approach is over every pair, its own too.
+    let c = m.fleet.safety_distance;
+    let mut all = f64::INFINITY;
+    for d in &outcome.distances {
+        for (v, t) in d.values.iter().zip(&outcome.times) {
+            all = all.min(*v);
+            if (d.a == 1 || d.b == 1) && *t > lost.time {
+                assert!(*v >= c, "pair {}-{} at {t} s: {v} m", d.a + 1, d.b + 1);
+            }
+        }
+    }
+    assert_eq!(
+        outcome.closest_agents.as_ref().map(|c| c.distance),
+        Some(all)
+    );
     assert_all_gone(&watcher.pids);
 }
 

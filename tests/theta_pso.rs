@@ -636,7 +636,11 @@ fn the_speed_is_the_formations_ground_speed_away_from_reconfigurations() {
     let top = pace.iter().copied().fold(0.0, f64::max);
     assert!((top - speed).abs() < 1e-6, "{top} m/s");
     let cruising = pace.iter().filter(|v| (*v - speed).abs() < 1e-6).count();
-    assert!(cruising * 2 > pace.len(), "{cruising} of {} samples", pace.len());
+    assert!(
+        cruising * 2 > pace.len(),
+        "{cruising} of {} samples",
+        pace.len()
+    );
     for tr in &o.trajectories {
         assert_eq!(tr.samples[0].velocity.norm(), 0.0, "from rest");
         let last = tr.samples.last().map(|s| s.velocity.norm());

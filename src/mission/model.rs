@@ -613,6 +613,12 @@ pub struct FlatloParams {
     pub load_factor: [f64; 2],
     /// Bank angle limit |μ|, degrees.
     pub max_bank_deg: f64,
+    /// [min, max] airspeed the aircraft may fly, m/s: every aircraft's
+    /// transition airspeed must lie in it, the autopilot keeps the flight in
+    /// it and verification judges it. Defaults from the airframe
+    /// (docs/flatlo.md): 1.25 × the stall speed at C_L,max = 1.8, and the
+    /// fastest level flight at full thrust.
+    pub airspeed_range: [f64; 2],
     /// Position-error PID gains [kp, ki, kd] of the tracking controller.
     pub pid: [f64; 3],
     /// Relative standard deviation of the multiplicative Gaussian noise on
@@ -647,6 +653,10 @@ impl Default for FlatloParams {
             max_thrust: 100.0,
             load_factor: [-1.0, 3.0],
             max_bank_deg: 60.0,
+            // V_s = √(2W / (ρ S C_L,max)) = 10.97 m/s at C_L,max = 1.8;
+            // ArduPlane's AIRSPEED_MIN "at least 25 % above the stall speed";
+            // T_max = D(V) at 54.0 m/s.
+            airspeed_range: [13.7, 54.0],
             pid: [0.02, 0.0002, 0.4],
             noise: 0.0025,
             min_separation: 1_000.0,

@@ -21,7 +21,8 @@ pub fn diagnose(mission: &Mission) -> Vec<Diagnostic> {
 }
 
 /// What the pipelines say of a mission that follows the rules: their budgets
-/// first (a run too large to start), then θ-PSO's IWPs and inspections.
+/// first (a run too large to start), then θ-PSO's IWPs and inspections,
+/// then FLATLO's airspeeds and bounds predicted from its references.
 fn pipeline_findings(mission: &Mission) -> Vec<Diagnostic> {
     use clap::ValueEnum as _;
     // Every registered pipeline's predicted size, in the order of `Kind`.
@@ -30,6 +31,7 @@ fn pipeline_findings(mission: &Mission) -> Vec<Diagnostic> {
         .flat_map(|&kind| crate::outcome::budget(kind, mission))
         .collect();
     out.extend(crate::pipelines::theta_pso::diagnostics(mission));
+    out.extend(crate::pipelines::flatlo::diagnostics(mission));
     out
 }
 

@@ -131,6 +131,48 @@ pub fn run(
     })
 }
 
+/// The fleet's pass rule: every pair (a lost agent where it was last heard)
+/// and every obstacle kept at c, no agent lost, every target's formation
+/// reached. Fails on the first broken one, in words; when agents were lost
+/// and that is not the first, they are named after it.
+fn fleet_verdict(o: &FleetOutcome) -> Verdict {
+    if o.completion == Completion::Cancelled {
+        return Verdict::Cancelled;
+    }
+    let lost = summary::lost_agents(o);
+    let first = if let Some(c) = o.closest_agents.as_ref().filter(|_| !o.kept_apart()) {
+        summary::too_close(o, c)
+    } else if let Some(c) = o.closest_obstacle.as_ref().filter(|_| !o.obstacles_clear()) {
+        format!(
+            "agent {} came {:.3} m from {} (t = {:.2} s), closer than c = {} m",
+            c.a + 1,
+            c.distance,
+            c.b,
+            c.time,
+            o.safety_distance
+        )
+    } else if let Some(lost) = &lost {
+        return Verdict::Failed(lost.clone());
+    } else if let Some((k, t)) = o
+        .targets
+        .iter()
+        .enumerate()
+        .find(|(_, t)| t.converged_after.is_none())
+    {
+        let how_far = t
+            .end
+            .as_ref()
+            .map_or_else(String::new, |e| format!(": {}", summary::shortfall(e)));
+        format!("target {}'s formation was never reached{how_far}", k + 1)
+    } else {
+        return Verdict::Passed;
+    };
+    Verdict::Failed(match lost {
+        Some(lost) => format!("{first}; {lost}"),
+        None => first,
+    })
+}
+
 impl Outcome {
     pub fn kind(&self) -> Kind {
         match self {
@@ -166,39 +208,30 @@ impl Outcome {
                 None => Verdict::Failed("a constraint is broken".into()),
                 Some(reason) => Verdict::Failed(reason),
             },
-            Outcome::Flatlo(o) => match (&o.verification, o.closest) {
-                (None, _) => Verdict::Cancelled,
-                (Some(v), _) if v.passed => Verdict::Passed,
-                (Some(v), Some(c)) => Verdict::Failed(format!(
-                    "aircraft {} and {} came {:.0} m apart (t = {:.0} s), closer than {:.0} m",
-                    c.a + 1,
-                    c.b + 1,
-                    c.min_distance,
-                    c.time,
-                    v.min_separation
-                )),
-                (Some(_), None) => Verdict::Failed("separation lost".into()),
-            },
-            Outcome::Fleet(o) => {
-                if o.completion == Completion::Cancelled {
-                    Verdict::Cancelled
-                } else if !o.kept_apart() {
-                    Verdict::Failed("two agents came closer than the safety distance".into())
-                } else if !o.obstacles_clear() {
-                    Verdict::Failed("an agent came closer to an obstacle than c".into())
-                } else if let Some(l) = o.lost.first() {
-                    Verdict::Failed(format!(
-                        "agent {} was lost at t = {:.2} s ({})",
-                        l.agent + 1,
-                        l.time,
-                        l.reason
-                    ))
-                } else if !o.converged() {
-                    Verdict::Failed("a target's formation was never reached".into())
-                } else {
-                    Verdict::Passed
+            Outcome::Flatlo(o) => match &o.verification {
+                None => Verdict::Cancelled,
+                Some(v) if v.passed => Verdict::Passed,
+                Some(v) => {
+                    // The first limit of the flight broken, then the separation.
+                    let separation = o.closest.filter(|_| !v.separated(o.closest)).map(|c| {
+                        format!(
+                            "aircraft {} and {} came {:.0} m apart (t = {:.0} s), closer than {:.0} m",
+                            c.a + 1,
+                            c.b + 1,
+                            c.min_distance,
+                            c.time,
+                            v.min_separation
+                        )
+                    });
+                    let flight = v.violation.map(|x| x.describe());
+                    Verdict::Failed(match (flight, separation) {
+                        (Some(f), Some(s)) => format!("{f}; {s}"),
+                        (Some(text), None) | (None, Some(text)) => text,
+                        (None, None) => "separation lost".into(),
+                    })
                 }
-            }
+            },
+            Outcome::Fleet(o) => fleet_verdict(o),
         }
     }
 
@@ -212,7 +245,7 @@ impl Outcome {
         let verdict = match self.verdict() {
             Verdict::Passed => match self.kind() {
                 Kind::ThetaPso => "feasible",
-                Kind::Flatlo => "separation kept",
+                Kind::Flatlo => "flyable, separation kept",
                 Kind::Fleet => "formed, safety distance kept",
             }
             .to_owned(),

@@ -4,7 +4,7 @@
 
 use super::Verdict;
 use crate::pipelines::flatlo::FlatloOutcome;
-use crate::pipelines::fleet::FleetOutcome;
+use crate::pipelines::fleet::{Closest, Deviation, FleetOutcome, FormationError, Other};
 use crate::pipelines::theta_pso::{ThetaPsoOutcome, unusable};
 
 /// How many unusable IWPs the summary names (the nearest the route).
@@ -286,10 +286,34 @@ pub fn flatlo(o: &FlatloOutcome) -> String {
         v.max_spacing_error * 100.0,
         v.lateral_spread
     );
-    let verdict = if v.passed { "PASS" } else { "FAIL" };
+    let [slowest, fastest] = v.airspeed_flown;
+    let [lo, hi] = v.airspeed_range;
     let _ = writeln!(
         s,
-        "  result       {verdict}: closest {closest}, minimum separation {:.0} m",
+        "  flight       airspeed {slowest:.2}-{fastest:.2} m/s flown (airspeed_range [{lo}, {hi}] m/s); \
+         bank at most {:.1}° (max_bank_deg {}°)",
+        v.bank_flown_deg, v.max_bank_deg
+    );
+    let bounds = if v.bounds_margin >= 0.0 {
+        format!(
+            "every aircraft and its reference inside the x-y bounds and the altitude band, {:.0} m from the nearest edge at least",
+            v.bounds_margin
+        )
+    } else {
+        format!(
+            "an aircraft left them: {:.0} m outside at worst",
+            -v.bounds_margin
+        )
+    };
+    let _ = writeln!(s, "  bounds       {bounds}");
+    let verdict = match (&v.violation, v.passed) {
+        (_, true) => "PASS:".to_owned(),
+        (Some(x), false) => format!("FAIL: not flyable, {};", x.describe()),
+        (None, false) => "FAIL:".to_owned(),
+    };
+    let _ = writeln!(
+        s,
+        "  result       {verdict} closest {closest}, minimum separation {:.0} m",
         v.min_separation
     );
     s
@@ -308,9 +332,11 @@ pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
         o.agents.len()
     );
     for (k, t) in o.targets.iter().enumerate() {
-        let reached = t.converged_after.map_or("NOT REACHED".to_owned(), |a| {
-            format!("formed {a:.2} s after it appeared")
-        });
+        let reached = match (t.converged_after, &t.end) {
+            (Some(a), _) => format!("formed {a:.2} s after it appeared"),
+            (None, Some(e)) => format!("NOT REACHED: {}", shortfall(e)),
+            (None, None) => "NOT REACHED (no sample while it was in force)".to_owned(),
+        };
         let _ = writeln!(
             s,
             "  target {:<5} ({:.2}, {:.2}) at t = {:.1} s: {reached}",
@@ -332,8 +358,15 @@ pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
         );
     }
     let agents = o.closest_agents.as_ref().map_or("-".to_owned(), |c| {
+        let lost = o
+            .lost
+            .iter()
+            .find(|l| l.time <= c.time && (l.agent == c.a || c.b == Other::Agent(l.agent)))
+            .map_or_else(String::new, |l| {
+                format!(", agent {} where it was last heard", l.agent + 1)
+            });
         format!(
-            "agents {} and {} at {:.3} m (t = {:.2} s)",
+            "agents {} and {} at {:.3} m (t = {:.2} s{lost})",
             c.a + 1,
             c.b,
             c.distance,
@@ -454,4 +487,98 @@ fn decisions_by_agent(o: &FleetOutcome) -> String {
     } else {
         format!(" ({least} to {most} by agent)")
     }
+}
+
+/// How far a formation stood from its target, for `NOT REACHED`: the
+/// distance furthest from its desired value between two agents and to the
+/// target (`d14 5.159 m, want 6.000 ± 0.300`), and the centre's offset.
+pub fn shortfall(e: &FormationError) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for d in [e.pair, e.to_target].iter().flatten() {
+        parts.push(deviation(d));
+    }
+    parts.push(format!("centre {:.3} m from the target", e.centre_offset));
+    format!("at t = {:.1} s {}", e.time, parts.join("; "))
+}
+
+/// One distance against its desired value: `d14 5.159 m (want 6.000 ±
+/// 0.300)` between agents, `agent 2 1.250 m from the target (want …)`.
+pub fn deviation(d: &Deviation) -> String {
+    let what = match d.b {
+        Some(b) => format!("d{}{} {:.3} m", d.a + 1, b + 1, d.distance),
+        None => format!("agent {} {:.3} m from the target", d.a + 1, d.distance),
+    };
+    format!("{what} (want {:.3} ± {:.3})", d.desired, d.tolerance)
+}
+
+/// Items as a list people read: `3`, `3 and 4`, `2, 3 and 5`.
+fn and_list(items: &[String]) -> String {
+    match items.split_last() {
+        None => String::new(),
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
+/// Every lost agent, when and why, in one sentence; None when none was.
+pub fn lost_agents(o: &FleetOutcome) -> Option<String> {
+    let first = o.lost.first()?;
+    let agents: Vec<String> = o.lost.iter().map(|l| (l.agent + 1).to_string()).collect();
+    let together = o.lost.iter().all(|l| l.step == first.step);
+    Some(if o.lost.len() == 1 {
+        format!(
+            "agent {} was lost at t = {:.2} s ({})",
+            first.agent + 1,
+            first.time,
+            first.reason
+        )
+    } else if together {
+        format!(
+            "agents {} were lost at t = {:.2} s ({})",
+            and_list(&agents),
+            first.time,
+            first.reason
+        )
+    } else {
+        let each: Vec<String> = o
+            .lost
+            .iter()
+            .map(|l| format!("{} at t = {:.2} s", l.agent + 1, l.time))
+            .collect();
+        format!("agents {} were lost ({})", and_list(&each), first.reason)
+    })
+}
+
+/// The closest approach of two agents that broke c, in words: a lost
+/// agent is named as where it was last heard.
+pub fn too_close(o: &FleetOutcome, c: &Closest) -> String {
+    let b = match c.b {
+        Other::Agent(b) => b,
+        Other::Obstacle(_) => return format!("agent {} came too close to {}", c.a + 1, c.b),
+    };
+    let lost_before = |agent: usize| o.lost.iter().any(|l| l.agent == agent && l.time <= c.time);
+    let pair = match (lost_before(c.a), lost_before(b)) {
+        (false, true) => format!(
+            "agent {} came within {:.3} m of where lost agent {} was last heard",
+            c.a + 1,
+            c.distance,
+            b + 1
+        ),
+        (true, false) => format!(
+            "agent {} came within {:.3} m of where lost agent {} was last heard",
+            b + 1,
+            c.distance,
+            c.a + 1
+        ),
+        _ => format!(
+            "agents {} and {} came {:.3} m apart",
+            c.a + 1,
+            b + 1,
+            c.distance
+        ),
+    };
+    format!(
+        "{pair} (t = {:.2} s), closer than the safety distance c = {} m",
+        c.time, o.safety_distance
+    )
 }

@@ -123,6 +123,15 @@ pub fn log_outcome(
             .with_level(level),
         )?;
     }
+    // The first limit of the flight broken, at its time.
+    if let Some(v) = o.verification.as_ref().and_then(|v| v.violation) {
+        stream.set_duration_secs("sim_time", v.time);
+        stream.log(
+            events.as_str(),
+            &rerun::TextLog::new(format!("not flyable: {}", v.describe()))
+                .with_level(rerun::TextLogLevel::WARN),
+        )?;
+    }
     stream.reset_time();
     Ok(())
 }

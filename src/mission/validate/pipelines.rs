@@ -98,6 +98,25 @@ impl Checker {
                 ),
             );
         }
+        let speeds = path.key("airspeed_range");
+        for (i, v) in p.airspeed_range.iter().enumerate() {
+            self.positive(speeds.index(i), *v, " m/s");
+        }
+        if self.range(speeds.clone(), p.airspeed_range, " m/s") {
+            let [lo, hi] = p.airspeed_range;
+            if p.airspeed.is_finite() && !(lo..=hi).contains(&p.airspeed) {
+                self.error(
+                    path.key("airspeed"),
+                    format!(
+                        "the nominal airspeed {} m/s is outside airspeed_range [{}, {}] m/s \
+                         (every aircraft flies it after the transition)",
+                        compact(p.airspeed),
+                        compact(lo),
+                        compact(hi)
+                    ),
+                );
+            }
+        }
         if p.max_bank_deg >= 90.0 {
             self.error(
                 path.key("max_bank_deg"),
@@ -282,7 +301,10 @@ impl Checker {
     }
 
     /// The desired distances must be a symmetric n×n matrix that keeps every
-    /// pair at least the safety distance c apart (fleet paper, eq. 5).
+    /// pair at least the safety distance c apart (fleet paper, eq. 5), and a
+    /// formation must be able to stand: the agents in the plane, each d_ip^d
+    /// from the target (eq. 6), every distance within `fleet.tolerance` of
+    /// its value ([`Self::fleet_formable`]).
     pub(super) fn fleet_distances(&mut self, path: &FieldPath, p: &FleetParams) {
         let n = p.agents;
         let at = path.key("distances");
@@ -306,9 +328,11 @@ impl Checker {
             self.error(at, format!("must be a {n}×{n} matrix (one row per agent)"));
             return;
         }
+        let mut sound = true;
         for i in 0..n {
             if p.distances[i][i] != 0.0 {
                 self.error(at.index(i).index(i), "the diagonal must be 0");
+                sound = false;
             }
             for j in (i + 1)..n {
                 let (a, b) = (p.distances[i][j], p.distances[j][i]);
@@ -317,6 +341,7 @@ impl Checker {
                         at.index(i).index(j),
                         format!("is {a} but distances[{j}][{i}] is {b}; must be symmetric"),
                     );
+                    sound = false;
                 } else if a < p.safety_distance {
                     self.error(
                         at.index(i).index(j),
@@ -325,8 +350,74 @@ impl Checker {
                             p.safety_distance
                         ),
                     );
+                    sound = false;
                 }
             }
+        }
+        if sound && p.tolerance > 0.0 && p.target_distance >= 0.0 {
+            self.fleet_formable(path, p);
+        }
+    }
+
+    /// A formation no fleet can stand in is refused, naming its entries
+    /// (docs/fleet.md, "Which distances a formation can have"): the agents
+    /// must have a place in the plane, and then, with the target d_ip^d from
+    /// each, on its circle. First every triangle of them must close (the
+    /// triangle inequality); then, placed in the plane from the farthest two
+    /// and the one farthest off their line, every other distance must come
+    /// out within the tolerance `formed` allows it, `fleet.tolerance` ×
+    /// max(d, c).
+    fn fleet_formable(&mut self, path: &FieldPath, p: &FleetParams) {
+        let n = p.agents;
+        // Point n is the target.
+        let d = |i: usize, j: usize| -> f64 {
+            match (i == n, j == n) {
+                (true, true) => 0.0,
+                (true, false) | (false, true) => p.target_distance,
+                (false, false) => p.distances[i][j],
+            }
+        };
+        let name = |i: usize| {
+            if i == n {
+                "the target".to_owned()
+            } else {
+                format!("agent {}", i + 1)
+            }
+        };
+        let entry = |i: usize, j: usize| {
+            if i == n || j == n {
+                "target_distance".to_owned()
+            } else {
+                format!("distances[{}][{}]", i.min(j), i.max(j))
+            }
+        };
+        let field = |i: usize, j: usize| {
+            if i == n || j == n {
+                path.key("target_distance")
+            } else {
+                path.key("distances").index(i.min(j)).index(i.max(j))
+            }
+        };
+        let slack = |want: f64| p.tolerance * want.max(p.safety_distance);
+        // The agents alone, then with the target.
+        for (points, around) in [(n, ""), (n + 1, " with the target")] {
+            let Some((at, why)) = unformable(points, &d, &slack, &name, &entry) else {
+                continue;
+            };
+            let circle = if around.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; every agent is target_distance = {} m from the target, so the agents \
+                     must lie on a circle of that radius",
+                    compact(p.target_distance)
+                )
+            };
+            self.error(
+                field(at[0], at[1]),
+                format!("no formation in the plane has these distances{around}: {why}{circle}"),
+            );
+            return;
         }
     }
 
@@ -426,5 +517,136 @@ impl Checker {
                 );
             }
         }
+    }
+}
+
+/// Why `m` points with distances `d` have no place in the plane within
+/// `slack` of each distance, and the two points of the entry to blame; None
+/// when they have one. A triangle that does not close comes first (its
+/// longest side is to blame); then the distance that misses most once the
+/// points are placed ([`place_in_plane`]).
+fn unformable(
+    m: usize,
+    d: &dyn Fn(usize, usize) -> f64,
+    slack: &dyn Fn(f64) -> f64,
+    name: &dyn Fn(usize) -> String,
+    entry: &dyn Fn(usize, usize) -> String,
+) -> Option<([usize; 2], String)> {
+    let mut broken: Vec<[usize; 3]> = Vec::new();
+    for i in 0..m {
+        for j in i + 1..m {
+            for k in j + 1..m {
+                let mut sides = [
+                    (d(i, j), [i, j, k]),
+                    (d(i, k), [i, k, j]),
+                    (d(j, k), [j, k, i]),
+                ];
+                sides.sort_by(|a, b| b.0.total_cmp(&a.0));
+                let (long, [a, b, c]) = sides[0];
+                if long > d(a, c) + d(c, b) + slack(long) {
+                    broken.push([a, b, c]);
+                }
+            }
+        }
+    }
+    if let Some(&[a, b, c]) = broken.first() {
+        let mut three = [a, b, c];
+        three.sort_unstable();
+        let more = match broken.len() - 1 {
+            0 => String::new(),
+            more => format!(" ({more} more triangle(s) do not close either)"),
+        };
+        let why = format!(
+            "{}, {} and {} cannot form a triangle, {} = {} m is longer than {} + {} = {} + {} \
+             = {} m{more}",
+            name(three[0]),
+            name(three[1]),
+            name(three[2]),
+            entry(a, b),
+            compact(d(a, b)),
+            entry(a, c),
+            entry(c, b),
+            compact(d(a, c)),
+            compact(d(c, b)),
+            compact(d(a, c) + d(c, b)),
+        );
+        return Some(([a, b], why));
+    }
+    let placed = place_in_plane(m, d);
+    let off = |j: usize, k: usize| {
+        let planar = (placed.points[j] - placed.points[k]).norm();
+        (planar, (planar - d(j, k)).abs() / slack(d(j, k)))
+    };
+    let (j, k) = (0..m)
+        .flat_map(|j| (j + 1..m).map(move |k| (j, k)))
+        .filter(|&(j, k)| off(j, k).1 > 1.0)
+        .max_by(|x, y| off(x.0, x.1).1.total_cmp(&off(y.0, y.1).1))?;
+    let [a, b, c] = placed.anchors;
+    let why = format!(
+        "placed from {}, {} and {}, {} and {} come {:.3} m apart, but {} = {} m \
+         (fleet.tolerance allows ± {:.3} m)",
+        name(a),
+        name(b),
+        name(c),
+        name(j),
+        name(k),
+        off(j, k).0,
+        entry(j, k),
+        compact(d(j, k)),
+        slack(d(j, k)),
+    );
+    Some(([j, k], why))
+}
+
+/// Points placed in the plane from their distances, and the three placed
+/// first.
+struct Placement {
+    points: Vec<nalgebra::Point2<f64>>,
+    anchors: [usize; 3],
+}
+
+/// Places `m` points (m ≥ 1) in the plane from their distances `d` (which
+/// close every triangle): a and b, the farthest two, on the x axis; c, the
+/// one farthest off their line, above it; every other point where its
+/// distances to a and b put it, on the side its distance to c prefers.
+/// When the distances are a plane's, every distance comes back.
+fn place_in_plane(m: usize, d: &dyn Fn(usize, usize) -> f64) -> Placement {
+    use nalgebra::Point2;
+    let (mut a, mut b) = (0, 0);
+    for i in 0..m {
+        for j in i + 1..m {
+            if d(i, j) > d(a, b) {
+                (a, b) = (i, j);
+            }
+        }
+    }
+    let base = d(a, b);
+    // Where each point falls on ab (x) and how far off it (|y|).
+    let foot = |k: usize| -> (f64, f64) {
+        if base <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let x = (d(a, k).powi(2) - d(b, k).powi(2) + base * base) / (2.0 * base);
+        (x, (d(a, k).powi(2) - x * x).max(0.0).sqrt())
+    };
+    let c = (0..m)
+        .max_by(|&i, &j| foot(i).1.total_cmp(&foot(j).1))
+        .unwrap_or(0);
+    let (cx, cy) = foot(c);
+    let points = (0..m)
+        .map(|k| {
+            let (x, y) = foot(k);
+            if k == c {
+                return Point2::new(cx, cy);
+            }
+            let up = Point2::new(x, y);
+            let down = Point2::new(x, -y);
+            let miss = |q: &Point2<f64>| ((q - Point2::new(cx, cy)).norm() - d(c, k)).abs();
+            if miss(&down) < miss(&up) { down } else { up }
+        })
+        .collect();
+    Placement {
+        points,
+        anchors: [a, b, c],
     }
 }

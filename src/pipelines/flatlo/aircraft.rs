@@ -44,6 +44,8 @@ pub struct Airframe {
     pub max_thrust: f64,
     pub load_factor: [f64; 2],
     pub max_bank: f64,
+    /// [min, max] airspeed, m/s (`airspeed_range`).
+    pub airspeed: [f64; 2],
 }
 
 impl Airframe {
@@ -57,6 +59,7 @@ impl Airframe {
             max_thrust: p.max_thrust,
             load_factor: p.load_factor,
             max_bank: p.max_bank_deg.to_radians(),
+            airspeed: p.airspeed_range,
         }
     }
 
@@ -115,7 +118,10 @@ pub struct Target {
 /// reference's acceleration fed forward:
 /// a = a_ref + kp e + ki ∫e + kd ė, e = p_ref − p; the acceleration is split
 /// along the velocity (→ V̇ → T) and across it (→ γ̇, χ̇ → n, μ), then
-/// thrust, load factor and bank are saturated.
+/// thrust, load factor and bank are saturated. V̇ is held to the airspeed
+/// envelope first, as a fixed-wing autopilot's speed protection does
+/// (ArduPlane's TECS between AIRSPEED_MIN and AIRSPEED_MAX): an aircraft
+/// ahead of its reference slows to the envelope's floor, never below.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Autopilot {
     pub gains: [f64; 3],
@@ -124,6 +130,16 @@ pub struct Autopilot {
 
 /// The integral term never asks for more than this, m/s² (anti-windup).
 const MAX_INTEGRAL_ACCEL: f64 = 1.0;
+
+/// The airspeed envelope the autopilot keeps, as a share of each limit
+/// inside it: the noise (0.25 % of V a step) and the lag of the speed loop
+/// stay within this of the limit (the paper's case: 13.86 m/s at the
+/// lowest over seeds 0-19, against a floor of 14.11 and a limit of 13.7).
+const ENVELOPE_GUARD: f64 = 0.03;
+
+/// Seconds in which the autopilot brings an airspeed outside its envelope
+/// back to its edge.
+const ENVELOPE_TIME: f64 = 0.5;
 
 impl Autopilot {
     pub fn new(gains: [f64; 3]) -> Self {
@@ -159,7 +175,17 @@ impl Autopilot {
         let along = Vector3::new(cg * cc, cg * sc, sg);
         let up = Vector3::new(-sg * cc, -sg * sc, cg);
         let side = Vector3::new(-sc, cc, 0.0);
-        let v_dot = a.dot(&along);
+        // The envelope, kept a guard inside the range, but never narrower
+        // than the reference's own speed: a plan that flies near a limit is
+        // flown there (and judged there).
+        let [slowest, fastest] = airframe.airspeed;
+        let planned = target.velocity.norm();
+        let floor = (slowest * (1.0 + ENVELOPE_GUARD)).min(planned);
+        let ceiling = (fastest * (1.0 - ENVELOPE_GUARD)).max(planned);
+        let v_dot = a
+            .dot(&along)
+            .max((floor - x[V]) / ENVELOPE_TIME)
+            .min((ceiling - x[V]) / ENVELOPE_TIME);
         let gamma_dot = a.dot(&up) / v;
         let chi_dot = a.dot(&side) / (v * cg.max(1e-6));
 

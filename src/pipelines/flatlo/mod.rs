@@ -8,6 +8,7 @@
 
 pub mod aircraft;
 pub mod algorithm;
+pub mod envelope;
 pub mod maneuver;
 
 use nalgebra::{Point3, Vector3};
@@ -18,11 +19,12 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::base::ode::rk4_step;
-use crate::mission::{Diagnostic, FieldPath, FlatloParams, Mission};
+use crate::mission::{Diagnostic, FieldPath, FlatloParams, Mission, compact};
 use crate::pipelines::{CancelToken, Completion, Event, Level, Observer, PipelineError};
 
 use aircraft::{Airframe, Autopilot, Controls, State, Target};
 use algorithm::Side;
+use envelope::{Envelope, Violation};
 use maneuver::{Path, Primitive};
 
 /// Simulated seconds between progress reports and cancellation checks.
@@ -53,6 +55,18 @@ pub struct Reference {
 }
 
 impl Reference {
+    /// The time the reference reaches arc length `s` (the inverse of
+    /// [`Self::distance`]).
+    pub fn time_at(&self, s: f64) -> f64 {
+        if s <= self.transition_length && self.airspeed > 0.0 {
+            s / self.airspeed
+        } else if s <= self.transition_length {
+            0.0
+        } else {
+            self.arrival + (s - self.transition_length) / self.nominal.max(f64::MIN_POSITIVE)
+        }
+    }
+
     /// Arc length reached at time t.
     pub fn distance(&self, t: f64) -> f64 {
         if t <= self.arrival {
@@ -232,6 +246,20 @@ pub struct FlatloVerification {
     /// The same for the exact references at the end (the theorem of Section 4.2).
     pub reference_spacing: Vec<Spacing>,
     pub reference_lateral_spread: f64,
+    /// The lowest and highest airspeed any aircraft flew, at any step, m/s,
+    /// and the range it must stay in (`airspeed_range`).
+    pub airspeed_flown: [f64; 2],
+    pub airspeed_range: [f64; 2],
+    /// The largest |bank| any aircraft flew, and its limit, degrees.
+    pub bank_flown_deg: f64,
+    pub max_bank_deg: f64,
+    /// The least distance inside the x-y bounds and the altitude band of
+    /// any aircraft, flown (on the sample grid) or its reference, metres;
+    /// negative when one left them.
+    pub bounds_margin: f64,
+    /// The first limit broken (airspeed, bank, bounds; by the flight or by a
+    /// reference), the earliest; `None` when the squadron flew within all.
+    pub violation: Option<Violation>,
 }
 
 /// Everything a FLATLO run produces.
@@ -258,6 +286,13 @@ pub struct FlatloOutcome {
     pub verification: Option<FlatloVerification>,
 }
 
+impl FlatloVerification {
+    /// The closest pair kept `min_separation`.
+    pub fn separated(&self, closest: Option<PairDistance>) -> bool {
+        closest.is_none_or(|c| c.min_distance >= self.min_separation)
+    }
+}
+
 impl FlatloOutcome {
     /// The whole transition was flown and verified, and passed.
     pub fn passed(&self) -> bool {
@@ -282,6 +317,37 @@ struct Flight {
     flown: Vec<FlownSample>,
     error_max: f64,
     error_sq: f64,
+    /// What the flight is judged against, and what it flew so far.
+    index: usize,
+    envelope: Envelope,
+    judged: Judged,
+}
+
+/// What one aircraft flew against its envelope: the first limit broken and
+/// the extremes.
+#[derive(Debug, Clone, Copy)]
+struct Judged {
+    first: Option<Violation>,
+    airspeed: [f64; 2],
+    bank: f64,
+    margin: f64,
+}
+
+impl Judged {
+    fn new() -> Self {
+        Judged {
+            first: None,
+            airspeed: [f64::INFINITY, f64::NEG_INFINITY],
+            bank: 0.0,
+            margin: f64::INFINITY,
+        }
+    }
+
+    fn note(&mut self, v: Violation) {
+        if self.first.is_none() {
+            self.first = Some(v);
+        }
+    }
 }
 
 impl Flight {
@@ -291,6 +357,17 @@ impl Flight {
         let s = &self.state;
         let position = aircraft::position(s);
         self.fresh.push((t, position));
+        self.judged.margin = self.judged.margin.min(self.envelope.margin(&position));
+        if let Some((check, value, limit)) = self.envelope.outside(&position) {
+            self.judged.note(Violation {
+                aircraft: self.index,
+                check,
+                time: t,
+                value,
+                limit,
+                reference: false,
+            });
+        }
         if self.samples.is_multiple_of(keep) || is_last {
             self.flown.push(FlownSample {
                 t,
@@ -314,6 +391,7 @@ impl Flight {
             self.error_max = self.error_max.max(error);
             self.error_sq += error * error;
             let u = self.pilot.command(&self.airframe, &self.state, &target, dt);
+            self.judge_bank(t, &u);
             if self.step.is_multiple_of(every) {
                 self.record(t, u, keep, false);
             }
@@ -332,12 +410,50 @@ impl Flight {
                 self.state[aircraft::CHI] += self.noise * z3;
             }
             self.step += 1;
+            self.judge_airspeed(self.step as f64 * dt);
             if self.step == last {
                 let t = last as f64 * dt;
                 let target = self.reference.at(t, &mut self.hint);
                 let u = self.pilot.command(&self.airframe, &self.state, &target, dt);
                 self.record(t, u, keep, true);
             }
+        }
+    }
+}
+
+impl Flight {
+    /// The bank commanded at `t` against `max_bank_deg`.
+    fn judge_bank(&mut self, t: f64, u: &Controls) {
+        let bank = u.bank.abs();
+        self.judged.bank = self.judged.bank.max(bank);
+        if bank > self.envelope.max_bank * (1.0 + 1e-12) {
+            self.judged.note(Violation {
+                aircraft: self.index,
+                check: envelope::Check::Bank,
+                time: t,
+                value: bank.to_degrees(),
+                limit: self.envelope.max_bank.to_degrees(),
+                reference: false,
+            });
+        }
+    }
+
+    /// The airspeed reached at `t` (after the step and its noise) against
+    /// `airspeed_range`.
+    fn judge_airspeed(&mut self, t: f64) {
+        let v = self.state[aircraft::V];
+        let [lo, hi] = &mut self.judged.airspeed;
+        *lo = lo.min(v);
+        *hi = hi.max(v);
+        if let Some((check, limit)) = self.envelope.airspeed_outside(v) {
+            self.judged.note(Violation {
+                aircraft: self.index,
+                check,
+                time: t,
+                value: v,
+                limit,
+                reference: false,
+            });
         }
     }
 }
@@ -413,6 +529,16 @@ pub fn plan(
 ) -> Result<FlatloOutcome, PipelineError> {
     crate::pipelines::require_valid(mission)?;
     crate::pipelines::require_within_budget(budget(mission))?;
+    // What `check` predicts from the references: an unflyable airspeed, or a
+    // squadron that leaves the bounds it starts in, is refused before flying.
+    let unflyable: Vec<String> = diagnostics(mission)
+        .into_iter()
+        .filter(Diagnostic::is_error)
+        .map(|d| d.to_string())
+        .collect();
+    if !unflyable.is_empty() {
+        return Err(PipelineError::InvalidMission(unflyable.join("\n")));
+    }
     let p = &mission.flatlo;
     let n = p.aircraft;
 
@@ -435,6 +561,7 @@ pub fn plan(
     let last = (plan.duration / dt).ceil() as usize;
     let keep = (last / every + 1).div_ceil(KEPT_SAMPLES).max(1);
     let airframe = Airframe::from_params(p);
+    let envelope = Envelope::of(mission);
     let mut flights: Vec<Flight> = plan
         .references
         .iter()
@@ -460,6 +587,9 @@ pub fn plan(
                 flown: Vec::with_capacity((last / every) / keep + 2),
                 error_max: 0.0,
                 error_sq: 0.0,
+                index: i,
+                envelope: envelope.clone(),
+                judged: Judged::new(),
             }
         })
         .collect();
@@ -489,6 +619,7 @@ pub fn plan(
 
     observer.on_event(Event::Stage("verification"));
     let reference_period = p.sample_period * keep as f64;
+    let judged: Vec<Judged> = flights.iter().map(|f| f.judged).collect();
     let aircraft: Vec<AircraftOutcome> = flights
         .into_iter()
         .enumerate()
@@ -511,9 +642,10 @@ pub fn plan(
         })
         .collect();
     let closest = separation.closest;
-    let verification =
-        (completion == Completion::Finished).then(|| verify(p, &plan, &aircraft, closest));
+    let verification = (completion == Completion::Finished)
+        .then(|| verify(p, &plan, &aircraft, closest, &envelope, &judged));
     if let (Some(c), Some(v)) = (closest, &verification) {
+        let separated = v.separated(Some(c));
         let text = format!(
             "closest approach: aircraft {} and {} at {:.0} m (t = {:.0} s); minimum separation {:.0} m: {}",
             c.a + 1,
@@ -521,10 +653,16 @@ pub fn plan(
             c.min_distance,
             c.time,
             p.min_separation,
-            if v.passed { "pass" } else { "FAIL" }
+            if separated { "pass" } else { "FAIL" }
         );
-        let level = if v.passed { Level::Info } else { Level::Warn };
+        let level = if separated { Level::Info } else { Level::Warn };
         observer.on_event(Event::Log(level, &text));
+    }
+    if let Some(v) = verification.as_ref().and_then(|v| v.violation) {
+        observer.on_event(Event::Log(
+            Level::Warn,
+            &format!("not flyable: {}", v.describe()),
+        ));
     }
     // A cancelled run stays at the share it got through.
     if completion == Completion::Finished {
@@ -660,13 +798,44 @@ pub fn line_spacing(points: &[Point3<f64>], line: &Vector3<f64>) -> (Vec<Spacing
     (spacing, if points.is_empty() { 0.0 } else { spread })
 }
 
+/// The squadron's verdict: separation, the final line, and the envelope
+/// (what each flight `judged` and each reference against the bounds).
 fn verify(
     p: &FlatloParams,
     plan: &Plan,
     aircraft: &[AircraftOutcome],
     closest: Option<PairDistance>,
+    envelope: &Envelope,
+    judged: &[Judged],
 ) -> FlatloVerification {
-    let passed = closest.is_none_or(|c| c.min_distance >= p.min_separation);
+    let spacing = p.sample_period * p.airspeed;
+    let exits: Vec<envelope::ReferenceExit> = plan
+        .references
+        .iter()
+        .enumerate()
+        .map(|(i, r)| envelope.reference_exit(i, r, spacing))
+        .collect();
+    let violation = judged
+        .iter()
+        .filter_map(|j| j.first)
+        .chain(exits.iter().filter_map(|e| e.first))
+        .min_by(|a, b| a.time.total_cmp(&b.time));
+    let bounds_margin = judged
+        .iter()
+        .map(|j| j.margin)
+        .chain(exits.iter().map(|e| e.margin))
+        .fold(f64::INFINITY, f64::min);
+    let airspeed_flown = judged
+        .iter()
+        .fold([f64::INFINITY, f64::NEG_INFINITY], |a, j| {
+            [a[0].min(j.airspeed[0]), a[1].max(j.airspeed[1])]
+        });
+    let bank_flown_deg = judged
+        .iter()
+        .map(|j| j.bank)
+        .fold(0.0, f64::max)
+        .to_degrees();
+    let passed = closest.is_none_or(|c| c.min_distance >= p.min_separation) && violation.is_none();
     let line = algorithm::line_direction(p.heading_deg.to_radians(), p.climb_deg.to_radians());
     let flown_end: Vec<Point3<f64>> = aircraft
         .iter()
@@ -691,5 +860,131 @@ fn verify(
         lateral_spread,
         reference_spacing,
         reference_lateral_spread,
+        airspeed_flown,
+        airspeed_range: p.airspeed_range,
+        bank_flown_deg,
+        max_bank_deg: p.max_bank_deg,
+        bounds_margin,
+        violation,
     }
+}
+
+/// What FLATLO predicts of a mission from its references alone (cheap: no
+/// flight), as the budget is: each aircraft's common-arrival airspeed (its
+/// transition length over the common duration) within `airspeed_range`,
+/// the bank its turns need at that airspeed within `max_bank_deg`; and, for a squadron that starts inside the bounds (a mission for FLATLO:
+/// a mission for another pipeline keeps the paper's squadron as its
+/// `[flatlo]` defaults, far outside a bridge's bounds, and `run flatlo`
+/// judges it there), every reference inside the x-y bounds and the
+/// altitude band, as the export judges them. Errors name the aircraft and
+/// the figure.
+pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
+    let p = &mission.flatlo;
+    if p.aircraft > crate::pipelines::limits::FLATLO_AIRCRAFT || p.aircraft < 2 {
+        return Vec::new(); // the budget and validation say why
+    }
+    let at = |key: &str| FieldPath::root().key("flatlo").key(key);
+    let plan = references(p);
+    let mut out = Vec::new();
+    let [lo, hi] = p.airspeed_range;
+    for (end, limit, word) in [(0, lo, "below"), (1, hi, "above")] {
+        let off: Vec<(usize, &Reference)> = plan
+            .references
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| {
+                if end == 0 {
+                    r.airspeed < lo
+                } else {
+                    r.airspeed > hi
+                }
+            })
+            .collect();
+        let Some(&(i, r)) = off.first() else {
+            continue;
+        };
+        let others = match off.len() - 1 {
+            0 => String::new(),
+            1 => format!(" (and aircraft {})", off[1].0 + 1),
+            more => format!(" (and {more} more aircraft)"),
+        };
+        out.push(Diagnostic::error(
+            at("airspeed_range").index(end),
+            format!(
+                "aircraft {} would fly its transition at {:.2} m/s ({:.0} m in the common \
+                 {:.0} s that brings the squadron onto the line together), {word} \
+                 airspeed_range[{end}] = {} m/s{others}",
+                i + 1,
+                r.airspeed,
+                r.transition_length,
+                plan.arrival,
+                compact(limit)
+            ),
+        ));
+    }
+    // The bank each aircraft's turns need at its transition airspeed
+    // (coordinated: tan μ = a_horizontal / g, a = v²/r along the turn's normal).
+    let needed = plan
+        .references
+        .iter()
+        .enumerate()
+        .flat_map(|(i, r)| {
+            r.path.primitives.iter().filter_map(move |m| match *m {
+                maneuver::Primitive::Turn { normal, radius, .. } if radius > 0.0 => {
+                    let lateral = r.airspeed.powi(2) / radius * normal.xy().norm();
+                    Some((i, (lateral / aircraft::G).atan().to_degrees()))
+                }
+                _ => None,
+            })
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    if let Some((i, bank)) = needed.filter(|(_, bank)| *bank > p.max_bank_deg) {
+        out.push(Diagnostic::error(
+            at("max_bank_deg"),
+            format!(
+                "aircraft {}'s turns of {} m radius at {:.2} m/s need a bank of {bank:.1}°, \
+                 beyond max_bank_deg = {}°",
+                i + 1,
+                compact(p.turn_radius),
+                plan.references[i].airspeed,
+                compact(p.max_bank_deg)
+            ),
+        ));
+    }
+    let envelope = Envelope::of(mission);
+    let start = plan.starts.first().copied().unwrap_or_default();
+    if envelope.outside(&start).is_none() {
+        let exits: Vec<envelope::ReferenceExit> = plan
+            .references
+            .iter()
+            .enumerate()
+            .map(|(i, r)| envelope.reference_exit(i, r, p.sample_period * p.airspeed))
+            .filter(|e| e.first.is_some())
+            .collect();
+        let first = exits
+            .iter()
+            .filter_map(|e| e.first)
+            .min_by(|a, b| a.time.total_cmp(&b.time));
+        let worst = exits
+            .iter()
+            .filter_map(|e| e.worst)
+            .max_by(|a, b| a.excess().total_cmp(&b.excess()));
+        if let (Some(first), Some(worst)) = (first, worst) {
+            let furthest = if worst == first {
+                String::new()
+            } else {
+                format!("; furthest, {}", worst.describe())
+            };
+            out.push(Diagnostic::error(
+                at("aircraft"),
+                format!(
+                    "{} of the {} aircraft leave the bounds the export judges: first, {}{furthest}",
+                    exits.len(),
+                    p.aircraft,
+                    first.describe()
+                ),
+            ));
+        }
+    }
+    out
 }

@@ -50,6 +50,12 @@ impl Planner {
         }
     }
 
+    /// Cost evaluations of one decision: the swarm's particles, evaluated
+    /// at the start and after every iteration (it never stops early).
+    pub fn evaluations_per_decision(p: &FleetParams) -> usize {
+        p.swarm_size * (p.iterations + 1)
+    }
+
     /// The step h that minimises Λ_i now. `round` numbers the fleet's
     /// decision rounds, so every (agent, round) has its own random stream.
     pub fn decide(&mut self, view: &Observation, round: u64) -> Vector2<f64> {
@@ -98,6 +104,7 @@ mod tests {
         assert!((h.x - 0.4).abs() < 1e-3 && h.y.abs() < 0.05, "{h}");
         assert_eq!(planner.decisions, 1);
         assert_eq!(planner.evaluations, p.swarm_size * (p.iterations + 1));
+        assert_eq!(planner.evaluations, Planner::evaluations_per_decision(&p));
     }
 
     #[test]

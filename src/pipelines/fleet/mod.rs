@@ -60,8 +60,47 @@ pub struct TargetOutcome {
     pub time: f64,
     pub position: Point2<f64>,
     /// Seconds after the target appeared when every distance (to the target
-    /// and between agents) entered its tolerance for good; None if never.
+    /// and between every two agents, lost ones where they were last heard)
+    /// entered its tolerance for good; None if never.
     pub converged_after: Option<f64>,
+    /// How far the formation was at the last sample while this target was in
+    /// force; None when no sample fell in its time.
+    pub end: Option<FormationError>,
+}
+
+/// How far a fleet stands from its desired formation at one instant.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FormationError {
+    pub time: f64,
+    /// The inter-agent distance furthest from its d_ij^d (None: one agent).
+    pub pair: Option<Deviation>,
+    /// The agent whose distance to the target is furthest from d_ip^d.
+    pub to_target: Option<Deviation>,
+    /// Distance from the agents' centroid to the target, metres.
+    pub centre_offset: f64,
+}
+
+/// One distance of the formation against its desired value.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Deviation {
+    /// 0-based agents; `b` is None for the distance from `a` to the target.
+    pub a: usize,
+    pub b: Option<usize>,
+    pub distance: f64,
+    pub desired: f64,
+    /// The ± metres `fleet.tolerance` allows it.
+    pub tolerance: f64,
+}
+
+impl Deviation {
+    /// How many tolerances off it is (within tolerance: at most 1).
+    pub fn tolerances(&self) -> f64 {
+        (self.distance - self.desired).abs() / self.tolerance.max(f64::MIN_POSITIVE)
+    }
+
+    pub fn within(&self) -> bool {
+        (self.distance - self.desired).abs() <= self.tolerance
+    }
 }
 
 /// A closest approach of agent `a` (0-based) to another agent or an obstacle.

@@ -21,8 +21,8 @@ use super::cost::{Detected, Neighbour, Observation};
 use super::network::{Message, Network};
 use super::quadrotor::{self, Body, State};
 use super::{
-    AgentOutcome, AgentSample, Closest, DistanceSeries, FleetOutcome, MAX_SERIES_AGENTS, Other,
-    SAMPLE_RATE, Scenario, TargetOutcome, neighbourhoods, scenario,
+    AgentOutcome, AgentSample, Closest, Deviation, DistanceSeries, FleetOutcome, FormationError,
+    MAX_SERIES_AGENTS, Other, SAMPLE_RATE, Scenario, TargetOutcome, neighbourhoods, scenario,
 };
 use crate::base::ode::rk4_step;
 use crate::mission::{FleetParams, FleetPush, Mission};
@@ -59,24 +59,46 @@ pub struct LinkError {
 /// The whole fleet in one process: every message is local.
 pub struct Loopback {
     agents: usize,
+    /// Agents lost at a step, with why: a process that dies, in process.
+    losses: Vec<(usize, usize, String)>,
 }
 
 impl Loopback {
     pub fn new(agents: usize) -> Self {
-        Loopback { agents }
+        Loopback {
+            agents,
+            losses: Vec::new(),
+        }
+    }
+
+    /// The same link, losing agent `agent` (0-based) at step `step` as a
+    /// transport does when the agent's process dies: from that step it is
+    /// neither heard nor flown, and the others are told why.
+    pub fn losing(mut self, agent: usize, step: usize, reason: impl Into<String>) -> Self {
+        self.losses.push((agent, step, reason.into()));
+        self
     }
 }
 
 impl Link for Loopback {
-    fn exchange(&mut self, _step: usize, local: &[Message]) -> Result<Delivery, LinkError> {
+    fn exchange(&mut self, step: usize, local: &[Message]) -> Result<Delivery, LinkError> {
         let mut messages = vec![None; self.agents];
         for m in local {
-            messages[m.sender] = Some(*m);
+            let gone = self
+                .losses
+                .iter()
+                .any(|(agent, at, _)| *agent == m.sender && *at <= step);
+            if !gone && let Some(slot) = messages.get_mut(m.sender) {
+                *slot = Some(*m);
+            }
         }
-        Ok(Delivery {
-            messages,
-            lost: Vec::new(),
-        })
+        let lost = self
+            .losses
+            .iter()
+            .filter(|(_, at, _)| *at == step)
+            .map(|(agent, _, reason)| (*agent, reason.clone()))
+            .collect();
+        Ok(Delivery { messages, lost })
     }
 }
 
@@ -141,6 +163,8 @@ pub struct Snapshot {
     positions: Vec<Point2<f64>>,
     /// A scheduled round (every τ): everyone decides, neighbour lists rebuilt.
     scheduled: bool,
+    /// Where each lost agent may be now ([`Simulation::lost_region`]).
+    lost: Vec<(usize, Detected)>,
 }
 
 /// What the run has recorded so far, on the sample grid.
@@ -153,6 +177,8 @@ struct Log {
     /// Per target: the last sampled time the formation was outside tolerance.
     outside: Vec<Option<f64>>,
     inside_at_end: Vec<bool>,
+    /// Per target: how far the formation was at its last sample.
+    ends: Vec<Option<FormationError>>,
     /// Per sample, the pairs (i < j) where each heard the other within l at
     /// that step (fleets up to `MAX_SERIES_AGENTS`): the links of the recording.
     links: Vec<Vec<(usize, usize)>>,
@@ -189,9 +215,13 @@ pub struct Simulation<'m> {
     round: u64,
     /// Each agent's last message (its state at the step being run).
     current: Vec<Message>,
-    /// Agents whose process went away: no longer flown, heard or recorded.
+    /// Agents whose process went away: no longer flown or heard; the
+    /// others keep clear of where they were last heard.
     alive: Vec<bool>,
     lost: Vec<LostAgent>,
+    /// Decisions of every agent, here or elsewhere, as the replicated rounds
+    /// tell them: an agent's effort when its own report never comes.
+    decided: Vec<usize>,
     /// Each agent's neighbours within `watch_radius`, rebuilt every round.
     near: Vec<Vec<usize>>,
     watch_radius: f64,
@@ -281,6 +311,7 @@ impl<'m> Simulation<'m> {
             closest_obstacle: None,
             outside: vec![None; sc.targets.len()],
             inside_at_end: vec![false; sc.targets.len()],
+            ends: vec![None; sc.targets.len()],
             links: Vec::new(),
         };
         let mut pushes: Vec<&FleetPush> = p.pushes.iter().collect();
@@ -301,6 +332,7 @@ impl<'m> Simulation<'m> {
             current,
             alive: vec![true; n],
             lost: Vec::new(),
+            decided: vec![0; n],
             near: vec![Vec::new(); n],
             // Each reference is at most √2·h_max from its agent, so two agents
             // close in on each other by well under 2·√2·h_max + 1 m in one τ.
@@ -343,6 +375,9 @@ impl<'m> Simulation<'m> {
             // Before the first target appears the agents hold their starts.
             let started = now.t >= self.scenario.targets[0].0;
             if started && due.iter().any(|&d| d) {
+                for (count, _) in self.decided.iter_mut().zip(&due).filter(|(_, d)| **d) {
+                    *count += 1;
+                }
                 let observations = self.observe(&now, &due);
                 self.count_ages(&now, &due);
                 self.decide(&now, &observations);
@@ -435,6 +470,11 @@ impl<'m> Simulation<'m> {
                 }
             }
         }
+        let lost = self
+            .lost
+            .iter()
+            .map(|l| (l.agent, self.lost_region(l.agent, k)))
+            .collect();
         Snapshot {
             step: k,
             t,
@@ -442,12 +482,38 @@ impl<'m> Simulation<'m> {
             target: targets[active].1,
             positions,
             scheduled,
+            lost,
+        }
+    }
+
+    /// Where lost agent `j` may be at step `k`, as every agent treats it (an
+    /// obstacle of eq. 9; docs/fleet.md, "A lost agent"): a disc about its
+    /// last known position x_j, the last state the transport delivered. Its
+    /// planner is gone, not its position law (eq. 11), which flies it on to
+    /// its last reference Y_j and holds it there; so the disc grows with the
+    /// news's age at its last speed ‖v_j‖, up to ‖Y_j − x_j‖ plus its
+    /// stopping distance at the tilt limit, ‖v_j‖² / (2 g tan θ_max).
+    pub fn lost_region(&self, j: usize, k: usize) -> Detected {
+        let m = &self.current[j];
+        let speed = m.velocity.norm();
+        let age = k.saturating_sub(m.step) as f64 * self.clock.dt;
+        let braking = quadrotor::G * self.p.max_tilt_deg.to_radians().tan();
+        let stop = if braking > 0.0 {
+            speed * speed / (2.0 * braking)
+        } else {
+            f64::INFINITY
+        };
+        let reach = (m.reference - m.position).norm() + stop;
+        Detected {
+            center: m.position,
+            radius: (speed * age).min(reach),
         }
     }
 
     /// Records (and checks) the snapshot: samples, closest approaches, the
     /// distance series, whether the formation stands.
     fn record(&mut self, now: &Snapshot) {
+        let ends = self.last_sample_of_target(now);
         let (p, log, positions, t) = (self.p, &mut self.log, &now.positions, now.t);
         log.times.push(t);
         for (i, m) in self.current.iter().enumerate() {
@@ -459,12 +525,14 @@ impl<'m> Simulation<'m> {
                 position: Point3::new(m.position.x, m.position.y, m.height),
                 reference: Point3::new(m.reference.x, m.reference.y, p.altitude),
             });
-            for &j in self.near[i].iter().filter(|&&j| j > i) {
+            // Every pair counts: a lost agent where it was last heard.
+            let lost = now.lost.iter().map(|(j, _)| *j);
+            for j in self.near[i].iter().copied().filter(|&j| j > i).chain(lost) {
                 let d = (positions[j] - positions[i]).norm();
                 if log.closest_agents.as_ref().is_none_or(|c| d < c.distance) {
                     log.closest_agents = Some(Closest {
-                        a: i,
-                        b: Other::Agent(j),
+                        a: i.min(j),
+                        b: Other::Agent(i.max(j)),
                         distance: d,
                         time: t,
                     });
@@ -506,24 +574,44 @@ impl<'m> Simulation<'m> {
                     .collect(),
             );
         }
-        let within =
-            |d: f64, want: f64| (d - want).abs() <= p.tolerance * want.max(p.safety_distance);
+        // Eq. 4: every distance, to the target and between every two agents
+        // (a lost one where it was last heard), within its tolerance.
+        let tolerance = |want: f64| p.tolerance * want.max(p.safety_distance);
+        let within = |d: f64, want: f64| (d - want).abs() <= tolerance(want);
         let desired = &self.scenario.desired;
-        let alive = &self.alive;
+        let n = positions.len();
         let formed = positions
             .iter()
-            .enumerate()
-            .filter(|(i, _)| alive[*i])
-            .all(|(_, q)| within((q - now.target).norm(), p.target_distance))
-            && (0..positions.len()).filter(|&i| alive[i]).all(|i| {
-                self.near[i]
-                    .iter()
-                    .all(|&j| within((positions[j] - positions[i]).norm(), desired[i][j]))
+            .all(|q| within((q - now.target).norm(), p.target_distance))
+            && (0..n).all(|i| {
+                (i + 1..n).all(|j| within((positions[j] - positions[i]).norm(), desired[i][j]))
             });
         log.inside_at_end[now.active] = formed;
         if !formed {
             log.outside[now.active] = Some(t);
         }
+        if ends {
+            log.ends[now.active] = Some(formation_error(
+                positions,
+                now.target,
+                p.target_distance,
+                desired,
+                &tolerance,
+                t,
+            ));
+        }
+    }
+
+    /// Whether `now` is the last sample recorded while its target is in force.
+    fn last_sample_of_target(&self, now: &Snapshot) -> bool {
+        let next = now.step + self.clock.record_every;
+        let t = next as f64 * self.clock.dt;
+        next > self.clock.steps
+            || self
+                .scenario
+                .targets
+                .get(now.active + 1)
+                .is_some_and(|(time, _)| *time <= t)
     }
 
     /// Disturbances (4.2): an impulse due by `t` changes the velocity at once
@@ -574,11 +662,16 @@ impl<'m> Simulation<'m> {
                     }
                     None => now.scheduled,
                 };
+                let c = self.p.safety_distance;
                 self.alive[i]
                     && (scheduled
                         || self
                             .heard_neighbours(i)
-                            .any(|m| (m.position - positions[i]).norm() < self.p.safety_distance))
+                            .any(|m| (m.position - positions[i]).norm() < c)
+                        || now
+                            .lost
+                            .iter()
+                            .any(|(_, r)| (r.center - positions[i]).norm() - r.radius < c))
             })
             .collect()
     }
@@ -635,9 +728,12 @@ impl<'m> Simulation<'m> {
                     desired: self.scenario.desired[i][m.sender],
                 })
                 .collect(),
+            // The obstacles within d_obs, and each lost agent's region as one
+            // (eq. 9: it is no longer a neighbour that steers itself).
             obstacles: self
                 .obstacles
                 .iter()
+                .chain(now.lost.iter().map(|(_, r)| r))
                 .filter(|o| (o.center - me).norm() - o.radius <= p.detection_range)
                 .copied()
                 .collect(),
@@ -709,11 +805,13 @@ impl<'m> Simulation<'m> {
         remote: &[Effort],
         observer: &mut dyn Observer,
     ) -> FleetOutcome {
+        // What the rounds say each agent did, until its own count replaces it.
+        let per_decision = Planner::evaluations_per_decision(self.p);
         let mut effort: Vec<Effort> = (0..self.p.agents)
             .map(|i| Effort {
                 agent: i,
-                decisions: 0,
-                evaluations: 0,
+                decisions: self.decided[i],
+                evaluations: self.decided[i] * per_decision,
                 network: self.network.stats()[i],
             })
             .collect();
@@ -747,6 +845,7 @@ impl<'m> Simulation<'m> {
                     time,
                     position,
                     converged_after,
+                    end: log.ends[k].clone(),
                 }
             })
             .collect();
@@ -798,5 +897,84 @@ impl<'m> Simulation<'m> {
             lost,
             distributed: None,
         }
+    }
+}
+
+/// How far the fleet at `positions` is from its formation around `target`
+/// at `t`: the pair distance and the distance to the target furthest from
+/// their desired values (in tolerances), and the centre's offset.
+fn formation_error(
+    positions: &[Point2<f64>],
+    target: Point2<f64>,
+    target_distance: f64,
+    desired: &[Vec<f64>],
+    tolerance: &dyn Fn(f64) -> f64,
+    t: f64,
+) -> FormationError {
+    let deviation = |a: usize, b: Option<usize>, distance: f64, want: f64| Deviation {
+        a,
+        b,
+        distance,
+        desired: want,
+        tolerance: tolerance(want),
+    };
+    let worse = |best: Option<Deviation>, d: Deviation| match best {
+        Some(b) if b.tolerances() >= d.tolerances() => Some(b),
+        _ => Some(d),
+    };
+    let n = positions.len();
+    let mut pair = None;
+    for i in 0..n {
+        for j in i + 1..n {
+            let d = (positions[j] - positions[i]).norm();
+            pair = worse(pair, deviation(i, Some(j), d, desired[i][j]));
+        }
+    }
+    let mut to_target = None;
+    for (i, q) in positions.iter().enumerate() {
+        let d = (q - target).norm();
+        to_target = worse(to_target, deviation(i, None, d, target_distance));
+    }
+    let centre = positions
+        .iter()
+        .fold(nalgebra::Vector2::zeros(), |s, q| s + q.coords)
+        / n.max(1) as f64;
+    FormationError {
+        time: t,
+        pair,
+        to_target,
+        centre_offset: (Point2::from(centre) - target).norm(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipelines::Silent;
+
+    /// The rounds' count of every agent's decisions (what a coordinator
+    /// reports for an agent whose own report never comes) is the agents'
+    /// own count: near a neighbour, on its own clock, or lost midway.
+    #[test]
+    fn the_rounds_count_each_agents_decisions_as_it_makes_them() {
+        let mut m = crate::mission::default_mission().mission;
+        m.fleet.duration = 8.0;
+        m.fleet.network.updates = vec![crate::mission::FleetUpdate {
+            agent: 2,
+            period: 30,
+            phase: 7,
+        }];
+        let mut simulation = Simulation::new(&m, 4);
+        let mut link = Loopback::new(3).losing(2, 900, "gone");
+        let flown = simulation.run(&mut link, &mut Silent, &CancelToken::new());
+        assert_eq!(flown, Ok(Completion::Finished));
+        let own: Vec<usize> = simulation
+            .flights
+            .iter()
+            .map(|f| f.planner.decisions)
+            .collect();
+        assert_eq!(simulation.decided, own);
+        assert!(own[2] > 0 && own[2] < own[0], "{own:?}");
+        assert_ne!(own[1], own[0], "agent 2 on a clock of its own");
     }
 }

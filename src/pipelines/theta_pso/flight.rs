@@ -105,7 +105,11 @@ fn slack_near(
     let motion = super::motion::Motion::new(path, &f.slots, span);
     let column = f.slots.len() as f64 * super::iwp::column_spacing(f) / 2.0;
     let reach = f.radius() + span + column + MAX_TOLERANCE;
-    let cylinders: Vec<_> = mission.obstacles.iter().map(|o| mission.cylinder(o)).collect();
+    let cylinders: Vec<_> = mission
+        .obstacles
+        .iter()
+        .map(|o| mission.cylinder(o))
+        .collect();
     let ground = mission.ground_model();
     let b = &mission.bounds;
     let mut here = Vec::new();
@@ -113,11 +117,18 @@ fn slack_near(
     planned
         .iter()
         .map(|c| {
-            let (from, to) = ((c.arc - reach).max(0.0), (c.arc + reach).min(motion.length()));
+            let (from, to) = (
+                (c.arc - reach).max(0.0),
+                (c.arc + reach).min(motion.length()),
+            );
             let steps = ((to - from) / 0.25).ceil().max(1.0) as usize;
             let mut slack = f64::INFINITY;
             for k in 0..=steps {
-                motion.read_into(from + (to - from) * k as f64 / steps as f64, &mut here, &mut reader);
+                motion.read_into(
+                    from + (to - from) * k as f64 / steps as f64,
+                    &mut here,
+                    &mut reader,
+                );
                 for (n, p) in here.iter().enumerate() {
                     for cylinder in &cylinders {
                         // Only what can be near: the bound on the slack.

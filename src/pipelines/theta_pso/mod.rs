@@ -16,9 +16,9 @@ pub mod repair;
 pub mod route;
 pub mod seeding;
 pub mod spso;
+pub mod timing;
 pub mod trajectory;
 pub mod unusable;
-pub mod timing;
 pub mod verify;
 
 use std::f64::consts::FRAC_PI_2;
@@ -159,7 +159,11 @@ impl ThetaPsoOutcome {
     /// Where the centroid is along `flown_path` at `t` seconds, metres
     /// (between samples, as the samples' straight line has it).
     pub fn arc_at(&self, t: f64) -> f64 {
-        let times = self.trajectories.first().map(|tr| &tr.samples[..]).unwrap_or(&[]);
+        let times = self
+            .trajectories
+            .first()
+            .map(|tr| &tr.samples[..])
+            .unwrap_or(&[]);
         let k = times.partition_point(|s| s.t <= t);
         match (k.checked_sub(1), times.get(k)) {
             (Some(a), Some(b)) if b.t > times[a].t => {

@@ -404,7 +404,11 @@ fn speed_cap(shapes: &[Shape], limits: &[VehicleLimits], cruise: f64) -> f64 {
         if horizontal > 1e-12 {
             x = x.min(limit.speed * limit.speed / horizontal);
         }
-        let vertical = if d1.z > 0.0 { limit.climb } else { limit.descent };
+        let vertical = if d1.z > 0.0 {
+            limit.climb
+        } else {
+            limit.descent
+        };
         if d1.z.abs() > 1e-9 {
             x = x.min(vertical * vertical / (d1.z * d1.z));
         }
@@ -503,7 +507,11 @@ mod tests {
         let law = TimeLaw::plan(&arcs, &p, &[limits()], 3.0, &[]);
         let a = limits().acceleration;
         let expected = 60.0 / 3.0 + 3.0 / a;
-        assert!((law.duration() - expected).abs() < 0.05, "{} vs {expected}", law.duration());
+        assert!(
+            (law.duration() - expected).abs() < 0.05,
+            "{} vs {expected}",
+            law.duration()
+        );
         assert!((law.top_speed() - 3.0).abs() < 1e-9);
         assert_eq!(law.at(0.0).speed, 0.0);
         assert_eq!(law.at(law.duration()).speed, 0.0);
@@ -524,13 +532,20 @@ mod tests {
         let p: Vec<Vec<Point3<f64>>> = (0..=n)
             .map(|i| {
                 let a = i as f64 * step / radius;
-                vec![Point3::new(radius * a.sin(), radius * (1.0 - a.cos()), 10.0)]
+                vec![Point3::new(
+                    radius * a.sin(),
+                    radius * (1.0 - a.cos()),
+                    10.0,
+                )]
             })
             .collect();
         let law = TimeLaw::plan(&even(n, step), &p, &[limits()], 12.0, &[]);
         let allowed = (limits().acceleration * radius).sqrt();
         let middle = law.at(law.duration() / 2.0).speed;
-        assert!((middle - allowed).abs() < 0.02 * allowed, "{middle} vs {allowed}");
+        assert!(
+            (middle - allowed).abs() < 0.02 * allowed,
+            "{middle} vs {allowed}"
+        );
         assert!(law.top_speed() <= allowed * 1.001);
     }
 

@@ -209,12 +209,16 @@ fn stops(rounded: &Rounded, motion: &Motion) -> Vec<f64> {
     let mut out = kinks.clone();
     for zone in &rounded.path.zones {
         let [a1, _, _, a4] = zone.arcs();
-        let spacings = [zone.shape, zone.from.unwrap_or(zone.shape), zone.into.unwrap_or(zone.shape)]
-            .into_iter()
-            .filter_map(|shape| match shape {
-                super::iwp::Shape::Alignment { spacing } => Some(spacing),
-                _ => None,
-            });
+        let spacings = [
+            zone.shape,
+            zone.from.unwrap_or(zone.shape),
+            zone.into.unwrap_or(zone.shape),
+        ]
+        .into_iter()
+        .filter_map(|shape| match shape {
+            super::iwp::Shape::Alignment { spacing } => Some(spacing),
+            _ => None,
+        });
         for spacing in spacings {
             for n in 0..motion.uavs() {
                 let place = motion.column_place(n, spacing);

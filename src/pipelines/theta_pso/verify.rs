@@ -371,7 +371,11 @@ impl Dynamics {
                 if speed.observe(horizontal, limit.speed, here) {
                     note(&speed, horizontal);
                 }
-                let rate = if v.z >= 0.0 { limit.climb } else { limit.descent };
+                let rate = if v.z >= 0.0 {
+                    limit.climb
+                } else {
+                    limit.descent
+                };
                 if vertical.observe(v.z.abs(), rate, here) {
                     note(&vertical, v.z.abs());
                 }

@@ -190,6 +190,8 @@ static SQUADRON: Table = Table { base: &[Key("flatlo")], derived: &[], fields: &
     Spec { name: "load factor min", unit: "", keys: &["load_factor"], get: |m, _| num(m.flatlo.load_factor[0]), set: |m, _, t| put(&mut m.flatlo.load_factor[0], number(t)) },
     Spec { name: "load factor max", unit: "", keys: &["load_factor"], get: |m, _| num(m.flatlo.load_factor[1]), set: |m, _, t| put(&mut m.flatlo.load_factor[1], number(t)) },
     Spec { name: "max bank", unit: "°", keys: &["max_bank_deg"], get: |m, _| num(m.flatlo.max_bank_deg), set: |m, _, t| put(&mut m.flatlo.max_bank_deg, number(t)) },
+    Spec { name: "airspeed min", unit: "m/s", keys: &["airspeed_range"], get: |m, _| num(m.flatlo.airspeed_range[0]), set: |m, _, t| put(&mut m.flatlo.airspeed_range[0], number(t)) },
+    Spec { name: "airspeed max", unit: "m/s", keys: &["airspeed_range"], get: |m, _| num(m.flatlo.airspeed_range[1]), set: |m, _, t| put(&mut m.flatlo.airspeed_range[1], number(t)) },
     Spec { name: "PID kp", unit: "", keys: &["pid"], get: |m, _| num(m.flatlo.pid[0]), set: |m, _, t| put(&mut m.flatlo.pid[0], number(t)) },
     Spec { name: "PID ki", unit: "", keys: &["pid"], get: |m, _| num(m.flatlo.pid[1]), set: |m, _, t| put(&mut m.flatlo.pid[1], number(t)) },
     Spec { name: "PID kd", unit: "", keys: &["pid"], get: |m, _| num(m.flatlo.pid[2]), set: |m, _, t| put(&mut m.flatlo.pid[2], number(t)) },

@@ -413,7 +413,18 @@ fn fleet_table(o: &crate::pipelines::fleet::FleetOutcome, stale: bool) -> Vec<Li
                 k + 1,
                 t.time
             ),
-            None => format!("target {} (t {:.0} s): NOT formed", k + 1, t.time),
+            None => format!(
+                "target {} (t {:.0} s): NOT formed{}",
+                k + 1,
+                t.time,
+                t.end
+                    .as_ref()
+                    .and_then(|e| e.pair.filter(|d| !d.within()).or(e.to_target))
+                    .map_or_else(String::new, |d| format!(
+                        ": {}",
+                        crate::outcome::summary::deviation(&d)
+                    ))
+            ),
         };
         let style = if t.converged_after.is_some() {
             Style::default()
@@ -488,6 +499,9 @@ fn fleet_table(o: &crate::pipelines::fleet::FleetOutcome, stale: bool) -> Vec<Li
 fn flatlo_table(o: &crate::pipelines::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'static>> {
     let verdict = match &o.verification {
         Some(v) if v.passed => Span::styled("✓ separation kept", Style::default().green()),
+        Some(v) if v.violation.is_some() => {
+            Span::styled("✗ NOT FLYABLE", Style::default().red().bold())
+        }
         Some(_) => Span::styled("✗ SEPARATION LOST", Style::default().red().bold()),
         None => Span::styled("cancelled: no verdict", Style::default().yellow()),
     };
@@ -531,6 +545,17 @@ fn flatlo_table(o: &crate::pipelines::flatlo::FlatloOutcome, stale: bool) -> Vec
         lines.push(Line::raw(format!("… {} more pairs", pairs.len() - 8)));
     }
     if let Some(v) = &o.verification {
+        if let Some(x) = &v.violation {
+            lines.push(Line::styled(x.describe(), Style::default().red()));
+        }
+        lines.push(Line::raw(format!(
+            "airspeed {:.1}-{:.1} m/s (range {}-{}) · bank ≤ {:.1}°",
+            v.airspeed_flown[0],
+            v.airspeed_flown[1],
+            v.airspeed_range[0],
+            v.airspeed_range[1],
+            v.bank_flown_deg
+        )));
         lines.push(Line::raw(format!(
             "final spacing error {:.3} % · lateral spread {:.1} m",
             v.max_spacing_error * 100.0,

@@ -438,7 +438,10 @@ mod tests {
         let expected = 20.0 - 2.0 * arc.tangent + arc.radius * std::f64::consts::FRAC_PI_2;
         assert!((flown - expected).abs() < 1e-3, "{flown} vs {expected}");
         assert!((r.map.rounded(20.0) - flown).abs() < 1e-9);
-        assert!((r.map.rounded(5.0) - 5.0).abs() < 1e-12, "before the corner");
+        assert!(
+            (r.map.rounded(5.0) - 5.0).abs() < 1e-12,
+            "before the corner"
+        );
         assert_eq!(r.planned[0].extent, arc.tangent);
     }
 
