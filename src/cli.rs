@@ -425,6 +425,9 @@ fn agent(args: &AgentArgs) -> u8 {
         seed: args.seed.unwrap_or(mission.seed),
         timeout: std::time::Duration::from_secs_f64(args.timeout.min(86_400.0)),
         realtime: args.realtime,
+        spawned_by: std::env::var(crate::distributed::agent::SPAWNED_BY)
+            .ok()
+            .and_then(|pid| pid.parse().ok()),
     };
     match crate::distributed::fly(&mission, ids, &options) {
         Ok(()) => exit::OK,

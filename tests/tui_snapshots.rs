@@ -109,15 +109,17 @@ fn jobs_panel_with_a_finished_result() {
     let screen = render(&app, started);
     // The verdict, then the CLI's verification table, row by row.
     assert!(
-        screen.contains("✓ FEASIBLE · all 8 checks pass"),
+        screen.contains("✓ FEASIBLE · all 12 checks pass"),
         "{screen}"
     );
+    // r_Q 0.5 + the safety margin 0.1.
     assert!(
-        screen.contains("✓ obstacle clearance worst 0.751 ≥ 0.5"),
+        screen.contains("✓ obstacle clearance worst 0.715 ≥ 0.6"),
         "{screen}"
     );
+    // The flight's own rows, against [vehicle]'s default 12 m/s.
     assert!(
-        screen.contains("✓ inspection of 'pier 1' 13.5 m ≥ 6 m"),
+        screen.contains("✓ horizontal speed (m/s) worst 4.316 ≤ 12"),
         "{screen}"
     );
     insta::assert_snapshot!(screen);
@@ -514,7 +516,7 @@ fn the_jobs_panel_puts_the_verdict_and_the_first_failure_on_top_at_80_by_24() {
     assert!(panel[1].starts_with("✗ INFEASIBLE · "), "{screen}");
     let detail = panel[1..].join(" ");
     assert!(
-        detail.starts_with("✗ INFEASIBLE · obstacle clearance worst 0.310 ≥ 0.5 (UAV 2 at t ="),
+        detail.starts_with("✗ INFEASIBLE · obstacle clearance worst 0.310 ≥ 0.6 (UAV 2 at t ="),
         "{screen}"
     );
 }
@@ -849,7 +851,7 @@ fn a_flatlo_result_turns_stale_after_an_edit() {
     );
     assert!(!fresh.contains("STALE"), "{fresh}");
     app.update(Action::Select(Item::Squadron));
-    type_into(&mut app, "airspeed (m/s)", "21");
+    type_into(&mut app, "airspeed (m/s)", "35");
     app.update(Action::FocusOn(Focus::Jobs));
     let stale = render(&app, started);
     assert!(

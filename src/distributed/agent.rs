@@ -38,7 +38,16 @@ pub struct AgentOptions {
     pub timeout: Duration,
     /// Fly on this process's own clock (`--realtime`).
     pub realtime: bool,
+    /// The coordinator's process id when it spawned this agent
+    /// ([`SPAWNED_BY`]): the agent also counts the coordinator gone when it
+    /// stops being this process's parent, which a `kill -9` does at once
+    /// while the token's withdrawal can be missed.
+    pub spawned_by: Option<u32>,
 }
+
+/// The environment variable in which a coordinator gives the agent
+/// processes it spawns its own process id.
+pub const SPAWNED_BY: &str = "SKYFORM_COORDINATOR_PID";
 
 /// Subscriptions deliver into bounded queues; these hold a few rounds of the
 /// largest fleet (256 agents, a message each).
@@ -91,7 +100,7 @@ pub fn fly(mission: &Mission, ids: Vec<usize>, options: &AgentOptions) -> Result
     };
     say(&session, keys.hello(), &hello, "saying hello")?;
 
-    let mut watch = Watch::new(&coordinator);
+    let mut watch = Watch::new(&coordinator, options.spawned_by);
     wait_for_start(&clock, &mut watch, &ids, options.timeout)?;
     let mut simulation = Simulation::flying(mission, options.seed, ids.clone(), false);
     let (flown, received) = if options.realtime {
@@ -169,23 +178,37 @@ fn say(
 pub const ENDED: &str = "ended by the coordinator";
 
 /// Whether the coordinator's liveliness token is there.
+/// (or, for an agent it spawned, whether it is still this process's parent).
 pub struct Watch<'a> {
     subscriber: &'a Subscriber<FifoChannelHandler<Sample>>,
+    parent: Option<u32>,
     seen: bool,
     gone: bool,
 }
 
 impl<'a> Watch<'a> {
-    pub fn new(subscriber: &'a Subscriber<FifoChannelHandler<Sample>>) -> Self {
+    pub fn new(
+        subscriber: &'a Subscriber<FifoChannelHandler<Sample>>,
+        parent: Option<u32>,
+    ) -> Self {
         Watch {
             subscriber,
+            parent,
             seen: false,
             gone: false,
         }
     }
 
-    /// The coordinator's token went away (after it was seen).
+    /// The coordinator's token went away (after it was seen), or the
+    /// coordinator that spawned this process is no longer its parent.
     pub fn gone(&mut self) -> bool {
+        #[cfg(unix)]
+        if self
+            .parent
+            .is_some_and(|p| std::os::unix::process::parent_id() != p)
+        {
+            self.gone = true;
+        }
         while let Ok(Some(s)) = self.subscriber.try_recv() {
             match s.kind() {
                 SampleKind::Put => self.seen = true,

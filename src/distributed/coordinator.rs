@@ -247,6 +247,7 @@ pub fn coordinate(
             .args(["--run", &run])
             .args(["--seed", &seed.to_string()])
             .args(["--timeout", &format!("{}", options.timeout.as_secs_f64())])
+            .env(super::agent::SPAWNED_BY, std::process::id().to_string())
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(Stdio::piped());

@@ -109,11 +109,9 @@ pub fn noun(pipeline: Kind) -> &'static str {
 }
 
 /// FLATLO's airspeed range [min, max], m/s, that every commanded airspeed
-/// must keep: the hook for `flatlo.airspeed_range`, which arrives with the
-/// FLATLO branch of issue 36 (then: `Some(mission.flatlo.airspeed_range)`).
-/// Until then no airspeed is judged (the report says so).
-fn flatlo_airspeed_range(_mission: &Mission) -> Option<[f64; 2]> {
-    None
+/// must keep (`flatlo.airspeed_range`).
+fn flatlo_airspeed_range(mission: &Mission) -> Option<[f64; 2]> {
+    Some(mission.flatlo.airspeed_range)
 }
 
 /// What a pipeline's outcome gives the export: each vehicle's track, the

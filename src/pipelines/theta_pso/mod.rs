@@ -73,8 +73,12 @@ pub struct WarmStart {
 
 /// A warm-started swarm stops once its best has not improved by more than
 /// this share of J for `WARM_STALL` iterations: it starts next to the answer.
-const WARM_TOLERANCE: f64 = 1e-4;
-const WARM_STALL: usize = 12;
+/// 0.1 % over 8: since J_T became continuous (issue 36) a warm swarm keeps
+/// shaving centimetres off the corners for its whole budget (the bridge
+/// after a 1 m nudge: 0.03 of J 173 per iteration); stopped at iteration 47
+/// it is within 0.5 % of a cold run's J.
+const WARM_TOLERANCE: f64 = 1e-3;
+const WARM_STALL: usize = 8;
 
 /// Everything a θ-PSO run produces.
 #[derive(Debug, Clone, PartialEq, Serialize)]

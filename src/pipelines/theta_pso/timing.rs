@@ -436,6 +436,8 @@ fn derivatives(
         } else {
             i
         };
+        // n indexes the rows of several grid points at once.
+        #[allow(clippy::needless_range_loop)]
         for n in 0..uavs {
             let shape = if centre == 0 || centre + 1 == nodes {
                 let (a, b) = if i == 0 { (0, 1) } else { (i - 1, i) };

@@ -290,13 +290,17 @@ fn simplify(p: &[Point3<f64>], budget: &[f64]) -> Vec<usize> {
     (0..p.len()).filter(|&i| keep[i]).collect()
 }
 
+/// (planned arc length, flown arc length) pairs, in order: what [`ArcMap`]
+/// interpolates.
+type ArcPairs = Vec<(f64, f64)>;
+
 /// Each corner of `p` (arc lengths `arcs`) rounded within `budget` (per
 /// vertex): the flown points, the arcs, and the map of arc lengths.
 fn round_corners(
     p: &[Point3<f64>],
     arcs: &[f64],
     budget: &[f64],
-) -> (Vec<Point3<f64>>, Vec<Arc>, Vec<(f64, f64)>) {
+) -> (Vec<Point3<f64>>, Vec<Arc>, ArcPairs) {
     let mut points = Vec::with_capacity(p.len() * 8);
     let mut flown = Vec::new();
     let mut knots = vec![(0.0, 0.0)];
