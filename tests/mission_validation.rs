@@ -413,3 +413,26 @@ fn an_invalid_mission_does_not_load_and_the_error_lists_every_problem() {
     assert!(err.contains("2 error(s)"), "{err}");
     assert!(err.contains("formation.ground_speed") && err.contains("formation.uav_radius"));
 }
+
+/// Issue 37 ("every input bounded"): a transition or a hold longer than the
+/// operating box's diagonal (141.4 m here) cannot be flown inside it, and a
+/// run once grew to 24 GB on `transition_distance = 1e9`: refused by
+/// `check`, naming the field and the diagonal; the diagonal itself passes.
+#[test]
+fn a_transition_or_hold_longer_than_the_site_is_refused() {
+    for field in ["transition_distance", "hold_distance"] {
+        let text = mission_with(&format!("[reconfiguration]\n{field} = 1e9\n"));
+        assert_error(
+            &text,
+            &format!("reconfiguration.{field}"),
+            field,
+            "longer than the operating box (its x-y diagonal is 141.4 m)",
+        );
+        let at_the_limit = mission_with(&format!("[reconfiguration]\n{field} = 141.4\n"));
+        let errors: Vec<_> = diagnostics(&at_the_limit)
+            .into_iter()
+            .filter(|d| d.severity == Severity::Error)
+            .collect();
+        assert!(errors.is_empty(), "{errors:?}");
+    }
+}

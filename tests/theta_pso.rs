@@ -650,6 +650,79 @@ fn the_speed_is_the_formations_ground_speed_away_from_reconfigurations() {
     assert!(o.duration < 1.5 * o.path_length / speed, "{} s", o.duration);
 }
 
+/// Issue 36, over the tracks themselves (not the verification table): every
+/// UAV's horizontal and vertical speed and acceleration, by central
+/// differences of its sampled positions, within its `[vehicle]` limits
+/// (1 % for the differences' own error).
+fn assert_within_the_vehicle(m: &Mission, o: &ThetaPsoOutcome, seed: u64) {
+    for (n, tr) in o.trajectories.iter().enumerate() {
+        let limit = m.vehicle.limits(n);
+        for w in tr.samples.windows(3) {
+            let (a, b, c) = (&w[0], &w[1], &w[2]);
+            // The last step is shorter (the flight ends between samples).
+            let (before, after) = (b.t - a.t, c.t - b.t);
+            let v = (c.position - a.position) / (before + after);
+            let acc = ((c.position - b.position) / after - (b.position - a.position) / before)
+                * (2.0 / (before + after));
+            let at = format!("seed {seed}, UAV {} at t = {:.1} s", n + 1, b.t);
+            assert!(v.xy().norm() <= limit.speed * 1.01, "{at}: {v}");
+            assert!(
+                v.z <= limit.climb * 1.01 && -v.z <= limit.descent * 1.01,
+                "{at}: {v}"
+            );
+            assert!(acc.xy().norm() <= limit.acceleration * 1.01, "{at}: {acc}");
+            assert!(
+                acc.z <= limit.up * 1.01 && -acc.z <= limit.down * 1.01,
+                "{at}: {acc}"
+            );
+        }
+    }
+}
+
+/// Issue 36: limits are met by flying slower, down to the slowest pace a
+/// plan is flown at (`timing::MIN_PACE`, 0.1 m/s). UAV 2 allowed 1e-4 m/s²
+/// flies the narrow passage's turns at 0.014 m/s, within it, FEASIBLE;
+/// allowed 1e-5 m/s² it would have to crawl below that pace, so it is
+/// flown at it and the plan is INFEASIBLE, naming the limit, the UAV, the
+/// time and the figure (in significant digits, not "0.000").
+#[test]
+fn a_formation_whose_limits_cannot_be_met_is_infeasible_naming_the_uav_time_and_figure() {
+    let with = |acceleration: f64| {
+        let mut m = narrow_passage();
+        m.theta_pso.restarts = 0;
+        m.vehicle.uavs = vec![skyform::mission::VehicleOverride {
+            uav: 2,
+            max_speed: None,
+            max_climb_rate: None,
+            max_descent_rate: None,
+            max_acceleration: Some(acceleration),
+            max_acceleration_up: None,
+            max_acceleration_down: None,
+        }];
+        run(&m, 1)
+    };
+    let slow = with(1e-4);
+    assert!(slow.feasible(), "{:?}", slow.verification.first_failure());
+    assert_within_the_vehicle(&narrow_passage(), &slow, 1);
+    let o = with(1e-5);
+    assert!(!o.feasible());
+    let failure = o.verification.first_failure().unwrap_or_default();
+    assert!(
+        failure.starts_with("horizontal acceleration (m/s²) worst ")
+            && failure.contains("e-5 ≤ 0.00001 (UAV 2 at t ="),
+        "{failure}"
+    );
+    let row = o
+        .verification
+        .checks
+        .iter()
+        .find(|c| c.name == "horizontal acceleration (m/s²)");
+    assert!(
+        row.is_some_and(|c| !c.ok && c.worst.is_some_and(|w| w > 1e-5)),
+        "{row:?}"
+    );
+}
+
 // ---- whole runs ------------------------------------------------------------------
 
 fn narrow_passage() -> Mission {
@@ -684,6 +757,7 @@ fn the_two_span_viaduct_is_planned_through_both_passages_for_20_seeds() {
             "seed {seed}: {:?}",
             o.verification.first_failure()
         );
+        assert_within_the_vehicle(&m, o, seed as u64);
         let mut crossed: Vec<usize> = o.reconfigurations.iter().filter_map(|r| r.iwp).collect();
         crossed.sort_unstable();
         crossed.dedup();
@@ -707,6 +781,7 @@ fn the_narrow_passage_is_planned_feasibly_through_the_gap_for_20_seeds() {
             "seed {seed}: {:?}",
             o.verification.first_failure()
         );
+        assert_within_the_vehicle(&m, o, seed as u64);
         assert_eq!(o.reconfigurations.len(), 1, "seed {seed}");
         assert_eq!(o.reconfigurations[0].shape.name(), "alignment");
         // The centroid path goes through the IWP between the two blocks...
@@ -751,6 +826,7 @@ fn the_bridge_is_planned_feasibly_and_inspects_its_end_piers_for_20_seeds() {
             "seed {seed}: {:?}",
             o.verification.first_failure()
         );
+        assert_within_the_vehicle(&m, o, seed as u64);
         // Eq. 8 over each pass: the facing UAV within [1, 5] m of the pier's
         // surface for at least 6 m of path (IV.A: d_s ∈ [1, 5] m).
         assert_eq!(o.verification.inspections.len(), 2);

@@ -109,9 +109,10 @@ pub struct VerificationRow {
 pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
     let mut rows = Vec::new();
     for check in &o.verification.checks {
-        let worst = check
-            .worst
-            .map_or_else(|| "n/a".to_owned(), |w| format!("{w:.3}"));
+        let worst = check.worst.map_or_else(
+            || "n/a".to_owned(),
+            crate::pipelines::theta_pso::verify::figure,
+        );
         let at = check.at.as_ref().map_or_else(String::new, |a| {
             let other = a
                 .other

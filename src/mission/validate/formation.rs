@@ -225,6 +225,30 @@ impl Checker {
         }
         self.positive(path.key("transition_distance"), r.transition_distance, " m");
         self.non_negative(path.key("hold_distance"), r.hold_distance, " m");
+        // A change of shape or a hold longer than the whole operating box
+        // cannot be flown inside it; unbounded, a value like 1e9 m made the
+        // route stage's costs and the crossings' straights that long (a run
+        // grew to 24 GB).
+        let b = &mission.bounds;
+        let diagonal = (b.x[1] - b.x[0]).hypot(b.y[1] - b.y[0]);
+        if diagonal.is_finite() && diagonal > 0.0 {
+            for (field, value) in [
+                ("transition_distance", r.transition_distance),
+                ("hold_distance", r.hold_distance),
+            ] {
+                if value.is_finite() && value > diagonal {
+                    self.error(
+                        path.key(field),
+                        format!(
+                            "{} m is longer than the operating box (its x-y diagonal is {} m): \
+                             no path inside the bounds could fly it",
+                            compact(value),
+                            compact((diagonal * 10.0).round() / 10.0)
+                        ),
+                    );
+                }
+            }
+        }
         let names: Vec<&str> = mission.obstacles.iter().map(|o| o.name.as_str()).collect();
         for (i, w) in r.waypoints.iter().enumerate() {
             let at = path.key("waypoints").index(i);

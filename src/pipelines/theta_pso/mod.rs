@@ -696,11 +696,11 @@ pub fn plan_warm(
     };
     for check in best.verification.checks.iter().filter(|c| !c.ok) {
         let message = format!(
-            "constraint broken: {} {} {} (worst {:.3})",
+            "constraint broken: {} {} {} (worst {})",
             check.name,
             check.relation,
             check.limit,
-            check.worst.unwrap_or(f64::NAN)
+            verify::figure(check.worst.unwrap_or(f64::NAN))
         );
         observer.on_event(Event::Log(Level::Warn, &message));
     }
