@@ -228,15 +228,21 @@ impl Checker {
         // A change of shape or a hold longer than the whole operating box
         // cannot be flown inside it; unbounded, a value like 1e9 m made the
         // route stage's costs and the crossings' straights that long (a run
-        // grew to 24 GB).
+        // grew to 24 GB). The defaults always pass (18 m and 1 m on a fleet's
+        // 10 m box are bounded, and θ-PSO shortens them to the path).
         let b = &mission.bounds;
         let diagonal = (b.x[1] - b.x[0]).hypot(b.y[1] - b.y[0]);
+        let defaults = crate::mission::model::Reconfiguration::default();
         if diagonal.is_finite() && diagonal > 0.0 {
-            for (field, value) in [
-                ("transition_distance", r.transition_distance),
-                ("hold_distance", r.hold_distance),
+            for (field, value, default) in [
+                (
+                    "transition_distance",
+                    r.transition_distance,
+                    defaults.transition_distance,
+                ),
+                ("hold_distance", r.hold_distance, defaults.hold_distance),
             ] {
-                if value.is_finite() && value > diagonal {
+                if value.is_finite() && value > diagonal.max(default) {
                     self.error(
                         path.key(field),
                         format!(
