@@ -54,6 +54,10 @@ fn edit_and_settle(app: &mut App, action: Action) -> Duration {
 }
 
 fn report(name: &str, mut all: Vec<Duration>, cold: Option<Duration>) {
+    // A filter (`-- bridge_nudge`) leaves the other groups without edits.
+    if all.is_empty() {
+        return;
+    }
     all.sort();
     let at = |q: f64| all[((all.len() - 1) as f64 * q).round() as usize].as_secs_f64() * 1e3;
     eprintln!(

@@ -1304,3 +1304,94 @@ fn an_earlier_corridor_is_reused_only_while_it_holds() {
         None
     );
 }
+
+/// Twenty posts 1.5 m apart north of an open field's route: 19 IWPs one
+/// UAV fits and the triangle does not, none of them on the way.
+fn posts_off_the_route() -> Mission {
+    let mut m = open_field();
+    m.obstacles = (0..20)
+        .map(|i| pole(&format!("post {}", i + 1), 20.0 + 2.5 * i as f64, 85.0, 0.5))
+        .collect();
+    m
+}
+
+/// Issue 37, an answer a person can read: IWPs the plan goes round are one
+/// summary line beyond three (the first named, `--verbose` lists them all);
+/// a few stay one line each.
+#[test]
+fn iwps_the_plan_goes_round_are_one_line_in_the_summary() {
+    let m = posts_off_the_route();
+    let o = run(&m, 1);
+    assert!(o.feasible());
+    assert_eq!(o.iwps.len(), 19, "{:?}", o.iwps.len());
+    assert_eq!(o.bypassed.len(), 19);
+    let outcome = skyform::outcome::Outcome::ThetaPso(Box::new(o));
+    let summary = outcome.summary();
+    let lines: Vec<&str> = summary
+        .lines()
+        .filter(|l| l.contains("not crossed"))
+        .collect();
+    assert_eq!(lines.len(), 1, "{summary}");
+    assert!(
+        lines[0].contains("19 not crossed, the plan goes round them: 'post 1' | 'post 2'")
+            && lines[0].contains("and 16 more (--verbose lists them)"),
+        "{}",
+        lines[0]
+    );
+    let verbose = outcome.summary_with(true);
+    assert_eq!(
+        verbose
+            .lines()
+            .filter(|l| l.contains("not crossed"))
+            .count(),
+        19
+    );
+}
+
+/// Issue 37: `check` on a site with many IWPs the default shape cannot use
+/// says so once per reason, with the count and the three nearest the
+/// start-goal line, not once per pair of posts; an IWP with its own entry
+/// in the file is still warned of by itself.
+#[test]
+fn unusable_iwps_under_the_default_shape_are_one_warning_per_reason() {
+    let mut m = posts_off_the_route();
+    m.reconfiguration.default_shape = ShapeChoice::Rotation;
+    let warnings: Vec<String> = skyform::pipelines::theta_pso::diagnostics(&m)
+        .into_iter()
+        .map(|d| format!("{}: {}", d.path, d.message))
+        .filter(|d| d.contains("unusable"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{warnings:#?}");
+    assert!(
+        warnings[0].starts_with("reconfiguration.default_shape: 19 IWPs are unusable: ")
+            && warnings[0].contains("(nearest the start-goal line: '"),
+        "{}",
+        warnings[0]
+    );
+    m.reconfiguration
+        .waypoints
+        .push(skyform::mission::WaypointChoice {
+            between: ["post 1".into(), "post 2".into()],
+            enabled: true,
+            shape: ShapeChoice::Rotation,
+            scale: None,
+        });
+    let warnings: Vec<String> = skyform::pipelines::theta_pso::diagnostics(&m)
+        .into_iter()
+        .map(|d| d.message)
+        .filter(|d| d.contains("unusable"))
+        .collect();
+    assert_eq!(warnings.len(), 2, "{warnings:#?}");
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.starts_with("18 IWPs are unusable")),
+        "{warnings:#?}"
+    );
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.starts_with("the IWP between 'post 1' and 'post 2'")),
+        "{warnings:#?}"
+    );
+}

@@ -177,8 +177,8 @@ fn say(
 /// The start of a [`LinkError`]'s reason when the coordinator ended the run.
 pub const ENDED: &str = "ended by the coordinator";
 
-/// Whether the coordinator's liveliness token is there.
-/// (or, for an agent it spawned, whether it is still this process's parent).
+/// Whether the coordinator's liveliness token is there (or, for an agent it
+/// spawned, whether it is still this process's parent).
 pub struct Watch<'a> {
     subscriber: &'a Subscriber<FifoChannelHandler<Sample>>,
     parent: Option<u32>,

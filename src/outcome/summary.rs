@@ -148,6 +148,9 @@ pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
     rows
 }
 
+/// Bypassed IWPs the summary names one per line; more are one line.
+const BYPASSED_NAMED: usize = 3;
+
 /// The IWP lines of the θ-PSO summary.
 fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
     use std::fmt::Write as _;
@@ -165,14 +168,31 @@ fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
         unusable.len(),
         o.bypassed.len()
     );
-    for &i in &o.bypassed {
-        if let Some(iwp) = o.iwps.get(i) {
+    let bypassed: Vec<&crate::pipelines::theta_pso::Iwp> =
+        o.bypassed.iter().filter_map(|&i| o.iwps.get(i)).collect();
+    if verbose || bypassed.len() <= BYPASSED_NAMED {
+        for iwp in &bypassed {
             let _ = writeln!(
                 s,
                 "  IWP          '{}' | '{}' not crossed: the plan goes round it",
                 iwp.between[0], iwp.between[1]
             );
         }
+    } else {
+        // A forest has dozens the plan goes round: one line, the first few
+        // named (--verbose lists every one).
+        let named: Vec<String> = bypassed
+            .iter()
+            .take(BYPASSED_NAMED)
+            .map(|i| format!("'{}' | '{}'", i.between[0], i.between[1]))
+            .collect();
+        let _ = writeln!(
+            s,
+            "  IWP          {} not crossed, the plan goes round them: {}, and {} more (--verbose lists them)",
+            bypassed.len(),
+            named.join(", "),
+            bypassed.len() - BYPASSED_NAMED
+        );
     }
     if verbose {
         for i in &unusable {

@@ -248,12 +248,61 @@ impl Problem {
     }
 }
 
+/// Usable IWPs the run's log names one by one (a forest has hundreds).
+const USABLE_LOGGED: usize = 10;
+
+/// Unusable IWPs under the default shape that `check` warns of one by one;
+/// more are grouped by reason.
+const UNUSABLE_WARNED: usize = 3;
+
 /// What θ-PSO can tell about a mission before planning it: unusable IWPs
 /// (warnings: the plan goes round) and inspection passes that cannot hold
 /// eq. 8 (errors). Shown by `check` and the designer beside validation.
 pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    for iwp in find_iwps(mission) {
+    let iwps = find_iwps(mission);
+    // IWPs under the default shape that cannot be used: on a maze or a
+    // forest there are hundreds (pairs of posts on two walls no route
+    // takes), so beyond a few they are one warning per reason; an IWP with
+    // its own entry in the file is always warned of by itself.
+    let chosen = |iwp: &Iwp| {
+        mission
+            .reconfiguration
+            .position(&iwp.between[0], &iwp.between[1])
+            .is_some()
+    };
+    let defaulted: Vec<Iwp> = iwps
+        .iter()
+        .filter(|i| i.enabled && i.unusable.is_some() && !chosen(i))
+        .cloned()
+        .collect();
+    let grouped = defaulted.len() > UNUSABLE_WARNED;
+    if grouped {
+        let route = [mission.route.start, mission.route.goal];
+        for group in unusable::unusable_groups(&defaulted, &route, UNUSABLE_WARNED) {
+            let nearest: Vec<String> = group
+                .nearest
+                .iter()
+                .map(|b| format!("'{}' ↔ '{}'", b[0], b[1]))
+                .collect();
+            out.push(Diagnostic::warning(
+                FieldPath::root()
+                    .key("reconfiguration")
+                    .key("default_shape"),
+                format!(
+                    "{} IWPs are unusable: {}; the plan will not go through them \
+                     (nearest the start-goal line: {})",
+                    group.count,
+                    group.reason,
+                    nearest.join(", ")
+                ),
+            ));
+        }
+    }
+    for iwp in iwps {
+        if grouped && !chosen(&iwp) {
+            continue;
+        }
         if let (true, Some(reason)) = (iwp.enabled, &iwp.unusable) {
             let at = mission
                 .reconfiguration
@@ -467,7 +516,12 @@ impl Attempt {
 /// The IWPs in a few log lines: each usable one, the unusable ones counted
 /// by reason (a forest has hundreds).
 fn log_iwps(observer: &mut dyn Observer, iwps: &[Iwp]) {
-    for iwp in iwps.iter().filter(|i| i.unusable.is_none()) {
+    let usable: Vec<&Iwp> = iwps.iter().filter(|i| i.unusable.is_none()).collect();
+    if usable.len() > USABLE_LOGGED {
+        let message = format!("{} usable IWPs; the {USABLE_LOGGED} first:", usable.len());
+        observer.on_event(Event::Log(Level::Info, &message));
+    }
+    for iwp in usable.into_iter().take(USABLE_LOGGED) {
         let state = if iwp.enabled { "enabled" } else { "disabled" };
         let message = format!(
             "IWP between '{}' and '{}': gap {:.2} m, {} ({state})",

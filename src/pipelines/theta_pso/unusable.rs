@@ -22,8 +22,8 @@ pub struct UnusableGroup {
 }
 
 /// An IWP of a group: its distance to the route, the obstacles it is
-/// between and the names its reason quotes.
-type Member = (f64, [String; 2], Vec<String>);
+/// between, the names its reason quotes and the figures it gives.
+type Member = (f64, [String; 2], Vec<String>, Vec<f64>);
 
 /// The enabled, unusable IWPs of `iwps` grouped by reason, the largest
 /// group first, each naming its `named` IWPs nearest `route` (x-y).
@@ -38,6 +38,7 @@ pub fn unusable_groups(iwps: &[Iwp], route: &[Point3<f64>], named: usize) -> Vec
             distance_to(route, &iwp.position),
             iwp.between.clone(),
             quoted(reason),
+            figures(reason),
         );
         match groups.iter_mut().find(|(k, _)| *k == key) {
             Some((_, members)) => members.push(entry),
@@ -51,7 +52,11 @@ pub fn unusable_groups(iwps: &[Iwp], route: &[Point3<f64>], named: usize) -> Vec
             UnusableGroup {
                 reason: with_names(&kind, &members),
                 count: members.len(),
-                nearest: members.into_iter().take(named).map(|(_, b, _)| b).collect(),
+                nearest: members
+                    .into_iter()
+                    .take(named)
+                    .map(|(_, b, ..)| b)
+                    .collect(),
             }
         })
         .collect();
@@ -101,16 +106,74 @@ fn quoted(reason: &str) -> Vec<String> {
         .collect()
 }
 
-/// A group's reason (`kind`, its quoted names taken out as `'…'`) with the
-/// names put back: at each place the one name every member quotes there,
-/// else the one of the IWP nearest the route and how many others ("'post
-/// 4c' or 3 others"): never a literal `'…'`.
+/// The figures `reason` gives before its colon, in order (outside quotes).
+fn figures(reason: &str) -> Vec<f64> {
+    let head = reason.split(':').next().unwrap_or(reason);
+    let mut out = Vec::new();
+    for (k, piece) in head.split('\'').enumerate() {
+        if k % 2 == 1 {
+            continue;
+        }
+        let mut number = String::new();
+        for c in piece.chars().chain(std::iter::once(' ')) {
+            if c.is_ascii_digit() || (!number.is_empty() && c == '.') {
+                number.push(c);
+            } else if !number.is_empty() {
+                out.push(number.trim_end_matches('.').parse().unwrap_or(f64::NAN));
+                number.clear();
+            }
+        }
+    }
+    out
+}
+
+/// The `slot`-th figure over a group: the one value, or the range.
+fn figure_range(members: &[Member], slot: usize) -> String {
+    let values: Vec<f64> = members
+        .iter()
+        .filter_map(|m| m.3.get(slot).copied())
+        .filter(|v| v.is_finite())
+        .collect();
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if values.is_empty() {
+        "#".to_owned()
+    } else if hi - lo < 1e-9 {
+        format!("{}", (lo * 100.0).round() / 100.0)
+    } else {
+        format!(
+            "{}-{}",
+            (lo * 100.0).round() / 100.0,
+            (hi * 100.0).round() / 100.0
+        )
+    }
+}
+
+/// A group's reason (`kind`, its quoted names taken out as `'…'`, its
+/// figures as `#`) with the names put back, at each place the one name
+/// every member quotes there, else the one of the IWP nearest the route and
+/// how many others ("'post 4c' or 3 others"), never a literal `'…'`; and
+/// each figure as the group's one value or its range ("1.5-2.1").
 fn with_names(kind: &str, members: &[Member]) -> String {
+    let mut figure = 0;
+    let kind: String = kind
+        .split('#')
+        .enumerate()
+        .map(|(k, piece)| {
+            if k == 0 {
+                piece.to_owned()
+            } else {
+                figure += 1;
+                format!("{}{piece}", figure_range(members, figure - 1))
+            }
+        })
+        .collect();
+    let kind = kind.as_str();
     let mut out = String::new();
     for (slot, piece) in kind.split("'…'").enumerate() {
         if slot > 0 {
             let mut names: Vec<&str> = Vec::new();
-            for (.., quoted) in members {
+            for (_, _, quoted, _) in members {
                 if let Some(name) = quoted.get(slot - 1)
                     && !names.contains(&name.as_str())
                 {
@@ -198,6 +261,25 @@ mod tests {
         let groups = unusable_groups(&iwps, &route, 3);
         assert_eq!(groups.len(), 3, "{groups:?}");
         assert_eq!(groups[0].reason, "no shape fits");
+        // The figures as the group's range (issue 37).
+        let mut rows = Vec::new();
+        for k in 0..4 {
+            let why = format!(
+                "rotation leaves the formation 4.47 m wide and the gap is 1.{} m",
+                k + 2
+            );
+            rows.push(iwp(
+                &format!("p {k}"),
+                &format!("p {}", k + 1),
+                0.0,
+                Some(&why),
+            ));
+        }
+        let one = unusable_groups(&rows, &route, 1);
+        assert_eq!(
+            one[0].reason,
+            "rotation leaves the formation 4.47 m wide and the gap is 1.2-1.5 m"
+        );
         assert_eq!(groups[0].count, 30);
         let nearest: Vec<&str> = groups[0].nearest.iter().map(|b| b[0].as_str()).collect();
         assert_eq!(nearest, ["tree 12", "tree 11", "tree 13"]);
