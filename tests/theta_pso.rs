@@ -1395,3 +1395,48 @@ fn unusable_iwps_under_the_default_shape_are_one_warning_per_reason() {
         "{warnings:#?}"
     );
 }
+
+/// Issue 37, the route stage in 3-D: a gapless wall of posts 9 m high
+/// across the route, band 5-20 m, the formation at 10 m. The straight line
+/// clears the tops by 1 m (r_Q 0.5 + margin 0.1 + the cost's 0.1 = 0.7
+/// needed), so the plan flies over, every UAV above the posts; at 9.5 m
+/// the wall is too high to pass at the formation's altitude and it is
+/// still refused, naming it.
+#[test]
+fn a_low_wall_the_formation_clears_is_flown_over() {
+    let wall = |height: f64| {
+        let mut m = open_field();
+        m.bounds.z = [5.0, 20.0];
+        m.formation.safety_margin = 0.1;
+        m.obstacles = (0..59)
+            .map(|k| {
+                let mut o = pole(&format!("block {}", k + 1), 50.0, 1.0 + 1.7 * k as f64, 1.0);
+                o.height = height;
+                o
+            })
+            .collect();
+        m
+    };
+    let o = run(&wall(9.0), 1);
+    assert!(o.feasible(), "{:?}", o.verification.first_failure());
+    let clearance = o
+        .verification
+        .checks
+        .iter()
+        .find(|c| c.name == "obstacle clearance");
+    assert!(
+        clearance.is_some_and(|c| c.worst.is_some_and(|w| w >= 0.6)),
+        "{clearance:?}"
+    );
+    for tr in &o.trajectories {
+        for s in tr
+            .samples
+            .iter()
+            .filter(|s| (s.position.x - 50.0).abs() < 1.6)
+        {
+            assert!(s.position.z >= 9.6, "UAV {} at {}", tr.uav + 1, s.position);
+        }
+    }
+    let refused = refusal(&wall(9.5));
+    assert!(refused.contains("'block 1'"), "{refused}");
+}

@@ -169,13 +169,41 @@ impl Shape {
     }
 }
 
-/// The obstacles a formation in the band cannot fly over, as discs.
+/// Whether the formation, at the altitude the seeded corridor flies (the
+/// lower of the start's and the goal's, in the band), passes over an
+/// obstacle `height` metres high, its lowest UAV clearing the top by r_Q +
+/// the safety margin + the cost's clearance margin.
+///
+/// The θ-PSO paper's obstacles are cylinders of height z_k and its paths
+/// 3-D; the cost (eq. 4 above a cylinder) and verification measure to the
+/// top disc. The route stage is 2-D: an obstacle the formation passes over
+/// as it flies is left out of its search, so a gapless wall of 9 m posts
+/// is no wall to a formation at 10 m. One it would have to climb over is
+/// still kept out (a climb, and a way to forbid flying over live
+/// equipment, come with the site in 3-D, issue 37).
+pub fn flown_over(mission: &Mission, height: f64) -> bool {
+    let f = &mission.formation;
+    let z = mission.bounds.z;
+    let seeded = mission
+        .route
+        .start
+        .z
+        .min(mission.route.goal.z)
+        .clamp(z[0], z[1].max(z[0]));
+    let lowest = f.slots.iter().map(|s| -s.z).fold(0.0, f64::max);
+    let clearance = f.least_clearance() + mission.theta_pso.clearance_margin.max(0.0);
+    height + clearance + lowest <= seeded
+}
+
+/// The obstacles a formation in the band cannot fly over, as discs (see
+/// [`flown_over`]).
 fn blocking(mission: &Mission) -> Vec<(usize, Disc)> {
+    let z = mission.bounds.z;
     mission
         .obstacles
         .iter()
         .enumerate()
-        .filter(|(_, o)| o.height > mission.bounds.z[0])
+        .filter(|(_, o)| o.height > z[0] && !flown_over(mission, o.height))
         .map(|(k, o)| {
             (
                 k,
