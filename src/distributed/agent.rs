@@ -16,10 +16,11 @@ use zenoh::Wait;
 use zenoh::handlers::{FifoChannel, FifoChannelHandler};
 use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
-use zenoh::sample::{Sample, SampleKind};
+use zenoh::sample::Sample;
 
 use super::inbox::{Inbox, drop_lost, missing, publish};
 use super::session;
+use super::watch::{ENDED, Watch};
 use super::wire::{Clock, Control, Hello, Keys, Report, fingerprint, ids_text};
 use crate::mission::Mission;
 use crate::pipelines::fleet::network::Message;
@@ -174,55 +175,6 @@ fn say(
         .wait()
         .map_err(|e| format!("{what}: {e}"))
 }
-/// The start of a [`LinkError`]'s reason when the coordinator ended the run.
-pub const ENDED: &str = "ended by the coordinator";
-
-/// Whether the coordinator's liveliness token is there (or, for an agent it
-/// spawned, whether it is still this process's parent).
-pub struct Watch<'a> {
-    subscriber: &'a Subscriber<FifoChannelHandler<Sample>>,
-    parent: Option<u32>,
-    seen: bool,
-    gone: bool,
-}
-
-impl<'a> Watch<'a> {
-    pub fn new(
-        subscriber: &'a Subscriber<FifoChannelHandler<Sample>>,
-        parent: Option<u32>,
-    ) -> Self {
-        Watch {
-            subscriber,
-            parent,
-            seen: false,
-            gone: false,
-        }
-    }
-
-    /// The coordinator's token went away (after it was seen), or the
-    /// coordinator that spawned this process is no longer its parent.
-    pub fn gone(&mut self) -> bool {
-        #[cfg(unix)]
-        if self
-            .parent
-            .is_some_and(|p| std::os::unix::process::parent_id() != p)
-        {
-            self.gone = true;
-        }
-        while let Ok(Some(s)) = self.subscriber.try_recv() {
-            match s.kind() {
-                SampleKind::Put => self.seen = true,
-                SampleKind::Delete => self.gone = true,
-            }
-        }
-        self.gone
-    }
-
-    pub fn seen(&self) -> bool {
-        self.seen
-    }
-}
-
 fn decode_clock(sample: &Sample) -> Result<Clock, String> {
     Clock::decode(&sample.payload().to_bytes())
 }

@@ -15,7 +15,8 @@
 //! same mission, seed and network model: every process applies the same
 //! model to the same messages. On the wall clock (`realtime.rs`) every
 //! process steps on its own timer. What goes over the wire, and under which
-//! keys, is `wire.rs`; the sessions' configuration is `session.rs`. The
+//! keys, is `wire.rs`; the sessions' configuration is `session.rs`; how an
+//! agent process knows its coordinator is gone, `watch.rs`. The
 //! network model and the topics are documented in `docs/fleet.md`.
 
 pub mod agent;
@@ -23,6 +24,7 @@ pub mod coordinator;
 pub mod inbox;
 pub mod realtime;
 pub mod session;
+pub mod watch;
 pub mod wire;
 
 pub use agent::{AgentOptions, fly};

@@ -11,8 +11,8 @@ use zenoh::handlers::FifoChannelHandler;
 use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::sample::Sample;
 
-use super::agent::{ENDED, Watch};
 use super::inbox::{Inbox, publish};
+use super::watch::{ENDED, Watch};
 use super::wire::{Clock, Control};
 use crate::pipelines::fleet::network::Message;
 use crate::pipelines::fleet::simulation::{Delivery, Link, LinkError};
