@@ -513,8 +513,9 @@ impl Attempt {
     }
 }
 
-/// The IWPs in a few log lines: each usable one, the unusable ones counted
-/// by reason (a forest has hundreds).
+/// The IWPs in a few log lines: the first [`USABLE_LOGGED`] usable ones
+/// (and how many there are), the unusable ones counted by reason (a forest
+/// has hundreds).
 fn log_iwps(observer: &mut dyn Observer, iwps: &[Iwp]) {
     let usable: Vec<&Iwp> = iwps.iter().filter(|i| i.unusable.is_none()).collect();
     if usable.len() > USABLE_LOGGED {
