@@ -201,6 +201,18 @@ fn with_distances(agents: usize, target_distance: f64, distances: Vec<Vec<f64>>)
     m
 }
 
+/// The distances of a square of side 2 m (diagonal 2√2), agents in order
+/// round it.
+fn square_of_side_2() -> Vec<Vec<f64>> {
+    let (a, d) = (2.0, 2.0 * 2f64.sqrt());
+    vec![
+        vec![0.0, a, d, a],
+        vec![a, 0.0, a, d],
+        vec![d, a, 0.0, a],
+        vec![a, d, a, 0.0],
+    ]
+}
+
 /// Eq. 4's ∂_d must be a formation: the paper's triangle as written (1.732
 /// for √3), a square round its circle, and the default regular polygons of
 /// 2 to 12 agents written out pass.
@@ -209,13 +221,7 @@ fn a_formation_the_fleet_can_stand_in_passes() {
     let s = 1.732;
     let triangle = vec![vec![0.0, s, s], vec![s, 0.0, s], vec![s, s, 0.0]];
     assert!(errors(&with_distances(3, 1.0, triangle)).is_empty());
-    let (a, d) = (2.0, 2.0 * 2f64.sqrt());
-    let square = vec![
-        vec![0.0, a, d, a],
-        vec![a, 0.0, a, d],
-        vec![d, a, 0.0, a],
-        vec![a, d, a, 0.0],
-    ];
+    let square = square_of_side_2();
     assert!(errors(&with_distances(4, 2f64.sqrt(), square)).is_empty());
     for n in 2..=12 {
         let polygon = fleet::polygon_distances(n, 3.0);
@@ -247,13 +253,7 @@ fn distances_no_triangle_can_have_are_refused_naming_the_triangle() {
             && found[0].contains("= 3 m"),
         "{found:?}"
     );
-    let (a, d) = (2.0, 2.0 * 2f64.sqrt());
-    let square = vec![
-        vec![0.0, a, d, a],
-        vec![a, 0.0, a, d],
-        vec![d, a, 0.0, a],
-        vec![a, d, a, 0.0],
-    ];
+    let square = square_of_side_2();
     // 1 m from the target, two corners 2.83 m apart cannot be.
     let found = errors(&with_distances(4, 1.0, square));
     assert_eq!(found.len(), 1, "{found:?}");

@@ -51,25 +51,29 @@ pub fn segment_point_distance(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>)
 /// Distance from `p` to the segment a-b in three dimensions.
 pub fn segment_point_distance_3d(a: &Point3<f64>, b: &Point3<f64>, p: &Point3<f64>) -> f64 {
     let ab = b - a;
+    (a + ab * clamped_fraction(&ab, &(p - a)) - p).norm()
+}
+
+/// The fraction t ∈ [0, 1] along a segment `ab` (a vector, in any
+/// dimension) of the point nearest to a point `ap` from its start; 0 for a
+/// segment of no length.
+fn clamped_fraction<const D: usize>(
+    ab: &nalgebra::SVector<f64, D>,
+    ap: &nalgebra::SVector<f64, D>,
+) -> f64 {
     let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+    if len2 > 0.0 {
+        (ap.dot(ab) / len2).clamp(0.0, 1.0)
     } else {
         0.0
-    };
-    (p - (a + ab * t)).norm()
+    }
 }
 
 /// Where `p` projects onto the segment a-b: the fraction t ∈ [0, 1] along
 /// it, and the distance from `p` to that point.
 pub fn segment_projection(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>) -> (f64, f64) {
     let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let t = clamped_fraction(&ab, &(p - a));
     (t, (a + ab * t - p).norm())
 }
 

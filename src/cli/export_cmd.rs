@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use super::{StderrProgress, cancel_on_ctrl_c, exit, load_reporting};
 use crate::export::{self, ExportError, Exported, Format, Options, Planned};
 use crate::mission::Mission;
+use crate::pipelines::theta_pso::verify::figure;
 use crate::pipelines::{Completion, Kind};
 use crate::run::Run;
 
@@ -198,10 +199,10 @@ pub fn summary(done: &Exported) -> String {
                 |l| format!("{} {l} m/s", rate.relation),
             );
             out.push_str(&format!(
-                "  {} {:<32} worst {:.3} {limit}\n",
+                "  {} {:<32} worst {} {limit}\n",
                 if rate.ok { "✓" } else { "✗" },
                 rate.name,
-                rate.worst,
+                figure(rate.worst),
             ));
         }
     }
@@ -225,8 +226,7 @@ fn checks(v: &crate::pipelines::theta_pso::verify::Verification, noun: &str) -> 
             "  {} {:<32} worst {} {} {}\n",
             if c.ok { "✓" } else { "✗" },
             export::reverify::worded(c.name, noun),
-            c.worst
-                .map_or_else(|| "n/a".to_owned(), |w| format!("{w:.3}")),
+            c.worst.map_or_else(|| "n/a".to_owned(), figure),
             c.relation,
             c.limit
         ));
