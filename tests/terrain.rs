@@ -66,7 +66,7 @@ fn judge(hill: bool) -> (f64, bool) {
         .collect();
     let path = CentroidPath::bare(points);
     let terms = CostModel::new(&m, &[]).terms(&path);
-    let (_, v) = flight::fly(&m, &path, &[], &[]);
+    let (_, v) = flight::fly(&m, &path, &[], &[]).unwrap_or_else(|e| panic!("{e}"));
     (terms.altitude, v.feasible)
 }
 

@@ -1440,3 +1440,48 @@ fn a_low_wall_the_formation_clears_is_flown_over() {
     let refused = refusal(&wall(9.5));
     assert!(refused.contains("'block 1'"), "{refused}");
 }
+
+/// Every input bounded: the bridge's straight line is level, so `check`
+/// cannot see that a climb rate of 1e-9 m/s makes its flight centuries long;
+/// the flight refuses before it samples (it once aborted allocating them),
+/// naming `[vehicle]` and the figure.
+#[test]
+fn a_flight_too_long_to_sample_is_refused_before_it_is_sampled() {
+    let mut m = mission::default_mission().mission;
+    m.vehicle.max_climb_rate = 1e-9;
+    m.theta_pso.restarts = 0;
+    let refused = plan(
+        &m,
+        1,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    );
+    match refused {
+        Err(PipelineError::OverBudget(why)) => assert!(
+            why.starts_with("vehicle: the planned flight")
+                && why.contains("trajectory samples (limit 1e7)"),
+            "{why}"
+        ),
+        other => panic!("{:?}", other.map(|o| o.verification.first_failure())),
+    }
+}
+
+/// Every input bounded: a vehicle limit so low that even the straight
+/// start-goal line needs more trajectory samples than the run-size limit
+/// is refused by `check` (the budget), naming the limit: 1e-9 m/s over the
+/// open field's 80 m is 8e10 s.
+#[test]
+fn a_vehicle_too_slow_to_sample_is_refused_naming_the_limit() {
+    let mut m = open_field();
+    m.vehicle.max_speed = 1e-9;
+    let errors: Vec<String> = skyform::pipelines::theta_pso::budget(&m)
+        .into_iter()
+        .map(|d| format!("{}: {}", d.path, d.message))
+        .collect();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert!(
+        errors[0].starts_with("vehicle.max_speed: 1e-9 m/s makes a flight of at least 8e10 s"),
+        "{errors:?}"
+    );
+}

@@ -112,7 +112,7 @@ pub fn plan(
         )));
     }
     observer.on_event(Event::Stage("verification"));
-    let (flight, verification) = super::flight::fly(mission, &centroid, &[], &[]);
+    let (flight, verification) = super::flight::fly(mission, &centroid, &[], &[])?;
     observer.on_event(Event::Progress(1.0));
     let n = model.nodes;
     let waypoints = (0..n)

@@ -26,6 +26,7 @@ use super::path::rounding::corners;
 use super::trajectory::{self, Flight};
 use super::verify::{self, Verification};
 use crate::mission::Mission;
+use crate::pipelines::PipelineError;
 
 /// Times a corner's tolerance is cut (to a quarter, then to nothing).
 const RETRIES: usize = 2;
@@ -35,13 +36,14 @@ pub const MAX_TOLERANCE: f64 = 1.0;
 const RETIMES: usize = 3;
 
 /// `path` flown and verified (see the module's doc). `names`: the mission's
-/// obstacle names.
+/// obstacle names. `OverBudget` when a timing of it needs more samples
+/// than the run-size limit (`trajectory::generate`).
 pub fn fly(
     mission: &Mission,
     path: &CentroidPath,
     iwps: &[Iwp],
     names: &[String],
-) -> (Flight, Verification) {
+) -> Result<(Flight, Verification), PipelineError> {
     let span = super::path::heading_span(mission);
     let planned = corners(&path.points);
     let floor = mission.theta_pso.clearance_margin.max(0.0);
@@ -53,7 +55,7 @@ pub fn fly(
     let generate = |tolerances: &[f64], share: f64| {
         trajectory::generate(path, iwps, names, mission, span, share, |i| tolerances[i])
     };
-    let mut flight = generate(&tolerances, share);
+    let mut flight = generate(&tolerances, share)?;
     let mut verification = verify::verify(mission, &flight.trajectories);
     for retry in 0..=RETRIES {
         if verification.feasible {
@@ -70,7 +72,7 @@ pub fn fly(
                 tolerances[i] / 4.0
             };
         }
-        flight = generate(&tolerances, share);
+        flight = generate(&tolerances, share)?;
         verification = verify::verify(mission, &flight.trajectories);
     }
     for _ in 0..RETIMES {
@@ -84,10 +86,10 @@ pub fn fly(
             break;
         }
         share *= 0.98 / over;
-        flight = generate(&tolerances, share);
+        flight = generate(&tolerances, share)?;
         verification = verify::verify(mission, &flight.trajectories);
     }
-    (flight, verification)
+    Ok((flight, verification))
 }
 
 /// For each corner of the planned path, the least slack of any UAV within

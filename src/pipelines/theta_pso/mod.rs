@@ -406,16 +406,14 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
             ),
         ));
     }
-    let distance = (mission.route.goal - mission.route.start).norm();
-    let speed = mission.formation.ground_speed;
-    let duration = distance / speed;
+    let (field, value, unit, duration) = shortest_flight(mission);
     let samples = trajectory_samples(duration, mission.formation.slots.len());
     if crate::pipelines::exceeds(samples, limits::TRAJECTORY_SAMPLES) {
         out.push(Diagnostic::error(
-            FieldPath::root().key("formation").key("ground_speed"),
+            field,
             format!(
-                "{} m/s makes a flight of at least {} s ({} trajectory samples for {} UAVs, limit {})",
-                figure(speed),
+                "{} {unit} makes a flight of at least {} s ({} trajectory samples for {} UAVs, limit {})",
+                figure(value),
                 figure(duration),
                 figure(samples),
                 mission.formation.slots.len(),
@@ -424,6 +422,98 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
         ));
     }
     out
+}
+
+/// A lower bound of the flight's duration over the straight start-goal
+/// line, and the limit that sets it (its field, value and unit): the
+/// horizontal and the vertical distance each at most at the slowest UAV's
+/// speed (and the ground speed), and each from rest to rest at most at its
+/// acceleration (2 √(d / a)). The time law (`timing`) keeps every one of
+/// these, so the flight is never shorter.
+fn shortest_flight(mission: &Mission) -> (FieldPath, f64, &'static str, f64) {
+    let (start, goal) = (mission.route.start, mission.route.goal);
+    let across = (goal.xy() - start.xy()).norm();
+    let rise = goal.z - start.z;
+    let limits: Vec<_> = (0..mission.formation.slots.len().max(1))
+        .map(|n| mission.vehicle.limits(n))
+        .collect();
+    // The field of UAV n's limit: its own entry's when it has one.
+    let field = |n: usize, key: &str, own: fn(&crate::mission::VehicleOverride) -> Option<f64>| {
+        let path = FieldPath::root().key("vehicle");
+        match mission
+            .vehicle
+            .uavs
+            .iter()
+            .position(|o| o.uav == n + 1 && own(o).is_some())
+        {
+            Some(i) => path.key("uavs").index(i).key(key),
+            None => path.key(key),
+        }
+    };
+    let slowest = |get: fn(&crate::mission::VehicleLimits) -> f64| {
+        limits
+            .iter()
+            .enumerate()
+            .map(|(n, l)| (n, get(l)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or((0, f64::NAN))
+    };
+    let speed = mission.formation.ground_speed;
+    let mut bounds = vec![(
+        FieldPath::root().key("formation").key("ground_speed"),
+        speed,
+        "m/s",
+        across / speed,
+    )];
+    let (n, v) = slowest(|l| l.speed);
+    bounds.push((field(n, "max_speed", |o| o.max_speed), v, "m/s", across / v));
+    let (n, a) = slowest(|l| l.acceleration);
+    let key = "max_acceleration";
+    bounds.push((
+        field(n, key, |o| o.max_acceleration),
+        a,
+        "m/s²",
+        2.0 * (across / a).sqrt(),
+    ));
+    let climbing = rise >= 0.0;
+    let (n, rate) = if climbing {
+        slowest(|l| l.climb)
+    } else {
+        slowest(|l| l.descent)
+    };
+    bounds.push(if climbing {
+        (
+            field(n, "max_climb_rate", |o| o.max_climb_rate),
+            rate,
+            "m/s",
+            rise.abs() / rate,
+        )
+    } else {
+        (
+            field(n, "max_descent_rate", |o| o.max_descent_rate),
+            rate,
+            "m/s",
+            rise.abs() / rate,
+        )
+    });
+    let (n, a) = slowest(|l| l.up.min(l.down));
+    let (key, own): (&str, fn(&crate::mission::VehicleOverride) -> Option<f64>) =
+        if limits[n].up <= limits[n].down {
+            ("max_acceleration_up", |o| o.max_acceleration_up)
+        } else {
+            ("max_acceleration_down", |o| o.max_acceleration_down)
+        };
+    bounds.push((field(n, key, own), a, "m/s²", 2.0 * (rise.abs() / a).sqrt()));
+    bounds
+        .into_iter()
+        .filter(|b| !b.3.is_nan())
+        .max_by(|a, b| a.3.total_cmp(&b.3))
+        .unwrap_or((
+            FieldPath::root().key("formation").key("ground_speed"),
+            speed,
+            "m/s",
+            0.0,
+        ))
 }
 
 /// Samples of every UAV's trajectory over `duration` seconds.
@@ -481,20 +571,9 @@ impl Attempt {
             )));
         }
         let names: Vec<String> = mission.obstacles.iter().map(|o| o.name.clone()).collect();
-        let (flight, verification) = flight::fly(mission, &path, &problem.iwps, &names);
         // Slowing through the turns makes the flight longer than the path
-        // over the ground speed: its samples are checked again.
-        let samples = trajectory_samples(flight.duration(), mission.formation.slots.len());
-        if crate::pipelines::exceeds(samples, crate::pipelines::limits::TRAJECTORY_SAMPLES) {
-            return Err(PipelineError::OverBudget(format!(
-                "vehicle: the planned flight ({:.1} m in {:.1} s within the [vehicle] limits) \
-                 needs {} trajectory samples (limit {})",
-                cost.length,
-                flight.duration(),
-                crate::pipelines::figure(samples),
-                crate::pipelines::figure(crate::pipelines::limits::TRAJECTORY_SAMPLES)
-            )));
-        }
+        // over the ground speed: the flight checks its own samples.
+        let (flight, verification) = flight::fly(mission, &path, &problem.iwps, &names)?;
         Ok(Attempt {
             position,
             convergence,

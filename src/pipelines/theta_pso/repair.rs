@@ -45,7 +45,9 @@ pub fn repair(mission: &Mission, problem: &Problem, position: &[f64]) -> Option<
     for _ in 0..ROUNDS {
         let particle = encode(&waypoints);
         let path = problem.path(&particle);
-        let (_, verification) = super::flight::fly(mission, &path, &problem.iwps, &names);
+        // A flight too long to sample cannot be repaired here; the attempt
+        // built from the particle says why.
+        let (_, verification) = super::flight::fly(mission, &path, &problem.iwps, &names).ok()?;
         if verification.feasible {
             return Some(particle);
         }

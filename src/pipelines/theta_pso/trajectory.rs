@@ -20,6 +20,7 @@ use super::path::rounding::{self, Rounded};
 use super::path::{CentroidPath, Zone, ZoneCause};
 use super::timing::{self, TimeLaw};
 use crate::mission::Mission;
+use crate::pipelines::PipelineError;
 
 /// One sample of a UAV's trajectory: the shared timed sample.
 pub use crate::pipelines::TrackSample as Sample;
@@ -102,7 +103,10 @@ impl Flight {
 /// (`rounding::corners`), timed within `share` of `mission`'s `[vehicle]`
 /// limits (`timing::PLANNED_SHARE` unless the samples showed that too
 /// close) at the formation's ground speed at most. `names`: the mission's obstacle
-/// names (for squeezed stretches).
+/// names (for squeezed stretches). `OverBudget`, before a sample is taken,
+/// when the timed flight needs more trajectory samples than
+/// `limits::TRAJECTORY_SAMPLES` (a vehicle allowed 1e-9 m/s² flies for
+/// years).
 pub fn generate(
     path: &CentroidPath,
     iwps: &[Iwp],
@@ -111,7 +115,7 @@ pub fn generate(
     span: f64,
     share: f64,
     tolerance: impl Fn(usize) -> f64,
-) -> Flight {
+) -> Result<Flight, PipelineError> {
     let formation = &mission.formation;
     let rounded = rounding::round(path, tolerance);
     let motion = Motion::new(&rounded.path, &formation.slots, span);
@@ -149,6 +153,16 @@ pub fn generate(
         .collect();
     let law = TimeLaw::plan(&arcs, &grid, &limits, formation.ground_speed, &stops);
     let duration = law.duration();
+    let needed = (duration / SAMPLE_PERIOD + 1.0) * n as f64;
+    if crate::pipelines::exceeds(needed, crate::pipelines::limits::TRAJECTORY_SAMPLES) {
+        return Err(PipelineError::OverBudget(format!(
+            "vehicle: the planned flight ({length:.1} m in {} s within the [vehicle] limits) \
+             needs {} trajectory samples (limit {})",
+            crate::pipelines::figure(duration),
+            crate::pipelines::figure(needed),
+            crate::pipelines::figure(crate::pipelines::limits::TRAJECTORY_SAMPLES)
+        )));
+    }
     let steps = (duration / SAMPLE_PERIOD).ceil().max(1.0) as usize;
     let mut samples = vec![Vec::with_capacity(steps + 1); n];
     let (mut behind, mut ahead) = (Vec::with_capacity(n), Vec::with_capacity(n));
@@ -186,13 +200,13 @@ pub fn generate(
         .map(|(uav, samples)| Trajectory { uav, samples })
         .collect();
     let reconfigurations = timetable(&rounded.path, &motion, iwps, names, &law);
-    Flight {
+    Ok(Flight {
         trajectories,
         reconfigurations,
         rounded,
         law,
         progress: arcs,
-    }
+    })
 }
 
 /// Where the formation must stop along the flown path: at each corner kept
