@@ -436,3 +436,49 @@ fn a_transition_or_hold_longer_than_the_site_is_refused() {
         assert!(errors.is_empty(), "{errors:?}");
     }
 }
+
+/// Issue 37, obstacles in three dimensions: a base is an underside, so one
+/// at or above the top is refused naming `base`; a deck with room below
+/// loads and says nothing.
+#[test]
+fn a_base_at_or_above_the_top_is_refused() {
+    let deck = |base: f64| {
+        mission_with(&format!(
+            "[[obstacles]]\nname = \"deck\"\ncenter = [50.0, 50.0]\nradius = 3.0\nheight = 10.0\n\
+             base = {base:?}\n"
+        ))
+    };
+    let d = error_at(&deck(10.0), "obstacles[0].base");
+    assert!(d.message.contains("at or above its top"), "{}", d.message);
+    let d = error_at(&deck(-1.0), "obstacles[0].base");
+    assert!(d.message.contains("must not be negative"), "{}", d.message);
+    assert!(
+        diagnostics(&deck(8.0)).iter().all(|d| !d.is_error()),
+        "{:?}",
+        diagnostics(&deck(8.0))
+    );
+}
+
+/// Issue 37, eq. 8 on a short obstacle: inspecting needs an altitude of the
+/// band level with the obstacle's side. A tower 4 m high under a band
+/// from 5 m is refused (the old "below the floor" rule); one standing from
+/// 16 to 30 m over a band ending at 15 m is refused naming its heights;
+/// one 9.3 m high in a band from 6.6 m is accepted.
+#[test]
+fn an_inspection_no_altitude_of_the_band_is_level_with_is_refused() {
+    let tower = |base: f64, height: f64| {
+        mission_with(&format!(
+            "[[obstacles]]\nname = \"tower\"\ncenter = [50.0, 30.0]\nradius = 1.0\n\
+             height = {height:?}\nbase = {base:?}\ninspect = true\n"
+        ))
+    };
+    error_at(&tower(0.0, 4.0), "obstacles[0].inspect");
+    let d = error_at(&tower(16.0, 30.0), "obstacles[0].inspect");
+    assert!(d.message.contains("from 16 to 30 m"), "{}", d.message);
+    let fine = tower(0.0, 9.3).replace("z = [5.0, 15.0]", "z = [6.6, 18.5]");
+    assert!(
+        diagnostics(&fine).iter().all(|d| !d.is_error()),
+        "{:?}",
+        diagnostics(&fine)
+    );
+}

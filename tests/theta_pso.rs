@@ -35,6 +35,8 @@ fn pole(name: &str, x: f64, y: f64, radius: f64) -> Obstacle {
         center: Point2::new(x, y),
         radius,
         height: 30.0,
+        base: 0.0,
+        overfly: true,
         kind: None,
         inspect: false,
         stand_off: None,
@@ -1439,6 +1441,95 @@ fn a_low_wall_the_formation_clears_is_flown_over() {
     }
     let refused = refusal(&wall(9.5));
     assert!(refused.contains("'block 1'"), "{refused}");
+}
+
+/// Issue 37, a deck across the route: a gapless row of deck sections from
+/// 14 to 16 m across the whole site, band 5-20 m, the formation at 10 m.
+/// Its underside leaves room (10 m + r_Q 0.5 + margins < 14 m), so the plan
+/// flies under it, every UAV below the base; with the base at 10.5 m there
+/// is no room under (nor over: the band ends at 20 m, the top plus the
+/// clearance is above the start's altitude) and it is refused, naming it.
+#[test]
+fn a_deck_with_room_below_is_flown_under() {
+    let deck = |base: f64| {
+        let mut m = open_field();
+        m.bounds.z = [5.0, 20.0];
+        m.formation.safety_margin = 0.1;
+        m.obstacles = (0..59)
+            .map(|k| {
+                let mut o = pole(&format!("deck {}", k + 1), 50.0, 1.0 + 1.7 * k as f64, 1.0);
+                o.base = base;
+                o.height = 16.0;
+                o
+            })
+            .collect();
+        m
+    };
+    let o = run(&deck(14.0), 1);
+    assert!(o.feasible(), "{:?}", o.verification.first_failure());
+    let mut under = 0;
+    for tr in &o.trajectories {
+        for s in tr
+            .samples
+            .iter()
+            .filter(|s| (s.position.x - 50.0).abs() < 1.6)
+        {
+            assert!(s.position.z <= 13.4, "UAV {} at {}", tr.uav + 1, s.position);
+            under += 1;
+        }
+    }
+    assert!(under > 0, "no sample passes under the deck");
+    let refused = refusal(&deck(10.5));
+    assert!(refused.contains("'deck 1'"), "{refused}");
+}
+
+/// Issue 37, `overfly = false`: the low wall of the test above, which the
+/// formation at 10 m clears by 1 m, is flown over; marked as not to be
+/// flown over (live equipment), it closes the way and the refusal names it.
+#[test]
+fn a_wall_marked_not_to_be_overflown_is_not() {
+    let mut m = open_field();
+    m.bounds.z = [5.0, 20.0];
+    m.formation.safety_margin = 0.1;
+    m.obstacles = (0..59)
+        .map(|k| {
+            let mut o = pole(&format!("bay {}", k + 1), 50.0, 1.0 + 1.7 * k as f64, 1.0);
+            o.height = 9.0;
+            o.overfly = false;
+            o
+        })
+        .collect();
+    let refused = refusal(&m);
+    assert!(refused.contains("'bay 1'"), "{refused}");
+}
+
+/// Issue 37, a short inspected tower: 9.3 m high, band 6.6-18.5 m, the
+/// formation at 12 m. The pass is flown level with the side (eq. 8
+/// measured to the side wall, within [1, 6] m), not over the top; the
+/// surface check passes on every seed tried.
+#[test]
+fn a_short_inspected_tower_is_inspected_from_beside_it() {
+    let mut m = open_field();
+    m.bounds.z = [6.6, 18.5];
+    m.route.start.z = 12.0;
+    m.route.goal.z = 12.0;
+    let mut tower = pole("tree 40", 50.0, 40.0, 1.0);
+    tower.height = 9.3;
+    tower.inspect = true;
+    m.obstacles = vec![tower];
+    for seed in 0..3 {
+        let o = run(&m, seed);
+        assert!(
+            o.feasible(),
+            "seed {seed}: {:?}",
+            o.verification.first_failure()
+        );
+        let inspection = &o.verification.inspections[0];
+        assert!(
+            inspection.ok && inspection.achieved >= inspection.required,
+            "seed {seed}: {inspection:?}"
+        );
+    }
 }
 
 /// Every input bounded: the bridge's straight line is level, so `check`

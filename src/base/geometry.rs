@@ -5,12 +5,13 @@
 
 use nalgebra::{Point2, Point3, Vector3};
 
-/// A vertical cylinder standing on the ground: axis through `center`, from
-/// z = 0 up to z = `height`.
+/// A vertical cylinder: axis through `center`, from z = `base` (0 for what
+/// stands on the ground, higher for a deck) up to z = `height`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cylinder {
     pub center: Point2<f64>,
     pub radius: f64,
+    pub base: f64,
     pub height: f64,
 }
 
@@ -20,9 +21,10 @@ impl Cylinder {
         (p.xy() - self.center).norm()
     }
 
-    /// Distance from `p` to the cylinder's axis, extended over the top: below
-    /// the top it is the horizontal distance to the axis; above it, the radius
-    /// plus the distance to the top disc. Continuous at the top, and equal to
+    /// Distance from `p` to the cylinder's axis, extended over the top and
+    /// under the base: between them it is the horizontal distance to the
+    /// axis; above (below), the radius plus the distance to the top (bottom)
+    /// disc. Continuous at the top, and equal to
     /// the radius exactly on the surface, so `1 - d / r_safe` measures how deep
     /// a point is inside a safety margin around the whole solid (θ-PSO eq. 4).
     pub fn axis_distance(&self, p: &Point3<f64>) -> f64 {
@@ -33,13 +35,15 @@ impl Cylinder {
     /// negative inside (as deep as the nearest side wall).
     pub fn clearance(&self, p: &Point3<f64>) -> f64 {
         let outward = self.horizontal_distance(p) - self.radius;
-        if p.z <= self.height {
-            outward
+        let off = if p.z > self.height {
+            p.z - self.height
+        } else if p.z < self.base {
+            self.base - p.z
         } else {
-            let above = p.z - self.height;
-            let sideways = outward.max(0.0);
-            (sideways * sideways + above * above).sqrt()
-        }
+            return outward;
+        };
+        let sideways = outward.max(0.0);
+        (sideways * sideways + off * off).sqrt()
     }
 }
 
@@ -95,6 +99,7 @@ mod tests {
     const POLE: Cylinder = Cylinder {
         center: Point2::new(0.0, 0.0),
         radius: 1.0,
+        base: 0.0,
         height: 10.0,
     };
 

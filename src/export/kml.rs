@@ -16,8 +16,8 @@
 use std::collections::HashMap;
 
 use kml::types::{
-    AltitudeMode, Coord, Element, Folder, Geometry, LineString, LineStyle, LinearRing, Placemark,
-    Point, PolyStyle, Polygon, Style,
+    AltitudeMode, Coord, Element, Folder, Geometry, LineString, LineStyle, LinearRing,
+    MultiGeometry, Placemark, Point, PolyStyle, Polygon, Style,
 };
 use kml::{Kml, KmlDocument, KmlVersion, KmlWriter};
 use nalgebra::{Point2, Point3};
@@ -277,16 +277,47 @@ fn mission_folder(mission: &Mission, placement: &Placement, placemarks: &mut usi
 }
 
 /// An obstacle: its circle at its top (absolute: [origin].altitude, the
-/// ground under its centre and its height), extruded to the ground.
+/// ground under its centre and its height), extruded to the ground; one
+/// with room under it (a deck) as a closed solid from its base to its top.
 fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> {
-    let top = mission.ground(o.center.x, o.center.y) + o.height;
-    let ring = circle(&o.center, o.radius, |p| {
-        absolute(placement, &Point3::new(p.x, p.y, top))
-    });
-    let mut text = format!(
-        "radius {} m, height {} m above the ground",
-        o.radius, o.height
-    );
+    let ground = mission.ground(o.center.x, o.center.y);
+    let ring_at = |z: f64| {
+        circle(&o.center, o.radius, |p| {
+            absolute(placement, &Point3::new(p.x, p.y, ground + z))
+        })
+    };
+    let geometry = if o.base > 0.0 {
+        let (top, bottom) = (ring_at(o.height), ring_at(o.base));
+        let walls = top.windows(2).zip(bottom.windows(2)).map(|(t, b)| {
+            let quad = vec![t[0], t[1], b[1], b[0], t[0]];
+            polygon(quad, Vec::new(), AltitudeMode::Absolute, false)
+        });
+        let mut faces = vec![
+            polygon(top.clone(), Vec::new(), AltitudeMode::Absolute, false),
+            polygon(bottom.clone(), Vec::new(), AltitudeMode::Absolute, false),
+        ];
+        faces.extend(walls);
+        Geometry::MultiGeometry(MultiGeometry {
+            geometries: faces,
+            attrs: HashMap::new(),
+        })
+    } else {
+        polygon(ring_at(o.height), Vec::new(), AltitudeMode::Absolute, true)
+    };
+    let mut text = if o.base > 0.0 {
+        format!(
+            "radius {} m, from {} to {} m above the ground",
+            o.radius, o.base, o.height
+        )
+    } else {
+        format!(
+            "radius {} m, height {} m above the ground",
+            o.radius, o.height
+        )
+    };
+    if !o.overfly {
+        text.push_str("; not to be flown over");
+    }
     if let Some(kind) = &o.kind {
         text = format!("{kind}: {text}");
     }
@@ -296,7 +327,7 @@ fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> 
     placemark(
         &o.name,
         text,
-        polygon(ring, Vec::new(), AltitudeMode::Absolute, true),
+        geometry,
         if o.inspect { "inspected" } else { "obstacle" },
     )
 }

@@ -186,6 +186,8 @@ mod tests {
             center: Point2::new(x, 10.0),
             radius: 1.0,
             height: 10.0,
+            base: 0.0,
+            overfly: true,
             kind: None,
             inspect: false,
             stand_off: None,

@@ -259,6 +259,8 @@ pub fn make(
                 center: d.center,
                 radius: d.radius,
                 height: height.unwrap_or(default_height),
+                base: 0.0,
+                overfly: true,
                 kind: kind.clone(),
                 inspect: false,
                 stand_off: None,

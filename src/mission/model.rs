@@ -98,12 +98,35 @@ impl Mission {
         })
     }
 
+    /// The centroid altitudes at which every UAV of the nominal shape is in
+    /// the band and level with obstacle `o`'s side (between its base and
+    /// its top), so the one facing it measures eq. 8's distance to the side
+    /// wall, not over the top; for a shape taller than the side, the
+    /// altitudes that keep the centroid level with it. `None` when no
+    /// altitude of the band is level with it.
+    pub fn inspection_altitudes(&self, o: &Obstacle) -> Option<[f64; 2]> {
+        let half = self
+            .formation
+            .slots
+            .iter()
+            .map(|s| s.z.abs())
+            .fold(0.0, f64::max);
+        let (floor, ceiling) = (self.bounds.z[0] + half, self.bounds.z[1] - half);
+        [half, 0.0].into_iter().find_map(|level| {
+            let lo = floor.max(o.base + level);
+            let hi = ceiling.min(o.height - level);
+            (lo <= hi).then_some([lo, hi])
+        })
+    }
+
     /// Obstacle `o` as a cylinder in the ENU frame: with terrain, standing on
     /// the ground under its centre (its height is above that ground).
     pub fn cylinder(&self, o: &Obstacle) -> crate::base::geometry::Cylinder {
         let mut c = o.cylinder();
         if self.terrain.is_some() {
-            c.height += self.ground(o.center.x, o.center.y);
+            let ground = self.ground(o.center.x, o.center.y);
+            c.height += ground;
+            c.base += ground;
         }
         c
     }
@@ -203,7 +226,7 @@ impl Bounds {
     }
 }
 
-/// A vertical cylinder from the ground to `height`.
+/// A vertical cylinder from `base` (the ground unless set) up to `height`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Obstacle {
@@ -212,8 +235,16 @@ pub struct Obstacle {
     pub center: Point2<f64>,
     /// Metres.
     pub radius: f64,
-    /// Metres above ground.
+    /// Its top, metres above ground.
     pub height: f64,
+    /// Its underside, metres above ground: 0 for what stands on the ground,
+    /// the clear height under a deck or a gantry beam otherwise.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub base: f64,
+    /// May the formation fly over its top? `false` for live equipment or
+    /// people: the planner then treats it as reaching the sky.
+    #[serde(default = "yes", skip_serializing_if = "is_yes")]
+    pub overfly: bool,
     /// Free label ("pier", "pole", "tree", …), for display only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kind: Option<String>,
@@ -478,6 +509,14 @@ pub struct WaypointChoice {
     /// Overrides `shrink_scale` for this IWP.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<f64>,
+}
+
+fn is_yes(b: &bool) -> bool {
+    *b
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 fn yes() -> bool {
@@ -863,11 +902,62 @@ impl Obstacle {
         self.stand_off.unwrap_or(formation.surface_distance)
     }
 
+    /// The top the planner keeps under the formation: the sky when it may
+    /// not be flown over.
+    pub fn top(&self) -> f64 {
+        if self.overfly {
+            self.height
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Does it stand in the way of a UAV at altitude `z` (between its base
+    /// and its top)?
+    pub fn spans(&self, z: f64) -> bool {
+        self.base < z && z < self.top()
+    }
+
+    /// Does any of it lie within the altitudes `band`?
+    pub fn within(&self, band: [f64; 2]) -> bool {
+        self.top() > band[0] && self.base < band[1]
+    }
+
+    /// Does it close the altitudes `band` to a UAV that keeps `clearance`
+    /// from it: no room over its top, nor under its base?
+    pub fn closes(&self, band: [f64; 2], clearance: f64) -> bool {
+        self.top() + clearance > band[1] && self.base - clearance < band[0]
+    }
+
+    /// The solid the planner keeps clear of: up to the sky when it may not
+    /// be flown over.
     pub fn cylinder(&self) -> crate::base::geometry::Cylinder {
         crate::base::geometry::Cylinder {
             center: self.center,
             radius: self.radius,
-            height: self.height,
+            base: self.base,
+            height: self.top(),
+        }
+    }
+
+    /// A cylinder standing on the ground, to be overflown: the fields every
+    /// obstacle has, with the rest at their defaults.
+    pub fn standing(
+        name: impl Into<String>,
+        center: Point2<f64>,
+        radius: f64,
+        height: f64,
+    ) -> Self {
+        Obstacle {
+            name: name.into(),
+            center,
+            radius,
+            height,
+            base: 0.0,
+            overfly: true,
+            kind: None,
+            inspect: false,
+            stand_off: None,
         }
     }
 }

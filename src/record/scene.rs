@@ -28,14 +28,14 @@ pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStrea
         stream.log_static(
             paths::OBSTACLES,
             &rerun::Cylinders3D::from_lengths_and_radii(
-                o.iter().map(|o| o.height as f32),
+                o.iter().map(|o| (o.height - o.base) as f32),
                 o.iter().map(|o| o.radius as f32),
             )
             .with_centers(o.iter().map(|o| {
                 [
                     o.center.x as f32,
                     o.center.y as f32,
-                    (o.height / 2.0) as f32,
+                    ((o.base + o.height) / 2.0) as f32,
                 ]
             }))
             .with_labels(o.iter().map(|o| o.name.clone()))

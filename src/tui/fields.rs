@@ -447,6 +447,8 @@ pub fn new_obstacle(mission: &Mission, center: Point2<f64>) -> Obstacle {
         center,
         radius: 1.0,
         height: (mission.bounds.z[1] + 1.0).max(1.0),
+        base: 0.0,
+        overfly: true,
         kind: None,
         inspect: false,
         stand_off: None,

@@ -318,6 +318,8 @@ fn generate(index: u64, wide: bool) -> Site {
             center: *center,
             radius: *r,
             height: z_max + rng.random_range(2.0..10.0),
+            base: 0.0,
+            overfly: true,
             kind: Some("wall".into()),
             inspect: false,
             stand_off: None,
@@ -412,6 +414,8 @@ fn generate(index: u64, wide: bool) -> Site {
             } else {
                 rng.random_range(6.0..30.0)
             },
+            base: 0.0,
+            overfly: true,
             kind: None,
             inspect,
             stand_off: None,

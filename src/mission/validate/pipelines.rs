@@ -271,7 +271,7 @@ impl Checker {
                     format!("({}, {}) is outside the bounds", t.position.x, t.position.y),
                 );
             }
-            for o in obstacles.iter().filter(|o| o.height > p.altitude) {
+            for o in obstacles.iter().filter(|o| o.spans(p.altitude)) {
                 let gap = (o.center - t.position).norm() - o.radius;
                 if gap < p.safety_distance {
                     self.warning(

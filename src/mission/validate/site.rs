@@ -100,7 +100,7 @@ impl Checker {
             || !mission
                 .obstacles
                 .iter()
-                .all(|o| finite(&[o.center.x, o.center.y, o.radius, o.height]))
+                .all(|o| finite(&[o.center.x, o.center.y, o.radius, o.height, o.base]))
         {
             return;
         }
@@ -206,6 +206,44 @@ impl Checker {
             }
             self.positive(at.key("radius"), o.radius, " m");
             self.positive(at.key("height"), o.height, " m");
+            self.non_negative(at.key("base"), o.base, " m");
+            if o.base.is_finite() && o.height.is_finite() && o.base >= o.height {
+                self.error(
+                    at.key("base"),
+                    format!(
+                        "{} m is at or above its top (height = {} m): the base is its underside",
+                        o.base, o.height
+                    ),
+                );
+            }
+            if o.inspect
+                && o.height > bounds.z[0]
+                && [o.base, o.height, bounds.z[0], bounds.z[1]]
+                    .iter()
+                    .all(|v| v.is_finite())
+                && mission.inspection_altitudes(o).is_none()
+            {
+                self.error(
+                    at.key("inspect"),
+                    format!(
+                        "'{}' stands from {} to {} m; no altitude of the band z {:?} m (the \
+                         centroid kept {} m inside it, half the shape's height) is level with \
+                         its side: the UAV facing it would measure eq. 8 over its top",
+                        o.name,
+                        compact(o.base),
+                        compact(o.height),
+                        bounds.z,
+                        compact(
+                            mission
+                                .formation
+                                .slots
+                                .iter()
+                                .map(|s| s.z.abs())
+                                .fold(0.0, f64::max)
+                        ),
+                    ),
+                );
+            }
             if !o.center.iter().all(|v| v.is_finite()) {
                 continue;
             }

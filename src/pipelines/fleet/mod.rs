@@ -306,7 +306,7 @@ pub fn default_target(m: &Mission) -> Point2<f64> {
             && q.y + reach <= b.y[1]
             && m.obstacles
                 .iter()
-                .filter(|o| o.height > p.altitude)
+                .filter(|o| o.spans(p.altitude))
                 .all(|o| (o.center - q).norm() - o.radius >= reach + p.safety_distance)
     };
     if free(&centre) {

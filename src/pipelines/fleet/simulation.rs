@@ -251,7 +251,7 @@ impl<'m> Simulation<'m> {
         let obstacles = mission
             .obstacles
             .iter()
-            .filter(|o| o.height > p.altitude)
+            .filter(|o| o.spans(p.altitude))
             .map(|o| Detected {
                 center: o.center,
                 radius: o.radius,
@@ -543,7 +543,7 @@ impl<'m> Simulation<'m> {
                 .mission
                 .obstacles
                 .iter()
-                .filter(|o| o.height > p.altitude)
+                .filter(|o| o.spans(p.altitude))
             {
                 let d = (o.center - positions[i]).norm() - o.radius;
                 if log.closest_obstacle.as_ref().is_none_or(|c| d < c.distance) {

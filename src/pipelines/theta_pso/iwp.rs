@@ -362,7 +362,7 @@ fn crossing_hold(
         }
     }
     let held = shape.map_or_else(|| f.slots.clone(), |s| s.offsets(&f.slots, 1.0));
-    let in_band = |k: &usize| obstacles[*k].height > mission.bounds.z[0];
+    let in_band = |k: &usize| obstacles[*k].within(mission.bounds.z);
     let mut depth: f64 = 0.0;
     for sign in [1.0, -1.0] {
         let forward = normal * sign;
@@ -442,7 +442,7 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
     for p in 0..obstacles.len() {
         for q in (p + 1)..obstacles.len() {
             let (a, b) = (&obstacles[p], &obstacles[q]);
-            if a.height <= mission.bounds.z[0] || b.height <= mission.bounds.z[0] {
+            if !a.within(mission.bounds.z) || !b.within(mission.bounds.z) {
                 continue;
             }
             let axis = b.center - a.center;
@@ -460,7 +460,7 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
             let blocked = obstacles.iter().enumerate().any(|(k, o)| {
                 k != p
                     && k != q
-                    && o.height > mission.bounds.z[0]
+                    && o.within(mission.bounds.z)
                     && segment_point_distance(&p_p, &p_q, &o.center) < o.radius + r_q
             });
             if blocked {

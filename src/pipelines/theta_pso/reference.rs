@@ -95,7 +95,7 @@ pub fn lower_bound(mission: &Mission, iwps: &[Iwp], resolution: f64) -> Option<R
     let discs: Vec<Disc> = mission
         .obstacles
         .iter()
-        .filter(|o| o.height + f.least_clearance() > mission.bounds.z[1])
+        .filter(|o| o.closes(mission.bounds.z, f.least_clearance()))
         .map(|o| {
             let reach = o.radius + f.least_clearance();
             let rho = shapes
@@ -132,7 +132,7 @@ pub fn seeding_route(
     let discs: Vec<Disc> = mission
         .obstacles
         .iter()
-        .filter(|o| o.height > mission.bounds.z[0])
+        .filter(|o| o.within(mission.bounds.z))
         .map(|o| Disc {
             center: o.center,
             radius: o.radius + f.safe_radius() + margin,

@@ -498,8 +498,10 @@ impl CostModel {
         rise: f64,
     ) -> Option<(f64, f64)> {
         let safe = c.radius + self.uav_radius + self.margin + reach;
-        if a.z.min(b.z) - rise >= c.height + self.uav_radius + self.margin {
-            // Entirely above the top by more than the safe distance.
+        let keep = self.uav_radius + self.margin;
+        if a.z.min(b.z) - rise >= c.height + keep || a.z.max(b.z) + rise <= c.base - keep {
+            // Entirely above the top, or under the base, by more than the
+            // safe distance.
             return None;
         }
         // |a + t (b − a) − c| < safe in the plane.

@@ -192,7 +192,11 @@ impl PathBuilder {
                 axis: mission.obstacles[k].center,
                 geometry,
                 half: mission.formation.inspection_pass / 2.0 + span,
-                z_range: band_for(vertical_half_height(nominal)),
+                // Level with the side (`check` refuses an obstacle no
+                // altitude of the band is level with).
+                z_range: mission
+                    .inspection_altitudes(&mission.obstacles[k])
+                    .unwrap_or_else(|| band_for(vertical_half_height(nominal))),
             })
             .collect();
         // The centroid searches a box shrunk by r_F so every UAV stays inside

@@ -49,7 +49,7 @@ use self::guide::Guide;
 use self::search::{Graph, Jump, LAYERS, Step, bit};
 use super::iwp::{Iwp, Shape as FormationShape, column_spacing, min_pair_distance};
 use super::path::{PathBuilder, SqueezeMap};
-use crate::mission::Mission;
+use crate::mission::{Mission, Obstacle};
 
 /// Angles tried round each inspected obstacle.
 const PASS_ANGLES: usize = 16;
@@ -169,41 +169,39 @@ impl Shape {
     }
 }
 
-/// Whether the formation, at the altitude the seeded corridor flies (the
-/// lower of the start's and the goal's, in the band), passes over an
-/// obstacle `height` metres high, its lowest UAV clearing the top by r_Q +
-/// the safety margin + the cost's clearance margin.
+/// Whether the formation, at the altitudes the seeded corridor flies
+/// (between the start's and the goal's, in the band), passes over
+/// obstacle `o` or under it: its lowest UAV clears the top, or its highest
+/// the base, by r_Q + the safety margin + the cost's clearance margin.
 ///
 /// The θ-PSO paper's obstacles are cylinders of height z_k and its paths
-/// 3-D; the cost (eq. 4 above a cylinder) and verification measure to the
-/// top disc. The route stage is 2-D: an obstacle the formation passes over
-/// as it flies is left out of its search, so a gapless wall of 9 m posts
-/// is no wall to a formation at 10 m. One it would have to climb over is
-/// still kept out (a climb, and a way to forbid flying over live
-/// equipment, come with the site in 3-D, issue 37).
-pub fn flown_over(mission: &Mission, height: f64) -> bool {
+/// 3-D; the cost (eq. 4 above and below a cylinder) and verification
+/// measure to the top and bottom discs. The route stage is 2-D: an
+/// obstacle the formation passes over or under as it flies is left out of
+/// its search, so a gapless wall of 9 m posts is no wall to a formation at
+/// 10 m, nor a deck 14 m up. One it would have to climb over is still kept
+/// out, as is one marked `overfly = false`.
+pub fn passed_by_altitude(mission: &Mission, o: &Obstacle) -> bool {
     let f = &mission.formation;
     let z = mission.bounds.z;
-    let seeded = mission
-        .route
-        .start
-        .z
-        .min(mission.route.goal.z)
-        .clamp(z[0], z[1].max(z[0]));
-    let lowest = f.slots.iter().map(|s| -s.z).fold(0.0, f64::max);
+    let band = |v: f64| v.clamp(z[0], z[1].max(z[0]));
+    let (start, goal) = (mission.route.start.z, mission.route.goal.z);
+    let (low, high) = (band(start.min(goal)), band(start.max(goal)));
+    let below = f.slots.iter().map(|s| -s.z).fold(0.0, f64::max);
+    let above = f.slots.iter().map(|s| s.z).fold(0.0, f64::max);
     let clearance = f.least_clearance() + mission.theta_pso.clearance_margin.max(0.0);
-    height + clearance + lowest <= seeded
+    o.top() + clearance + below <= low || high + above + clearance <= o.base
 }
 
-/// The obstacles a formation in the band cannot fly over, as discs (see
-/// [`flown_over`]).
+/// The obstacles a formation in the band cannot fly over or under, as
+/// discs (see [`passed_by_altitude`]).
 fn blocking(mission: &Mission) -> Vec<(usize, Disc)> {
     let z = mission.bounds.z;
     mission
         .obstacles
         .iter()
         .enumerate()
-        .filter(|(_, o)| o.height > z[0] && !flown_over(mission, o.height))
+        .filter(|(_, o)| o.within(z) && !passed_by_altitude(mission, o))
         .map(|(k, o)| {
             (
                 k,

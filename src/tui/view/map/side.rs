@@ -94,9 +94,9 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
                     };
                     ctx.draw(&Rectangle {
                         x: s - o.radius,
-                        y: 0.0,
+                        y: o.base,
                         width: 2.0 * o.radius,
-                        height: o.height,
+                        height: o.height - o.base,
                         color,
                     });
                     if o.inspect {
