@@ -111,6 +111,7 @@ fn post(name: String, x: f64, y: f64, radius: f64) -> Obstacle {
         center: Point2::new(x, y),
         radius,
         height: 30.0,
+        footprint: Vec::new(),
         base: 0.0,
         overfly: true,
         kind: None,

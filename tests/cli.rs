@@ -18,6 +18,7 @@ fn check_passes_on_the_shipped_missions() {
         "missions/fleet-triangle.toml",
         "missions/narrow-passage.toml",
         "missions/two-span-viaduct.toml",
+        "missions/substation.toml",
     ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
     // Issue 24, item 18: and without a warning (the fleet's route stood
@@ -26,7 +27,7 @@ fn check_passes_on_the_shipped_missions() {
         text(&out.stdout)
             .matches(": ok (0 error(s), 0 warning(s))")
             .count(),
-        5,
+        6,
         "{}",
         text(&out.stdout)
     );

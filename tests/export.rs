@@ -297,7 +297,7 @@ struct Shipped {
 
 /// Every mission in missions/ with the pipeline it is written for. The
 /// viaduct and the SPSO benchmark have no `[origin]`: they export CSV only.
-const SHIPPED: [Shipped; 7] = [
+const SHIPPED: [Shipped; 8] = [
     Shipped {
         mission: "missions/bridge-inspection.toml",
         stem: "bridge-inspection",
@@ -316,6 +316,11 @@ const SHIPPED: [Shipped; 7] = [
     Shipped {
         mission: "missions/two-span-viaduct.toml",
         stem: "two-span-viaduct",
+        pipeline: "theta-pso",
+    },
+    Shipped {
+        mission: "missions/substation.toml",
+        stem: "substation",
         pipeline: "theta-pso",
     },
     Shipped {
@@ -1636,8 +1641,11 @@ fn kml_expectation(m: &Mission, p: &Planned, done: &Exported, dir: &Path) -> Pat
         .obstacles
         .iter()
         .map(|o| {
-            let top = datum + m.ground(o.center.x, o.center.y) + o.height;
-            json!({"name": o.name, "center": [o.center.x, o.center.y], "radius": o.radius, "top": top})
+            let ground = datum + m.ground(o.center.x, o.center.y);
+            let footprint: Vec<[f64; 2]> = o.footprint.iter().map(|v| [v.x, v.y]).collect();
+            json!({"name": o.name, "center": [o.center.x, o.center.y], "radius": o.radius,
+                   "top": ground + o.height, "base": ground + o.base, "raised": o.base > 0.0,
+                   "footprint": footprint})
         })
         .collect();
     let bands: Vec<Value> = m

@@ -100,6 +100,7 @@ fn one_agent_goes_around_an_obstacle_outside_the_safety_distance() {
         center: Point2::new(0.0, 0.0),
         radius: 0.3,
         height: 2.5,
+        footprint: Vec::new(),
         base: 0.0,
         overfly: true,
         kind: None,

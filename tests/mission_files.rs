@@ -194,6 +194,7 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                     center: Point2::new(-w / 2.0 + fx * w, fy * d),
                     radius: r.min(w / 20.0),
                     height: h,
+                    footprint: Vec::new(),
                     base: 0.0,
                     overfly: true,
                     kind: (!kind.is_empty()).then_some(kind),

@@ -35,6 +35,7 @@ fn pole(name: &str, x: f64, y: f64, radius: f64) -> Obstacle {
         center: Point2::new(x, y),
         radius,
         height: 30.0,
+        footprint: Vec::new(),
         base: 0.0,
         overfly: true,
         kind: None,
@@ -765,6 +766,59 @@ fn the_two_span_viaduct_is_planned_through_both_passages_for_20_seeds() {
         crossed.dedup();
         assert_eq!(crossed.len(), 2, "seed {seed}: both passages, {crossed:?}");
         assert!(o.bypassed.is_empty(), "seed {seed}");
+    }
+}
+
+/// Issue 37: the shipped substation (footprints kept as polygons, live bays
+/// not to be flown over with 4 m aisles, a gantry beam 12-13 m up) plans on
+/// seeds 0-19: every UAV among the bays flies in an aisle (the cylinder
+/// cover the import once made left 2.66 m), and every UAV under the beam's
+/// footprint flies below its base.
+#[test]
+fn the_substation_is_planned_through_an_aisle_and_under_the_gantry_for_20_seeds() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("missions/substation.toml");
+    let m = mission::load(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    assert!(
+        m.obstacles
+            .iter()
+            .filter(|o| !o.footprint.is_empty())
+            .count()
+            >= 8
+    );
+    let outcomes: Vec<_> = (0..20u64)
+        .into_par_iter()
+        .map(|seed| run(&m, seed))
+        .collect();
+    let r_q = m.formation.uav_radius;
+    for (seed, o) in outcomes.iter().enumerate() {
+        assert!(
+            o.feasible(),
+            "seed {seed}: {:?}",
+            o.verification.first_failure()
+        );
+        assert_within_the_vehicle(&m, o, seed as u64);
+        let (mut among, mut under) = (0, 0);
+        for tr in &o.trajectories {
+            for s in &tr.samples {
+                let p = s.position;
+                if (30.0..=38.0).contains(&p.x) {
+                    among += 1;
+                    let in_aisle = (p.y - 8.0).rem_euclid(10.0);
+                    assert!(
+                        (r_q..4.0 - r_q).contains(&in_aisle),
+                        "seed {seed}: UAV {} at {p} is not in an aisle",
+                        tr.uav + 1
+                    );
+                }
+                if (p.x - 50.0).abs() < 0.4 + r_q && (4.0..=56.0).contains(&p.y) {
+                    under += 1;
+                    assert!(p.z <= 12.0 - r_q, "seed {seed}: UAV {} at {p}", tr.uav + 1);
+                }
+            }
+        }
+        assert!(among > 0 && under > 0, "seed {seed}: {among} {under}");
     }
 }
 

@@ -3,22 +3,68 @@
 //! Metres, ENU (z up), ground at z = 0. This module is a leaf: it knows nothing
 //! of missions or pipelines.
 
+use std::sync::Arc;
+
 use nalgebra::{Point2, Point3, Vector3};
 
-/// A vertical cylinder: axis through `center`, from z = `base` (0 for what
-/// stands on the ground, higher for a deck) up to z = `height`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Cylinder {
+/// A vertical prism: a footprint in the plane, from z = `base` (0 for what
+/// stands on the ground, higher for a deck) up to z = `height`. The
+/// footprint is the circle (`center`, `radius`), a cylinder, unless
+/// `polygon` holds vertices; then the circle is the polygon's bounding
+/// circle, which the broad phases read (nothing of the polygon is outside
+/// it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Prism {
     pub center: Point2<f64>,
     pub radius: f64,
+    /// A simple polygon's vertices, either winding, not closed (the last
+    /// joins the first); empty for a cylinder.
+    pub polygon: Arc<[Point2<f64>]>,
     pub base: f64,
     pub height: f64,
 }
 
-impl Cylinder {
-    /// Horizontal distance from `p` to the axis.
+impl Prism {
+    /// A cylinder from `base` to `height`.
+    pub fn cylinder(center: Point2<f64>, radius: f64, base: f64, height: f64) -> Self {
+        Prism {
+            center,
+            radius,
+            polygon: Arc::from([]),
+            base,
+            height,
+        }
+    }
+
+    /// Horizontal distance from `p` to the axis (the bounding circle's
+    /// centre for a polygon).
     pub fn horizontal_distance(&self, p: &Point3<f64>) -> f64 {
         (p.xy() - self.center).norm()
+    }
+
+    /// Signed distance in the plane from `q` to the footprint's outline:
+    /// positive outside, negative inside.
+    pub fn outward(&self, q: &Point2<f64>) -> f64 {
+        if self.polygon.is_empty() {
+            (q - self.center).norm() - self.radius
+        } else {
+            polygon_signed_distance(&self.polygon, q)
+        }
+    }
+
+    /// The point of the footprint's outline nearest `q`.
+    pub fn nearest_on_outline(&self, q: &Point2<f64>) -> Point2<f64> {
+        if self.polygon.is_empty() {
+            let away = q - self.center;
+            let n = away.norm();
+            if n > 0.0 {
+                self.center + away * (self.radius / n)
+            } else {
+                self.center + nalgebra::Vector2::new(self.radius, 0.0)
+            }
+        } else {
+            polygon_nearest(&self.polygon, q)
+        }
     }
 
     /// Distance from `p` to the cylinder's axis, extended over the top and
@@ -34,7 +80,7 @@ impl Cylinder {
     /// Signed distance from `p` to the solid cylinder: positive outside,
     /// negative inside (as deep as the nearest side wall).
     pub fn clearance(&self, p: &Point3<f64>) -> f64 {
-        let outward = self.horizontal_distance(p) - self.radius;
+        let outward = self.outward(&p.xy());
         let off = if p.z > self.height {
             p.z - self.height
         } else if p.z < self.base {
@@ -45,6 +91,92 @@ impl Cylinder {
         let sideways = outward.max(0.0);
         (sideways * sideways + off * off).sqrt()
     }
+}
+
+/// The closest points of two footprints' outlines, `a`'s then `b`'s (for
+/// two apart). Between polygons the distance is attained at a vertex of
+/// one of them; a circle's point is towards the other's nearest point.
+pub fn nearest_points(a: &Prism, b: &Prism) -> (Point2<f64>, Point2<f64>) {
+    match (a.polygon.is_empty(), b.polygon.is_empty()) {
+        (true, true) => (
+            a.nearest_on_outline(&b.center),
+            b.nearest_on_outline(&a.center),
+        ),
+        (true, false) => {
+            let on_b = b.nearest_on_outline(&a.center);
+            (a.nearest_on_outline(&on_b), on_b)
+        }
+        (false, true) => {
+            let (on_b, on_a) = nearest_points(b, a);
+            (on_a, on_b)
+        }
+        (false, false) => {
+            let from = |x: &Prism, y: &Prism| {
+                x.polygon
+                    .iter()
+                    .map(|v| (*v, y.nearest_on_outline(v)))
+                    .min_by(|p, q| (p.0 - p.1).norm().total_cmp(&(q.0 - q.1).norm()))
+            };
+            let ab = from(a, b);
+            let ba = from(b, a).map(|(on_b, on_a)| (on_a, on_b));
+            match (ab, ba) {
+                (Some(p), Some(q)) if (q.0 - q.1).norm() < (p.0 - p.1).norm() => q,
+                (Some(p), _) => p,
+                _ => (a.center, b.center),
+            }
+        }
+    }
+}
+
+/// Signed distance from `q` to the simple polygon `vertices`: the distance
+/// to its nearest edge, negative inside (even-odd rule).
+pub fn polygon_signed_distance(vertices: &[Point2<f64>], q: &Point2<f64>) -> f64 {
+    let mut nearest = f64::INFINITY;
+    let mut inside = false;
+    let n = vertices.len();
+    for i in 0..n {
+        let (a, b) = (&vertices[i], &vertices[(i + 1) % n]);
+        nearest = nearest.min(segment_point_distance(a, b, q));
+        if (a.y > q.y) != (b.y > q.y) && q.x < a.x + (q.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    if inside { -nearest } else { nearest }
+}
+
+/// The point of the polygon's boundary nearest `q`.
+pub fn polygon_nearest(vertices: &[Point2<f64>], q: &Point2<f64>) -> Point2<f64> {
+    let n = vertices.len();
+    let mut best = (f64::INFINITY, *q);
+    for i in 0..n {
+        let (a, b) = (vertices[i], vertices[(i + 1) % n]);
+        let ab = b - a;
+        let p = a + ab * clamped_fraction(&ab, &(q - a));
+        let d = (p - q).norm();
+        if d < best.0 {
+            best = (d, p);
+        }
+    }
+    best.1
+}
+
+/// The circle round `vertices` that the broad phases read: centred on the
+/// middle of their bounding box, through the farthest vertex.
+pub fn bounding_circle(vertices: &[Point2<f64>]) -> (Point2<f64>, f64) {
+    let (mut lo, mut hi) = (
+        Point2::new(f64::INFINITY, f64::INFINITY),
+        Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
+    for v in vertices {
+        lo = Point2::new(lo.x.min(v.x), lo.y.min(v.y));
+        hi = Point2::new(hi.x.max(v.x), hi.y.max(v.y));
+    }
+    let center = nalgebra::center(&lo, &hi);
+    let radius = vertices
+        .iter()
+        .map(|v| (v - center).norm())
+        .fold(0.0, f64::max);
+    (center, radius)
 }
 
 /// Distance from `p` to the segment a-b, in the plane.
@@ -96,30 +228,85 @@ pub fn polyline_length(points: &[Point3<f64>]) -> f64 {
 mod tests {
     use super::*;
 
-    const POLE: Cylinder = Cylinder {
-        center: Point2::new(0.0, 0.0),
-        radius: 1.0,
-        base: 0.0,
-        height: 10.0,
-    };
+    fn pole() -> Prism {
+        Prism::cylinder(Point2::new(0.0, 0.0), 1.0, 0.0, 10.0)
+    }
+
+    /// An L-shaped building, 10 × 10 with the 5 × 5 north-east quarter cut
+    /// out, 6 m high.
+    fn ell() -> Prism {
+        let polygon: Vec<_> = [
+            [0.0, 0.0],
+            [10.0, 0.0],
+            [10.0, 5.0],
+            [5.0, 5.0],
+            [5.0, 10.0],
+            [0.0, 10.0],
+        ]
+        .iter()
+        .map(|&[x, y]| Point2::new(x, y))
+        .collect();
+        let (center, radius) = bounding_circle(&polygon);
+        Prism {
+            center,
+            radius,
+            polygon: polygon.into(),
+            base: 0.0,
+            height: 6.0,
+        }
+    }
+
+    #[test]
+    fn clearance_to_a_footprint_is_to_its_nearest_edge_and_negative_inside() {
+        let l = ell();
+        // In the cut-out corner: 2 m from both inner edges' corner.
+        let notch = l.clearance(&Point3::new(7.0, 7.0, 3.0));
+        assert!((notch - 8f64.sqrt()).abs() < 1e-12, "{notch}");
+        // Beside the south face, and inside the west wing.
+        assert_eq!(l.clearance(&Point3::new(3.0, -2.0, 3.0)), 2.0);
+        assert_eq!(l.clearance(&Point3::new(2.0, 8.0, 3.0)), -2.0);
+        // Over the roof: straight up to it, and diagonally past its edge.
+        assert_eq!(l.clearance(&Point3::new(2.0, 2.0, 9.0)), 3.0);
+        let past = l.clearance(&Point3::new(13.0, 2.0, 10.0));
+        assert!(
+            (past - 5.0).abs() < 1e-12,
+            "3-4-5 over the east edge, got {past}"
+        );
+        // The bounding circle holds every vertex; the notch is outside the
+        // footprint although inside that circle.
+        assert!((l.radius - 50f64.sqrt()).abs() < 1e-12);
+        assert_eq!(
+            l.nearest_on_outline(&Point2::new(7.0, 7.0)),
+            Point2::new(5.0, 5.0)
+        );
+    }
+
+    #[test]
+    fn a_deck_is_cleared_under_its_base() {
+        let deck = Prism::cylinder(Point2::new(0.0, 0.0), 3.0, 8.0, 10.0);
+        assert_eq!(deck.clearance(&Point3::new(0.0, 0.0, 5.0)), 3.0);
+        assert_eq!(deck.clearance(&Point3::new(0.0, 0.0, 9.0)), -3.0);
+        let corner = deck.clearance(&Point3::new(7.0, 0.0, 5.0));
+        assert!((corner - 5.0).abs() < 1e-12, "{corner}");
+    }
 
     #[test]
     fn clearance_beside_the_wall_is_horizontal() {
-        assert_eq!(POLE.clearance(&Point3::new(3.0, 0.0, 5.0)), 2.0);
-        assert_eq!(POLE.clearance(&Point3::new(0.5, 0.0, 5.0)), -0.5);
+        assert_eq!(pole().clearance(&Point3::new(3.0, 0.0, 5.0)), 2.0);
+        assert_eq!(pole().clearance(&Point3::new(0.5, 0.0, 5.0)), -0.5);
     }
 
     #[test]
     fn clearance_above_the_top_is_to_the_top_disc() {
-        assert_eq!(POLE.clearance(&Point3::new(0.0, 0.0, 13.0)), 3.0);
-        let corner = POLE.clearance(&Point3::new(4.0, 0.0, 14.0));
+        assert_eq!(pole().clearance(&Point3::new(0.0, 0.0, 13.0)), 3.0);
+        let corner = pole().clearance(&Point3::new(4.0, 0.0, 14.0));
         assert!((corner - 5.0).abs() < 1e-12, "3-4-5 triangle, got {corner}");
     }
 
     #[test]
     fn axis_distance_is_continuous_over_the_top() {
-        let below = POLE.axis_distance(&Point3::new(2.5, 0.0, 10.0));
-        let above = POLE.axis_distance(&Point3::new(2.5, 0.0, 10.0 + 1e-9));
+        let below = pole().axis_distance(&Point3::new(2.5, 0.0, 10.0));
+        let above = pole().axis_distance(&Point3::new(2.5, 0.0, 10.0 + 1e-9));
         assert!((below - above).abs() < 1e-6);
         assert_eq!(below, 2.5);
     }

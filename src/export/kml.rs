@@ -282,9 +282,19 @@ fn mission_folder(mission: &Mission, placement: &Placement, placemarks: &mut usi
 fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> {
     let ground = mission.ground(o.center.x, o.center.y);
     let ring_at = |z: f64| {
-        circle(&o.center, o.radius, |p| {
-            absolute(placement, &Point3::new(p.x, p.y, ground + z))
-        })
+        let at = |p: &Point2<f64>| absolute(placement, &Point3::new(p.x, p.y, ground + z));
+        if o.footprint.is_empty() {
+            circle(&o.center, o.radius, at)
+        } else {
+            // The footprint as surveyed, closed, counter-clockwise (KML's
+            // outer boundary winding).
+            let mut ring: Vec<_> = o.footprint.iter().map(at).collect();
+            if signed_area(&o.footprint) < 0.0 {
+                ring.reverse();
+            }
+            ring.push(ring[0]);
+            ring
+        }
     };
     let geometry = if o.base > 0.0 {
         let (top, bottom) = (ring_at(o.height), ring_at(o.base));
@@ -304,16 +314,18 @@ fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> 
     } else {
         polygon(ring_at(o.height), Vec::new(), AltitudeMode::Absolute, true)
     };
+    let outline = if o.footprint.is_empty() {
+        format!("radius {} m", o.radius)
+    } else {
+        format!("footprint of {} vertices", o.footprint.len())
+    };
     let mut text = if o.base > 0.0 {
         format!(
-            "radius {} m, from {} to {} m above the ground",
-            o.radius, o.base, o.height
+            "{outline}, from {} to {} m above the ground",
+            o.base, o.height
         )
     } else {
-        format!(
-            "radius {} m, height {} m above the ground",
-            o.radius, o.height
-        )
+        format!("{outline}, height {} m above the ground", o.height)
     };
     if !o.overfly {
         text.push_str("; not to be flown over");
@@ -330,6 +342,13 @@ fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> 
         geometry,
         if o.inspect { "inspected" } else { "obstacle" },
     )
+}
+
+/// Twice the signed area of a polygon: positive counter-clockwise.
+fn signed_area(v: &[Point2<f64>]) -> f64 {
+    (0..v.len())
+        .map(|i| v[i].coords.perp(&v[(i + 1) % v.len()].coords))
+        .sum()
 }
 
 /// An inspected obstacle's stand-off band [d_min, d_max] from its surface,

@@ -140,6 +140,7 @@ pub fn merge(mission: &Mission, features: &[FeatureObstacles]) -> (Mission, Chan
                     Some(what) => {
                         old.center = new.center;
                         old.radius = new.radius;
+                        old.footprint = new.footprint.clone();
                         old.height = new.height;
                         old.kind = new.kind.clone();
                         changes.list.push(Change::Updated(new.name.clone(), what));
@@ -165,6 +166,13 @@ fn differences(old: &Obstacle, new: &Obstacle) -> Option<String> {
     if (new.radius - old.radius).abs() > 1e-6 {
         what.push(format!("radius {} → {} m", old.radius, new.radius));
     }
+    if new.footprint != old.footprint {
+        what.push(format!(
+            "footprint of {} → {} vertices",
+            old.footprint.len(),
+            new.footprint.len()
+        ));
+    }
     if (new.height - old.height).abs() > 1e-6 {
         what.push(format!("height {} → {} m", old.height, new.height));
     }
@@ -186,6 +194,7 @@ mod tests {
             center: Point2::new(x, 10.0),
             radius: 1.0,
             height: 10.0,
+            footprint: Vec::new(),
             base: 0.0,
             overfly: true,
             kind: None,

@@ -1,8 +1,9 @@
 //! A survey's features as cylinders in the mission's ENU frame.
 //!
 //! A point is one cylinder; a line a row of them (`cover::cover_line`); a
-//! polygon a cover whose union contains it (`cover::cover_polygon`). Lines
-//! and polygons are clipped to the bounds first (obstacle centres must lie
+//! polygon a footprint, as surveyed (holes filled: a courtyard is no way
+//! through for a formation). Lines and polygons are clipped to the bounds
+//! first (obstacle centres must lie
 //! in them), points outside are left out; both are said. Radius and height
 //! come from the feature's `radius` and `height` properties (metres),
 //! else from the defaults here, with a warning; the name from its name
@@ -43,16 +44,18 @@ pub struct FeatureObstacles {
     pub obstacles: Vec<Obstacle>,
 }
 
-/// What a polygon's or a line's cylinders are, for the report.
+/// What a polygon's footprints or a line's cylinders are, for the report.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Note {
     Polygon {
         label: String,
-        cylinders: usize,
-        /// m² of the polygon inside the bounds, of the union of its cylinders,
-        /// and of the polygon outside the bounds (left out).
+        /// Footprints made (a polygon the bounds cut in two makes two).
+        footprints: usize,
+        vertices: usize,
+        /// m² of the polygon inside the bounds, and outside (left out).
         area: f64,
-        covered: f64,
+        /// Holes filled in.
+        holes: usize,
         outside: f64,
     },
     Line {
@@ -70,22 +73,20 @@ impl fmt::Display for Note {
         match self {
             Note::Polygon {
                 label,
-                cylinders,
+                footprints,
+                vertices,
                 area,
-                covered,
+                holes,
                 outside,
             } => {
-                let excess = (covered - area).max(0.0);
                 write!(
                     f,
-                    "polygon {label}: {cylinders} cylinder(s) covering {covered:.1} m² for its \
-                     {area:.1} m²: {excess:.1} m² ({:.0} %) more than the polygon",
-                    if *area > 0.0 {
-                        100.0 * excess / area
-                    } else {
-                        0.0
-                    }
+                    "polygon {label}: kept as {footprints} footprint(s) of {vertices} vertices, \
+                     {area:.1} m²"
                 )?;
+                if *holes > 0 {
+                    write!(f, "; {holes} hole(s) filled in")?;
+                }
                 if *outside > 0.05 {
                     write!(f, "; {outside:.1} m² outside the bounds left out")?;
                 }
@@ -152,6 +153,7 @@ pub fn make(
         let radius = property(f, "radius", &mut problems);
         let height = property(f, "height", &mut problems);
         let mut discs: Vec<Disc> = Vec::new();
+        let mut footprints: Vec<Vec<Point2<f64>>> = Vec::new();
         let mut outside_points = 0;
         let mut no_area = false;
         for shape in &f.shapes {
@@ -160,7 +162,7 @@ pub fn make(
                     let center = enu(p);
                     if bounds.contains_xy(&center) {
                         let r = radius.unwrap_or(DEFAULT_POINT_RADIUS);
-                        discs.push(tidy(Disc { center, radius: r }, false));
+                        discs.push(tidy(Disc { center, radius: r }));
                     } else {
                         outside_points += 1;
                     }
@@ -172,7 +174,7 @@ pub fn make(
                     let before = discs.len();
                     for piece in pieces {
                         let row = cover::cover_line(&piece, r);
-                        discs.extend(row.into_iter().map(|d| tidy(d, false)));
+                        discs.extend(row.into_iter().map(tidy));
                     }
                     if discs.len() > before {
                         made.notes.push(Note::Line {
@@ -198,29 +200,26 @@ pub fn make(
                     if area <= 1e-6 {
                         continue;
                     }
-                    let Some(c) = cover::cover_polygon(&inside, radius) else {
-                        problems.push(format!(
-                            "{}: a cover with cylinders of radius {} m would need more than {} \
-                             of them; give a larger radius",
-                            f.label(),
-                            radius.unwrap_or_default(),
-                            cover::MAX_DISCS
-                        ));
-                        continue;
-                    };
-                    let tidied: Vec<Disc> = c.discs.into_iter().map(|d| tidy(d, true)).collect();
+                    let before = footprints.len();
+                    let mut holes = 0;
+                    for part in &inside {
+                        holes += part.interiors().len();
+                        if let Some(outline) = footprint_of(part.exterior()) {
+                            footprints.push(outline);
+                        }
+                    }
                     made.notes.push(Note::Polygon {
                         label: f.label(),
-                        cylinders: tidied.len(),
+                        footprints: footprints.len() - before,
+                        vertices: footprints[before..].iter().map(Vec::len).sum(),
                         area,
-                        covered: cover::union_area(&tidied),
+                        holes,
                         outside: (whole - area).max(0.0),
                     });
-                    discs.extend(tidied);
                 }
             }
         }
-        if discs.is_empty() {
+        if discs.is_empty() && footprints.is_empty() {
             let why = if no_area {
                 "a polygon of no area".to_owned()
             } else {
@@ -246,19 +245,26 @@ pub fn make(
             .property("kind")
             .and_then(text)
             .or_else(|| f.folder.clone());
-        let several = discs.len() > 1;
-        let obstacles = discs
+        let several = discs.len() + footprints.len() > 1;
+        let shapes = discs
             .into_iter()
+            .map(|d| (d.center, d.radius, Vec::new()))
+            .chain(footprints.into_iter().map(|v| {
+                let (center, radius) = crate::base::geometry::bounding_circle(&v);
+                (center, radius, v)
+            }));
+        let obstacles = shapes
             .enumerate()
-            .map(|(k, d)| Obstacle {
+            .map(|(k, (center, radius, footprint))| Obstacle {
                 name: if several {
                     format!("{name} #{}", k + 1)
                 } else {
                     name.clone()
                 },
-                center: d.center,
-                radius: d.radius,
+                center,
+                radius,
                 height: height.unwrap_or(default_height),
+                footprint,
                 base: 0.0,
                 overfly: true,
                 kind: kind.clone(),
@@ -288,21 +294,14 @@ pub fn make(
 }
 
 /// As the mission file writes it: the centre to 0.1 mm (a survey's points
-/// are not known better; the file stays readable). A cover's disc (`grow`)
-/// also gets its radius up to the next 0.1 mm beyond what the rounding can
-/// take away, so that it still holds its part of the polygon; a radius the
-/// survey gives stays as given.
-fn tidy(d: Disc, grow: bool) -> Disc {
+/// are not known better; the file stays readable), the radius as given.
+fn tidy(d: Disc) -> Disc {
     // Through the decimal text, so the file shows the short form.
     let short = |v: f64| format!("{v:.4}").parse().unwrap_or(v);
-    let center = Point2::new(short(d.center.x), short(d.center.y));
-    let moved = (center - d.center).norm();
-    let radius = if grow {
-        short(((d.radius + moved) * 1e4).ceil() / 1e4)
-    } else {
-        d.radius
-    };
-    Disc { center, radius }
+    Disc {
+        center: Point2::new(short(d.center.x), short(d.center.y)),
+        radius: d.radius,
+    }
 }
 
 /// A few labels and how many more.
@@ -413,6 +412,24 @@ fn enu_polygon(
     let (outer, holes) = rings.split_first()?;
     let polygon = Polygon::new(ring(outer), holes.iter().map(ring).collect());
     Some(MultiPolygon::new(vec![polygon]))
+}
+
+/// A ring as a footprint: its vertices to 0.1 mm (the file shows the short
+/// form), without the closing repeat or repeated vertices; `None` when
+/// fewer than three remain.
+fn footprint_of(ring: &LineString<f64>) -> Option<Vec<Point2<f64>>> {
+    let short = |v: f64| format!("{v:.4}").parse().unwrap_or(v);
+    let mut out: Vec<Point2<f64>> = Vec::new();
+    for c in ring.coords() {
+        let p = Point2::new(short(c.x), short(c.y));
+        if out.last() != Some(&p) {
+            out.push(p);
+        }
+    }
+    if out.len() > 1 && out.first() == out.last() {
+        out.pop();
+    }
+    (out.len() >= 3).then_some(out)
 }
 
 /// The parts of `line` inside `bounds`, their length and the length left

@@ -121,8 +121,8 @@ impl Mission {
 
     /// Obstacle `o` as a cylinder in the ENU frame: with terrain, standing on
     /// the ground under its centre (its height is above that ground).
-    pub fn cylinder(&self, o: &Obstacle) -> crate::base::geometry::Cylinder {
-        let mut c = o.cylinder();
+    pub fn prism(&self, o: &Obstacle) -> crate::base::geometry::Prism {
+        let mut c = o.prism();
         if self.terrain.is_some() {
             let ground = self.ground(o.center.x, o.center.y);
             c.height += ground;
@@ -226,15 +226,24 @@ impl Bounds {
     }
 }
 
-/// A vertical cylinder from `base` (the ground unless set) up to `height`.
+/// A vertical prism from `base` (the ground unless set) up to `height`: a
+/// cylinder (`center`, `radius`), or a polygon `footprint` (a building, a
+/// transformer bay), whose bounding circle `center` and `radius` then are.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Obstacle {
     pub name: String,
-    /// Axis position, metres ENU.
+    /// Axis position, metres ENU; derived from the footprint when there is
+    /// one (then the file may leave it out).
+    #[serde(default = "unset_point")]
     pub center: Point2<f64>,
-    /// Metres.
+    /// Metres; derived from the footprint when there is one.
+    #[serde(default = "unset")]
     pub radius: f64,
+    /// A simple polygon's vertices, metres ENU, either winding, not closed;
+    /// empty for a cylinder.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub footprint: Vec<Point2<f64>>,
     /// Its top, metres above ground.
     pub height: f64,
     /// Its underside, metres above ground: 0 for what stands on the ground,
@@ -509,6 +518,16 @@ pub struct WaypointChoice {
     /// Overrides `shrink_scale` for this IWP.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<f64>,
+}
+
+/// A centre or a radius the file left out: NaN, which validation names
+/// unless a footprint sets them.
+fn unset() -> f64 {
+    f64::NAN
+}
+
+fn unset_point() -> Point2<f64> {
+    Point2::new(f64::NAN, f64::NAN)
 }
 
 fn is_yes(b: &bool) -> bool {
@@ -931,13 +950,43 @@ impl Obstacle {
 
     /// The solid the planner keeps clear of: up to the sky when it may not
     /// be flown over.
-    pub fn cylinder(&self) -> crate::base::geometry::Cylinder {
-        crate::base::geometry::Cylinder {
+    pub fn prism(&self) -> crate::base::geometry::Prism {
+        crate::base::geometry::Prism {
             center: self.center,
             radius: self.radius,
+            polygon: self.footprint.as_slice().into(),
             base: self.base,
             height: self.top(),
         }
+    }
+
+    /// A polygon's `center` and `radius` are its bounding circle's: set
+    /// them from the footprint (after reading a file, after an edit of a
+    /// vertex).
+    pub fn settle(&mut self) {
+        if self.footprint.len() >= 3 {
+            (self.center, self.radius) = crate::base::geometry::bounding_circle(&self.footprint);
+        }
+    }
+
+    /// Moves the obstacle, its footprint with it, so its centre is at `p`.
+    pub fn move_to(&mut self, p: Point2<f64>) {
+        let by = p - self.center;
+        for v in &mut self.footprint {
+            *v += by;
+        }
+        self.center = p;
+    }
+
+    /// Sets the radius; a footprint is scaled about the centre to match.
+    pub fn set_radius(&mut self, radius: f64) {
+        if !self.footprint.is_empty() && self.radius > 0.0 && radius.is_finite() && radius > 0.0 {
+            let k = radius / self.radius;
+            for v in &mut self.footprint {
+                *v = self.center + (*v - self.center) * k;
+            }
+        }
+        self.radius = radius;
     }
 
     /// A cylinder standing on the ground, to be overflown: the fields every
@@ -953,6 +1002,7 @@ impl Obstacle {
             center,
             radius,
             height,
+            footprint: Vec::new(),
             base: 0.0,
             overfly: true,
             kind: None,

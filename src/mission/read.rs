@@ -20,8 +20,11 @@ pub(super) fn read_model(
     let root = DeTable::parse(text).map_err(|e| vec![locate_toml_error(&e, source)])?;
     let conversions = geodetic::convert(&root)?;
     let root = geodetic::apply(root, &conversions);
-    let mission = Mission::deserialize(toml::de::Deserializer::from(root))
+    let mut mission = Mission::deserialize(toml::de::Deserializer::from(root))
         .map_err(|e| vec![locate_toml_error(&e, source)])?;
+    for o in &mut mission.obstacles {
+        o.settle();
+    }
     Ok((mission, conversions.forms))
 }
 

@@ -124,7 +124,9 @@ pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
             ok: check.ok,
             text: format!(
                 "{:<32} worst {worst:>9} {} {}{at}",
-                check.name, check.relation, check.limit
+                check.name,
+                check.relation,
+                crate::pipelines::theta_pso::verify::limit_figure(check.limit)
             ),
         });
     }

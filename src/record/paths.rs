@@ -7,6 +7,9 @@ use crate::pipelines::Kind;
 pub const WORLD: &str = "world";
 pub const BOUNDS: &str = "world/bounds";
 pub const OBSTACLES: &str = "world/obstacles";
+/// Obstacles with a polygon footprint, one mesh each (`world/footprints/<k>`,
+/// k the obstacle's index in the mission).
+pub const FOOTPRINTS: &str = "world/footprints";
 pub const INSPECTION: &str = "world/inspection";
 pub const ROUTE: &str = "world/route";
 pub const TERRAIN: &str = "world/terrain";

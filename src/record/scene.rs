@@ -4,8 +4,53 @@
 use rerun::RecordingStream;
 
 use super::{f32x3, paths};
-use crate::mission::{Mission, to_toml_string};
+use crate::mission::{Mission, Obstacle, to_toml_string};
 use crate::pipelines::theta_pso::find_iwps;
+
+/// An obstacle's colour: inspected ones stand out.
+fn obstacle_color(o: &Obstacle) -> rerun::Color {
+    if o.inspect {
+        rerun::Color::from_rgb(200, 90, 200)
+    } else {
+        rerun::Color::from_rgb(150, 150, 160)
+    }
+}
+
+/// A footprint's prism as a closed mesh from its base to its top: the
+/// footprint triangulated (ear clipping, `geo`) for the caps, a quad per
+/// edge for the sides. `None` for a cylinder.
+fn footprint_mesh(o: &Obstacle) -> Option<rerun::Mesh3D> {
+    use geo::TriangulateEarcut;
+    if o.footprint.len() < 3 {
+        return None;
+    }
+    let ring: Vec<geo::Coord<f64>> = o
+        .footprint
+        .iter()
+        .map(|p| geo::coord! { x: p.x, y: p.y })
+        .collect();
+    let raw = geo::Polygon::new(geo::LineString::new(ring), Vec::new()).earcut_triangles_raw();
+    let v = &raw.vertices;
+    let n = v.len() as u32;
+    let at = |p: &[f64; 2], z: f64| [p[0] as f32, p[1] as f32, z as f32];
+    let vertices: Vec<[f32; 3]> = v
+        .iter()
+        .map(|p| at(p, o.base))
+        .chain(v.iter().map(|p| at(p, o.height)))
+        .collect();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    for t in raw.triangle_indices.chunks_exact(3) {
+        let [a, b, c] = [t[0] as u32, t[1] as u32, t[2] as u32];
+        triangles.push([c, b, a]);
+        triangles.push([a + n, b + n, c + n]);
+    }
+    for i in 0..n {
+        let j = (i + 1) % n;
+        triangles.push([i, j, j + n]);
+        triangles.push([i, j + n, i + n]);
+    }
+    Some(rerun::Mesh3D::new(vertices).with_triangle_indices(triangles))
+}
 
 /// The mission as static data.
 pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamResult<()> {
@@ -23,8 +68,20 @@ pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStrea
         )
         .with_labels(["altitude band"]),
     )?;
-    if !m.obstacles.is_empty() {
-        let o = &m.obstacles;
+    for (k, o) in m.obstacles.iter().enumerate() {
+        if let Some(mesh) = footprint_mesh(o) {
+            stream.log_static(
+                format!("{}/{k}", paths::FOOTPRINTS),
+                &mesh.with_albedo_factor(obstacle_color(o).0),
+            )?;
+        }
+    }
+    let o: Vec<_> = m
+        .obstacles
+        .iter()
+        .filter(|o| o.footprint.is_empty())
+        .collect();
+    if !o.is_empty() {
         stream.log_static(
             paths::OBSTACLES,
             &rerun::Cylinders3D::from_lengths_and_radii(
@@ -39,13 +96,7 @@ pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStrea
                 ]
             }))
             .with_labels(o.iter().map(|o| o.name.clone()))
-            .with_colors(o.iter().map(|o| {
-                if o.inspect {
-                    rerun::Color::from_rgb(200, 90, 200)
-                } else {
-                    rerun::Color::from_rgb(150, 150, 160)
-                }
-            })),
+            .with_colors(o.iter().map(|o| obstacle_color(o))),
         )?;
         // Inspected surfaces (eq. 8): the stand-off band's outer shell,
         // translucent, over the altitude band.

@@ -54,7 +54,7 @@ fn log_clearances(
     o: &ThetaPsoOutcome,
     m: &Mission,
 ) -> rerun::RecordingStreamResult<()> {
-    let cylinders: Vec<_> = m.obstacles.iter().map(|ob| m.cylinder(ob)).collect();
+    let cylinders: Vec<_> = m.obstacles.iter().map(|ob| m.prism(ob)).collect();
     if cylinders.is_empty() {
         return Ok(());
     }

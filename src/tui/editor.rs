@@ -746,7 +746,7 @@ fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
     match item {
         Item::Obstacle(i) => {
             if let Some(o) = m.obstacles.get_mut(*i) {
-                o.center = p;
+                o.move_to(p);
             }
         }
         Item::Start => {

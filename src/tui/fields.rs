@@ -447,6 +447,7 @@ pub fn new_obstacle(mission: &Mission, center: Point2<f64>) -> Obstacle {
         center,
         radius: 1.0,
         height: (mission.bounds.z[1] + 1.0).max(1.0),
+        footprint: Vec::new(),
         base: 0.0,
         overfly: true,
         kind: None,
@@ -459,7 +460,7 @@ pub fn new_obstacle(mission: &Mission, center: Point2<f64>) -> Obstacle {
 pub fn duplicate_obstacle(mission: &Mission, original: &Obstacle) -> Obstacle {
     let offset = 2.0 * original.radius + 1.0;
     let mut copy = original.clone();
-    copy.center.x += offset;
+    copy.move_to(copy.center + nalgebra::Vector2::new(offset, 0.0));
     let mut k = 2;
     while mission
         .obstacles

@@ -252,9 +252,10 @@ fn hit(
                 }
             }
             for (i, o) in m.obstacles.iter().enumerate() {
-                let d = (o.center - p).norm();
-                if d <= o.radius + tolerance {
-                    consider(d - o.radius, Item::Obstacle(i));
+                // To the outline: a footprint is hit on or inside it.
+                let d = o.prism().outward(&p);
+                if d <= tolerance {
+                    consider(d, Item::Obstacle(i));
                 }
             }
             for (i, t) in m.fleet.targets.iter().enumerate() {

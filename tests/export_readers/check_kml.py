@@ -20,7 +20,9 @@ Expectation file (JSON)::
              "home": [lat, lon, alt],                # the waypoint files' home
              "samples": [[x, y, z, altitude], ...]}  # ENU metres, the plan; its absolute altitude
           ],
-          "obstacles": [{"name": "pier 1", "center": [x, y], "radius": 2.5, "top": 16.0}],
+          "obstacles": [{"name": "pier 1", "center": [x, y], "radius": 2.5, "top": 16.0,
+                         "base": 0.0, "raised": false,   # base > 0: a closed solid
+                         "footprint": []}],               # [[x, y], ...]: a polygon
           "bands": [{"name": "pier 1 band", "center": [x, y], "inner": 3.5, "outer": 7.5}]
         }
       ]
@@ -35,7 +37,8 @@ a vehicle holding, share a vertex): every sample's latitude/longitude within the
 frame, its altitude within the tolerance of the expected absolute altitude
 ([origin].altitude + z, the export's convention); the vehicle's home Point at the expected
 home. Each obstacle is an extruded Polygon, absolute, every vertex at its radius from its
-centre and at its top; each band a ring on the ground between its two radii.
+centre (or one of its footprint's vertices) and at its top; one raised off the ground (a
+deck) a MultiGeometry of polygons, every vertex at its base or its top; each band a ring on the ground between its two radii.
 """
 
 import argparse
@@ -78,6 +81,8 @@ def coords_of(placemark):
     g = placemark.kml_geometry
     if type(g).__name__ == "Polygon":
         return list(placemark.geometry.exterior.coords)
+    if type(g).__name__ == "MultiGeometry":
+        return [c for part in placemark.geometry.geoms for c in part.exterior.coords]
     return list(placemark.geometry.coords)
 
 
@@ -199,17 +204,31 @@ def check_file(entry, tol):
             errors.append(f"{where}: not found")
             continue
         g = p.kml_geometry
-        if type(g).__name__ != "Polygon" or not g.extrude:
-            errors.append(f"{where}: expected an extruded Polygon, got {type(g).__name__}")
-            continue
-        if g.altitude_mode != AltitudeMode.absolute:
-            errors.append(f"{where}: altitudeMode {g.altitude_mode}, expected absolute")
+        raised = o.get("raised", False)
+        if raised:
+            # A deck: a closed solid (MultiGeometry of polygons) from base to top.
+            if type(g).__name__ != "MultiGeometry":
+                errors.append(f"{where}: expected a MultiGeometry solid, got {type(g).__name__}")
+                continue
+            heights = (o["base"], o["top"])
+        else:
+            if type(g).__name__ != "Polygon" or not g.extrude:
+                errors.append(f"{where}: expected an extruded Polygon, got {type(g).__name__}")
+                continue
+            if g.altitude_mode != AltitudeMode.absolute:
+                errors.append(f"{where}: altitudeMode {g.altitude_mode}, expected absolute")
+            heights = (o["top"],)
+        footprint = o.get("footprint") or []
         for c in coords_of(p):
             e, n = ground_point(c[0], c[1], origin)
-            off = abs(math.hypot(e - o["center"][0], n - o["center"][1]) - o["radius"])
+            if footprint:
+                # A surveyed footprint: every vertex is one of its vertices.
+                off = min(math.hypot(e - x, n - y) for x, y in footprint)
+            else:
+                off = abs(math.hypot(e - o["center"][0], n - o["center"][1]) - o["radius"])
             worst_h = max(worst_h, off)
-            if off > tol or abs(c[2] - o["top"]) > tol:
-                errors.append(f"{where}: vertex {c} is {off:.4f} m off its circle or not at its height")
+            if off > tol or min(abs(c[2] - h) for h in heights) > tol:
+                errors.append(f"{where}: vertex {c} is {off:.4f} m off its outline or not at its height")
                 break
     for b in entry.get("bands", []):
         where = f"{name} band {b['name']!r}"

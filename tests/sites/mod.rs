@@ -318,6 +318,7 @@ fn generate(index: u64, wide: bool) -> Site {
             center: *center,
             radius: *r,
             height: z_max + rng.random_range(2.0..10.0),
+            footprint: Vec::new(),
             base: 0.0,
             overfly: true,
             kind: Some("wall".into()),
@@ -414,6 +415,7 @@ fn generate(index: u64, wide: bool) -> Site {
             } else {
                 rng.random_range(6.0..30.0)
             },
+            footprint: Vec::new(),
             base: 0.0,
             overfly: true,
             kind: None,

@@ -111,7 +111,7 @@ impl Checker {
             && mission
                 .obstacles
                 .iter()
-                .all(|o| mission.cylinder(o).clearance(p) >= reach + f.uav_radius);
+                .all(|o| mission.prism(o).clearance(p) >= reach + f.uav_radius);
         if roomy {
             return;
         }
@@ -204,6 +204,29 @@ impl Checker {
                     ),
                 );
             }
+            if o.footprint.is_empty() {
+                for (key, unset) in [
+                    ("center", !o.center.iter().all(|v| v.is_finite())),
+                    ("radius", o.radius.is_nan()),
+                ] {
+                    if unset {
+                        self.error(
+                            at.key(key),
+                            "missing: a cylinder needs `center` and `radius` (a building or a bay \
+                             may give `footprint = [[x, y], …]` instead)",
+                        );
+                    }
+                }
+            } else {
+                self.footprint(at.key("footprint"), o, bounds);
+                if o.inspect {
+                    self.error(
+                        at.key("inspect"),
+                        "inspecting a footprint is not supported yet: the pass is planned round a \
+                         cylinder's axis; inspect a cylinder standing at the face to be seen",
+                    );
+                }
+            }
             self.positive(at.key("radius"), o.radius, " m");
             self.positive(at.key("height"), o.height, " m");
             self.non_negative(at.key("base"), o.base, " m");
@@ -244,7 +267,7 @@ impl Checker {
                     ),
                 );
             }
-            if !o.center.iter().all(|v| v.is_finite()) {
+            if !o.center.iter().all(|v| v.is_finite()) || !o.footprint.is_empty() {
                 continue;
             }
             if !bounds.contains_xy(&o.center) {
@@ -264,6 +287,44 @@ impl Checker {
                     self.warning(at.key("radius"), "the cylinder reaches outside the bounds");
                 }
             }
+        }
+    }
+
+    /// A footprint: a simple polygon of at least three distinct vertices
+    /// with an area, inside the bounds (partly outside is a warning, as a
+    /// cylinder's reach is).
+    fn footprint(&mut self, path: FieldPath, o: &crate::mission::Obstacle, bounds: &Bounds) {
+        use geo::{Area, Validation};
+        let v = &o.footprint;
+        if !v.iter().all(|p| p.x.is_finite() && p.y.is_finite()) {
+            return; // named by the finite check, located
+        }
+        let ring: Vec<geo::Coord<f64>> = v.iter().map(|p| geo::coord! { x: p.x, y: p.y }).collect();
+        let polygon = geo::Polygon::new(geo::LineString::new(ring), Vec::new());
+        if v.len() < 3 {
+            self.error(path, format!("needs at least 3 vertices, got {}", v.len()));
+            return;
+        }
+        if let Err(why) = polygon.check_validation() {
+            let why = why.to_string().replace("exterior ring", "the outline");
+            self.error(path, format!("is not a simple polygon: {why}"));
+            return;
+        }
+        if polygon.unsigned_area() < 1e-6 {
+            self.error(path, "is degenerate: its vertices enclose no area");
+            return;
+        }
+        let inside = v.iter().filter(|p| bounds.contains_xy(p)).count();
+        if inside == 0 {
+            self.error(
+                path,
+                format!(
+                    "lies outside the bounds x {:?}, y {:?}: no vertex is inside",
+                    bounds.x, bounds.y
+                ),
+            );
+        } else if inside < v.len() {
+            self.warning(path, "the footprint reaches outside the bounds");
         }
     }
 
@@ -379,7 +440,7 @@ fn fit_at(mission: &Mission, p: &Point3<f64>, heading: f64) -> Misfit {
             }
         }
         for obstacle in &mission.obstacles {
-            let inside = f.uav_radius - mission.cylinder(obstacle).clearance(&q);
+            let inside = f.uav_radius - mission.prism(obstacle).clearance(&q);
             if inside > worst.depth {
                 worst = Misfit {
                     uav: n,

@@ -107,11 +107,7 @@ fn slack_near(
     let motion = super::motion::Motion::new(path, &f.slots, span);
     let column = f.slots.len() as f64 * super::iwp::column_spacing(f) / 2.0;
     let reach = f.radius() + span + column + MAX_TOLERANCE;
-    let cylinders: Vec<_> = mission
-        .obstacles
-        .iter()
-        .map(|o| mission.cylinder(o))
-        .collect();
+    let cylinders: Vec<_> = mission.obstacles.iter().map(|o| mission.prism(o)).collect();
     let ground = mission.ground_model();
     let b = &mission.bounds;
     let mut here = Vec::new();

@@ -27,7 +27,7 @@
 use nalgebra::{Point2, Vector2, Vector3};
 use serde::Serialize;
 
-use crate::base::geometry::segment_point_distance;
+use crate::base::geometry::{nearest_points, segment_point_distance};
 use crate::mission::{Formation, Mission, ShapeChoice};
 
 /// An intermediate waypoint between two obstacles.
@@ -445,18 +445,30 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
             if !a.within(mission.bounds.z) || !b.within(mission.bounds.z) {
                 continue;
             }
-            let axis = b.center - a.center;
-            let distance = axis.norm();
-            if distance == 0.0 {
-                continue;
-            }
-            let gap = distance - a.radius - b.radius;
+            let (p_p, p_q, gap, u) = if a.footprint.is_empty() && b.footprint.is_empty() {
+                let axis = b.center - a.center;
+                let distance = axis.norm();
+                if distance == 0.0 {
+                    continue;
+                }
+                let u = axis / distance;
+                let gap = distance - a.radius - b.radius;
+                (a.center + u * a.radius, b.center - u * b.radius, gap, u)
+            } else {
+                // Footprints: the IWP is at the middle of their nearest
+                // points (eq. 9's P_p, P_q on the outlines).
+                if (a.center - b.center).norm() - a.radius - b.radius >= fits_formation {
+                    continue;
+                }
+                let (pa, pb) = (a.prism(), b.prism());
+                let (p_p, p_q) = nearest_points(&pa, &pb);
+                let apart = pa.outward(&p_q) > 0.0 && pb.outward(&p_p) > 0.0;
+                let gap = if apart { (p_q - p_p).norm() } else { -1.0 };
+                (p_p, p_q, gap, (p_q - p_p) / gap.abs().max(1e-12))
+            };
             if !(too_narrow <= gap && gap < fits_formation) {
                 continue;
             }
-            let u = axis / distance;
-            let p_p = a.center + u * a.radius;
-            let p_q = b.center - u * b.radius;
             let blocked = obstacles.iter().enumerate().any(|(k, o)| {
                 k != p
                     && k != q

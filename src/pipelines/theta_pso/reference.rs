@@ -97,7 +97,14 @@ pub fn lower_bound(mission: &Mission, iwps: &[Iwp], resolution: f64) -> Option<R
         .iter()
         .filter(|o| o.closes(mission.bounds.z, f.least_clearance()))
         .map(|o| {
-            let reach = o.radius + f.least_clearance();
+            // A footprint's inscribed circle about its bounding centre (none
+            // when that centre is outside it): the bound stays a lower bound.
+            let inner = if o.footprint.is_empty() {
+                o.radius
+            } else {
+                (-crate::base::geometry::polygon_signed_distance(&o.footprint, &o.center)).max(0.0)
+            };
+            let reach = inner + f.least_clearance();
             let rho = shapes
                 .iter()
                 .map(|s| closest_centroid(s, reach))

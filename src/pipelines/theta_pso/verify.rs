@@ -56,6 +56,17 @@ pub fn figure(value: f64) -> String {
     }
 }
 
+/// A limit as the tables print it: as written, without the float noise a
+/// sum such as r_Q + margin leaves (0.44999999999999996 is 0.45).
+pub fn limit_figure(value: f64) -> String {
+    let rounded = (value * 1e9).round() / 1e9;
+    if value.abs() >= 1e-3 && rounded.is_finite() {
+        format!("{rounded}")
+    } else {
+        format!("{value}")
+    }
+}
+
 /// A sample that breaks a constraint.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Violation {
@@ -95,7 +106,9 @@ impl Verification {
             });
             return Some(format!(
                 "{} worst {worst} {} {}{at}",
-                c.name, c.relation, c.limit
+                c.name,
+                c.relation,
+                limit_figure(c.limit)
             ));
         }
         self.inspections.iter().find(|i| !i.ok).map(|i| {
@@ -210,11 +223,7 @@ pub fn verify_within(
             });
         }
     };
-    let cylinders: Vec<_> = mission
-        .obstacles
-        .iter()
-        .map(|o| mission.cylinder(o))
-        .collect();
+    let cylinders: Vec<_> = mission.obstacles.iter().map(|o| mission.prism(o)).collect();
     let ground = mission.ground_model();
     let samples = trajectories
         .iter()
@@ -496,7 +505,7 @@ pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec
         .filter(|o| o.inspect)
         .map(|o| {
             let band = o.stand_off_band(f);
-            let cylinder = o.cylinder();
+            let cylinder = o.prism();
             // (start, end) sample indices of the current and the best run.
             let mut run: Option<usize> = None;
             let mut best: Option<(usize, usize)> = None;

@@ -88,12 +88,14 @@ static TERRAIN: Table = Table { base: &[Key("terrain")], derived: &[], fields: &
 static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], derived: &[], fields: &[
     Spec { name: "name", unit: "", keys: &["name"], get: |m, i| text(&obstacle_at(m, i)?.name), set: rename_obstacle },
     Spec { name: "kind", unit: "", keys: &["kind"], get: |m, i| text(obstacle_at(m, i)?.kind.as_deref().unwrap_or("")), set: |m, i, t| put(&mut obstacle(m, i)?.kind, Ok((!t.is_empty()).then(|| t.to_owned()))) },
-    Spec { name: "centre x", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.x), set: |m, i, t| put(&mut obstacle(m, i)?.center.x, number(t)) },
-    Spec { name: "centre y", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.y), set: |m, i, t| put(&mut obstacle(m, i)?.center.y, number(t)) },
+    Spec { name: "centre x", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.x), set: |m, i, t| { let o = obstacle(m, i)?; let x = number(t)?; o.move_to(Point2::new(x, o.center.y)); Ok(()) } },
+    Spec { name: "centre y", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.y), set: |m, i, t| { let o = obstacle(m, i)?; let y = number(t)?; o.move_to(Point2::new(o.center.x, y)); Ok(()) } },
     Spec { name: "centre lat", unit: "°", keys: &["center", "latitude"], get: |m, i| geo(m, i, LAT), set: |m, i, t| set_geo(m, i, t, LAT) },
     Spec { name: "centre lon", unit: "°", keys: &["center", "longitude"], get: |m, i| geo(m, i, LON), set: |m, i, t| set_geo(m, i, t, LON) },
-    Spec { name: "radius", unit: "m", keys: &["radius"], get: |m, i| num(obstacle_at(m, i)?.radius), set: |m, i, t| put(&mut obstacle(m, i)?.radius, number(t)) },
+    Spec { name: "radius", unit: "m", keys: &["radius"], get: |m, i| num(obstacle_at(m, i)?.radius), set: |m, i, t| { let r = number(t)?; obstacle(m, i)?.set_radius(r); Ok(()) } },
     Spec { name: "height", unit: "m", keys: &["height"], get: |m, i| num(obstacle_at(m, i)?.height), set: |m, i, t| put(&mut obstacle(m, i)?.height, number(t)) },
+    Spec { name: "base", unit: "m", keys: &["base"], get: |m, i| num(obstacle_at(m, i)?.base), set: |m, i, t| put(&mut obstacle(m, i)?.base, number(t)) },
+    Spec { name: "overfly", unit: "", keys: &["overfly"], get: |m, i| yes(obstacle_at(m, i)?.overfly), set: |m, i, t| put(&mut obstacle(m, i)?.overfly, yes_no(t)) },
     Spec { name: "inspect (eq. 8)", unit: "", keys: &["inspect"], get: |m, i| yes(obstacle_at(m, i)?.inspect), set: |m, i, t| put(&mut obstacle(m, i)?.inspect, yes_no(t)) },
     Spec { name: "stand-off min", unit: "m", keys: &["stand_off"], get: |m, i| num(obstacle_at(m, i)?.stand_off_band(&m.formation)[0]), set: |m, i, t| set_stand_off(m, i, 0, t) },
     Spec { name: "stand-off max", unit: "m", keys: &["stand_off"], get: |m, i| num(obstacle_at(m, i)?.stand_off_band(&m.formation)[1]), set: |m, i, t| set_stand_off(m, i, 1, t) },
@@ -303,7 +305,7 @@ fn set_geo(m: &mut Mission, item: &Item, text: &str, lat: bool) -> Result<(), St
     match item {
         Item::Start => (m.route.start.x, m.route.start.y) = (p.x, p.y),
         Item::Goal => (m.route.goal.x, m.route.goal.y) = (p.x, p.y),
-        Item::Obstacle(_) => obstacle(m, item)?.center = p,
+        Item::Obstacle(_) => obstacle(m, item)?.move_to(p),
         Item::FleetTarget(_) => target(m, item)?.position = p,
         _ => return Err("this item has no position".into()),
     }

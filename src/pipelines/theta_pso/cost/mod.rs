@@ -38,7 +38,7 @@ use super::iwp::{Iwp, Shape};
 use super::motion::{Motion, Reader};
 use super::path::Hint;
 use super::path::{CentroidPath, heading_span};
-use crate::base::geometry::Cylinder;
+use crate::base::geometry::Prism;
 use crate::mission::{Bounds, Mission, ThetaPsoParams};
 use serde::Serialize;
 
@@ -63,7 +63,7 @@ const MAX_DEPTH: u32 = 8;
 #[derive(Debug, Clone)]
 pub struct CostModel {
     params: ThetaPsoParams,
-    obstacles: Vec<Cylinder>,
+    obstacles: Vec<Prism>,
     slots: Vec<Vector3<f64>>,
     /// r_Q + the safety margin: what every UAV keeps from an obstacle and
     /// a bound before the cost's own margin.
@@ -217,11 +217,7 @@ impl CostModel {
             .min((spare / 2.0).max(0.0));
         CostModel {
             params: mission.theta_pso.clone(),
-            obstacles: mission
-                .obstacles
-                .iter()
-                .map(|o| mission.cylinder(o))
-                .collect(),
+            obstacles: mission.obstacles.iter().map(|o| mission.prism(o)).collect(),
             bands: mission
                 .obstacles
                 .iter()
@@ -493,7 +489,7 @@ impl CostModel {
         &self,
         a: &Point3<f64>,
         b: &Point3<f64>,
-        c: &Cylinder,
+        c: &Prism,
         reach: f64,
         rise: f64,
     ) -> Option<(f64, f64)> {
@@ -878,7 +874,23 @@ struct Scratch {
 /// part of the piece within √(R² − h²) of the closest point. Exact for a
 /// level piece below the top; above it, h is the axis distance at the closest
 /// point (which counts the height over the top disc).
-pub fn violation_along(p: &Point3<f64>, q: &Point3<f64>, c: &Cylinder, safe: f64) -> f64 {
+///
+/// A polygon footprint has no axis: d is R + its clearance (R its bounding
+/// circle's radius, so r^S − d is the clearance short of r_Q + margin, as
+/// for a cylinder), integrated by the midpoint rule at 0.2 m or finer.
+pub fn violation_along(p: &Point3<f64>, q: &Point3<f64>, c: &Prism, safe: f64) -> f64 {
+    if !c.polygon.is_empty() {
+        let length = (q - p).norm();
+        let n = ((length / 0.2).ceil() as usize).clamp(2, 64);
+        let step = length / n as f64;
+        return (0..n)
+            .map(|i| {
+                let at = p + (q - p) * ((i as f64 + 0.5) / n as f64);
+                (1.0 - (c.radius + c.clearance(&at)) / safe).max(0.0)
+            })
+            .sum::<f64>()
+            * step;
+    }
     let (a, b) = (p.xy(), q.xy());
     let ab = b - a;
     let length = ab.norm();

@@ -267,10 +267,7 @@ mod tests {
     fn map(centres: &[(f64, f64)]) -> SqueezeMap {
         let discs: Vec<Disc> = centres
             .iter()
-            .map(|&(x, y)| Disc {
-                center: Point2::new(x, y),
-                radius: 3.0,
-            })
+            .map(|&(x, y)| Disc::round(Point2::new(x, y), 3.0))
             .collect();
         let field = Field::new([[0.0, 40.0], [0.0, 40.0]], &discs, 0.5, 20.0);
         let cells = field.len();

@@ -76,7 +76,7 @@ pub fn explain(
         i
     }
     let b = &mission.bounds;
-    let gap_of = |a: &Disc, c: &Disc| (a.center - c.center).norm() - a.radius - c.radius;
+    let gap_of = |a: &Disc, c: &Disc| a.gap_to(c);
     for i in 0..n {
         for j in (i + 1)..n {
             if gap_of(&obstacles[i].1, &obstacles[j].1) < 2.0 * need {

@@ -7,13 +7,57 @@
 //! conservative). The route stage reads it at two reaches, the nominal shape
 //! and the smallest shrink, so one field serves both.
 
+use std::sync::Arc;
+
 use nalgebra::Point2;
 
-/// An obstacle as the field sees it: a disc in the plane.
-#[derive(Debug, Clone, Copy)]
+use crate::base::geometry::polygon_signed_distance;
+
+/// An obstacle as the field sees it: its footprint in the plane, a disc
+/// (`center`, `radius`) or a polygon whose bounding circle the disc is.
+#[derive(Debug, Clone)]
 pub struct Disc {
     pub center: Point2<f64>,
     pub radius: f64,
+    pub polygon: Option<Arc<[Point2<f64>]>>,
+}
+
+impl Disc {
+    /// A plain disc.
+    pub fn round(center: Point2<f64>, radius: f64) -> Self {
+        Disc {
+            center,
+            radius,
+            polygon: None,
+        }
+    }
+
+    /// Signed distance from `p` to the footprint's edge (negative inside).
+    pub fn gap(&self, p: Point2<f64>) -> f64 {
+        match &self.polygon {
+            Some(v) => polygon_signed_distance(v, &p),
+            None => (p - self.center).norm() - self.radius,
+        }
+    }
+
+    /// The distance between two footprints' edges (negative where they
+    /// overlap, as deep as a disc's): between polygons, the least of
+    /// every vertex's distance to the other, which for two apart is
+    /// attained at a vertex of one of them.
+    pub fn gap_to(&self, other: &Disc) -> f64 {
+        match (&self.polygon, &other.polygon) {
+            (None, _) => other.gap(self.center) - self.radius,
+            (Some(_), None) => self.gap(other.center) - other.radius,
+            (Some(a), Some(b)) => {
+                let of = |from: &[Point2<f64>], to: &[Point2<f64>]| {
+                    from.iter()
+                        .map(|v| polygon_signed_distance(to, v))
+                        .fold(f64::INFINITY, f64::min)
+                };
+                of(a, b).min(of(b, a))
+            }
+        }
+    }
 }
 
 /// A grid of clearances over a rectangle.
@@ -52,7 +96,7 @@ impl Field {
                 let cy = origin.y + iy as f64 * cell;
                 for ix in lo_x..hi_x {
                     let cx = origin.x + ix as f64 * cell;
-                    let gap = ((cx - d.center.x).hypot(cy - d.center.y) - d.radius) as f32;
+                    let gap = d.gap(Point2::new(cx, cy)) as f32;
                     let i = iy * nx + ix;
                     if gap < clearance[i] {
                         clearance[i] = gap;
@@ -120,7 +164,7 @@ impl Field {
         let mut best = self.cap;
         for j in self.neighbourhood(i) {
             if let Some(d) = self.nearest_disc(j).and_then(|k| discs.get(k)) {
-                best = best.min((p - d.center).norm() - d.radius);
+                best = best.min(d.gap(p));
             }
         }
         best
@@ -218,14 +262,8 @@ mod tests {
     #[test]
     fn the_field_is_the_distance_to_the_nearest_edge() {
         let discs = [
-            Disc {
-                center: Point2::new(5.0, 5.0),
-                radius: 1.0,
-            },
-            Disc {
-                center: Point2::new(8.0, 5.0),
-                radius: 0.5,
-            },
+            Disc::round(Point2::new(5.0, 5.0), 1.0),
+            Disc::round(Point2::new(8.0, 5.0), 0.5),
         ];
         let f = Field::new([[0.0, 10.0], [0.0, 10.0]], &discs, 0.5, 3.0);
         let at = |x: f64, y: f64| f.clearance(f.index_of(Point2::new(x, y)));

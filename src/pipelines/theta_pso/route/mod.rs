@@ -208,6 +208,7 @@ fn blocking(mission: &Mission) -> Vec<(usize, Disc)> {
                 Disc {
                     center: o.center,
                     radius: o.radius,
+                    polygon: (!o.footprint.is_empty()).then(|| o.footprint.as_slice().into()),
                 },
             )
         })
@@ -259,7 +260,7 @@ impl Site {
         let cells = (MAX_STATES / (LAYERS * (stops + 1)) as f64).min(MAX_CELLS);
         let cell = (area / cells).sqrt().max(FINEST_CELL);
         let obstacles = blocking(mission);
-        let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| *d).collect();
+        let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| d.clone()).collect();
         let field = Field::new([b.x, b.y], &discs, cell, need[0] + 2.0 * cell);
         let boxes = [
             [dx_dy(builder)[0], dx_dy(builder)[1]],

@@ -406,7 +406,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     });
     let safe = m.formation.safe_radius();
     // Safe radii first, lightly, so obstacles and paths draw over them.
-    for o in &m.obstacles {
+    for o in m.obstacles.iter().filter(|o| o.footprint.is_empty()) {
         ctx.draw(&Ring {
             x: o.center.x,
             y: o.center.y,
@@ -438,13 +438,27 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
         } else {
             Color::LightRed
         };
-        ctx.draw(&Ring {
-            x: o.center.x,
-            y: o.center.y,
-            radius: o.radius,
-            color,
-            dot,
-        });
+        if o.footprint.is_empty() {
+            ctx.draw(&Ring {
+                x: o.center.x,
+                y: o.center.y,
+                radius: o.radius,
+                color,
+                dot,
+            });
+        } else {
+            // The footprint's outline, closed.
+            let outline: Vec<(f64, f64)> = o
+                .footprint
+                .iter()
+                .chain(o.footprint.first())
+                .map(|p| (p.x, p.y))
+                .collect();
+            ctx.draw(&Polyline {
+                points: &outline,
+                color,
+            });
+        }
         if selected {
             // A filled centre so a small selected obstacle is easy to see.
             ctx.draw(&Ring {
@@ -736,9 +750,20 @@ fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
             o.name.clone()
         };
         let width = Span::raw(label.as_str()).width() as f64;
+        // Beside the outline at its centre's height: a footprint's own
+        // extent across, not its bounding circle's (a long beam's is wide).
+        let (west, east) = if o.footprint.is_empty() {
+            (o.center.x - o.radius, o.center.x + o.radius)
+        } else {
+            o.footprint
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                    (lo.min(p.x), hi.max(p.x))
+                })
+        };
         let spots = [
-            (o.center.x + o.radius + scale, o.center.y),
-            (o.center.x - o.radius - scale * (width + 1.0), o.center.y),
+            (east + scale, o.center.y),
+            (west - scale * (width + 1.0), o.center.y),
         ];
         labels.place(ctx, &spots, Span::styled(label, style), selected == Some(i));
     }
