@@ -482,3 +482,55 @@ fn an_inspection_no_altitude_of_the_band_is_level_with_is_refused() {
         diagnostics(&fine)
     );
 }
+
+/// Issue 37, footprints: a polygon that crosses itself, one of no area, one
+/// outside the bounds and one of too many vertices are refused at
+/// `footprint`; a cylinder without its radius is refused naming `radius`;
+/// an L-shaped building loads, its centre and radius its bounding circle.
+#[test]
+fn a_footprint_must_be_a_simple_polygon_with_an_area_in_the_bounds() {
+    let building = |footprint: &str| {
+        mission_with(&format!(
+            "[[obstacles]]\nname = \"hall\"\nfootprint = {footprint}\nheight = 8.0\n"
+        ))
+    };
+    let message =
+        |footprint: &str| error_at(&building(footprint), "obstacles[0].footprint").message;
+    let bowtie = message("[[40.0, 40.0], [60.0, 60.0], [60.0, 40.0], [40.0, 60.0]]");
+    assert!(bowtie.contains("not a simple polygon"), "{bowtie}");
+    let flat = message("[[40.0, 40.0], [50.0, 40.0], [60.0, 40.0]]");
+    assert!(
+        flat.contains("no area") || flat.contains("not a simple"),
+        "{flat}"
+    );
+    let away = message("[[140.0, 40.0], [160.0, 40.0], [160.0, 60.0]]");
+    assert!(away.contains("outside the bounds"), "{away}");
+    let many: Vec<String> = (0..600)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::TAU / 600.0;
+            format!(
+                "[{:.4}, {:.4}]",
+                50.0 + 10.0 * a.cos(),
+                50.0 + 10.0 * a.sin()
+            )
+        })
+        .collect();
+    let dense = message(&format!("[{}]", many.join(", ")));
+    assert!(dense.contains("600 vertices, more than 500"), "{dense}");
+    let cylinder =
+        mission_with("[[obstacles]]\nname = \"mast\"\ncenter = [50.0, 50.0]\nheight = 8.0\n");
+    let d = error_at(&cylinder, "obstacles[0].radius");
+    assert!(d.message.contains("missing"), "{}", d.message);
+    let ell = building(
+        "[[40.0, 40.0], [60.0, 40.0], [60.0, 50.0], [50.0, 50.0], [50.0, 60.0], [40.0, 60.0]]",
+    );
+    assert!(
+        diagnostics(&ell).iter().all(|d| !d.is_error()),
+        "{:?}",
+        diagnostics(&ell)
+    );
+    let loaded = parse_str(&ell, FILE).unwrap_or_else(|e| panic!("{e}"));
+    let hall = &loaded.mission.obstacles[0];
+    assert_eq!(hall.center, nalgebra::Point2::new(50.0, 50.0));
+    assert!((hall.radius - 200f64.sqrt()).abs() < 1e-12);
+}

@@ -1493,7 +1493,71 @@ fn a_low_wall_the_formation_clears_is_flown_over() {
             assert!(s.position.z >= 9.6, "UAV {} at {}", tr.uav + 1, s.position);
         }
     }
+    // The summary states it: the posts under some UAV's track, by name.
+    assert!(
+        !o.passed_over.is_empty() && o.passed_over.iter().all(|n| n.starts_with("block ")),
+        "{:?}",
+        o.passed_over
+    );
+    assert!(o.passed_under.is_empty(), "{:?}", o.passed_under);
+    let summary = skyform::outcome::summary::theta_pso(&o, false);
+    assert!(
+        summary.contains(&format!("flies over   '{}'", o.passed_over[0])),
+        "{summary}"
+    );
     let refused = refusal(&wall(9.5));
+    assert!(refused.contains("'block 1'"), "{refused}");
+}
+
+/// Issue 37, the route stage in 3-D, the climb: the gapless wall of the test
+/// above 12 m high, the formation at 10 m, the band up to 20 m. No corridor
+/// exists at 10 m, so the search is repeated at altitudes that pass over
+/// what closes the way (12.7 m here) and the plan climbs over, every UAV
+/// above the posts; with the ceiling at 12.5 m there is no room and the
+/// refusal names the wall.
+#[test]
+fn a_wall_above_the_flight_with_room_under_the_ceiling_is_climbed_over() {
+    let wall = |ceiling: f64| {
+        let mut m = open_field();
+        m.bounds.z = [5.0, ceiling];
+        m.formation.safety_margin = 0.1;
+        m.obstacles = (0..59)
+            .map(|k| {
+                let mut o = pole(&format!("block {}", k + 1), 50.0, 1.0 + 1.7 * k as f64, 1.0);
+                o.height = 12.0;
+                o
+            })
+            .collect();
+        m
+    };
+    for seed in 0..3 {
+        let o = run(&wall(20.0), seed);
+        assert!(
+            o.feasible(),
+            "seed {seed}: {:?}",
+            o.verification.first_failure()
+        );
+        assert!(
+            o.corridor.cruise.is_some_and(|z| z > 12.0),
+            "{:?}",
+            o.corridor.cruise
+        );
+        for tr in &o.trajectories {
+            for s in tr
+                .samples
+                .iter()
+                .filter(|s| (s.position.x - 50.0).abs() < 1.6)
+            {
+                assert!(
+                    s.position.z >= 12.6,
+                    "seed {seed}: UAV {} at {}",
+                    tr.uav + 1,
+                    s.position
+                );
+            }
+        }
+    }
+    let refused = refusal(&wall(12.5));
     assert!(refused.contains("'block 1'"), "{refused}");
 }
 
@@ -1533,6 +1597,11 @@ fn a_deck_with_room_below_is_flown_under() {
         }
     }
     assert!(under > 0, "no sample passes under the deck");
+    assert!(
+        !o.passed_under.is_empty() && o.passed_over.is_empty(),
+        "{:?}",
+        o.passed_under
+    );
     let refused = refusal(&deck(10.5));
     assert!(refused.contains("'deck 1'"), "{refused}");
 }

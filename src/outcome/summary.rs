@@ -64,6 +64,11 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
         o.route_length
     );
     iwps(&mut s, o, verbose);
+    for (word, names) in [("over", &o.passed_over), ("under", &o.passed_under)] {
+        if !names.is_empty() {
+            let _ = writeln!(s, "  flies {word:<6} {}", few_names(names));
+        }
+    }
     for r in &o.reconfigurations {
         let why = if r.iwp.is_some() {
             "at the IWP"
@@ -93,6 +98,16 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
     };
     let _ = writeln!(s, "  result       {verdict}");
     s
+}
+
+/// Up to three names in quotes, then how many more: a gapless wall of 59
+/// posts flown over is one short line.
+fn few_names(names: &[String]) -> String {
+    let shown: Vec<String> = names.iter().take(3).map(|n| format!("'{n}'")).collect();
+    match names.len() {
+        n if n > 3 => format!("{} and {} more", shown.join(", "), n - 3),
+        _ => shown.join(", "),
+    }
 }
 
 /// One row of θ-PSO's verification table: a check or an inspection pass,

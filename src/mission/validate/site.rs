@@ -3,6 +3,9 @@
 
 use super::*;
 
+/// Most vertices a footprint may have.
+pub const MAX_FOOTPRINT_VERTICES: usize = 500;
+
 impl Checker {
     pub(super) fn origin(&mut self, path: &FieldPath, origin: &GeoOrigin) {
         if origin.latitude.abs() > 90.0 {
@@ -235,7 +238,8 @@ impl Checker {
                     at.key("base"),
                     format!(
                         "{} m is at or above its top (height = {} m): the base is its underside",
-                        o.base, o.height
+                        compact(o.base),
+                        compact(o.height)
                     ),
                 );
             }
@@ -303,6 +307,18 @@ impl Checker {
         let polygon = geo::Polygon::new(geo::LineString::new(ring), Vec::new());
         if v.len() < 3 {
             self.error(path, format!("needs at least 3 vertices, got {}", v.len()));
+            return;
+        }
+        if v.len() > MAX_FOOTPRINT_VERTICES {
+            // Every clearance the planners take walks the outline.
+            self.error(
+                path,
+                format!(
+                    "has {} vertices, more than {MAX_FOOTPRINT_VERTICES}: simplify it (a survey \
+                     tool's simplify to 0.1 m keeps a building's shape)",
+                    v.len()
+                ),
+            );
             return;
         }
         if let Err(why) = polygon.check_validation() {

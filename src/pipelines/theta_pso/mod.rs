@@ -134,6 +134,13 @@ pub struct ThetaPsoOutcome {
     /// Usable, enabled IWPs the plan does not cross (it goes round them),
     /// as indices into `iwps`.
     pub bypassed: Vec<usize>,
+    /// The obstacles some UAV flies over (above the top, inside the
+    /// footprint) and under (below the base), by name, in mission order:
+    /// what the summary states, the site being the user's to allow.
+    #[serde(default)]
+    pub passed_over: Vec<String>,
+    #[serde(default)]
+    pub passed_under: Vec<String>,
     /// Where the plan kept comes from: the swarm, its repair, or the corridor.
     pub source: PlanSource,
     /// The route stage's corridor length, metres.
@@ -873,6 +880,7 @@ pub fn plan_warm(
         })
         .collect();
     let reference_length = reference.map(|r| r.length);
+    let [passed_over, passed_under] = passed_by_altitude(mission, &best.flight.trajectories);
     Ok(ThetaPsoOutcome {
         pipeline: crate::pipelines::Kind::ThetaPso,
         mission: mission.name.clone(),
@@ -899,12 +907,40 @@ pub fn plan_warm(
         flown_arcs: best.flight.progress,
         reconfigurations: best.flight.reconfigurations,
         bypassed,
+        passed_over,
+        passed_under,
         source: best.source,
         route_length: corridor.length,
         corridor,
         trajectories: best.flight.trajectories,
         verification: best.verification,
     })
+}
+
+/// The obstacles some UAV's track passes over and under (see
+/// [`ThetaPsoOutcome::passed_over`]).
+pub fn passed_by_altitude(mission: &Mission, tracks: &[Trajectory]) -> [Vec<String>; 2] {
+    let mut found = [Vec::new(), Vec::new()];
+    for o in &mission.obstacles {
+        let prism = mission.prism(o);
+        let (mut over, mut under) = (false, false);
+        for s in tracks.iter().flat_map(|t| &t.samples) {
+            let p = s.position;
+            if prism.outward(&p.xy()) <= 0.0 {
+                over |= p.z > prism.height;
+                under |= p.z < prism.base;
+            }
+            if over && under {
+                break;
+            }
+        }
+        for (list, passed) in found.iter_mut().zip([over, under]) {
+            if passed {
+                list.push(o.name.clone());
+            }
+        }
+    }
+    found
 }
 
 /// One run of the swarm from `starts` (the rest at random) on the `attempt`-th

@@ -158,7 +158,8 @@ fn waypoints(problem: &Problem, corridor: &Corridor) -> (Vec<Point3<f64>>, Vec<f
         .enumerate()
         .map(|(i, p)| {
             let u = (i + 1) as f64 / total as f64;
-            let height = (start.z + (goal.z - start.z) * u).clamp(z[0], z[1]);
+            let along = start.z + (goal.z - start.z) * u;
+            let height = corridor.cruise.unwrap_or(along).clamp(z[0], z[1]);
             Point3::new(p.x, p.y, height)
         })
         .collect();

@@ -83,6 +83,11 @@ pub struct Corridor {
     /// Per inspection (builder order): the angle round the axis and the side.
     pub passes: Vec<(f64, bool)>,
     pub length: f64,
+    /// The centroid altitude the corridor is flown at, when the search had
+    /// to climb (or descend) off the start's and goal's altitudes to pass
+    /// over (under) what closes the way there; `None`: between them.
+    #[serde(default)]
+    pub cruise: Option<f64>,
     /// Where the formation flies squeezed, for every path the swarm tries
     /// (worked out from the site for each run, never written).
     #[serde(skip)]
@@ -97,6 +102,7 @@ impl PartialEq for Corridor {
             && self.legs == other.legs
             && self.passes == other.passes
             && self.length == other.length
+            && self.cruise == other.cruise
     }
 }
 
@@ -181,27 +187,87 @@ impl Shape {
 /// its search, so a gapless wall of 9 m posts is no wall to a formation at
 /// 10 m, nor a deck 14 m up. One it would have to climb over is still kept
 /// out, as is one marked `overfly = false`.
-pub fn passed_by_altitude(mission: &Mission, o: &Obstacle) -> bool {
-    let f = &mission.formation;
+///
+/// With a `cruise` altitude the corridor is flown at that altitude instead.
+pub fn passed_by_altitude(mission: &Mission, o: &Obstacle, cruise: Option<f64>) -> bool {
+    let [over, under] = pass_altitudes(mission, o);
+    let (low, high) = cruise.map_or_else(|| seeded_altitudes(mission), |z| (z, z));
+    over <= low || high <= under
+}
+
+/// The lower and the higher of the start's and the goal's altitudes, in
+/// the band: the altitudes a corridor between them flies.
+fn seeded_altitudes(mission: &Mission) -> (f64, f64) {
     let z = mission.bounds.z;
     let band = |v: f64| v.clamp(z[0], z[1].max(z[0]));
     let (start, goal) = (mission.route.start.z, mission.route.goal.z);
-    let (low, high) = (band(start.min(goal)), band(start.max(goal)));
+    (band(start.min(goal)), band(start.max(goal)))
+}
+
+/// The lowest centroid altitude that passes over `o` (its lowest UAV r_Q +
+/// margins above the top) and the highest that passes under it.
+fn pass_altitudes(mission: &Mission, o: &Obstacle) -> [f64; 2] {
+    let f = &mission.formation;
     let below = f.slots.iter().map(|s| -s.z).fold(0.0, f64::max);
     let above = f.slots.iter().map(|s| s.z).fold(0.0, f64::max);
     let clearance = f.least_clearance() + mission.theta_pso.clearance_margin.max(0.0);
-    o.top() + clearance + below <= low || high + above + clearance <= o.base
+    [o.top() + clearance + below, o.base - clearance - above]
 }
+
+/// Altitudes to search at when no corridor exists between the start's and
+/// the goal's: those that pass over (then under) more of what is in the
+/// way there, inside the band the centroid may take (`z_box`), from the
+/// nearest; at most [`MAX_CRUISE_TRIES`], the one passing over (under) all
+/// of them among them.
+fn cruise_altitudes(mission: &Mission, z_box: [f64; 2]) -> Vec<f64> {
+    let (low, high) = seeded_altitudes(mission);
+    let in_way: Vec<[f64; 2]> = mission
+        .obstacles
+        .iter()
+        .filter(|o| o.within(mission.bounds.z) && !passed_by_altitude(mission, o, None))
+        .map(|o| pass_altitudes(mission, o))
+        .collect();
+    let pick = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v.dedup_by(|a, b| (*a - *b).abs() < 0.05);
+        let n = v.len();
+        let per = MAX_CRUISE_TRIES / 2;
+        let mut chosen: Vec<f64> = (1..=per)
+            .filter_map(|i| v.get((n * i).div_ceil(per).max(1) - 1).copied())
+            .collect();
+        chosen.dedup();
+        chosen
+    };
+    let over = pick(
+        in_way
+            .iter()
+            .map(|[o, _]| *o)
+            .filter(|z| *z > high && *z <= z_box[1])
+            .collect(),
+    );
+    let mut under = pick(
+        in_way
+            .iter()
+            .map(|[_, u]| *u)
+            .filter(|z| *z < low && *z >= z_box[0])
+            .collect(),
+    );
+    under.reverse();
+    over.into_iter().chain(under).collect()
+}
+
+/// Most altitudes the route stage tries off the start's and goal's.
+const MAX_CRUISE_TRIES: usize = 6;
 
 /// The obstacles a formation in the band cannot fly over or under, as
 /// discs (see [`passed_by_altitude`]).
-fn blocking(mission: &Mission) -> Vec<(usize, Disc)> {
+fn blocking(mission: &Mission, cruise: Option<f64>) -> Vec<(usize, Disc)> {
     let z = mission.bounds.z;
     mission
         .obstacles
         .iter()
         .enumerate()
-        .filter(|(_, o)| o.within(z) && !passed_by_altitude(mission, o))
+        .filter(|(_, o)| o.within(z) && !passed_by_altitude(mission, o, cruise))
         .map(|(k, o)| {
             (
                 k,
@@ -247,7 +313,7 @@ impl Site {
         })
     }
 
-    fn new(mission: &Mission, builder: &PathBuilder, margin: f64) -> Self {
+    fn new(mission: &Mission, builder: &PathBuilder, margin: f64, cruise: Option<f64>) -> Self {
         let shape = Shape::new(mission, margin);
         let need = shape.need();
         let b = &mission.bounds;
@@ -259,7 +325,7 @@ impl Site {
         let stops = builder.inspections().len() + builder.crossing_iwps().len();
         let cells = (MAX_STATES / (LAYERS * (stops + 1)) as f64).min(MAX_CELLS);
         let cell = (area / cells).sqrt().max(FINEST_CELL);
-        let obstacles = blocking(mission);
+        let obstacles = blocking(mission, cruise);
         let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| d.clone()).collect();
         let field = Field::new([b.x, b.y], &discs, cell, need[0] + 2.0 * cell);
         let boxes = [
@@ -339,7 +405,29 @@ pub fn find(
     iwps: &[Iwp],
     margin: f64,
 ) -> Result<Corridor, Blocked> {
-    let site = Site::new(mission, builder, margin);
+    let flat = find_at(mission, builder, iwps, margin, None);
+    let Err(blocked) = flat else {
+        return flat;
+    };
+    // Closed between the start's and the goal's altitudes: climb over (or
+    // descend under) what closes it, when the band leaves room.
+    for z in cruise_altitudes(mission, builder.decoding_box()[2]) {
+        if let Ok(corridor) = find_at(mission, builder, iwps, margin, Some(z)) {
+            return Ok(corridor);
+        }
+    }
+    Err(blocked)
+}
+
+/// The route search with the corridor flown at `cruise` (see [`find`]).
+fn find_at(
+    mission: &Mission,
+    builder: &PathBuilder,
+    iwps: &[Iwp],
+    margin: f64,
+    cruise: Option<f64>,
+) -> Result<Corridor, Blocked> {
+    let site = Site::new(mission, builder, margin, cruise);
     let Site {
         shape,
         need,
@@ -463,6 +551,7 @@ pub fn find(
         builder.inspections().len(),
     );
     corridor.squeeze = site.squeeze_of(&corridor, mission);
+    corridor.cruise = cruise;
     Ok(corridor)
 }
 
@@ -596,6 +685,7 @@ fn assemble(
         legs,
         passes,
         length,
+        cruise: None,
         squeeze: None,
     }
 }

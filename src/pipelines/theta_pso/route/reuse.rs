@@ -36,7 +36,7 @@ pub fn reuse(
     {
         return None;
     }
-    let site = Site::new(mission, builder, margin);
+    let site = Site::new(mission, builder, margin, previous.cruise);
     let crossings = builder.crossings();
     let mut passed = vec![0usize; previous.passes.len()];
     let mut crossed = vec![false; crossings.len()];
