@@ -319,11 +319,6 @@ const SHIPPED: [Shipped; 8] = [
         pipeline: "theta-pso",
     },
     Shipped {
-        mission: "missions/substation.toml",
-        stem: "substation",
-        pipeline: "theta-pso",
-    },
-    Shipped {
         mission: "missions/spso-benchmark.toml",
         stem: "spso-benchmark",
         pipeline: "theta-pso",
@@ -337,6 +332,11 @@ const SHIPPED: [Shipped; 8] = [
         mission: "missions/fleet-triangle.toml",
         stem: "fleet-triangle",
         pipeline: "fleet",
+    },
+    Shipped {
+        mission: "missions/substation.toml",
+        stem: "substation",
+        pipeline: "theta-pso",
     },
 ];
 
@@ -1482,9 +1482,13 @@ fn flight_expectation(m: &Mission, p: &Planned, done: &Exported, dir: &Path) -> 
     let obstacles: Vec<Value> = m
         .obstacles
         .iter()
-        .map(
-            |o| json!({"center": [o.center.x, o.center.y], "radius": o.radius, "height": o.height}),
-        )
+        .map(|o| {
+            let footprint: Vec<[f64; 2]> = o.footprint.iter().map(|v| [v.x, v.y]).collect();
+            // Not to be flown over: as high as the sky (JSON has no infinity).
+            let top = if o.overfly { o.height } else { 1e9 };
+            json!({"center": [o.center.x, o.center.y], "radius": o.radius, "height": top,
+                   "base": o.base, "footprint": footprint})
+        })
         .collect();
     let kml = done
         .files

@@ -259,9 +259,12 @@ mod tests {
     #[test]
     fn clearance_to_a_footprint_is_to_its_nearest_edge_and_negative_inside() {
         let l = ell();
-        // In the cut-out corner: 2 m from both inner edges' corner.
-        let notch = l.clearance(&Point3::new(7.0, 7.0, 3.0));
-        assert!((notch - 8f64.sqrt()).abs() < 1e-12, "{notch}");
+        // In the cut-out corner: 1 m from the inner edge x = 5 (the
+        // bounding circle holds it, the footprint does not).
+        let notch = l.clearance(&Point3::new(6.0, 8.0, 3.0));
+        assert!((notch - 1.0).abs() < 1e-12, "{notch}");
+        let corner = l.clearance(&Point3::new(7.0, 7.0, 3.0));
+        assert!((corner - 2.0).abs() < 1e-12, "{corner}");
         // Beside the south face, and inside the west wing.
         assert_eq!(l.clearance(&Point3::new(3.0, -2.0, 3.0)), 2.0);
         assert_eq!(l.clearance(&Point3::new(2.0, 8.0, 3.0)), -2.0);
@@ -276,8 +279,8 @@ mod tests {
         // footprint although inside that circle.
         assert!((l.radius - 50f64.sqrt()).abs() < 1e-12);
         assert_eq!(
-            l.nearest_on_outline(&Point2::new(7.0, 7.0)),
-            Point2::new(5.0, 5.0)
+            l.nearest_on_outline(&Point2::new(6.0, 8.0)),
+            Point2::new(5.0, 8.0)
         );
     }
 

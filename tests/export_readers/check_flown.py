@@ -145,12 +145,35 @@ def position(points, arrive, depart, t):
     return points[-1]
 
 
+def outward(p, o):
+    """Signed distance in the plane from p to o's outline: its circle, or its footprint
+    polygon when it has one (negative inside, even-odd rule)."""
+    footprint = o.get("footprint") or []
+    if not footprint:
+        return math.hypot(p[0] - o["center"][0], p[1] - o["center"][1]) - o["radius"]
+    nearest, inside, n = math.inf, False, len(footprint)
+    for i in range(n):
+        (ax, ay), (bx, by) = footprint[i], footprint[(i + 1) % n]
+        dx, dy = bx - ax, by - ay
+        length2 = dx * dx + dy * dy
+        t = 0.0 if length2 == 0 else max(0.0, min(1.0, ((p[0] - ax) * dx + (p[1] - ay) * dy) / length2))
+        nearest = min(nearest, math.hypot(ax + t * dx - p[0], ay + t * dy - p[1]))
+        if (ay > p[1]) != (by > p[1]) and p[0] < ax + (p[1] - ay) / (by - ay) * (bx - ax):
+            inside = not inside
+    return -nearest if inside else nearest
+
+
 def clearance(p, o):
-    """Distance from p to the solid cylinder o standing on flat ground."""
-    outward = math.hypot(p[0] - o["center"][0], p[1] - o["center"][1]) - o["radius"]
-    if p[2] <= o["height"]:
-        return outward
-    return math.hypot(max(outward, 0.0), p[2] - o["height"])
+    """Distance from p to the solid prism o (flat ground): beside it, to its outline; above
+    its top or below its base, to the nearest point of that face."""
+    side = outward(p, o)
+    if p[2] > o["height"]:
+        off = p[2] - o["height"]
+    elif p[2] < o.get("base", 0.0):
+        off = o["base"] - p[2]
+    else:
+        return side
+    return math.hypot(max(side, 0.0), off)
 
 
 def read_csv(path):

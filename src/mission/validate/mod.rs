@@ -85,7 +85,18 @@ impl Checker {
     /// NaN and ±inf are legal TOML but never a legal length, time or gain.
     /// Checked once over the serialised tree so no float field can be missed.
     fn finite_everywhere(&mut self, mission: &Mission) {
-        if let Ok(tree) = toml::Value::try_from(mission) {
+        // A cylinder's centre or radius the file left out is NaN: the
+        // obstacle's own check names it as missing.
+        let mut mission = mission.clone();
+        for o in &mut mission.obstacles {
+            if o.center.iter().any(|v| v.is_nan()) {
+                o.center = nalgebra::Point2::origin();
+            }
+            if o.radius.is_nan() {
+                o.radius = 0.0;
+            }
+        }
+        if let Ok(tree) = toml::Value::try_from(&mission) {
             self.finite_in(&FieldPath::root(), &tree);
         }
     }

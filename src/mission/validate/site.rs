@@ -215,8 +215,8 @@ impl Checker {
                     if unset {
                         self.error(
                             at.key(key),
-                            "missing: a cylinder needs `center` and `radius` (a building or a bay \
-                             may give `footprint = [[x, y], …]` instead)",
+                            "missing or not a number: a cylinder needs `center` and `radius` (a \
+                             building or a bay may give `footprint = [[x, y], …]` instead)",
                         );
                     }
                 }

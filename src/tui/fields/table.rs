@@ -94,11 +94,11 @@ static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], derived: &[],
     Spec { name: "centre lon", unit: "°", keys: &["center", "longitude"], get: |m, i| geo(m, i, LON), set: |m, i, t| set_geo(m, i, t, LON) },
     Spec { name: "radius", unit: "m", keys: &["radius"], get: |m, i| num(obstacle_at(m, i)?.radius), set: |m, i, t| { let r = number(t)?; obstacle(m, i)?.set_radius(r); Ok(()) } },
     Spec { name: "height", unit: "m", keys: &["height"], get: |m, i| num(obstacle_at(m, i)?.height), set: |m, i, t| put(&mut obstacle(m, i)?.height, number(t)) },
-    Spec { name: "base", unit: "m", keys: &["base"], get: |m, i| num(obstacle_at(m, i)?.base), set: |m, i, t| put(&mut obstacle(m, i)?.base, number(t)) },
-    Spec { name: "overfly", unit: "", keys: &["overfly"], get: |m, i| yes(obstacle_at(m, i)?.overfly), set: |m, i, t| put(&mut obstacle(m, i)?.overfly, yes_no(t)) },
     Spec { name: "inspect (eq. 8)", unit: "", keys: &["inspect"], get: |m, i| yes(obstacle_at(m, i)?.inspect), set: |m, i, t| put(&mut obstacle(m, i)?.inspect, yes_no(t)) },
     Spec { name: "stand-off min", unit: "m", keys: &["stand_off"], get: |m, i| num(obstacle_at(m, i)?.stand_off_band(&m.formation)[0]), set: |m, i, t| set_stand_off(m, i, 0, t) },
     Spec { name: "stand-off max", unit: "m", keys: &["stand_off"], get: |m, i| num(obstacle_at(m, i)?.stand_off_band(&m.formation)[1]), set: |m, i, t| set_stand_off(m, i, 1, t) },
+    Spec { name: "base", unit: "m", keys: &["base"], get: |m, i| num(obstacle_at(m, i)?.base), set: |m, i, t| put(&mut obstacle(m, i)?.base, number(t)) },
+    Spec { name: "overfly", unit: "", keys: &["overfly"], get: |m, i| yes(obstacle_at(m, i)?.overfly), set: |m, i, t| put(&mut obstacle(m, i)?.overfly, yes_no(t)) },
 ]};
 
 #[rustfmt::skip]
