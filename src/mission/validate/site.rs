@@ -215,7 +215,7 @@ impl Checker {
                     if unset {
                         self.error(
                             at.key(key),
-                            "missing or not a number: a cylinder needs `center` and `radius` (a \
+                            "missing or not a finite number: a cylinder needs `center` and `radius` (a \
                              building or a bay may give `footprint = [[x, y], …]` instead)",
                         );
                     }
