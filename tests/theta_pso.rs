@@ -1572,6 +1572,43 @@ fn a_wall_above_the_flight_with_room_under_the_ceiling_is_climbed_over() {
     assert!(refused.contains("'block 1'"), "{refused}");
 }
 
+/// Issue 37, "an answer a person can read": a 200-tree forest (trees of
+/// 0.5 m at least 4.5 m apart, placed by a fixed generator) has hundreds of
+/// IWPs, most unusable or gone round; its summary is at most 30 lines with
+/// the verdict on line 2 (107 lines at the issue's filing).
+#[test]
+fn a_forests_summary_is_a_page_with_the_verdict_first() {
+    let mut m = open_field();
+    m.bounds.z = [5.0, 20.0];
+    m.route.start = Point3::new(5.0, 50.0, 10.0);
+    m.route.goal = Point3::new(95.0, 50.0, 10.0);
+    let mut state: u64 = 37;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut trees: Vec<Point2<f64>> = Vec::new();
+    while trees.len() < 200 {
+        let p = Point2::new(12.0 + 76.0 * next(), 3.0 + 94.0 * next());
+        if trees.iter().all(|q| (p - q).norm_squared() > 20.0) {
+            trees.push(p);
+        }
+    }
+    m.obstacles = trees
+        .iter()
+        .enumerate()
+        .map(|(k, p)| pole(&format!("tree {}", k + 1), p.x, p.y, 0.5))
+        .collect();
+    let o = run(&m, 1);
+    let summary = skyform::outcome::summary::theta_pso(&o, false);
+    let lines: Vec<&str> = summary.lines().collect();
+    assert!(lines.len() <= 30, "{} lines:\n{summary}", lines.len());
+    assert!(lines[1].starts_with("  result "), "{summary}");
+    assert!(o.iwps.len() > 100, "{}", o.iwps.len());
+}
+
 /// Issue 37, a deck across the route: a gapless row of deck sections from
 /// 14 to 16 m across the whole site, band 5-20 m, the formation at 10 m.
 /// Its underside leaves room (10 m + r_Q 0.5 + margins < 14 m), so the plan

@@ -239,23 +239,22 @@ fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
     let mut nearest: Vec<(f64, &crate::pipelines::theta_pso::Iwp)> =
         unusable.iter().map(|i| (distance(i), *i)).collect();
     nearest.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (d, i) in nearest.iter().take(NAMED_UNUSABLE) {
-        let _ = writeln!(
-            s,
-            "  IWP          '{}' | '{}' ({:.1} m from the path) unusable: {}",
-            i.between[0],
-            i.between[1],
-            d,
-            i.unusable.as_deref().unwrap_or_default()
-        );
-    }
-    if nearest.len() > NAMED_UNUSABLE {
-        let _ = writeln!(
-            s,
-            "  IWP          … and {} more (--verbose lists them all)",
-            nearest.len() - NAMED_UNUSABLE
-        );
-    }
+    // One line: a forest's hundreds of unusable gaps are the groups above.
+    let named: Vec<String> = nearest
+        .iter()
+        .take(NAMED_UNUSABLE)
+        .map(|(d, i)| format!("'{}' | '{}' ({d:.1} m)", i.between[0], i.between[1]))
+        .collect();
+    let _ = writeln!(
+        s,
+        "  IWP          unusable, nearest the path: {}{}",
+        named.join(", "),
+        if nearest.len() > NAMED_UNUSABLE {
+            " (--verbose lists them all)"
+        } else {
+            ""
+        }
+    );
 }
 
 /// The human summary of a FLATLO outcome.
