@@ -1650,6 +1650,16 @@ fn a_deck_with_room_below_is_flown_under() {
         "{:?}",
         o.passed_under
     );
+    // One from 8 to 19.5 m: no room over, none under at 10 m; the route
+    // stage descends under it (7.3 m).
+    let low = run(&deck(8.0, 19.5), 1);
+    assert!(low.feasible(), "{:?}", low.verification.first_failure());
+    assert!(
+        low.corridor.cruise.is_some_and(|z| z < 8.0),
+        "{:?}",
+        low.corridor.cruise
+    );
+    assert!(!low.passed_under.is_empty());
     let refused = refusal(&deck(5.5, 19.5));
     assert!(refused.contains("'deck 1'"), "{refused}");
 }

@@ -227,6 +227,8 @@ fn cruise_altitudes(mission: &Mission, z_box: [f64; 2]) -> Vec<f64> {
         .filter(|o| o.within(mission.bounds.z) && !passed_by_altitude(mission, o, None))
         .map(|o| pass_altitudes(mission, o))
         .collect();
+    // Up to half the tries among `v`, nearest first, at its thirds, the last
+    // being the largest (for `under`, negated: the lowest, under all).
     let pick = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v.dedup_by(|a, b| (*a - *b).abs() < 0.05);
@@ -245,15 +247,16 @@ fn cruise_altitudes(mission: &Mission, z_box: [f64; 2]) -> Vec<f64> {
             .filter(|z| *z > high && *z <= z_box[1])
             .collect(),
     );
-    let mut under = pick(
+    let under = pick(
         in_way
             .iter()
-            .map(|[_, u]| *u)
-            .filter(|z| *z < low && *z >= z_box[0])
+            .map(|[_, u]| -*u)
+            .filter(|z| -*z < low && -*z >= z_box[0])
             .collect(),
     );
-    under.reverse();
-    over.into_iter().chain(under).collect()
+    over.into_iter()
+        .chain(under.into_iter().map(|z| -z))
+        .collect()
 }
 
 /// Most altitudes the route stage tries off the start's and goal's.
