@@ -114,6 +114,7 @@ fn post(name: String, x: f64, y: f64, radius: f64) -> Obstacle {
         footprint: Vec::new(),
         base: 0.0,
         overfly: true,
+        clearance_above: 0.0,
         kind: None,
         inspect: false,
         stand_off: None,

@@ -103,6 +103,7 @@ fn one_agent_goes_around_an_obstacle_outside_the_safety_distance() {
         footprint: Vec::new(),
         base: 0.0,
         overfly: true,
+        clearance_above: 0.0,
         kind: None,
         inspect: false,
         stand_off: None,

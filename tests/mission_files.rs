@@ -197,6 +197,7 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                     footprint: Vec::new(),
                     base: 0.0,
                     overfly: true,
+                    clearance_above: 0.0,
                     kind: (!kind.is_empty()).then_some(kind),
                     inspect: false,
                     stand_off: None,

@@ -38,6 +38,7 @@ fn pole(name: &str, x: f64, y: f64, radius: f64) -> Obstacle {
         footprint: Vec::new(),
         base: 0.0,
         overfly: true,
+        clearance_above: 0.0,
         kind: None,
         inspect: false,
         stand_off: None,
@@ -1505,6 +1506,23 @@ fn a_low_wall_the_formation_clears_is_flown_over() {
         summary.contains(&format!("flies over   '{}'", o.passed_over[0])),
         "{summary}"
     );
+    // With 2 m to keep above its roofs (aerials), the same wall is climbed:
+    // every UAV over a post is at least 9 + 2 + r_Q up.
+    let mut kept = wall(9.0);
+    for o in &mut kept.obstacles {
+        o.clearance_above = 2.0;
+    }
+    let high = run(&kept, 1);
+    assert!(high.feasible(), "{:?}", high.verification.first_failure());
+    for tr in &high.trajectories {
+        for s in tr
+            .samples
+            .iter()
+            .filter(|s| (s.position.x - 50.0).abs() < 1.6)
+        {
+            assert!(s.position.z >= 11.5, "UAV {} at {}", tr.uav + 1, s.position);
+        }
+    }
     // At 9.5 m the wall is too high to pass at 10 m: the route stage climbs
     // (the next test) rather than refusing.
     let climbed = run(&wall(9.5), 1);

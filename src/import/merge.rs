@@ -197,6 +197,7 @@ mod tests {
             footprint: Vec::new(),
             base: 0.0,
             overfly: true,
+            clearance_above: 0.0,
             kind: None,
             inspect: false,
             stand_off: None,

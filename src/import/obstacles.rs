@@ -267,6 +267,7 @@ pub fn make(
                 footprint,
                 base: 0.0,
                 overfly: true,
+                clearance_above: 0.0,
                 kind: kind.clone(),
                 inspect: false,
                 stand_off: None,

@@ -254,6 +254,11 @@ pub struct Obstacle {
     /// people: the planner then treats it as reaching the sky.
     #[serde(default = "yes", skip_serializing_if = "is_yes")]
     pub overfly: bool,
+    /// Metres the formation keeps above its top when it flies over, beyond
+    /// r_Q and the margins (a roof's aerials, a crane's swing): the planner
+    /// treats it as that much taller.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub clearance_above: f64,
     /// Free label ("pier", "pole", "tree", …), for display only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kind: Option<String>,
@@ -925,7 +930,7 @@ impl Obstacle {
     /// not be flown over.
     pub fn top(&self) -> f64 {
         if self.overfly {
-            self.height
+            self.height + self.clearance_above.max(0.0)
         } else {
             f64::INFINITY
         }
@@ -1005,6 +1010,7 @@ impl Obstacle {
             footprint: Vec::new(),
             base: 0.0,
             overfly: true,
+            clearance_above: 0.0,
             kind: None,
             inspect: false,
             stand_off: None,

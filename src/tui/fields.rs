@@ -450,6 +450,7 @@ pub fn new_obstacle(mission: &Mission, center: Point2<f64>) -> Obstacle {
         footprint: Vec::new(),
         base: 0.0,
         overfly: true,
+        clearance_above: 0.0,
         kind: None,
         inspect: false,
         stand_off: None,

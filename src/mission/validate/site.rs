@@ -233,6 +233,7 @@ impl Checker {
             self.positive(at.key("radius"), o.radius, " m");
             self.positive(at.key("height"), o.height, " m");
             self.non_negative(at.key("base"), o.base, " m");
+            self.non_negative(at.key("clearance_above"), o.clearance_above, " m");
             if o.base.is_finite() && o.height.is_finite() && o.base >= o.height {
                 self.error(
                     at.key("base"),

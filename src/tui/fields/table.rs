@@ -99,6 +99,7 @@ static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], derived: &[],
     Spec { name: "stand-off max", unit: "m", keys: &["stand_off"], get: |m, i| num(obstacle_at(m, i)?.stand_off_band(&m.formation)[1]), set: |m, i, t| set_stand_off(m, i, 1, t) },
     Spec { name: "base", unit: "m", keys: &["base"], get: |m, i| num(obstacle_at(m, i)?.base), set: |m, i, t| put(&mut obstacle(m, i)?.base, number(t)) },
     Spec { name: "overfly", unit: "", keys: &["overfly"], get: |m, i| yes(obstacle_at(m, i)?.overfly), set: |m, i, t| put(&mut obstacle(m, i)?.overfly, yes_no(t)) },
+    Spec { name: "clearance above", unit: "m", keys: &["clearance_above"], get: |m, i| num(obstacle_at(m, i)?.clearance_above), set: |m, i, t| put(&mut obstacle(m, i)?.clearance_above, number(t)) },
 ]};
 
 #[rustfmt::skip]
