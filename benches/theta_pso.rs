@@ -106,19 +106,7 @@ fn budget_check(c: &mut Criterion) {
 }
 
 fn post(name: String, x: f64, y: f64, radius: f64) -> Obstacle {
-    Obstacle {
-        name,
-        center: Point2::new(x, y),
-        radius,
-        height: 30.0,
-        footprint: Vec::new(),
-        base: 0.0,
-        overfly: true,
-        clearance_above: 0.0,
-        kind: None,
-        inspect: false,
-        stand_off: None,
-    }
+    Obstacle::standing(name, Point2::new(x, y), radius, 30.0)
 }
 
 /// The two missions of the route stage's refusal tests (`tests/theta_pso.rs`):

@@ -95,19 +95,12 @@ fn one_agent_recovers_from_a_push() {
 fn one_agent_goes_around_an_obstacle_outside_the_safety_distance() {
     let mut m = one_agent(Point2::new(-3.5, 0.2), &[(0.0, [3.5, 0.0])], 25.0);
     m.bounds.x = [-5.0, 5.0];
-    m.obstacles = vec![Obstacle {
-        name: "barrier".into(),
-        center: Point2::new(0.0, 0.0),
-        radius: 0.3,
-        height: 2.5,
-        footprint: Vec::new(),
-        base: 0.0,
-        overfly: true,
-        clearance_above: 0.0,
-        kind: None,
-        inspect: false,
-        stand_off: None,
-    }];
+    m.obstacles = vec![Obstacle::standing(
+        "barrier",
+        Point2::new(0.0, 0.0),
+        0.3,
+        2.5,
+    )];
     let o = run(&m, 3);
     assert!(
         (last_xy(&o, 0) - Point2::new(3.5, 0.0)).norm() < 0.05,

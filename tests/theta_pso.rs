@@ -30,19 +30,30 @@ fn open_field() -> Mission {
 }
 
 fn pole(name: &str, x: f64, y: f64, radius: f64) -> Obstacle {
-    Obstacle {
-        name: name.into(),
-        center: Point2::new(x, y),
-        radius,
-        height: 30.0,
-        footprint: Vec::new(),
-        base: 0.0,
-        overfly: true,
-        clearance_above: 0.0,
-        kind: None,
-        inspect: false,
-        stand_off: None,
-    }
+    Obstacle::standing(name, Point2::new(x, y), radius, 30.0)
+}
+
+/// The open field (formation at 10 m) with a gapless row across it at
+/// x = 50: 59 posts of 1 m radius, 1.7 m apart, from `base` to `top`,
+/// named `<name> 1`…; the band `z`, a 0.1 m safety margin.
+fn row_across(name: &str, z: [f64; 2], base: f64, top: f64) -> Mission {
+    let mut m = open_field();
+    m.bounds.z = z;
+    m.formation.safety_margin = 0.1;
+    m.obstacles = (0..59)
+        .map(|k| {
+            let mut o = pole(
+                &format!("{name} {}", k + 1),
+                50.0,
+                1.0 + 1.7 * k as f64,
+                1.0,
+            );
+            o.base = base;
+            o.height = top;
+            o
+        })
+        .collect();
+    m
 }
 
 fn bare(points: Vec<Point3<f64>>) -> CentroidPath {
@@ -1461,19 +1472,7 @@ fn unusable_iwps_under_the_default_shape_are_one_warning_per_reason() {
 /// still refused, naming it.
 #[test]
 fn a_low_wall_the_formation_clears_is_flown_over() {
-    let wall = |height: f64| {
-        let mut m = open_field();
-        m.bounds.z = [5.0, 20.0];
-        m.formation.safety_margin = 0.1;
-        m.obstacles = (0..59)
-            .map(|k| {
-                let mut o = pole(&format!("block {}", k + 1), 50.0, 1.0 + 1.7 * k as f64, 1.0);
-                o.height = height;
-                o
-            })
-            .collect();
-        m
-    };
+    let wall = |height: f64| row_across("block", [5.0, 20.0], 0.0, height);
     let o = run(&wall(9.0), 1);
     assert!(o.feasible(), "{:?}", o.verification.first_failure());
     let clearance = o
@@ -1546,19 +1545,7 @@ fn a_low_wall_the_formation_clears_is_flown_over() {
 /// refusal names the wall.
 #[test]
 fn a_wall_above_the_flight_with_room_under_the_ceiling_is_climbed_over() {
-    let wall = |ceiling: f64| {
-        let mut m = open_field();
-        m.bounds.z = [5.0, ceiling];
-        m.formation.safety_margin = 0.1;
-        m.obstacles = (0..59)
-            .map(|k| {
-                let mut o = pole(&format!("block {}", k + 1), 50.0, 1.0 + 1.7 * k as f64, 1.0);
-                o.height = 12.0;
-                o
-            })
-            .collect();
-        m
-    };
+    let wall = |ceiling: f64| row_across("block", [5.0, ceiling], 0.0, 12.0);
     for seed in 0..3 {
         let o = run(&wall(20.0), seed);
         assert!(
@@ -1635,20 +1622,7 @@ fn a_forests_summary_is_a_page_with_the_verdict_first() {
 /// and it is refused, naming it.
 #[test]
 fn a_deck_with_room_below_is_flown_under() {
-    let deck = |base: f64, top: f64| {
-        let mut m = open_field();
-        m.bounds.z = [5.0, 20.0];
-        m.formation.safety_margin = 0.1;
-        m.obstacles = (0..59)
-            .map(|k| {
-                let mut o = pole(&format!("deck {}", k + 1), 50.0, 1.0 + 1.7 * k as f64, 1.0);
-                o.base = base;
-                o.height = top;
-                o
-            })
-            .collect();
-        m
-    };
+    let deck = |base: f64, top: f64| row_across("deck", [5.0, 20.0], base, top);
     let o = run(&deck(14.0, 16.0), 1);
     assert!(o.feasible(), "{:?}", o.verification.first_failure());
     let mut under = 0;
@@ -1687,17 +1661,10 @@ fn a_deck_with_room_below_is_flown_under() {
 /// flown over (live equipment), it closes the way and the refusal names it.
 #[test]
 fn a_wall_marked_not_to_be_overflown_is_not() {
-    let mut m = open_field();
-    m.bounds.z = [5.0, 20.0];
-    m.formation.safety_margin = 0.1;
-    m.obstacles = (0..59)
-        .map(|k| {
-            let mut o = pole(&format!("bay {}", k + 1), 50.0, 1.0 + 1.7 * k as f64, 1.0);
-            o.height = 9.0;
-            o.overfly = false;
-            o
-        })
-        .collect();
+    let mut m = row_across("bay", [5.0, 20.0], 0.0, 9.0);
+    for o in &mut m.obstacles {
+        o.overfly = false;
+    }
     let refused = refusal(&m);
     assert!(refused.contains("'bay 1'"), "{refused}");
 }

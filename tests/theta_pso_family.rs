@@ -162,19 +162,12 @@ pub fn generated(index: u64) -> Mission {
             });
         if clear {
             let k = m.obstacles.len() - wall.len() + 1;
-            m.obstacles.push(Obstacle {
-                name: format!("free {k}"),
-                center: c,
-                radius: r,
-                height: rng.random_range(6.0..25.0),
-                footprint: Vec::new(),
-                base: 0.0,
-                overfly: true,
-                clearance_above: 0.0,
-                kind: None,
-                inspect: false,
-                stand_off: None,
-            });
+            m.obstacles.push(Obstacle::standing(
+                format!("free {k}"),
+                c,
+                r,
+                rng.random_range(6.0..25.0),
+            ));
         }
     }
     m

@@ -189,19 +189,7 @@ mod tests {
     use nalgebra::Point2;
 
     fn obstacle(name: &str, x: f64) -> Obstacle {
-        Obstacle {
-            name: name.into(),
-            center: Point2::new(x, 10.0),
-            radius: 1.0,
-            height: 10.0,
-            footprint: Vec::new(),
-            base: 0.0,
-            overfly: true,
-            clearance_above: 0.0,
-            kind: None,
-            inspect: false,
-            stand_off: None,
-        }
+        Obstacle::standing(name, Point2::new(x, 10.0), 1.0, 10.0)
     }
 
     #[test]

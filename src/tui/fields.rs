@@ -442,19 +442,12 @@ pub fn new_obstacle(mission: &Mission, center: Point2<f64>) -> Obstacle {
     while taken(&format!("obstacle {n}")) {
         n += 1;
     }
-    Obstacle {
-        name: format!("obstacle {n}"),
+    Obstacle::standing(
+        format!("obstacle {n}"),
         center,
-        radius: 1.0,
-        height: (mission.bounds.z[1] + 1.0).max(1.0),
-        footprint: Vec::new(),
-        base: 0.0,
-        overfly: true,
-        clearance_above: 0.0,
-        kind: None,
-        inspect: false,
-        stand_off: None,
-    }
+        1.0,
+        (mission.bounds.z[1] + 1.0).max(1.0),
+    )
 }
 
 /// A copy of `original` next to it, with a fresh name.
