@@ -9,7 +9,12 @@
 //! Arguments: sites, seeds per site (default 100 × 3), and the index of the
 //! first site (default 0; a different range is a set the planner was not
 //! tuned on). `--wide` measures the wide variant (`sites::generated_wide`:
-//! more shapes, r_Q from 0.3 to 0.7 m, sites mirrored and transposed).
+//! more shapes, r_Q from 0.3 to 0.7 m, sites mirrored and transposed);
+//! `--3d` the sites in three dimensions (`sites::three_d`: walls of posts
+//! and segments, decoy pockets, rows of footprints, decks, low fences, walls
+//! to fly over or climb, short towers and trees near a bound, 30 shapes).
+//! `write DIR N [FIRST]` writes N sites of the chosen family as mission
+//! files, to run them from the command line.
 
 #[path = "../tests/sites/mod.rs"]
 mod sites;
@@ -177,15 +182,62 @@ fn heading(m: &skyform::mission::Mission) -> &'static str {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut raw: Vec<String> = std::env::args().skip(1).collect();
     let wide = raw.iter().any(|a| a == "--wide");
-    raw.retain(|a| a != "--wide");
+    let three_d = raw.iter().any(|a| a == "--3d");
+    raw.retain(|a| a != "--wide" && a != "--3d");
     let generated = if wide {
         sites::generated_wide
     } else {
         sites::generated
     };
+    // A site of the chosen family: its mission, the dimensions it is
+    // reported by, and its mission file's text when it has one.
+    let family = move |i: u64| -> (
+        skyform::mission::Mission,
+        Vec<(&'static str, String)>,
+        Option<String>,
+    ) {
+        if three_d {
+            let site = sites::three_d::generated_3d(i);
+            let mut dims = site.dims;
+            dims.push(("route", heading(&site.mission).to_owned()));
+            return (site.mission, dims, Some(site.toml));
+        }
+        let site = generated(i);
+        let dims = vec![
+            ("walls", site.walls.to_string()),
+            ("narrow gaps", site.narrow.to_string()),
+            ("shape", site.shape.to_owned()),
+            ("UAVs", site.uavs.to_string()),
+            ("inspected", site.inspected.to_string()),
+            ("route", heading(&site.mission).to_owned()),
+            (
+                "closest walls",
+                if site.closest_walls < 22.0 {
+                    "< 22 m".to_owned()
+                } else {
+                    "≥ 22 m".to_owned()
+                },
+            ),
+        ];
+        (site.mission, dims, None)
+    };
     if raw.first().map(String::as_str) == Some("detail") {
         let n = |i: usize| raw.get(i).and_then(|v| v.parse().ok()).unwrap_or(0);
-        detail(&generated(n(1)).mission, n(2));
+        detail(&family(n(1)).0, n(2));
+        return Ok(());
+    }
+    if raw.first().map(String::as_str) == Some("write") {
+        let dir = std::path::PathBuf::from(raw.get(1).ok_or("write DIR N [FIRST]")?);
+        let n = |i: usize, or: u64| raw.get(i).and_then(|v| v.parse().ok()).unwrap_or(or);
+        std::fs::create_dir_all(&dir)?;
+        for i in n(3, 0)..n(3, 0) + n(2, 10) {
+            let (mission, _, text) = family(i);
+            let text = match text {
+                Some(t) => t,
+                None => skyform::mission::to_toml_string(&mission)?,
+            };
+            std::fs::write(dir.join(format!("site-{i}.toml")), text)?;
+        }
         return Ok(());
     }
     if raw.first().map(String::as_str) == Some("mission") {
@@ -204,14 +256,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // A census of the sites alone, no planning.
         let mut by: BTreeMap<String, usize> = BTreeMap::new();
         for i in first..first + count {
-            let site = generated(i);
-            for key in [
-                format!("walls {}", site.walls),
-                format!("shape {}", site.shape),
-                format!("inspected {}", site.inspected),
-                format!("narrow {}", site.narrow),
-            ] {
-                *by.entry(key).or_default() += 1;
+            for (dim, value) in family(i).1 {
+                *by.entry(format!("{dim} {value}")).or_default() += 1;
             }
         }
         for (k, v) in by {
@@ -226,26 +272,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let runs: Vec<Run> = jobs
         .par_iter()
         .map(|&(i, seed)| {
-            let site = generated(i);
-            let dims = vec![
-                ("walls", site.walls.to_string()),
-                ("narrow gaps", site.narrow.to_string()),
-                ("shape", site.shape.to_owned()),
-                ("UAVs", site.uavs.to_string()),
-                ("inspected", site.inspected.to_string()),
-                ("route", heading(&site.mission).to_owned()),
-                (
-                    "closest walls",
-                    if site.closest_walls < 22.0 {
-                        "< 22 m".to_owned()
-                    } else {
-                        "≥ 22 m".to_owned()
-                    },
-                ),
-            ];
+            let (mission, dims, _) = family(i);
             let t = Instant::now();
             let outcome = plan(
-                &site.mission,
+                &mission,
                 seed,
                 PlanOptions { parallel: false },
                 &mut Silent,
@@ -293,7 +323,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             println!("  {dim}:");
             last = dim;
         }
-        println!("    {value:<12} {ok:>4} / {all:<4}");
+        println!("    {value:<28} {ok:>4} / {all:<4}");
     }
     let slowest = runs.iter().map(|r| r.seconds).fold(0.0, f64::max);
     let mean = runs.iter().map(|r| r.seconds).sum::<f64>() / runs.len().max(1) as f64;

@@ -98,6 +98,19 @@ impl Mission {
         })
     }
 
+    /// The lowest centroid altitude at which the nominal shape passes over
+    /// obstacle `o` (its lowest UAV r_Q + the safety margin + θ-PSO's
+    /// clearance margin above the top; ∞ for one that may not be flown
+    /// over) and the highest at which it passes under it (its highest UAV
+    /// as far below the base). Between the two, `o` stands in the way.
+    pub fn passing_altitudes(&self, o: &Obstacle) -> [f64; 2] {
+        let f = &self.formation;
+        let below = f.slots.iter().map(|s| -s.z).fold(0.0, f64::max);
+        let above = f.slots.iter().map(|s| s.z).fold(0.0, f64::max);
+        let clearance = f.least_clearance() + self.theta_pso.clearance_margin.max(0.0);
+        [o.top() + clearance + below, o.base - clearance - above]
+    }
+
     /// The centroid altitudes at which every UAV of the nominal shape is in
     /// the band and level with obstacle `o`'s side (between its base and
     /// its top), so the one facing it measures eq. 8's distance to the side

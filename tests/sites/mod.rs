@@ -26,6 +26,8 @@
 
 #![allow(dead_code)]
 
+pub mod three_d;
+
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};

@@ -299,7 +299,7 @@ impl Checker {
     /// with an area, inside the bounds (partly outside is a warning, as a
     /// cylinder's reach is).
     fn footprint(&mut self, path: FieldPath, o: &crate::mission::Obstacle, bounds: &Bounds) {
-        use geo::{Area, Validation};
+        use geo::{Area, Intersects, Validation};
         let v = &o.footprint;
         if !v.iter().all(|p| p.x.is_finite() && p.y.is_finite()) {
             return; // named by the finite check, located
@@ -331,12 +331,18 @@ impl Checker {
             self.error(path, "is degenerate: its vertices enclose no area");
             return;
         }
+        // Outside when it has no point in the box: a deck may cross the
+        // whole site with every vertex beyond the bounds.
         let inside = v.iter().filter(|p| bounds.contains_xy(p)).count();
-        if inside == 0 {
+        let box_ = geo::Rect::new(
+            geo::coord! { x: bounds.x[0], y: bounds.y[0] },
+            geo::coord! { x: bounds.x[1], y: bounds.y[1] },
+        );
+        if !polygon.intersects(&box_) {
             self.error(
                 path,
                 format!(
-                    "lies outside the bounds x {:?}, y {:?}: no vertex is inside",
+                    "lies outside the bounds x {:?}, y {:?}: no part of it is inside",
                     bounds.x, bounds.y
                 ),
             );

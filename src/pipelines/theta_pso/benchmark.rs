@@ -151,7 +151,7 @@ pub fn plan(
             legs: Vec::new(),
             passes: Vec::new(),
             length: 0.0,
-            cruise: None,
+            heights: Vec::new(),
             squeeze: None,
         },
         trajectories: flight.trajectories,

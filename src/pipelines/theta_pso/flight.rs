@@ -18,7 +18,7 @@
 //! The time law plans a little inside the vehicle's limits
 //! (`timing::PLANNED_SHARE`); where the samples still show a UAV over a
 //! limit (the grid misses a peak), the flight is timed again that much
-//! further inside them.
+//! further inside them (at most half as fast each time).
 
 use super::iwp::Iwp;
 use super::path::CentroidPath;
@@ -85,7 +85,10 @@ pub fn fly(
         if over <= 1.0 {
             break;
         }
-        share *= 0.98 / over;
+        // At most halved each time: a peak far over a limit is a kink in a
+        // UAV's path, which a slower flight does not smooth; the whole
+        // flight crawling (hours for a few hundred metres) helps nobody.
+        share *= (0.98 / over).max(0.5);
         flight = generate(&tolerances, share)?;
         verification = verify::verify(mission, &flight.trajectories);
     }

@@ -11,8 +11,11 @@
 //! flight engineer needs and the paper leaves implicit:
 //! - a gap blocked by a third obstacle (the segment P_p P_q passes within
 //!   r_Q of it) is not a passage and gets no IWP;
-//! - both obstacles must reach into the altitude band; over a lower one the
-//!   formation can simply fly.
+//! - both obstacles must stand in the formation's way at a common altitude
+//!   of the band (`Iwp::window`): over a lower one, or under a deck, the
+//!   formation can simply fly, and a gap between a deck and a post that
+//!   stands below it is no passage; a third obstacle or the wall's depth
+//!   counts only where it stands at those altitudes too.
 //!
 //! The formation crosses an IWP straight along the gap's normal, so what must
 //! fit is its *lateral* width (UAV radius included), not r_F. Hence:
@@ -62,6 +65,11 @@ pub struct Iwp {
     /// h plus the heading's span for a rigid shape, only through the posts
     /// for a column (whose UAVs follow the path).
     pub straight: f64,
+    /// The centroid altitudes at which both obstacles stand in the
+    /// formation's way (`Mission::passing_altitudes`), metres: outside them
+    /// the formation passes over or under one of them, and the gap is none.
+    #[serde(skip)]
+    pub window: [f64; 2],
 }
 
 impl Iwp {
@@ -348,6 +356,7 @@ fn crossing_hold(
     center: Point2<f64>,
     normal: Vector2<f64>,
     shape: Option<Shape>,
+    window: [f64; 2],
 ) -> Result<(f64, f64), String> {
     let f = &mission.formation;
     let r_q = f.least_clearance();
@@ -362,7 +371,7 @@ fn crossing_hold(
         }
     }
     let held = shape.map_or_else(|| f.slots.clone(), |s| s.offsets(&f.slots, 1.0));
-    let in_band = |k: &usize| obstacles[*k].within(mission.bounds.z);
+    let in_band = |k: &usize| stands_in(mission, &obstacles[*k], window);
     let mut depth: f64 = 0.0;
     for sign in [1.0, -1.0] {
         let forward = normal * sign;
@@ -431,6 +440,13 @@ fn crossing_hold(
     Ok((hold, line))
 }
 
+/// Whether obstacle `o` reaches into the band and stands in the way of a
+/// centroid somewhere in `window` (metres).
+fn stands_in(mission: &Mission, o: &crate::mission::Obstacle, window: [f64; 2]) -> bool {
+    let [over, under] = mission.passing_altitudes(o);
+    o.within(mission.bounds.z) && under < window[1] && over > window[0]
+}
+
 /// Every IWP of the mission by eq. 9, with the operator's choices applied.
 pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
     let f = &mission.formation;
@@ -443,6 +459,16 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
         for q in (p + 1)..obstacles.len() {
             let (a, b) = (&obstacles[p], &obstacles[q]);
             if !a.within(mission.bounds.z) || !b.within(mission.bounds.z) {
+                continue;
+            }
+            // The altitudes at which both stand in the way, within those the
+            // centroid may take (the band less the shape's half height).
+            let ([over_a, under_a], [over_b, under_b]) =
+                (mission.passing_altitudes(a), mission.passing_altitudes(b));
+            let window = [under_a.max(under_b), over_a.min(over_b)];
+            let half = vertical_half_height(&f.slots);
+            let z = mission.bounds.z;
+            if window[0] >= window[1] || window[0] >= z[1] - half || window[1] <= z[0] + half {
                 continue;
             }
             let (p_p, p_q, gap, u) = if a.footprint.is_empty() && b.footprint.is_empty() {
@@ -472,7 +498,7 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
             let blocked = obstacles.iter().enumerate().any(|(k, o)| {
                 k != p
                     && k != q
-                    && o.within(mission.bounds.z)
+                    && stands_in(mission, o, window)
                     && segment_point_distance(&p_p, &p_q, &o.center) < o.radius + r_q
             });
             if blocked {
@@ -495,7 +521,8 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
             let normal = Vector2::new(-u.y, u.x);
             let margin = mission.theta_pso.clearance_margin.max(0.0);
             let resolved = resolve_shape(shape_choice, gap, f, scale, margin).and_then(|shape| {
-                crossing_hold(mission, [p, q], position, normal, shape).map(|hold| (shape, hold))
+                crossing_hold(mission, [p, q], position, normal, shape, window)
+                    .map(|hold| (shape, hold))
             });
             let (shape, (hold, straight), unusable) = match resolved {
                 Ok((shape, hold)) => (shape, hold, None),
@@ -513,6 +540,7 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
                 unusable,
                 hold,
                 straight,
+                window,
             });
         }
     }

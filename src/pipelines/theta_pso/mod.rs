@@ -740,6 +740,7 @@ pub fn plan_warm(
 
     let p = &mission.theta_pso;
     let mut kept: Option<Attempt> = None;
+    let mut over_budget: Option<PipelineError> = None;
     let (mut iterations, mut evaluations, mut restarts) = (0usize, 0usize, 0usize);
     let mut completion = Completion::Finished;
     for attempt in 0..=p.restarts {
@@ -779,13 +780,24 @@ pub fn plan_warm(
             completion = Completion::Cancelled;
         }
         observer.on_event(Event::Stage("verification"));
-        let mut tried = Attempt::new(
+        // A plan whose flight would be too long to sample is no plan: the
+        // next run of the swarm may find another (the budget error stands
+        // when none does).
+        let mut tried = match Attempt::new(
             mission,
             &problem,
             result.best.position,
             convergence,
             PlanSource::Swarm,
-        )?;
+        ) {
+            Ok(tried) => tried,
+            Err(e @ PipelineError::OverBudget(_)) if completion == Completion::Finished => {
+                observer.on_event(Event::Log(Level::Warn, &e.to_string()));
+                over_budget = Some(e);
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         if !tried.verification.feasible
             && completion == Completion::Finished
             && let Some(fixed) = repair::repair(mission, &problem, &tried.position)
@@ -798,7 +810,13 @@ pub fn plan_warm(
                 ),
             ));
             let convergence = std::mem::take(&mut tried.convergence);
-            tried = Attempt::new(mission, &problem, fixed, convergence, PlanSource::Repaired)?;
+            match Attempt::new(mission, &problem, fixed, convergence, PlanSource::Repaired) {
+                Ok(repaired) => tried = repaired,
+                Err(e @ PipelineError::OverBudget(_)) => {
+                    observer.on_event(Event::Log(Level::Warn, &e.to_string()));
+                }
+                Err(e) => return Err(e),
+            }
         }
         let done = tried.verification.feasible || completion == Completion::Cancelled;
         if kept.as_ref().is_none_or(|k| tried.better_than(k)) {
@@ -809,31 +827,40 @@ pub fn plan_warm(
         }
     }
     // Every run of the swarm failed: fly the corridor itself, if it verifies.
-    if let (Some(k), Some(start)) = (&kept, starts.first())
-        && !k.verification.feasible
+    if let Some(start) = starts.first()
+        && kept.as_ref().is_none_or(|k| !k.verification.feasible)
         && completion == Completion::Finished
     {
         let position = repair::repair(mission, &problem, start).unwrap_or_else(|| start.clone());
-        let convergence = k.convergence.clone();
-        let fallback = Attempt::new(
+        let convergence = kept
+            .as_ref()
+            .map(|k| k.convergence.clone())
+            .unwrap_or_default();
+        match Attempt::new(
             mission,
             &problem,
             position,
             convergence,
             PlanSource::Corridor,
-        )?;
-        if fallback.verification.feasible {
-            observer.on_event(Event::Log(
-                Level::Warn,
-                "every run of the swarm failed verification; the route stage's corridor is flown",
-            ));
-            kept = Some(fallback);
+        ) {
+            Ok(fallback) if fallback.verification.feasible || kept.is_none() => {
+                if fallback.verification.feasible {
+                    observer.on_event(Event::Log(
+                        Level::Warn,
+                        "every run of the swarm failed verification; the route stage's corridor is flown",
+                    ));
+                }
+                kept = Some(fallback);
+            }
+            Ok(_) => {}
+            Err(e @ PipelineError::OverBudget(_)) => over_budget = Some(e),
+            Err(e) => return Err(e),
         }
     }
     let Some(best) = kept else {
-        return Err(PipelineError::Unsupported(
-            "the swarm never ran (no attempt)".into(),
-        ));
+        return Err(over_budget.unwrap_or_else(|| {
+            PipelineError::Unsupported("the swarm never ran (no attempt)".into())
+        }));
     };
     for check in best.verification.checks.iter().filter(|c| !c.ok) {
         let message = format!(

@@ -132,7 +132,8 @@ fn fit_waypoints(
 }
 
 /// The corridor's inner points as free waypoints (fitted to the builder's
-/// count), at heights along start → goal, and its pass angles.
+/// count), at the corridor's heights when it climbs, else at heights along
+/// start → goal, and its pass angles.
 fn waypoints(problem: &Problem, corridor: &Corridor) -> (Vec<Point3<f64>>, Vec<f64>) {
     let builder = &problem.builder;
     let [_, _, z] = builder.decoding_box();
@@ -159,12 +160,34 @@ fn waypoints(problem: &Problem, corridor: &Corridor) -> (Vec<Point3<f64>>, Vec<f
         .map(|(i, p)| {
             let u = (i + 1) as f64 / total as f64;
             let along = start.z + (goal.z - start.z) * u;
-            let height = corridor.cruise.unwrap_or(along).clamp(z[0], z[1]);
+            let height = corridor_height(corridor, *p)
+                .unwrap_or(along)
+                .clamp(z[0], z[1]);
             Point3::new(p.x, p.y, height)
         })
         .collect();
     let pass_angles = corridor.passes.iter().map(|(phi, _)| *phi).collect();
     (waypoints, pass_angles)
+}
+
+/// The corridor's height at `p`, one of its points or on one of its legs
+/// (the nearest leg, its height in proportion); `None` for a corridor left
+/// between the start's and the goal's altitudes.
+fn corridor_height(corridor: &Corridor, p: Point2<f64>) -> Option<f64> {
+    let h = &corridor.heights;
+    if h.len() != corridor.points.len() {
+        return None;
+    }
+    corridor
+        .points
+        .windows(2)
+        .zip(h.windows(2))
+        .map(|(w, z)| {
+            let (t, d) = crate::base::geometry::segment_projection(&w[0], &w[1], &p);
+            (d, z[0] + (z[1] - z[0]) * t)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, z)| z)
 }
 
 /// Exactly `count` points from the route's corners: the corners that turn

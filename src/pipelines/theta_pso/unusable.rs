@@ -224,6 +224,7 @@ mod tests {
             unusable: reason.map(str::to_owned),
             hold: 0.0,
             straight: 0.0,
+            window: [f64::NEG_INFINITY, f64::INFINITY],
         }
     }
 

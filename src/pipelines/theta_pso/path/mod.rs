@@ -118,6 +118,9 @@ struct Crossing {
     /// Altitudes the centroid may take at the IWP so every UAV of the shape
     /// stays in the band.
     z_range: [f64; 2],
+    /// Altitudes at which both obstacles stand in the way (`Iwp::window`):
+    /// a leg crossing the gate outside them flies over or under the gap.
+    window: [f64; 2],
 }
 
 /// An inspected obstacle as a via: a straight pass tangent to it.
@@ -182,6 +185,7 @@ impl PathBuilder {
                     hold,
                     transition: mission.reconfiguration.transition_distance,
                     z_range: band_for(half_height),
+                    window: iwp.window,
                 }
             })
             .collect();
@@ -254,6 +258,32 @@ impl PathBuilder {
     /// The IWP (index into the problem's IWPs) of each crossing.
     pub fn crossing_iwps(&self) -> Vec<usize> {
         self.crossings.iter().map(|c| c.iwp).collect()
+    }
+
+    /// Each crossing's gate: the gap line widened by the formation's safe
+    /// radius into the obstacles on either side. A leg across it is taken
+    /// through the crossing (`crossing_leg`).
+    pub fn crossing_gates(&self) -> Vec<[Point2<f64>; 2]> {
+        self.crossings
+            .iter()
+            .map(|via| {
+                let along = Vector2::new(via.reach.y, -via.reach.x);
+                let across = along * (via.gate / along.norm().max(1e-12));
+                [via.center - across, via.center + across]
+            })
+            .collect()
+    }
+
+    /// The altitudes at which each crossing's gap stands in the way (the
+    /// crossing is flown only there).
+    pub fn crossing_windows(&self) -> Vec<[f64; 2]> {
+        self.crossings.iter().map(|c| c.window).collect()
+    }
+
+    /// The centroid altitudes each inspection's pass may be flown at
+    /// (level with the side, in the band).
+    pub fn pass_altitudes(&self) -> Vec<[f64; 2]> {
+        self.inspections.iter().map(|i| i.z_range).collect()
     }
 
     /// Inspected obstacles, in the order their pass angles follow the
@@ -479,7 +509,12 @@ impl PathBuilder {
             if locked[i] || !segments_cross(&a.xy(), &b.xy(), &g0, &g1) {
                 return None;
             }
-            let z = ((a.z + b.z) / 2.0).clamp(via.z_range[0], via.z_range[1]);
+            // Over (or under) the gap's obstacles the leg needs no crossing.
+            let mid = (a.z + b.z) / 2.0;
+            if !(via.window[0] < mid && mid < via.window[1]) {
+                return None;
+            }
+            let z = mid.clamp(via.z_range[0], via.z_range[1]);
             let sign = if (b.xy() - a.xy()).dot(&via.reach) >= 0.0 {
                 1.0
             } else {

@@ -1,5 +1,5 @@
-//! What is left of the route from each cell, layer and stage, bounded from
-//! below on a coarse grid: the A*'s heuristic.
+//! What is left of the route from each cell, mode (a layer at a level) and
+//! stage, bounded from below on a coarse grid: the A*'s heuristic.
 //!
 //! A straight-line bound knows nothing of the walls nor of the transitions,
 //! so on a site whose route bends round piers and changes shape at a gap the
@@ -8,8 +8,9 @@
 //! runs one Dijkstra per stage, backwards from the goal (or from the stage's
 //! stop edges and what is left after them), over a grid `FACTOR` times
 //! coarser, in a relaxation of the search's graph:
-//! - a coarse cell is open in a layer when any of its cells is;
-//! - the layer changes cost what they cost in the search;
+//! - a coarse cell is open in a mode when any of its cells is, and may be
+//!   climbed in when any of its cells may;
+//! - the layer changes and the climbs cost what they cost in the search;
 //! - a crossing is left in a layer its near cell is open in and lands in
 //!   that layer or any narrower one its far cell is open in.
 //!
@@ -23,18 +24,19 @@
 //! complete, and the corridor is pulled tight afterwards anyway.
 
 use super::field::CellLists;
-use super::search::{Graph, LAYERS, bit};
+use super::search::{Graph, LAYERS, bit, climb_bit};
 use crate::base::nearest::Nearest;
 
 /// Fine cells per coarse cell along each axis.
 const FACTOR: usize = 4;
 
-/// Per stage, layer and coarse cell, the relaxed distance left to the goal.
+/// Per stage, mode and coarse cell, the relaxed distance left to the goal.
 pub struct Guide {
     fine_nx: usize,
     nx: usize,
     ny: usize,
     cells: usize,
+    modes: usize,
     left: Vec<f32>,
     slack: f64,
     /// The way from a fine cell to the centres of the 3 × 3 coarse cells
@@ -49,9 +51,12 @@ struct Coarse {
     ny: usize,
     cells: usize,
     side: f64,
-    /// Per coarse cell, the layers any of its cells is open in.
-    open: Vec<u8>,
+    /// Per coarse cell, the modes any of its cells is open in and the
+    /// climbs any may make (the search's bits).
+    open: Vec<u64>,
     switch_cost: f64,
+    climb_cost: Vec<f64>,
+    levels: usize,
     /// The free crossings backwards: from the coarse cell they land in, the
     /// one they leave and their ends' layers (`Ends`).
     back: CellLists<Ends>,
@@ -65,18 +70,21 @@ impl Guide {
         let (nx, ny) = (fine_nx.div_ceil(FACTOR), fine_ny.div_ceil(FACTOR));
         let cells = nx * ny;
         let coarse = |i: usize| (i / fine_nx / FACTOR) * nx + (i % fine_nx) / FACTOR;
-        let all = (0..LAYERS).fold(0, |bits, l| bits | bit(l));
-        let mut open = vec![0u8; cells];
+        let levels = graph.levels();
+        let modes = graph.modes();
+        let goal_modes = (0..LAYERS).fold(0, |bits, l| bits | bit(graph.goal_level, l));
+        let mut open = vec![0u64; cells];
         for (i, bits) in graph.open.iter().enumerate() {
             open[coarse(i)] |= *bits;
         }
-        open[coarse(goal)] = all;
+        open[coarse(goal)] |= goal_modes;
         let ends = |jump: &super::search::Jump| Ends {
             from: coarse(jump.from),
             length: jump.length,
+            level: jump.level,
             leave: graph.open[jump.from],
             lands_from: (0..LAYERS)
-                .find(|&l| graph.open[jump.to] & bit(l) != 0)
+                .find(|&l| graph.open[jump.to] & bit(jump.level, l) != 0)
                 .unwrap_or(LAYERS),
         };
         let back = CellLists::new(
@@ -95,10 +103,12 @@ impl Guide {
             side: FACTOR as f64 * field.cell(),
             open,
             switch_cost: graph.switch_cost,
+            climb_cost: graph.climb_cost.to_vec(),
+            levels,
             back,
         };
         let stages = graph.stages;
-        let per_stage = cells * LAYERS;
+        let per_stage = cells * modes;
         let mut left = vec![f32::INFINITY; per_stage * (stages + 1)];
         for stage in (0..=stages).rev() {
             // Where the stage's routes end: the goal, or a stop edge and
@@ -106,24 +116,29 @@ impl Guide {
             let mut sources: Vec<(usize, f64)> = Vec::new();
             if stage == stages {
                 let g = coarse(goal);
-                sources.extend((0..LAYERS).map(|l| (l * cells + g, 0.0)));
+                let at = graph.goal_level * LAYERS;
+                sources.extend((0..LAYERS).map(|l| ((at + l) * cells + g, 0.0)));
             } else {
                 let after = &left[(stage + 1) * per_stage..(stage + 2) * per_stage];
                 for jump in graph.jumps.iter().filter(|j| j.pass_at == Some(stage)) {
                     let (from, to) = (coarse(jump.from), coarse(jump.to));
+                    let at = jump.level * LAYERS;
                     if !jump.crossing {
                         // A pass: in the nominal layer, to the nominal layer.
-                        sources.push((from, jump.length + f64::from(after[to])));
+                        sources.push((
+                            at * cells + from,
+                            jump.length + f64::from(after[at * cells + to]),
+                        ));
                         continue;
                     }
                     // A crossing lands in the layer it is entered in, or the
                     // widest narrower one its far end is open in.
                     let e = ends(jump);
-                    for l in (0..LAYERS).filter(|&l| e.leave & bit(l) != 0) {
+                    for l in (0..LAYERS).filter(|&l| e.leave & bit(jump.level, l) != 0) {
                         let rest = (l.max(e.lands_from)..LAYERS)
-                            .map(|a| after[a * cells + to])
+                            .map(|a| after[(at + a) * cells + to])
                             .fold(f32::INFINITY, f32::min);
-                        sources.push((l * cells + from, jump.length + f64::from(rest)));
+                        sources.push(((at + l) * cells + from, jump.length + f64::from(rest)));
                     }
                 }
             }
@@ -151,20 +166,21 @@ impl Guide {
             nx,
             ny,
             cells,
+            modes,
             left,
             slack: relaxed.side * std::f64::consts::FRAC_1_SQRT_2,
             way,
         }
     }
 
-    /// A bound of the route left from fine cell `cell` in `layer` at
-    /// `stage`, or `None` when the relaxation has none (nor has the search):
-    /// the least over the coarse cells round it of what is left from their
-    /// centre plus the way there, less the slack.
-    pub fn bound(&self, cell: usize, layer: usize, stage: usize) -> Option<f64> {
+    /// A bound of the route left from fine cell `cell` in `mode` (a layer
+    /// at a level) at `stage`, or `None` when the relaxation has none (nor
+    /// has the search): the least over the coarse cells round it of what is
+    /// left from their centre plus the way there, less the slack.
+    pub fn bound(&self, cell: usize, mode: usize, stage: usize) -> Option<f64> {
         let (fx, fy) = (cell % self.fine_nx, cell / self.fine_nx);
         let (cx, cy) = (fx / FACTOR, fy / FACTOR);
-        let plane = &self.left[(stage * LAYERS + layer) * self.cells..][..self.cells];
+        let plane = &self.left[(stage * self.modes + mode) * self.cells..][..self.cells];
         let own = plane[cy * self.nx + cx];
         if !own.is_finite() {
             return None;
@@ -186,7 +202,7 @@ impl Guide {
 }
 
 impl Coarse {
-    /// Distances over the coarse states (layer × cell) to `sources`, into
+    /// Distances over the coarse states (mode × cell) to `sources`, into
     /// `dist`, following the search's moves backwards.
     fn dijkstra(&self, dist: &mut [f32], sources: &[(usize, f64)]) {
         let cells = self.cells;
@@ -209,7 +225,8 @@ impl Coarse {
             if d as f32 > dist[state] {
                 continue;
             }
-            let (layer, c) = (state / cells, state % cells);
+            let (mode, c) = (state / cells, state % cells);
+            let (level, layer) = (mode / LAYERS, mode % LAYERS);
             let mut relax = |to: usize, length: f64, heap: &mut Buckets| {
                 let next = d + length;
                 if (next as f32) < dist[to] {
@@ -220,7 +237,7 @@ impl Coarse {
                     });
                 }
             };
-            let here = bit(layer);
+            let here = bit(level, layer);
             let (x, y) = ((c % self.nx) as isize, (c / self.nx) as isize);
             if self.open[c] & here != 0 {
                 for dy in -1..=1isize {
@@ -241,24 +258,37 @@ impl Coarse {
                             } else {
                                 self.side
                             };
-                            relax(layer * cells + from, length, &mut heap);
+                            relax(mode * cells + from, length, &mut heap);
                         }
                     }
                 }
             }
             for other in (0..LAYERS).filter(|&l| l != layer) {
-                if self.open[c] & bit(other.min(layer)) != 0 {
-                    relax(other * cells + c, self.switch_cost, &mut heap);
+                if self.open[c] & bit(level, other.min(layer)) != 0 {
+                    relax(
+                        (level * LAYERS + other) * cells + c,
+                        self.switch_cost,
+                        &mut heap,
+                    );
                 }
+            }
+            // Climbs, backwards: from the level below or above, here.
+            if level > 0 && self.open[c] & climb_bit(level - 1, layer) != 0 {
+                let cost = self.climb_cost[level - 1];
+                relax((mode - LAYERS) * cells + c, cost, &mut heap);
+            }
+            if level + 1 < self.levels && self.open[c] & climb_bit(level, layer) != 0 {
+                let cost = self.climb_cost[level];
+                relax((mode + LAYERS) * cells + c, cost, &mut heap);
             }
             // A crossing landing here in this layer was entered in it or in a
             // wider one its near end is open in.
             for e in self.back.at(c) {
-                if layer < e.lands_from {
+                if layer < e.lands_from || e.level != level {
                     continue;
                 }
-                for l in (0..=layer).filter(|&l| e.leave & bit(l) != 0) {
-                    relax(l * cells + e.from, e.length, &mut heap);
+                for l in (0..=layer).filter(|&l| e.leave & bit(level, l) != 0) {
+                    relax((level * LAYERS + l) * cells + e.from, e.length, &mut heap);
                 }
             }
         }
@@ -269,8 +299,10 @@ struct Ends {
     /// The coarse cell it leaves.
     from: usize,
     length: f64,
-    /// The layers its near end's cell is open in (it is entered in one).
-    leave: u8,
+    /// The level it is flown at.
+    level: usize,
+    /// The bits of its near end's cell (it is entered in a layer open there).
+    leave: u64,
     /// The widest layer its far end's cell is open in: it lands in that one
     /// or narrower.
     lands_from: usize,

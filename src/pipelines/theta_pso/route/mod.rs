@@ -33,6 +33,7 @@
 mod blocked;
 pub mod field;
 mod guide;
+pub mod levels;
 mod reuse;
 mod search;
 
@@ -46,9 +47,11 @@ pub use reuse::reuse;
 
 use self::field::{Disc, Field};
 use self::guide::Guide;
-use self::search::{Graph, Jump, LAYERS, Step, bit};
+use self::levels::Levels;
+use self::search::{Graph, Jump, LAYERS, Step, bit, climb_bit};
 use super::iwp::{Iwp, Shape as FormationShape, column_spacing, min_pair_distance};
 use super::path::{PathBuilder, SqueezeMap};
+use crate::base::geometry::segment_point_distance;
 use crate::mission::{Mission, Obstacle};
 
 /// Angles tried round each inspected obstacle.
@@ -59,6 +62,9 @@ const MAX_CELLS: f64 = 160_000.0;
 pub(crate) const FINEST_CELL: f64 = 0.2;
 /// Search states (cell × layer × stage) at most: about 16 bytes each.
 const MAX_STATES: f64 = 2_000_000.0;
+/// The same for a search over several levels (cell × layer × level ×
+/// stage): about 100 MB at most, once per run, when the flat search failed.
+const MAX_STACKED_STATES: f64 = 6_000_000.0;
 /// Extra spacing the squeezed shape keeps beyond 2 r_Q between two UAVs.
 const SQUEEZE_SPACING_MARGIN: f64 = 0.05;
 
@@ -83,11 +89,12 @@ pub struct Corridor {
     /// Per inspection (builder order): the angle round the axis and the side.
     pub passes: Vec<(f64, bool)>,
     pub length: f64,
-    /// The centroid altitude the corridor is flown at, when the search had
+    /// The centroid's altitude at each point, metres, when the search had
     /// to climb (or descend) off the start's and goal's altitudes to pass
-    /// over (under) what closes the way there; `None`: between them.
-    #[serde(default)]
-    pub cruise: Option<f64>,
+    /// over (under) what closes the way there; empty: between them, as the
+    /// seeding spreads it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub heights: Vec<f64>,
     /// Where the formation flies squeezed, for every path the swarm tries
     /// (worked out from the site for each run, never written).
     #[serde(skip)]
@@ -102,7 +109,7 @@ impl PartialEq for Corridor {
             && self.legs == other.legs
             && self.passes == other.passes
             && self.length == other.length
-            && self.cruise == other.cruise
+            && self.heights == other.heights
     }
 }
 
@@ -175,162 +182,110 @@ impl Shape {
     }
 }
 
-/// Whether the formation, at the altitudes the seeded corridor flies
-/// (between the start's and the goal's, in the band), passes over
-/// obstacle `o` or under it: its lowest UAV clears the top, or its highest
-/// the base, by r_Q + the safety margin + the cost's clearance margin.
-///
-/// The θ-PSO paper's obstacles are cylinders of height z_k and its paths
-/// 3-D; the cost (eq. 4 above and below a cylinder) and verification
-/// measure to the top and bottom discs. The route stage is 2-D: an
-/// obstacle the formation passes over or under as it flies is left out of
-/// its search, so a gapless wall of 9 m posts is no wall to a formation at
-/// 10 m, nor a deck 14 m up. One it would have to climb over is still kept
-/// out, as is one marked `overfly = false`.
-///
-/// With a `cruise` altitude the corridor is flown at that altitude instead.
-pub fn passed_by_altitude(mission: &Mission, o: &Obstacle, cruise: Option<f64>) -> bool {
-    let [over, under] = pass_altitudes(mission, o);
-    let (low, high) = cruise.map_or_else(|| seeded_altitudes(mission), |z| (z, z));
-    over <= low || high <= under
-}
-
-/// The lower and the higher of the start's and the goal's altitudes, in
-/// the band: the altitudes a corridor between them flies.
-fn seeded_altitudes(mission: &Mission) -> (f64, f64) {
-    let z = mission.bounds.z;
-    let band = |v: f64| v.clamp(z[0], z[1].max(z[0]));
-    let (start, goal) = (mission.route.start.z, mission.route.goal.z);
-    (band(start.min(goal)), band(start.max(goal)))
-}
-
-/// The lowest centroid altitude that passes over `o` (its lowest UAV r_Q +
-/// margins above the top) and the highest that passes under it.
-fn pass_altitudes(mission: &Mission, o: &Obstacle) -> [f64; 2] {
-    let f = &mission.formation;
-    let below = f.slots.iter().map(|s| -s.z).fold(0.0, f64::max);
-    let above = f.slots.iter().map(|s| s.z).fold(0.0, f64::max);
-    let clearance = f.least_clearance() + mission.theta_pso.clearance_margin.max(0.0);
-    [o.top() + clearance + below, o.base - clearance - above]
-}
-
-/// Altitudes to search at when no corridor exists between the start's and
-/// the goal's: those that pass over (then under) more of what is in the
-/// way there, inside the band the centroid may take (`z_box`), from the
-/// nearest; at most [`MAX_CRUISE_TRIES`], the one passing over (under) all
-/// of them among them.
-fn cruise_altitudes(mission: &Mission, z_box: [f64; 2]) -> Vec<f64> {
-    let (low, high) = seeded_altitudes(mission);
-    let in_way: Vec<[f64; 2]> = mission
-        .obstacles
-        .iter()
-        .filter(|o| o.within(mission.bounds.z) && !passed_by_altitude(mission, o, None))
-        .map(|o| pass_altitudes(mission, o))
-        .collect();
-    // Up to half the tries among `v`, nearest first, at its thirds, the last
-    // being the largest (for `under`, negated: the lowest, under all).
-    let pick = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v.dedup_by(|a, b| (*a - *b).abs() < 0.05);
-        let n = v.len();
-        let per = MAX_CRUISE_TRIES / 2;
-        let mut chosen: Vec<f64> = (1..=per)
-            .filter_map(|i| v.get((n * i).div_ceil(per).max(1) - 1).copied())
-            .collect();
-        chosen.dedup();
-        chosen
-    };
-    let over = pick(
-        in_way
-            .iter()
-            .map(|[o, _]| *o)
-            .filter(|z| *z > high && *z <= z_box[1])
-            .collect(),
-    );
-    let under = pick(
-        in_way
-            .iter()
-            .map(|[_, u]| -*u)
-            .filter(|z| -*z < low && -*z >= z_box[0])
-            .collect(),
-    );
-    over.into_iter()
-        .chain(under.into_iter().map(|z| -z))
-        .collect()
-}
-
-/// Most altitudes the route stage tries off the start's and goal's.
-const MAX_CRUISE_TRIES: usize = 6;
-
-/// The obstacles a formation in the band cannot fly over or under, as
-/// discs (see [`passed_by_altitude`]).
-fn blocking(mission: &Mission, cruise: Option<f64>) -> Vec<(usize, Disc)> {
-    let z = mission.bounds.z;
+/// The obstacles in the way of a formation flying anywhere in `span`, as
+/// discs (see [`levels::blocks`]).
+fn blocking(mission: &Mission, span: [f64; 2]) -> Vec<(usize, Disc)> {
     mission
         .obstacles
         .iter()
         .enumerate()
-        .filter(|(_, o)| o.within(z) && !passed_by_altitude(mission, o, cruise))
-        .map(|(k, o)| {
-            (
-                k,
-                Disc {
-                    center: o.center,
-                    radius: o.radius,
-                    polygon: (!o.footprint.is_empty()).then(|| o.footprint.as_slice().into()),
-                },
-            )
-        })
+        .filter(|(_, o)| levels::blocks(mission, o, span))
+        .map(|(k, o)| (k, disc_of(o)))
         .collect()
 }
 
+fn disc_of(o: &Obstacle) -> Disc {
+    Disc {
+        center: o.center,
+        radius: o.radius,
+        polygon: (!o.footprint.is_empty()).then(|| o.footprint.as_slice().into()),
+    }
+}
+
+/// Cost of a metre climbed or descended between levels, in metres of
+/// route: a climb is slower than level flight (PX4's climb and descent
+/// rates are below its horizontal speed) and the paper's paths keep their
+/// altitude where they can.
+const CLIMB_COST: f64 = 2.0;
+
+/// Half the horizontal run of a climb between two levels `dz` apart: the
+/// ramp is flown within this of the cell the search climbed at, so that
+/// cell keeps this much more clearance over every altitude between.
+fn ramp(dz: f64, cell: f64) -> f64 {
+    (0.5 * dz.abs()).clamp(1.5 * cell, 2.5)
+}
+
+/// One level of the search: what stands in the way there.
+pub(crate) struct Level {
+    /// The obstacles in the way (mission index, disc) and their discs alone.
+    obstacles: Vec<(usize, Disc)>,
+    discs: Vec<Disc>,
+    /// The clearance field to them.
+    field: Field,
+}
+
 /// The grid the route stage searches and what it knows of every cell: the
-/// clearance field, and in which layers each cell may be entered.
+/// clearance field at every level, and in which modes (a layer at a level)
+/// each cell may be entered and where the formation may climb.
 pub(crate) struct Site {
     shape: Shape,
     /// The clearance the centroid needs in each layer.
     need: [f64; LAYERS],
-    /// The obstacles in the way (mission index, disc) and their discs alone.
-    obstacles: Vec<(usize, Disc)>,
-    discs: Vec<Disc>,
-    field: Field,
-    /// Per cell, one bit per layer it may be entered in.
-    open: Vec<u8>,
+    levels: Levels,
+    at: Vec<Level>,
+    /// Per cell, the search's bits (`search::bit`, `search::climb_bit`).
+    open: Vec<u64>,
 }
 
 impl Site {
+    /// The grid's geometry (every level's field shares it).
+    fn field(&self) -> &Field {
+        &self.at[0].field
+    }
+
     /// The squeezed regions `corridor` passes, as the paths the swarm tries
     /// read them (`None` when it never squeezes).
     fn squeeze_of(&self, corridor: &Corridor, mission: &Mission) -> Option<Arc<SqueezeMap>> {
-        squeeze_map(
-            &self.field,
-            &self.open,
-            corridor,
-            &self.shape,
-            mission,
-            &self.discs,
-        )
-        .map(|mut map| {
-            map.obstacle_of = self.obstacles.iter().map(|(k, d)| (*k, d.center)).collect();
-            Arc::new(map)
-        })
+        squeeze_map(self, corridor, mission)
     }
 
-    fn new(mission: &Mission, builder: &PathBuilder, margin: f64, cruise: Option<f64>) -> Self {
+    fn new(mission: &Mission, builder: &PathBuilder, margin: f64, levels: Levels) -> Self {
         let shape = Shape::new(mission, margin);
         let need = shape.need();
         let b = &mission.bounds;
         let area = (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]);
-        // The search holds a state per cell, layer and stage: the grid shares
-        // MAX_STATES among the stages (a stop per pass and requested crossing),
-        // never finer than 0.2 m. A large site gets coarse cells rather than
-        // gigabytes (the refusal then speaks for that resolution).
+        // The search holds a state per cell, layer, level and stage: the grid
+        // shares its states among the stages (a stop per pass and requested
+        // crossing) and the levels, never finer than 0.2 m. A large site gets
+        // coarse cells rather than gigabytes (the refusal then speaks for
+        // that resolution).
         let stops = builder.inspections().len() + builder.crossing_iwps().len();
-        let cells = (MAX_STATES / (LAYERS * (stops + 1)) as f64).min(MAX_CELLS);
+        let budget = if levels.is_flat() {
+            MAX_STATES
+        } else {
+            MAX_STACKED_STATES
+        };
+        let cells = (budget / (LAYERS * levels.len() * (stops + 1)) as f64).min(MAX_CELLS);
         let cell = (area / cells).sqrt().max(FINEST_CELL);
-        let obstacles = blocking(mission, cruise);
-        let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| d.clone()).collect();
-        let field = Field::new([b.x, b.y], &discs, cell, need[0] + 2.0 * cell);
+        let ramps: Vec<f64> = (0..levels.len().saturating_sub(1))
+            .map(|pair| {
+                let [lo, hi] = levels.hull(pair);
+                ramp(hi - lo, cell)
+            })
+            .collect();
+        let cap = need[0] + 2.0 * cell;
+        let at: Vec<Level> = (0..levels.len())
+            .map(|l| {
+                let obstacles = blocking(mission, levels.span(l));
+                let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| d.clone()).collect();
+                let field = Field::new([b.x, b.y], &discs, cell, cap);
+                Level {
+                    obstacles,
+                    discs,
+                    field,
+                }
+            })
+            .collect();
         let boxes = [
             [dx_dy(builder)[0], dx_dy(builder)[1]],
             [
@@ -339,112 +294,247 @@ impl Site {
             ],
             [b.x, b.y],
         ];
-
         let inside = |p: Point2<f64>, [x, y]: [[f64; 2]; 2]| {
             x[0] <= p.x && p.x <= x[1] && y[0] <= p.y && p.y <= y[1]
         };
-        let (start, goal) = (mission.route.start.xy(), mission.route.goal.xy());
-        let mut open: Vec<u8> = (0..field.len())
+        // Half a cell's diagonal of slack: a straight between two open cell
+        // centres stays clear in between.
+        let slack = cell * std::f64::consts::FRAC_1_SQRT_2;
+        let geometry = &at[0].field;
+        let mut open: Vec<u64> = (0..geometry.len())
             .map(|i| {
-                let (c, p) = (field.clearance(i), field.center(i));
-                // Half a cell's diagonal of slack: a straight between two open
-                // cell centres stays clear in between.
-                let slack = cell * std::f64::consts::FRAC_1_SQRT_2;
-                (0..LAYERS)
-                    .filter(|&l| c >= need[l] + slack && inside(p, boxes[l]))
-                    .fold(0, |bits, l| bits | bit(l))
+                let p = geometry.center(i);
+                let mut bits = 0;
+                for (l, level) in at.iter().enumerate() {
+                    let c = level.field.clearance(i);
+                    for layer in 0..LAYERS {
+                        if c >= need[layer] + slack && inside(p, boxes[layer]) {
+                            bits |= bit(l, layer);
+                        }
+                    }
+                }
+                bits
             })
             .collect();
+        // Where the formation may climb between two levels: every altitude
+        // between them clear by the layer's need and the ramp's run.
+        for (pair, run) in ramps.iter().enumerate() {
+            let discs: Vec<Disc> = blocking(mission, levels.hull(pair))
+                .into_iter()
+                .map(|(_, d)| d)
+                .collect();
+            let hull = Field::new([b.x, b.y], &discs, cell, cap + run);
+            for (i, bits) in open.iter_mut().enumerate() {
+                let (c, p) = (hull.clearance(i), hull.center(i));
+                for layer in 0..LAYERS {
+                    if c >= need[layer] + slack + run && inside(p, boxes[layer]) {
+                        *bits |= climb_bit(pair, layer);
+                    }
+                }
+            }
+        }
+        // Through an IWP's gap only by its crossing: the path builder takes
+        // every leg across a crossing's gate through the crossing, so a
+        // corridor that slipped through in single file on free cells would
+        // be flown doubling back over the crossing's straight. The gate's
+        // cells are closed at the levels where the gap stands in the way.
+        let windows = builder.crossing_windows();
+        for (gate, window) in builder.crossing_gates().iter().zip(&windows) {
+            for l in (0..levels.len()).filter(|&l| {
+                let span = levels.span(l);
+                window[0] <= span[1] + 1e-9 && span[0] <= window[1] + 1e-9
+            }) {
+                let closed = !(0..LAYERS).fold(0u64, |bits, layer| bits | bit(l, layer));
+                let mid = nalgebra::center(&gate[0], &gate[1]);
+                let half = (gate[1] - gate[0]).norm() / 2.0 + cell;
+                for i in geometry.cells_within(mid, half) {
+                    let p = geometry.center(i);
+                    if segment_point_distance(&gate[0], &gate[1], &p) <= cell {
+                        open[i] &= closed;
+                    }
+                }
+            }
+        }
         // Round the start and the goal the disc model is too strict: validation
         // has checked the formation fits there; let the centroid leave them
-        // wherever it is itself clear.
-        for end in [start, goal] {
+        // wherever it is itself clear, at the level it is at there.
+        let (start, goal) = (mission.route.start.xy(), mission.route.goal.xy());
+        for (end, l) in [(start, levels.start), (goal, levels.goal)] {
             let around = shape.reach + cell;
+            let field = &at[l].field;
             for i in field.cells_within(end, around) {
                 let p = field.center(i);
                 if (p - end).norm() <= around
                     && field.clearance(i) >= shape.r_q + margin
                     && b.contains_xy(&p)
                 {
-                    open[i] |= bit(0) | bit(1) | bit(2);
+                    open[i] |= bit(l, 0) | bit(l, 1) | bit(l, 2);
                 }
             }
         }
         Site {
             shape,
             need,
-            obstacles,
-            discs,
-            field,
+            levels,
+            at,
             open,
         }
+    }
+
+    /// Cost of each climb between neighbouring levels, metres of route.
+    fn climb_costs(&self) -> Vec<f64> {
+        (0..self.levels.len().saturating_sub(1))
+            .map(|pair| {
+                let [lo, hi] = self.levels.hull(pair);
+                CLIMB_COST * (hi - lo) + self.field().cell()
+            })
+            .collect()
+    }
+
+    /// The half run of the ramp of a climb between level `pair` and the one above.
+    fn ramp(&self, pair: usize) -> f64 {
+        let [lo, hi] = self.levels.hull(pair);
+        ramp(hi - lo, self.field().cell())
     }
 }
 
 /// Whether a pass along the straight `ends` round obstacle `k` (mission
-/// index) is open: every cell on it open in the nominal layer, or nearest to
-/// `k` itself and clear of it by r_Q (the pass flies close to its obstacle
-/// on purpose), and both ends open.
-fn pass_clear(
-    field: &Field,
-    open: &[u8],
-    obstacles: &[(usize, Disc)],
-    r_q: f64,
-    k: usize,
-    ends: [Point2<f64>; 2],
-) -> bool {
+/// index) is open at `level`: every cell on it open in the nominal layer, or
+/// nearest to `k` itself and clear of it by r_Q (the pass flies close to its
+/// obstacle on purpose), and both ends open.
+fn pass_clear(site: &Site, level: usize, k: usize, ends: [Point2<f64>; 2]) -> bool {
+    let Level {
+        field, obstacles, ..
+    } = &site.at[level];
+    let open = &site.open;
     let obstacle = obstacles.iter().position(|(o, _)| *o == k);
+    let nominal = bit(level, 0);
     field.cells_along(ends[0], ends[1]).all(|c| {
-        open[c] & bit(0) != 0 || (field.nearest_disc(c) == obstacle && field.clearance(c) > r_q)
-    }) && ends.iter().all(|p| open[field.index_of(*p)] & bit(0) != 0)
+        open[c] & nominal != 0
+            || (field.nearest_disc(c) == obstacle && field.clearance(c) > site.shape.r_q)
+    }) && ends.iter().all(|p| open[field.index_of(*p)] & nominal != 0)
 }
 
 /// The route stage for `mission`: the cheapest corridor, or why none exists.
 ///
-/// Long (~170 lines): the stage in order (grid, open layers, stops, jumps, search, corridor, squeeze map), each step reading the one before.
+/// First at the altitudes between the start's and the goal's (flat); when
+/// that finds no corridor, again with the formation free to climb over (or
+/// descend under) what closes the way, level by level (`levels`).
 pub fn find(
     mission: &Mission,
     builder: &PathBuilder,
     iwps: &[Iwp],
     margin: f64,
 ) -> Result<Corridor, Blocked> {
-    let flat = find_at(mission, builder, iwps, margin, None);
+    let flat = find_at(mission, builder, iwps, margin, Levels::flat(mission));
     let Err(blocked) = flat else {
         return flat;
     };
-    // Closed between the start's and the goal's altitudes: climb over (or
-    // descend under) what closes it, when the band leaves room.
-    for z in cruise_altitudes(mission, builder.decoding_box()[2]) {
-        if let Ok(corridor) = find_at(mission, builder, iwps, margin, Some(z)) {
-            return Ok(corridor);
-        }
+    let z_box = builder.decoding_box()[2];
+    let levels = Levels::stacked(
+        mission,
+        z_box,
+        &builder.pass_altitudes(),
+        &blocked.obstacles,
+    );
+    if levels.len() < 2 {
+        return Err(with_altitudes(mission, blocked, z_box));
     }
-    Err(blocked)
+    find_at(mission, builder, iwps, margin, levels).map_err(|stacked| {
+        // The stacked search names what closes the way at every altitude it
+        // tried; when nothing does (the way closes only in combination), the
+        // flat search's chain is the one to name.
+        let named = if stacked.obstacles.is_empty() {
+            blocked
+        } else {
+            stacked
+        };
+        with_altitudes(mission, named, z_box)
+    })
 }
 
-/// The route search with the corridor flown at `cruise` (see [`find`]).
+/// `blocked`'s reason with what the band leaves over and under the
+/// obstacles it names: the altitude the formation would need to pass over
+/// (under) them, and why it cannot.
+fn with_altitudes(mission: &Mission, blocked: Blocked, z_box: [f64; 2]) -> Blocked {
+    let members = &blocked.obstacles;
+    if members.is_empty() {
+        return blocked;
+    }
+    let obstacles = &mission.obstacles;
+    let top = members
+        .iter()
+        .map(|&k| obstacles[k].height)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let base = members
+        .iter()
+        .map(|&k| obstacles[k].base)
+        .fold(f64::INFINITY, f64::min);
+    let reach = if base > 0.0 {
+        format!(" from {base:.1} m to {top:.1} m")
+    } else {
+        format!(" from the ground to {top:.1} m")
+    };
+    let over = match members.iter().find(|&&k| !obstacles[k].overfly) {
+        Some(&k) => format!("'{}' may not be flown over", obstacles[k].name),
+        None => {
+            let z = members
+                .iter()
+                .map(|&k| mission.passing_altitudes(&obstacles[k])[0])
+                .fold(f64::NEG_INFINITY, f64::max);
+            if z > z_box[1] {
+                format!(
+                    "over them the formation's centroid would fly at {z:.1} m, above the {:.1} m                      the band's ceiling leaves it",
+                    z_box[1]
+                )
+            } else {
+                format!("climbing over them (at {z:.1} m) does not open the way")
+            }
+        }
+    };
+    let under = if base <= 0.0 {
+        String::new()
+    } else {
+        let z = members
+            .iter()
+            .map(|&k| mission.passing_altitudes(&obstacles[k])[1])
+            .fold(f64::INFINITY, f64::min);
+        if z < z_box[0] {
+            format!(
+                "; under them it would fly at {z:.1} m, below the {:.1} m the band's floor leaves it",
+                z_box[0]
+            )
+        } else {
+            format!("; descending under them (at {z:.1} m) does not open the way")
+        }
+    };
+    Blocked {
+        reason: format!("{}; they stand{reach}: {over}{under}", blocked.reason),
+        obstacles: blocked.obstacles,
+    }
+}
+
+/// The route search at `levels` (see [`find`]).
+///
+/// Long (~170 lines): the stage in order (grid, open modes, stops, jumps, search, corridor, squeeze map), each step reading the one before.
 fn find_at(
     mission: &Mission,
     builder: &PathBuilder,
     iwps: &[Iwp],
     margin: f64,
-    cruise: Option<f64>,
+    levels: Levels,
 ) -> Result<Corridor, Blocked> {
-    let site = Site::new(mission, builder, margin, cruise);
-    let Site {
-        shape,
-        need,
-        obstacles,
-        field,
-        open,
-        ..
-    } = &site;
+    let site = Site::new(mission, builder, margin, levels);
+    let field = site.field();
+    let levels = &site.levels;
     let (start, goal) = (mission.route.start.xy(), mission.route.goal.xy());
+    let overlaps = |a: [f64; 2], b: [f64; 2]| a[0] <= b[1] + 1e-9 && b[0] <= a[1] + 1e-9;
 
     // The stops, in order along start → goal: every inspection pass, and
     // every crossing the user asked for by name (a `[[reconfiguration.
     // waypoints]]` entry): the route must take those; the others it may.
     let crossings = builder.crossings();
+    let windows = builder.crossing_windows();
     let requested: Vec<bool> = builder
         .crossing_iwps()
         .iter()
@@ -457,56 +547,72 @@ fn find_at(
     let stage_of_crossing = |c: usize| order.iter().position(|s| *s == Stop::Crossing(c));
     let mut jumps = Vec::new();
     for (c, [a, z]) in crossings.iter().enumerate() {
-        for (direction, (from, to)) in [(*a, *z), (*z, *a)].into_iter().enumerate() {
-            jumps.push(Jump {
-                from: field.index_of(from),
-                to: field.index_of(to),
-                length: (to - from).norm(),
-                pass_at: stage_of_crossing(c),
-                crossing: true,
-                tag: 2 * c + direction,
-            });
+        // At the levels where both sides of its gap stand in the way.
+        for level in (0..levels.len()).filter(|&l| overlaps(windows[c], levels.span(l))) {
+            for (direction, (from, to)) in [(*a, *z), (*z, *a)].into_iter().enumerate() {
+                jumps.push(Jump {
+                    from: field.index_of(from),
+                    to: field.index_of(to),
+                    length: (to - from).norm(),
+                    pass_at: stage_of_crossing(c),
+                    crossing: true,
+                    tag: 2 * c + direction,
+                    level,
+                });
+            }
         }
     }
+    let pass_altitudes = builder.pass_altitudes();
     let mut candidates: Vec<(usize, f64, bool, [Point2<f64>; 2])> = Vec::new();
     for (stage, stop) in order.iter().enumerate() {
         let Stop::Pass(i) = *stop else { continue };
         let (k, _) = builder.inspections()[i];
-        for j in 0..PASS_ANGLES {
-            let phi = TAU * j as f64 / PASS_ANGLES as f64 - PI;
-            for on_left in [true, false] {
-                let ends = builder.pass_ends(i, phi, on_left);
-                if pass_clear(field, open, obstacles, shape.r_q, k, ends) {
-                    jumps.push(Jump {
-                        from: field.index_of(ends[0]),
-                        to: field.index_of(ends[1]),
-                        length: (ends[1] - ends[0]).norm(),
-                        pass_at: Some(stage),
-                        crossing: false,
-                        tag: 2 * crossings.len() + candidates.len(),
-                    });
-                    candidates.push((i, phi, on_left, ends));
+        // At the levels the pass may be flown at (the flat one: any).
+        let at = (0..levels.len())
+            .filter(|&l| levels.is_flat() || overlaps(pass_altitudes[i], levels.span(l)));
+        for level in at {
+            for j in 0..PASS_ANGLES {
+                let phi = TAU * j as f64 / PASS_ANGLES as f64 - PI;
+                for on_left in [true, false] {
+                    let ends = builder.pass_ends(i, phi, on_left);
+                    if pass_clear(&site, level, k, ends) {
+                        jumps.push(Jump {
+                            from: field.index_of(ends[0]),
+                            to: field.index_of(ends[1]),
+                            length: (ends[1] - ends[0]).norm(),
+                            pass_at: Some(stage),
+                            crossing: false,
+                            tag: 2 * crossings.len() + candidates.len(),
+                            level,
+                        });
+                        candidates.push((i, phi, on_left, ends));
+                    }
                 }
             }
         }
     }
 
+    let climb_cost = site.climb_costs();
     let graph = Graph {
         field,
-        open,
+        open: &site.open,
         jumps: &jumps,
         stages: order.len(),
         switch_cost: mission
             .reconfiguration
             .transition_distance
             .max(field.cell()),
+        climb_cost: &climb_cost,
+        start_level: levels.start,
+        goal_level: levels.goal,
     };
     let (s, g) = (field.index_of(start), field.index_of(goal));
     let guide = Guide::new(&graph, g);
+    let first_mode = levels.start * LAYERS;
     // A start the relaxation cannot leave needs no search.
     let guided = guide
-        .bound(s, 0, 0)
-        .and_then(|_| search::search(&graph, s, g, |c, l, st| guide.bound(c, l, st)).ok());
+        .bound(s, first_mode, 0)
+        .and_then(|_| search::search(&graph, s, g, |c, m, st| guide.bound(c, m, st)).ok());
     let found = match guided {
         Some(steps) => Ok(steps),
         // No route. What the formation reaches, to say what closes the way:
@@ -519,33 +625,11 @@ fn find_at(
     };
     let steps = match found {
         Ok(steps) => steps,
-        Err(reached) => {
-            return Err(blocked::explain(
-                mission,
-                iwps,
-                field,
-                obstacles,
-                &reached,
-                &order,
-                builder,
-                // The narrowest layer's: what nothing at all fits through.
-                if shape.column.is_some() {
-                    need[2]
-                } else {
-                    need[1]
-                },
-                if shape.column.is_some() {
-                    0.0
-                } else {
-                    shape.smallest * shape.reach
-                },
-            ));
-        }
+        Err(reached) => return Err(explain(mission, iwps, builder, &site, &reached, &order)),
     };
 
     let mut corridor = assemble(
-        field,
-        open,
+        &site,
         &steps,
         start,
         goal,
@@ -554,8 +638,59 @@ fn find_at(
         builder.inspections().len(),
     );
     corridor.squeeze = site.squeeze_of(&corridor, mission);
-    corridor.cruise = cruise;
     Ok(corridor)
+}
+
+/// Why the search at `site`'s levels reached no corridor: the chain of
+/// obstacles round what it reached (`blocked::explain`), among those in
+/// the way at every level (for the flat search, its one level's).
+fn explain(
+    mission: &Mission,
+    iwps: &[Iwp],
+    builder: &PathBuilder,
+    site: &Site,
+    reached: &search::Reached,
+    order: &[Stop],
+) -> Blocked {
+    let shape = &site.shape;
+    // The narrowest layer's need: what nothing at all fits through.
+    let (need, squeezed) = if shape.column.is_some() {
+        (site.need[2], 0.0)
+    } else {
+        (site.need[1], shape.smallest * shape.reach)
+    };
+    let everywhere;
+    let (field, obstacles) = if site.levels.len() == 1 {
+        (&site.at[0].field, &site.at[0].obstacles)
+    } else {
+        // In the way at every level: nothing the search tried passes them.
+        let kept: Vec<(usize, Disc)> = site.at[0]
+            .obstacles
+            .iter()
+            .filter(|(k, _)| {
+                site.at
+                    .iter()
+                    .all(|l| l.obstacles.iter().any(|(o, _)| o == k))
+            })
+            .cloned()
+            .collect();
+        let discs: Vec<Disc> = kept.iter().map(|(_, d)| d.clone()).collect();
+        let geometry = site.field();
+        let b = &mission.bounds;
+        everywhere = (
+            Field::new(
+                [b.x, b.y],
+                &discs,
+                geometry.cell(),
+                site.need[0] + 2.0 * geometry.cell(),
+            ),
+            kept,
+        );
+        (&everywhere.0, &everywhere.1)
+    };
+    blocked::explain(
+        mission, iwps, field, obstacles, reached, order, builder, need, squeezed,
+    )
 }
 
 /// The x and y ranges of the builder's decoding box (the nominal layer's).
@@ -611,11 +746,12 @@ fn shrink([lo, hi]: [f64; 2], by: f64) -> [f64; 2] {
 }
 
 /// The search's steps as a corridor: runs of cells pulled tight within their
-/// layer, the jumps kept exact.
+/// mode, the jumps kept exact, each climb a short ramp round its cell.
+///
+/// Long (~130 lines): one walk over the steps (runs, layer changes, climbs, jumps), then the ramps laid out.
 #[allow(clippy::too_many_arguments)]
 fn assemble(
-    field: &Field,
-    open: &[u8],
+    site: &Site,
     steps: &[Step],
     start: Point2<f64>,
     goal: Point2<f64>,
@@ -623,42 +759,113 @@ fn assemble(
     candidates: &[(usize, f64, bool, [Point2<f64>; 2])],
     inspections: usize,
 ) -> Corridor {
+    let field = site.field();
+    let levels = &site.levels;
+    let height = |level: usize| levels.altitude(level);
+    let first = levels.start;
     let mut points = vec![start];
+    let mut heights = vec![height(first)];
     let mut legs = Vec::new();
     let mut passes = vec![(0.0, true); inspections];
-    // The current run: its points and layer.
+    // Climbs: the index of the leg that climbs, and its ramp's half run.
+    let mut climbs: Vec<(usize, f64)> = Vec::new();
+    // The current run: its points and mode.
     let mut run: Vec<Point2<f64>> = vec![start];
-    let mut layer = 0;
+    let (mut layer, mut level) = (0, first);
     let flush = |run: &mut Vec<Point2<f64>>,
-                 layer: usize,
+                 (layer, level): (usize, usize),
                  points: &mut Vec<Point2<f64>>,
+                 heights: &mut Vec<f64>,
                  legs: &mut Vec<Leg>,
                  end: Point2<f64>| {
         run.push(end);
-        let pulled = pull_tight(field, open, bit(layer), run);
+        let pulled = pull_tight(field, &site.open, bit(level, layer), run);
         for p in pulled.into_iter().skip(1) {
             if (p - points[points.len() - 1]).norm() > 1e-9 {
                 points.push(p);
+                heights.push(height(level));
                 legs.push(Leg::Free { layer });
             }
         }
         run.clear();
     };
     for (k, step) in steps.iter().enumerate().skip(1) {
+        let last = k + 1 == steps.len();
         match *step {
-            Step::Cell { cell, layer: l } => {
-                if l != layer {
+            Step::Cell {
+                cell,
+                layer: l,
+                level: v,
+            } => {
+                let here = field.center(cell);
+                if v != level {
+                    // A climb: up (or down) at this cell, from the run so far.
+                    flush(
+                        &mut run,
+                        (layer, level),
+                        &mut points,
+                        &mut heights,
+                        &mut legs,
+                        here,
+                    );
+                    let pair = v.min(level);
+                    let run_half = site.ramp(pair);
+                    // Climbs through several levels at one cell are one ramp.
+                    match climbs.last_mut() {
+                        Some((leg, half)) if *leg + 1 == legs.len() && points[*leg] == here => {
+                            *half = half.min(run_half);
+                            *heights.last_mut().unwrap_or(&mut 0.0) = height(v);
+                        }
+                        _ => {
+                            climbs.push((legs.len(), run_half));
+                            points.push(here);
+                            heights.push(height(v));
+                            legs.push(Leg::Free { layer: l });
+                        }
+                    }
+                    run.push(here);
+                    (layer, level) = (l, v);
+                    if last {
+                        flush(
+                            &mut run,
+                            (layer, level),
+                            &mut points,
+                            &mut heights,
+                            &mut legs,
+                            goal,
+                        );
+                    }
+                } else if l != layer {
                     // A change of layer: a vertex where the transition is.
-                    flush(&mut run, layer, &mut points, &mut legs, field.center(cell));
-                    run.push(field.center(cell));
+                    flush(
+                        &mut run,
+                        (layer, level),
+                        &mut points,
+                        &mut heights,
+                        &mut legs,
+                        here,
+                    );
+                    run.push(here);
                     layer = l;
-                } else if k + 1 == steps.len() {
-                    flush(&mut run, layer, &mut points, &mut legs, goal);
+                } else if last {
+                    flush(
+                        &mut run,
+                        (layer, level),
+                        &mut points,
+                        &mut heights,
+                        &mut legs,
+                        goal,
+                    );
                 } else {
-                    run.push(field.center(cell));
+                    run.push(here);
                 }
             }
-            Step::Jump { tag, layer: l, .. } => {
+            Step::Jump {
+                tag,
+                layer: l,
+                level: v,
+                ..
+            } => {
                 let (ends, leg) = if tag < 2 * crossings.len() {
                     let [a, z] = crossings[tag / 2];
                     let ends = if tag % 2 == 0 { [a, z] } else { [z, a] };
@@ -668,34 +875,90 @@ fn assemble(
                     passes[i] = (phi, on_left);
                     (ends, Leg::Pass(i))
                 };
-                flush(&mut run, layer, &mut points, &mut legs, ends[0]);
+                flush(
+                    &mut run,
+                    (layer, level),
+                    &mut points,
+                    &mut heights,
+                    &mut legs,
+                    ends[0],
+                );
                 points.push(ends[1]);
+                heights.push(height(v));
                 legs.push(leg);
                 run.push(ends[1]);
-                layer = l;
-                if k + 1 == steps.len() {
-                    flush(&mut run, layer, &mut points, &mut legs, goal);
+                (layer, level) = (l, v);
+                if last {
+                    flush(
+                        &mut run,
+                        (layer, level),
+                        &mut points,
+                        &mut heights,
+                        &mut legs,
+                        goal,
+                    );
                 }
             }
         }
     }
     if points.last() != Some(&goal) {
-        flush(&mut run, layer, &mut points, &mut legs, goal);
+        flush(
+            &mut run,
+            (layer, level),
+            &mut points,
+            &mut heights,
+            &mut legs,
+            goal,
+        );
     }
-    let length = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    // Each climb, a vertical leg at its cell, becomes a ramp: its foot back
+    // along the leg before, its top on along the leg after, each within the
+    // ramp's half run of the cell (clear at every altitude between).
+    for &(leg, half) in &climbs {
+        let c = points[leg];
+        if leg > 0 {
+            let before = points[leg - 1];
+            let back = (before - c).norm();
+            if back > 1e-9 {
+                points[leg] = c + (before - c) * (half.min(0.45 * back) / back);
+            }
+        }
+        if leg + 2 < points.len() {
+            let after = points[leg + 2];
+            let on = (after - c).norm();
+            if on > 1e-9 {
+                points[leg + 1] = c + (after - c) * (half.min(0.45 * on) / on);
+            }
+        }
+    }
+    let length = points
+        .iter()
+        .zip(&heights)
+        .collect::<Vec<_>>()
+        .windows(2)
+        .map(|w| {
+            let (a, za) = w[0];
+            let (b, zb) = w[1];
+            (b - a).norm().hypot(zb - za)
+        })
+        .sum();
     Corridor {
         points,
         legs,
         passes,
         length,
-        cruise: None,
+        heights: if levels.is_flat() {
+            Vec::new()
+        } else {
+            heights
+        },
         squeeze: None,
     }
 }
 
 /// The run's points with every corner removed that a straight line on open
 /// cells can skip: from each kept point, the farthest one in sight.
-fn pull_tight(field: &Field, open: &[u8], bit: u8, run: &[Point2<f64>]) -> Vec<Point2<f64>> {
+fn pull_tight(field: &Field, open: &[u64], bit: u64, run: &[Point2<f64>]) -> Vec<Point2<f64>> {
     if run.len() <= 2 {
         return run.to_vec();
     }
@@ -715,33 +978,51 @@ fn pull_tight(field: &Field, open: &[u8], bit: u8, run: &[Point2<f64>]) -> Vec<P
 
 /// The squeezed regions the corridor passes: the connected cells where only
 /// the shrink fits (flown at the scale the corridor needs through it) or
-/// only the column does; `None` when the corridor never squeezes.
-fn squeeze_map(
-    field: &Field,
-    open: &[u8],
-    corridor: &Corridor,
-    shape: &Shape,
-    mission: &Mission,
-    discs: &[Disc],
-) -> Option<SqueezeMap> {
-    // The narrowest layer a cell is open in, when it is not open in the nominal.
-    let narrow = |i: usize| -> Option<usize> {
-        (open[i] & bit(0) == 0)
-            .then(|| (1..LAYERS).find(|&l| open[i] & bit(l) != 0))
+/// only the column does, at the level each leg is flown at; `None` when the
+/// corridor never squeezes.
+fn squeeze_map(site: &Site, corridor: &Corridor, mission: &Mission) -> Option<Arc<SqueezeMap>> {
+    let field = site.field();
+    let open = &site.open;
+    let shape = &site.shape;
+    // The narrowest layer a cell is open in at `level`, when it is not open
+    // in the nominal one.
+    let narrow = |i: usize, level: usize| -> Option<usize> {
+        (open[i] & bit(level, 0) == 0)
+            .then(|| (1..LAYERS).find(|&l| open[i] & bit(level, l) != 0))
             .flatten()
+    };
+    let level_of_leg = |leg: usize| {
+        corridor
+            .heights
+            .get(leg)
+            .and_then(|z| site.levels.level_of(*z))
+            .unwrap_or(0)
     };
     let mut region = vec![0u16; field.len()];
     let mut shapes: Vec<FormationShape> = Vec::new();
-    for (leg, w) in corridor.legs.iter().zip(corridor.points.windows(2)) {
+    // The level whose obstacles name the squeezes' sides.
+    let mut named: Option<usize> = None;
+    for (k, (leg, w)) in corridor
+        .legs
+        .iter()
+        .zip(corridor.points.windows(2))
+        .enumerate()
+    {
         if matches!(leg, Leg::Free { layer: 0 } | Leg::Pass(_)) {
             continue;
         }
+        let level = level_of_leg(k);
+        let Level {
+            field: at, discs, ..
+        } = &site.at[level];
         let (a, b) = (w[0], w[1]);
         let steps = (((b - a).norm() / (field.cell() / 3.0)).ceil() as usize).max(1);
-        for k in 0..=steps {
-            let p = a + (b - a) * (k as f64 / steps as f64);
+        for j in 0..=steps {
+            let p = a + (b - a) * (j as f64 / steps as f64);
             let i = field.index_of(p);
-            let Some(layer) = narrow(i) else { continue };
+            let Some(layer) = narrow(i, level) else {
+                continue;
+            };
             if region[i] == 0 {
                 if shapes.len() >= u16::MAX as usize - 1 {
                     break;
@@ -750,13 +1031,16 @@ fn squeeze_map(
                     (2, Some(column)) => column,
                     _ => FormationShape::Shrink { scale: 1.0 },
                 });
+                named.get_or_insert(level);
                 let label = shapes.len() as u16;
-                flood(field, &mut region, i, label, &|j| narrow(j) == Some(layer));
+                flood(field, &mut region, i, label, &|c| {
+                    narrow(c, level) == Some(layer)
+                });
             }
             let r = region[i] as usize - 1;
             if let FormationShape::Shrink { scale } = &mut shapes[r] {
                 let fits = shape.scale_for(
-                    field.clearance_at(p, discs),
+                    at.clearance_at(p, discs),
                     mission
                         .bounds
                         .horizontal_margin(&nalgebra::Point3::new(p.x, p.y, 0.0)),
@@ -765,19 +1049,21 @@ fn squeeze_map(
             }
         }
     }
-    if shapes.is_empty() {
-        return None;
-    }
+    let named = &site.at[named?];
     let free = chebyshev_distance(field, &region);
     let extent = region_extent(field, &region);
-    Some(SqueezeMap {
-        field: field.clone(),
+    Some(Arc::new(SqueezeMap {
+        field: named.field.clone(),
         region,
         shapes,
-        obstacle_of: Vec::new(),
+        obstacle_of: named
+            .obstacles
+            .iter()
+            .map(|(k, d)| (*k, d.center))
+            .collect(),
         free,
         extent,
-    })
+    }))
 }
 
 /// The box holding every point whose cell is in a region.

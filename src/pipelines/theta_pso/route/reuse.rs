@@ -4,6 +4,7 @@
 
 use nalgebra::Point2;
 
+use super::levels::Levels;
 use super::search::{LAYERS, bit, visible};
 use super::{Corridor, Leg, Site, pass_clear};
 use crate::mission::Mission;
@@ -18,7 +19,8 @@ const SAME: f64 = 1e-6;
 /// crossing where the builder puts an IWP's crossing now, every pass where
 /// the builder puts it and clear, each inspection passed once and each
 /// crossing the user asked for taken; its squeezed stretches are worked out
-/// anew on this site. `None`: the search must run.
+/// anew on this site. A corridor that climbs between levels is searched
+/// again. `None`: the search must run.
 pub fn reuse(
     mission: &Mission,
     builder: &PathBuilder,
@@ -33,38 +35,35 @@ pub fn reuse(
         || !same(*points.first()?, start)
         || !same(*points.last()?, goal)
         || previous.passes.len() != builder.inspections().len()
+        || !previous.heights.is_empty()
     {
         return None;
     }
-    let site = Site::new(mission, builder, margin, previous.cruise);
+    let site = Site::new(mission, builder, margin, Levels::flat(mission));
+    let field = site.field();
     let crossings = builder.crossings();
+    let windows = builder.crossing_windows();
+    let [low, high] = site.levels.span(0);
     let mut passed = vec![0usize; previous.passes.len()];
     let mut crossed = vec![false; crossings.len()];
     for (leg, w) in previous.legs.iter().zip(points.windows(2)) {
         let (a, b) = (w[0], w[1]);
         let holds = match *leg {
             Leg::Free { layer } => {
-                layer < LAYERS && visible(&site.field, &site.open, bit(layer), a, b)
+                layer < LAYERS && visible(field, &site.open, bit(0, layer), a, b)
             }
             Leg::Crossing(c) => crossings.get(c).is_some_and(|&[p, q]| {
                 crossed[c] = true;
-                (same(a, p) && same(b, q)) || (same(a, q) && same(b, p))
+                let [w0, w1] = windows[c];
+                let in_the_way = w0 <= high + 1e-9 && low <= w1 + 1e-9;
+                in_the_way && ((same(a, p) && same(b, q)) || (same(a, q) && same(b, p)))
             }),
             Leg::Pass(i) => {
                 let &(phi, on_left) = previous.passes.get(i)?;
                 passed[i] += 1;
                 let ends = builder.pass_ends(i, phi, on_left);
                 let (k, _) = builder.inspections()[i];
-                same(a, ends[0])
-                    && same(b, ends[1])
-                    && pass_clear(
-                        &site.field,
-                        &site.open,
-                        &site.obstacles,
-                        site.shape.r_q,
-                        k,
-                        ends,
-                    )
+                same(a, ends[0]) && same(b, ends[1]) && pass_clear(&site, 0, k, ends)
             }
         };
         if !holds {

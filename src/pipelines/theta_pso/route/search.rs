@@ -1,6 +1,7 @@
 //! A* over the clearance field's cells, in three layers (the nominal shape,
-//! the smallest shrink, the column) and in stages (the inspection passes
-//! flown so far), with the IWP crossings and the passes as edges of their own.
+//! the smallest shrink, the column), at one or more levels (altitudes, see
+//! `levels`) and in stages (the inspection passes flown so far), with the
+//! IWP crossings and the passes as edges of their own.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -13,10 +14,22 @@ use super::field::{CellLists, Field};
 /// column (single file along the path).
 pub const LAYERS: usize = 3;
 
-/// The bit of `layer` in a cell's open bits.
-pub const fn bit(layer: usize) -> u8 {
-    1 << layer
+/// The bit of `layer` at `level` in a cell's open bits.
+pub const fn bit(level: usize, layer: usize) -> u64 {
+    1 << (level * LAYERS + layer)
 }
+
+/// The bit saying the formation in `layer` may climb at a cell between
+/// level `pair` and the one above (every altitude between them clear).
+pub const fn climb_bit(pair: usize, layer: usize) -> u64 {
+    1 << (CLIMBS + pair * LAYERS + layer)
+}
+
+/// Where the climb bits begin: the levels' bits fill the ones below.
+const CLIMBS: usize = 32;
+
+/// The bits of every level and layer (no climbs).
+pub const LEVEL_BITS: u64 = (1 << CLIMBS) - 1;
 
 /// A straight edge of its own: an IWP crossing (any layer, stage kept) or an
 /// inspection pass (nominal layer, to the next stage).
@@ -32,31 +45,58 @@ pub struct Jump {
     pub crossing: bool,
     /// Index of the crossing or of the pass candidate, for the caller.
     pub tag: usize,
+    /// The level it is flown at (it lands there too).
+    pub level: usize,
 }
 
 /// What the search works on.
 pub struct Graph<'a> {
     pub field: &'a Field,
-    /// Per cell, one bit per layer it may be entered in.
-    pub open: &'a [u8],
+    /// Per cell, one bit per level and layer it may be entered in, and one
+    /// per pair of levels and layer it may be climbed between in.
+    pub open: &'a [u64],
     pub jumps: &'a [Jump],
     /// Stops to make, in order (passes, requested crossings): the stages
     /// are 0..=stops.
     pub stages: usize,
     /// Cost of changing layer, metres (a transition flown).
     pub switch_cost: f64,
+    /// Cost of climbing between level `i` and `i + 1`, metres; one entry
+    /// fewer than there are levels.
+    pub climb_cost: &'a [f64],
+    /// The levels the route starts and ends at.
+    pub start_level: usize,
+    pub goal_level: usize,
+}
+
+impl Graph<'_> {
+    /// How many levels the graph has.
+    pub fn levels(&self) -> usize {
+        self.climb_cost.len() + 1
+    }
+
+    /// Its modes: a layer at a level, `level * LAYERS + layer`.
+    pub fn modes(&self) -> usize {
+        self.levels() * LAYERS
+    }
 }
 
 /// One step of the found route.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Step {
-    /// Moved to a neighbouring cell (or started there), in a layer.
-    Cell { cell: usize, layer: usize },
+    /// Moved to a neighbouring cell (or started there), changed layer or
+    /// climbed to another level there.
+    Cell {
+        cell: usize,
+        layer: usize,
+        level: usize,
+    },
     /// Took jump `tag` (a crossing or a pass) ending at `cell`.
     Jump {
         cell: usize,
         tag: usize,
         layer: usize,
+        level: usize,
     },
 }
 
@@ -81,8 +121,8 @@ fn jumps_from(graph: &Graph<'_>) -> CellLists<usize> {
 }
 
 /// The cells reached from `start` when `goal` is not among them, in a
-/// relaxation of the search's graph: a cell open in any layer is open to
-/// all, every jump may be taken at any stage. No plain flood (a few
+/// relaxation of the search's graph: a cell open in any layer at any level
+/// is open to all, every jump may be taken at any stage and level. No plain flood (a few
 /// milliseconds) reaching the goal means no route at all, and the refusal
 /// needs no search; when it does reach, the search decides.
 pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reached> {
@@ -97,7 +137,7 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
         }
         let next = field
             .neighbourhood(cell)
-            .filter(|&j| graph.open[j] != 0 || j == goal)
+            .filter(|&j| graph.open[j] & LEVEL_BITS != 0 || j == goal)
             .chain(jumps.at(cell).iter().map(|&j| graph.jumps[j].to));
         for j in next {
             if !seen[j] {
@@ -112,12 +152,13 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
 }
 
 /// The cheapest route from `start` to `goal` through every stage, ranked by
-/// `heuristic` (cell, layer, stage → a bound of what is left, or `None`
+/// `heuristic` (cell, mode, stage → a bound of what is left, or `None`
 /// where the goal is out of reach: the state is never entered), or the
 /// cells reached when there is none: all of them when the heuristic prunes
-/// nothing.
+/// nothing. It starts at the graph's start level and ends at its goal
+/// level.
 ///
-/// Long (~140 lines): one A* loop whose moves (steps, layer changes, crossings, passes) share its state arrays.
+/// Long (~150 lines): one A* loop whose moves (steps, layer changes, climbs, crossings, passes) share its state arrays.
 pub fn search(
     graph: &Graph<'_>,
     start: usize,
@@ -126,9 +167,10 @@ pub fn search(
 ) -> Result<Vec<Step>, Reached> {
     let field = graph.field;
     let cells = field.len();
-    let layers = LAYERS;
-    let states = cells * layers * (graph.stages + 1);
-    let state = |cell: usize, layer: usize, stage: usize| (stage * layers + layer) * cells + cell;
+    let modes = graph.modes();
+    let levels = graph.levels();
+    let states = cells * modes * (graph.stages + 1);
+    let state = |cell: usize, mode: usize, stage: usize| (stage * modes + mode) * cells + cell;
     // Zeroed arrays: the system hands them out untouched, so a search that
     // reaches a corner of a large site pays only for that corner's pages.
     // `link[s]` is 0 for a state never reached, `ROOT` for the start, else
@@ -143,10 +185,11 @@ pub fn search(
     let index = jumps_from(graph);
 
     let mut open = BinaryHeap::new();
-    let first = state(start, 0, 0);
+    let first_mode = graph.start_level * LAYERS;
+    let first = state(start, first_mode, 0);
     cost[first] = 0.0;
     link[first] = ROOT;
-    if let Some(estimate) = heuristic(start, 0, 0) {
+    if let Some(estimate) = heuristic(start, first_mode, 0) {
         open.push(Entry {
             estimate,
             reached: 0.0,
@@ -159,20 +202,20 @@ pub fn search(
     }) = open.pop()
     {
         let cell = s % cells;
-        let layer = (s / cells) % layers;
-        let stage = s / (cells * layers);
+        let mode = (s / cells) % modes;
+        let (level, layer) = (mode / LAYERS, mode % LAYERS);
+        let stage = s / (cells * modes);
         let g = known(&link, &cost, s);
         if reached > g {
             continue; // stale entry: a cheaper way here was found since
         }
-        if cell == goal && stage == graph.stages {
+        if cell == goal && stage == graph.stages && level == graph.goal_level {
             done = Some(s);
             break;
         }
         let mut relax = |to: usize, g_to: f64, through: u32, open: &mut BinaryHeap<Entry>| {
             if g_to < known(&link, &cost, to) {
-                let Some(left) =
-                    heuristic(to % cells, (to / cells) % layers, to / (cells * layers))
+                let Some(left) = heuristic(to % cells, (to / cells) % modes, to / (cells * modes))
                 else {
                     return; // no way on from there, even relaxed
                 };
@@ -186,62 +229,81 @@ pub fn search(
                 });
             }
         };
-        let here = bit(layer);
+        let here = bit(level, layer);
         for (next, length) in field.steps(cell) {
             if graph.open[next] & here != 0 || next == goal {
-                relax(state(next, layer, stage), g + length, 0, &mut open);
+                relax(state(next, mode, stage), g + length, 0, &mut open);
             }
         }
         // A transition to another layer, flown where the wider shape fits.
-        for other in (0..layers).filter(|&l| l != layer) {
-            if graph.open[cell] & bit(other.min(layer)) != 0 {
+        for other in (0..LAYERS).filter(|&l| l != layer) {
+            if graph.open[cell] & bit(level, other.min(layer)) != 0 {
                 relax(
-                    state(cell, other, stage),
+                    state(cell, level * LAYERS + other, stage),
                     g + graph.switch_cost,
                     0,
                     &mut open,
                 );
             }
         }
-        {
-            for &j in index.at(cell) {
-                let jump = &graph.jumps[j];
-                let next_stage = match jump.pass_at {
-                    None => stage,
-                    Some(at) if at == stage => stage + 1,
-                    Some(_) => continue,
-                };
-                if !jump.crossing {
-                    if layer == 0 {
-                        relax(
-                            state(jump.to, 0, next_stage),
-                            g + jump.length,
-                            j as u32 + 1,
-                            &mut open,
-                        );
-                    }
-                    continue;
-                }
-                // Out of a crossing in the widest layer the far side
-                // allows, no wider than the one it came in.
-                let Some(arrive) = (layer..layers).find(|&l| graph.open[jump.to] & bit(l) != 0)
-                else {
-                    continue;
-                };
-                relax(
-                    state(jump.to, arrive, next_stage),
-                    g + jump.length,
-                    j as u32 + 1,
-                    &mut open,
-                );
+        // A climb to the level above or below, where every altitude between
+        // is clear.
+        if level + 1 < levels && graph.open[cell] & climb_bit(level, layer) != 0 {
+            relax(
+                state(cell, mode + LAYERS, stage),
+                g + graph.climb_cost[level],
+                0,
+                &mut open,
+            );
+        }
+        if level > 0 && graph.open[cell] & climb_bit(level - 1, layer) != 0 {
+            relax(
+                state(cell, mode - LAYERS, stage),
+                g + graph.climb_cost[level - 1],
+                0,
+                &mut open,
+            );
+        }
+        for &j in index.at(cell) {
+            let jump = &graph.jumps[j];
+            if jump.level != level {
+                continue;
             }
+            let next_stage = match jump.pass_at {
+                None => stage,
+                Some(at) if at == stage => stage + 1,
+                Some(_) => continue,
+            };
+            if !jump.crossing {
+                if layer == 0 {
+                    relax(
+                        state(jump.to, level * LAYERS, next_stage),
+                        g + jump.length,
+                        j as u32 + 1,
+                        &mut open,
+                    );
+                }
+                continue;
+            }
+            // Out of a crossing in the widest layer the far side allows, no
+            // wider than the one it came in.
+            let Some(arrive) = (layer..LAYERS).find(|&l| graph.open[jump.to] & bit(level, l) != 0)
+            else {
+                continue;
+            };
+            relax(
+                state(jump.to, level * LAYERS + arrive, next_stage),
+                g + jump.length,
+                j as u32 + 1,
+                &mut open,
+            );
         }
     }
     let Some(end) = done else {
         let mut stage = vec![None; cells];
         for (s, l) in link.iter().enumerate() {
             if *l != 0 {
-                let (cell, st) = (s % cells, s / (cells * layers));
+                let (cell, st) = (s % cells, s / (cells * modes));
                 if stage[cell].is_none_or(|old| st > old) {
                     stage[cell] = Some(st);
                 }
@@ -253,15 +315,17 @@ pub fn search(
     let mut s = end;
     loop {
         let cell = s % cells;
-        let layer = (s / cells) % layers;
+        let mode = (s / cells) % modes;
+        let (level, layer) = (mode / LAYERS, mode % LAYERS);
         let step = if via[s] != 0 {
             Step::Jump {
                 cell,
                 tag: graph.jumps[via[s] as usize - 1].tag,
                 layer,
+                level,
             }
         } else {
-            Step::Cell { cell, layer }
+            Step::Cell { cell, layer, level }
         };
         steps.push(step);
         if link[s] == ROOT {
@@ -303,6 +367,6 @@ impl PartialOrd for Entry {
 }
 
 /// Whether the straight from `a` to `b` stays on cells open in `bit`.
-pub fn visible(field: &Field, open: &[u8], bit: u8, a: Point2<f64>, b: Point2<f64>) -> bool {
+pub fn visible(field: &Field, open: &[u64], bit: u64, a: Point2<f64>, b: Point2<f64>) -> bool {
     field.cells_along(a, b).all(|i| open[i] & bit != 0)
 }
