@@ -31,10 +31,7 @@ fn decision(c: &mut Criterion) {
                 desired: 1.732,
             })
             .to_vec(),
-        obstacles: vec![cost::Detected {
-            center: Point2::new(1.0, -1.0),
-            radius: 0.1,
-        }],
+        obstacles: vec![cost::Detected::disc(Point2::new(1.0, -1.0), 0.1)],
         rho: p.rho,
         safety: p.safety_distance,
         sigma: p.sigma,

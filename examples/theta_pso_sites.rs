@@ -160,7 +160,7 @@ fn detail(m: &skyform::mission::Mission, seed: u64) {
                 );
             }
             for q in &o.centroid_path {
-                print!(" ({:.1},{:.1})", q.x, q.y);
+                print!(" ({:.1},{:.1},{:.1})", q.x, q.y, q.z);
             }
             println!();
         }

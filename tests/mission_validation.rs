@@ -505,6 +505,14 @@ fn a_footprint_must_be_a_simple_polygon_with_an_area_in_the_bounds() {
     );
     let away = message("[[140.0, 40.0], [160.0, 40.0], [160.0, 60.0]]");
     assert!(away.contains("outside the bounds"), "{away}");
+    // A deck across the whole site has every vertex outside the bounds and
+    // is inside all the same (a warning that it reaches outside, no error).
+    let across = building("[[-5.0, 40.0], [150.0, 40.0], [150.0, 48.0], [-5.0, 48.0]]");
+    assert!(
+        diagnostics(&across).iter().all(|d| !d.is_error()),
+        "{:?}",
+        diagnostics(&across)
+    );
     let many: Vec<String> = (0..600)
         .map(|k| {
             let a = k as f64 * std::f64::consts::TAU / 600.0;

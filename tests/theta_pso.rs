@@ -1554,9 +1554,9 @@ fn a_wall_above_the_flight_with_room_under_the_ceiling_is_climbed_over() {
             o.verification.first_failure()
         );
         assert!(
-            o.corridor.cruise.is_some_and(|z| z > 12.0),
+            o.corridor.heights.iter().any(|z| *z > 12.0),
             "{:?}",
-            o.corridor.cruise
+            o.corridor.heights
         );
         for tr in &o.trajectories {
             for s in tr
@@ -1647,13 +1647,100 @@ fn a_deck_with_room_below_is_flown_under() {
     let low = run(&deck(8.0, 19.5), 1);
     assert!(low.feasible(), "{:?}", low.verification.first_failure());
     assert!(
-        low.corridor.cruise.is_some_and(|z| z < 8.0),
+        low.corridor.heights.iter().any(|z| *z < 8.0),
         "{:?}",
-        low.corridor.cruise
+        low.corridor.heights
     );
     assert!(!low.passed_under.is_empty());
     let refused = refusal(&deck(5.5, 19.5));
     assert!(refused.contains("'deck 1'"), "{refused}");
+}
+
+/// Issue 37, the route stage searches altitude level by level: a wall of
+/// 12 m posts across the site at x = 35 and a deck from 8 to 19.5 m at
+/// x = 65, band 5-20 m, the formation starting and ending at 10 m. No one
+/// altitude passes both (over the wall is 12.7 m or more, under the deck
+/// 7.3 m or less): the plan climbs over the wall, then descends under the
+/// deck, every UAV over the posts and under the deck.
+#[test]
+fn a_wall_then_a_deck_are_climbed_over_then_descended_under() {
+    let mut m = row_across("block", [5.0, 20.0], 0.0, 12.0);
+    for o in &mut m.obstacles {
+        o.center.x = 35.0;
+    }
+    let deck = row_across("deck", [5.0, 20.0], 8.0, 19.5);
+    m.obstacles.extend(deck.obstacles.into_iter().map(|mut o| {
+        o.center.x = 65.0;
+        o
+    }));
+    for seed in 0..3 {
+        let o = run(&m, seed);
+        assert!(
+            o.feasible(),
+            "seed {seed}: {:?}",
+            o.verification.first_failure()
+        );
+        let mut checked = [0, 0];
+        for tr in &o.trajectories {
+            for s in &tr.samples {
+                if (s.position.x - 35.0).abs() < 1.6 {
+                    assert!(
+                        s.position.z >= 12.6,
+                        "seed {seed}: over the wall {}",
+                        s.position
+                    );
+                    checked[0] += 1;
+                }
+                if (s.position.x - 65.0).abs() < 1.6 {
+                    assert!(
+                        s.position.z <= 7.4,
+                        "seed {seed}: under the deck {}",
+                        s.position
+                    );
+                    checked[1] += 1;
+                }
+            }
+        }
+        assert!(checked[0] > 0 && checked[1] > 0, "{checked:?}");
+        assert!(
+            o.passed_over.iter().any(|n| n.starts_with("block"))
+                && o.passed_under.iter().any(|n| n.starts_with("deck")),
+            "{:?} {:?}",
+            o.passed_over,
+            o.passed_under
+        );
+    }
+}
+
+/// Issue 37, a footprint is inspected along a face: a transformer bay
+/// 8 × 6 m, 7.5 m high, live (not to be flown over), band 5-15 m. The pass
+/// runs parallel to one of its faces, so the facing UAV's distance to the
+/// bay (measured to the footprint, `Prism::clearance`) stays in eq. 8's band
+/// [1, 5] m and barely varies along the pass.
+#[test]
+fn a_bay_is_inspected_along_its_face() {
+    let text = "name = \"bay\"\n[bounds]\nx = [0.0, 100.0]\ny = [0.0, 100.0]\nz = [5.0, 15.0]\n\
+                [route]\nstart = [10.0, 50.0, 6.0]\ngoal = [90.0, 50.0, 6.0]\n\
+                [[obstacles]]\nname = \"T1\"\nfootprint = [[46.0, 40.0], [54.0, 40.0], [54.0, 46.0], [46.0, 46.0]]\n\
+                height = 7.5\noverfly = false\ninspect = true\n";
+    let m = mission::parse_str(text, "bay.toml")
+        .map(|l| l.mission)
+        .unwrap_or_else(|e| panic!("{e}"));
+    for seed in 0..3 {
+        let o = run(&m, seed);
+        assert!(
+            o.feasible(),
+            "seed {seed}: {:?}",
+            o.verification.first_failure()
+        );
+        let inspection = &o.verification.inspections[0];
+        let [lo, hi] = inspection.distance.unwrap_or([f64::NAN; 2]);
+        assert!(
+            inspection.ok && (1.0..=5.0).contains(&lo) && (1.0..=5.0).contains(&hi),
+            "seed {seed}: {inspection:?}"
+        );
+        assert!(hi - lo < 1.0, "seed {seed}: along a face, {lo}..{hi} m");
+    }
 }
 
 /// Issue 37, `overfly = false`: the low wall of the test above, which the

@@ -108,3 +108,54 @@ fn every_site_of_the_wide_share_is_planned_feasible() {
     let failures = failures(&runs);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Sites 400-423 of the family in three dimensions (`sites::three_d`:
+/// walls of posts and of segments with decoy pockets, rows of footprints
+/// with aisles, decks, low fences, walls to fly over or climb, short
+/// towers, trees near a bound), one seed each: every one planned feasible.
+#[test]
+fn every_site_of_the_three_dimensional_share_is_planned_feasible() {
+    let runs: Vec<(
+        String,
+        Vec<(&'static str, String)>,
+        Result<bool, String>,
+        String,
+    )> = (400..424u64)
+        .into_par_iter()
+        .map(|i| {
+            let site = sites::three_d::generated_3d(i);
+            let result = plan(
+                &site.mission,
+                i % 3,
+                PlanOptions { parallel: false },
+                &mut Silent,
+                &CancelToken::new(),
+            );
+            let (feasible, why) = match result {
+                Ok(o) => (
+                    Ok(o.feasible()),
+                    o.verification.first_failure().unwrap_or_default(),
+                ),
+                Err(e) => (Err(e.to_string()), String::new()),
+            };
+            (site.mission.name.clone(), site.dims, feasible, why)
+        })
+        .collect();
+    // The share reaches the dimensions of the family.
+    let barriers: BTreeSet<String> = runs
+        .iter()
+        .flat_map(|r| r.1.iter())
+        .filter(|(d, _)| *d == "barrier")
+        .map(|(_, v)| v.split(',').next().unwrap_or_default().to_owned())
+        .collect();
+    assert!(barriers.len() >= 4, "barrier kinds covered: {barriers:?}");
+    let failures: Vec<String> = runs
+        .iter()
+        .filter(|r| !matches!(r.2, Ok(true)))
+        .map(|r| match &r.2 {
+            Err(e) => format!("{}: refused: {e}", r.0),
+            _ => format!("{}: infeasible: {}", r.0, r.3),
+        })
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

@@ -179,6 +179,14 @@ pub fn bounding_circle(vertices: &[Point2<f64>]) -> (Point2<f64>, f64) {
     (center, radius)
 }
 
+/// Whether the plane segments a-b and c-d intersect (touching counts).
+pub fn segments_cross(a: &Point2<f64>, b: &Point2<f64>, c: &Point2<f64>, d: &Point2<f64>) -> bool {
+    let orient = |p: &Point2<f64>, q: &Point2<f64>, r: &Point2<f64>| (q - p).perp(&(r - p));
+    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
+    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
+    d1 * d2 <= 0.0 && d3 * d4 <= 0.0 && !(d1 == 0.0 && d2 == 0.0 && d3 == 0.0 && d4 == 0.0)
+}
+
 /// Distance from `p` to the segment a-b, in the plane.
 pub fn segment_point_distance(a: &Point2<f64>, b: &Point2<f64>, p: &Point2<f64>) -> f64 {
     segment_projection(a, b, p).1

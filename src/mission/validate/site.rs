@@ -222,13 +222,6 @@ impl Checker {
                 }
             } else {
                 self.footprint(at.key("footprint"), o, bounds);
-                if o.inspect {
-                    self.error(
-                        at.key("inspect"),
-                        "inspecting a footprint is not supported yet: the pass is planned round a \
-                         cylinder's axis; inspect a cylinder standing at the face to be seen",
-                    );
-                }
             }
             self.positive(at.key("radius"), o.radius, " m");
             self.positive(at.key("height"), o.height, " m");

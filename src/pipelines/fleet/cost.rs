@@ -38,11 +38,35 @@ pub struct Neighbour {
     pub desired: f64,
 }
 
-/// A detected obstacle (within d_obs): a vertical cylinder.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// A detected obstacle (within d_obs): a vertical cylinder, or a polygon
+/// footprint (`radius` then its bounding circle's).
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Detected {
     pub center: Point2<f64>,
     pub radius: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub polygon: Option<std::sync::Arc<[Point2<f64>]>>,
+}
+
+impl Detected {
+    /// A disc (a lost agent's region).
+    pub fn disc(center: Point2<f64>, radius: f64) -> Self {
+        Detected {
+            center,
+            radius,
+            polygon: None,
+        }
+    }
+
+    /// d_ik of eq. 9: the distance from `p` to the obstacle's nearest point
+    /// (negative inside), the footprint's own for a polygon
+    /// (`base::geometry::Prism::outward`, as the other pipelines measure).
+    pub fn distance(&self, p: &Point2<f64>) -> f64 {
+        match &self.polygon {
+            Some(v) => crate::base::geometry::polygon_signed_distance(v, p),
+            None => (p - self.center).norm() - self.radius,
+        }
+    }
 }
 
 /// Everything agent i's planner knows at a decision.
@@ -80,7 +104,7 @@ impl Observation {
             cost += CONSTRAINT * (self.keep_apart - distance).max(0.0);
         }
         for o in &self.obstacles {
-            let distance = (o.center - next).norm() - o.radius;
+            let distance = o.distance(&next);
             cost += obstacle_penalty(distance, self.safety, self.sigma);
             cost += CONSTRAINT * (self.keep_clear - distance).max(0.0);
         }
@@ -100,6 +124,31 @@ mod tests {
         assert!((influence(1.732, 0.8, 0.4) - (1.0 + (-2.33f64).exp())).abs() < 1e-12);
         assert!(influence(10.0, 0.8, 0.4) - 1.0 < 2e-10);
         assert_eq!(influence(100.0, 0.8, 0.4), 1.0);
+    }
+
+    /// Eq. 9's d_ik to a footprint is to its nearest point, not to the
+    /// circle round it: beside the middle of a 10 m wall's face, 1 m out, an
+    /// agent is 1 m from it (the bounding circle would put it inside).
+    #[test]
+    fn a_footprint_is_measured_to_its_nearest_point_eq9() {
+        let wall: Vec<Point2<f64>> = [[0.0, 0.0], [10.0, 0.0], [10.0, 1.0], [0.0, 1.0]]
+            .iter()
+            .map(|&[x, y]| Point2::new(x, y))
+            .collect();
+        let (center, radius) = crate::base::geometry::bounding_circle(&wall);
+        let o = Detected {
+            center,
+            radius,
+            polygon: Some(wall.into()),
+        };
+        let beside = Point2::new(5.0, 2.0);
+        assert!((o.distance(&beside) - 1.0).abs() < 1e-12);
+        assert!((beside - center).norm() - radius < 0.0, "inside the circle");
+        assert!((o.distance(&Point2::new(12.0, 0.5)) - 2.0).abs() < 1e-12);
+        assert!((o.distance(&Point2::new(5.0, 0.5)) + 0.5).abs() < 1e-12);
+        // The penalty follows: at c it is 1 (eq. 9).
+        let at_c = Point2::new(5.0, 1.8);
+        assert!((obstacle_penalty(o.distance(&at_c), 0.8, 0.4) - 1.0).abs() < 1e-9);
     }
 
     /// Eq. 9 with Table 1's c = 0.8 m, σ = 0.4.

@@ -264,7 +264,7 @@ pub fn scenario(m: &Mission, seed: u64) -> Scenario {
                 .all(|s| (s - q).norm() >= 2.0 * p.safety_distance)
                 && m.obstacles
                     .iter()
-                    .all(|o| (o.center - q).norm() - o.radius >= 2.0 * p.safety_distance);
+                    .all(|o| o.prism().outward(&q) >= 2.0 * p.safety_distance);
             // A crowded box still gets its agents (the check is a courtesy).
             if clear || attempts > 1000 * n {
                 starts.push(q);
@@ -307,7 +307,7 @@ pub fn default_target(m: &Mission) -> Point2<f64> {
             && m.obstacles
                 .iter()
                 .filter(|o| o.spans(p.altitude))
-                .all(|o| (o.center - q).norm() - o.radius >= reach + p.safety_distance)
+                .all(|o| o.prism().outward(q) >= reach + p.safety_distance)
     };
     if free(&centre) {
         return centre;

@@ -255,6 +255,7 @@ impl<'m> Simulation<'m> {
             .map(|o| Detected {
                 center: o.center,
                 radius: o.radius,
+                polygon: (!o.footprint.is_empty()).then(|| o.footprint.as_slice().into()),
             })
             .collect();
         let local: Vec<usize> = local.into_iter().filter(|&i| i < n).collect();
@@ -504,10 +505,7 @@ impl<'m> Simulation<'m> {
             f64::INFINITY
         };
         let reach = (m.reference - m.position).norm() + stop;
-        Detected {
-            center: m.position,
-            radius: (speed * age).min(reach),
-        }
+        Detected::disc(m.position, (speed * age).min(reach))
     }
 
     /// Records (and checks) the snapshot: samples, closest approaches, the
@@ -545,7 +543,7 @@ impl<'m> Simulation<'m> {
                 .iter()
                 .filter(|o| o.spans(p.altitude))
             {
-                let d = (o.center - positions[i]).norm() - o.radius;
+                let d = o.prism().outward(&positions[i]);
                 if log.closest_obstacle.as_ref().is_none_or(|c| d < c.distance) {
                     log.closest_obstacle = Some(Closest {
                         a: i,
@@ -734,8 +732,8 @@ impl<'m> Simulation<'m> {
                 .obstacles
                 .iter()
                 .chain(now.lost.iter().map(|(_, r)| r))
-                .filter(|o| (o.center - me).norm() - o.radius <= p.detection_range)
-                .copied()
+                .filter(|o| o.distance(&me) <= p.detection_range)
+                .cloned()
                 .collect(),
             rho: p.rho,
             safety: p.safety_distance,

@@ -9,7 +9,10 @@
 //! The other UAVs only keep their clearance (≥ r_Q, checked as for every
 //! obstacle). The pass is tangent to the cylinder; its distance from the axis
 //! is chosen so that the facing UAV's distance, which grows toward the pass's
-//! ends, sits in the middle of the band.
+//! ends, sits in the middle of the band. A footprint (a building, a bay) is
+//! inspected along one of its faces: the pass runs parallel to the face, as
+//! far from it as puts the facing UAV in the middle of the band, where the
+//! distance does not vary along the face.
 
 use nalgebra::Vector3;
 
@@ -97,6 +100,28 @@ impl PassGeometry {
     }
 }
 
+impl PassGeometry {
+    /// The pass along a straight face (a footprint's edge): the centroid's
+    /// line `radius_*` from the face, the facing UAV (the slot nearest the
+    /// face) in the middle of the band over the whole pass.
+    pub fn face(slots: &[Vector3<f64>], band: [f64; 2], length: f64) -> PassGeometry {
+        let target = (band[0] + band[1]) / 2.0;
+        let extent = |sign: f64| {
+            slots
+                .iter()
+                .map(|o| sign * o.y)
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        PassGeometry {
+            radius_left: target + extent(1.0),
+            radius_right: target + extent(-1.0),
+            pass_length: length,
+            range_left: [target, target],
+            range_right: [target, target],
+        }
+    }
+}
+
 /// The pass geometry of every inspected obstacle, or the first reason one
 /// cannot be flown, with its obstacle index.
 pub fn pass_geometries(mission: &Mission) -> Result<Vec<(usize, PassGeometry)>, (usize, String)> {
@@ -107,6 +132,25 @@ pub fn pass_geometries(mission: &Mission) -> Result<Vec<(usize, PassGeometry)>, 
         .enumerate()
         .filter(|(_, o)| o.inspect)
         .map(|(k, o)| {
+            if !o.footprint.is_empty() {
+                let longest = (0..o.footprint.len())
+                    .map(|i| (o.footprint[(i + 1) % o.footprint.len()] - o.footprint[i]).norm())
+                    .fold(0.0, f64::max);
+                if longest < f.inspection_pass {
+                    return Err((
+                        k,
+                        format!(
+                            "its longest face is {longest:.1} m, shorter than the {} m pass \
+                             (formation.inspection_pass) flown along a face",
+                            f.inspection_pass
+                        ),
+                    ));
+                }
+                return Ok((
+                    k,
+                    PassGeometry::face(&f.slots, o.stand_off_band(f), f.inspection_pass),
+                ));
+            }
             PassGeometry::new(&f.slots, o.radius, o.stand_off_band(f), f.inspection_pass)
                 .map(|g| (k, g))
                 .map_err(|e| (k, e))

@@ -250,7 +250,6 @@ pub fn resolve_shape(
     let fits =
         |shape: &Shape| lateral_half_width(&shape.offsets(slots, 1.0), r_q) <= gap / 2.0 + FIT_EPS;
     let width = |shape: &Shape| 2.0 * lateral_half_width(&shape.offsets(slots, 1.0), r_q);
-    let nominal_width = 2.0 * lateral_half_width(slots, r_q);
     let alignment = Shape::Alignment {
         spacing: column_spacing(formation),
     };
@@ -283,50 +282,66 @@ pub fn resolve_shape(
         ShapeChoice::Rotation => explicit(Shape::Rotation),
         ShapeChoice::Shrink => explicit(Shape::Shrink { scale: shrink }),
         ShapeChoice::Auto => {
-            if nominal_width <= gap + 2.0 * FIT_EPS {
-                return Ok(None);
-            }
-            let mut candidates = if column_ok {
-                vec![alignment]
-            } else {
-                Vec::new()
-            };
-            let widest = slots.iter().map(|o| o.y.abs()).fold(0.0, f64::max);
-            if widest > 0.0 {
-                let fit = (gap / 2.0 - r_q - margin.max(0.0)) / widest;
-                let closest = min_pair_distance(slots);
-                let floor = if closest.is_finite() {
-                    formation.closest_pair() / closest
-                } else {
-                    0.0
-                };
-                // fit < 1 here (the nominal shape does not fit), so a shrink
-                // at `fit` always narrows the formation.
-                if fit > 0.0 && fit >= floor {
-                    candidates.push(Shape::Shrink { scale: fit });
-                }
-            }
-            let displacement = |shape: &Shape| {
-                let target = shape.offsets(slots, 1.0);
-                slots
-                    .iter()
-                    .zip(&target)
-                    .map(|(a, b)| (a - b).norm())
-                    .fold(0.0, f64::max)
-            };
-            candidates
-                .into_iter()
-                .filter(|s| fits(s))
-                .min_by(|a, b| displacement(a).total_cmp(&displacement(b)))
-                .map(Some)
-                .ok_or_else(|| {
-                    format!(
-                        "no shape fits: the narrowest, a column, is {:.2} m wide and the gap is {gap:.2} m",
-                        width(&alignment)
-                    )
-                })
+            auto_shapes(gap, formation, margin).map(|shapes| shapes.first().copied())
         }
     }
+}
+
+/// `Auto`'s shapes for a gap of width `gap`, the least change first: none
+/// (`Ok(vec![])`) when the nominal shape already fits, else the shapes that
+/// narrow the formation enough, by their largest slot displacement (the
+/// column, a shrink at the largest scale that leaves `margin` beside the
+/// outer UAVs and 2 r_Q + the safety margin between two), or why none fits.
+/// `find_iwps` takes the first whose crossing the site leaves room for.
+pub fn auto_shapes(gap: f64, formation: &Formation, margin: f64) -> Result<Vec<Shape>, String> {
+    let slots = &formation.slots;
+    let r_q = formation.least_clearance();
+    let fits =
+        |shape: &Shape| lateral_half_width(&shape.offsets(slots, 1.0), r_q) <= gap / 2.0 + FIT_EPS;
+    let nominal_width = 2.0 * lateral_half_width(slots, r_q);
+    if nominal_width <= gap + 2.0 * FIT_EPS {
+        return Ok(Vec::new());
+    }
+    let alignment = Shape::Alignment {
+        spacing: column_spacing(formation),
+    };
+    let mut candidates = if column_keeps_eq7(formation) {
+        vec![alignment]
+    } else {
+        Vec::new()
+    };
+    let widest = slots.iter().map(|o| o.y.abs()).fold(0.0, f64::max);
+    if widest > 0.0 {
+        let fit = (gap / 2.0 - r_q - margin.max(0.0)) / widest;
+        let closest = min_pair_distance(slots);
+        let floor = if closest.is_finite() {
+            formation.closest_pair() / closest
+        } else {
+            0.0
+        };
+        // fit < 1 here (the nominal shape does not fit), so a shrink at
+        // `fit` always narrows the formation.
+        if fit > 0.0 && fit >= floor {
+            candidates.push(Shape::Shrink { scale: fit });
+        }
+    }
+    let displacement = |shape: &Shape| {
+        let target = shape.offsets(slots, 1.0);
+        slots
+            .iter()
+            .zip(&target)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max)
+    };
+    candidates.retain(|s| fits(s));
+    candidates.sort_by(|a, b| displacement(a).total_cmp(&displacement(b)));
+    if candidates.is_empty() {
+        let width = 2.0 * lateral_half_width(&alignment.offsets(slots, 1.0), r_q);
+        return Err(format!(
+            "no shape fits: the narrowest, a column, is {width:.2} m wide and the gap is {gap:.2} m"
+        ));
+    }
+    Ok(candidates)
 }
 
 /// Where a UAV at offset `o` (crossing frame: forward, lateral) would be
@@ -424,10 +439,13 @@ fn crossing_hold(
                 let (lo, hi) = (lo.max(-line - o.x), hi.min(line - o.x));
                 (lo < hi).then_some((lo, hi))
             };
+            // Held over the hold, and (a rigid shape) on along its straight
+            // as it turns back: nothing may stand in its way there either.
+            let along = hold.max(line);
             if held
                 .iter()
                 .filter_map(|o| conflict(o, x_k, y_k, reach).and_then(|c| on_line(o, c)))
-                .any(|(lo, hi)| lo < hold && hi > -hold)
+                .any(|(lo, hi)| lo < along && hi > -along)
             {
                 return Err(format!(
                     "held through the gap, the {} would pass within r_Q of '{}'",
@@ -520,10 +538,32 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
             let position = Point2::from((p_p.coords + p_q.coords) / 2.0);
             let normal = Vector2::new(-u.y, u.x);
             let margin = mission.theta_pso.clearance_margin.max(0.0);
-            let resolved = resolve_shape(shape_choice, gap, f, scale, margin).and_then(|shape| {
+            let hold_for = |shape: Option<Shape>| {
                 crossing_hold(mission, [p, q], position, normal, shape, window)
-                    .map(|hold| (shape, hold))
-            });
+            };
+            let resolved = if shape_choice == ShapeChoice::Auto {
+                // The least change whose crossing the site leaves room for
+                // (a shrink's straight may run into the next wall where a
+                // column's, through the posts only, does not).
+                auto_shapes(gap, f, margin).and_then(|shapes| {
+                    if shapes.is_empty() {
+                        return hold_for(None).map(|hold| (None, hold));
+                    }
+                    let mut first_reason = None;
+                    for shape in &shapes {
+                        match hold_for(Some(*shape)) {
+                            Ok(hold) => return Ok((Some(*shape), hold)),
+                            Err(reason) => {
+                                first_reason.get_or_insert(reason);
+                            }
+                        }
+                    }
+                    Err(first_reason.unwrap_or_default())
+                })
+            } else {
+                resolve_shape(shape_choice, gap, f, scale, margin)
+                    .and_then(|shape| hold_for(shape).map(|hold| (shape, hold)))
+            };
             let (shape, (hold, straight), unusable) = match resolved {
                 Ok((shape, hold)) => (shape, hold, None),
                 Err(reason) => (None, (0.0, 0.0), Some(reason)),
@@ -544,5 +584,64 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
             });
         }
     }
+    prefer_columns_in_sequence(mission, &mut found);
     found
+}
+
+/// Two crossings in sequence whose straights overlap along the way (walls
+/// closer than the straights are long, the gaps not far apart across it)
+/// could only be flown one after the other by doubling back between them.
+/// Where `auto` chose a rigid shape for either, its column is taken
+/// instead when the site leaves room for it: a column's straight runs
+/// through the posts only.
+fn prefer_columns_in_sequence(mission: &Mission, iwps: &mut [Iwp]) {
+    let auto = |iwp: &Iwp| {
+        iwp.is_via()
+            && iwp.choice == ShapeChoice::Auto
+            && iwp
+                .shape
+                .is_some_and(|s| !matches!(s, Shape::Alignment { .. }))
+    };
+    let mut switch = vec![false; iwps.len()];
+    for i in 0..iwps.len() {
+        for j in (i + 1)..iwps.len() {
+            let (a, b) = (&iwps[i], &iwps[j]);
+            if !(auto(a) || auto(b)) || !a.is_via() || !b.is_via() {
+                continue;
+            }
+            let d = b.position - a.position;
+            let along = d.dot(&a.normal).abs();
+            let across = d.dot(&Vector2::new(-a.normal.y, a.normal.x)).abs();
+            let overlap = a.straight + b.straight - along;
+            let f = &mission.formation;
+            if overlap > 0.0 && across < 2.0 * overlap + 2.0 * f.radius() && along > 1e-6 {
+                switch[i] |= auto(a);
+                switch[j] |= auto(b);
+            }
+        }
+    }
+    let f = &mission.formation;
+    for (iwp, _) in iwps.iter_mut().zip(&switch).filter(|(_, s)| **s) {
+        let column = Shape::Alignment {
+            spacing: column_spacing(f),
+        };
+        if !column_keeps_eq7(f)
+            || lateral_half_width(&column.offsets(&f.slots, 1.0), f.least_clearance())
+                > iwp.gap / 2.0 + FIT_EPS
+        {
+            continue;
+        }
+        if let Ok((hold, straight)) = crossing_hold(
+            mission,
+            iwp.obstacles,
+            iwp.position,
+            iwp.normal,
+            Some(column),
+            iwp.window,
+        ) {
+            iwp.shape = Some(column);
+            iwp.hold = hold;
+            iwp.straight = straight;
+        }
+    }
 }

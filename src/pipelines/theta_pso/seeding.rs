@@ -153,12 +153,23 @@ fn waypoints(problem: &Problem, corridor: &Corridor) -> (Vec<Point3<f64>>, Vec<f
         .map(|leg| matches!(leg, Leg::Free { .. }))
         .collect();
     let chosen = fit_corners(start.xy(), goal.xy(), inner, free, builder.free_waypoints());
-    let total = chosen.len() + 1;
+    // Between the start's and the goal's altitudes in proportion to the
+    // distance flown, so the crossings and passes the builder puts on a
+    // leg (at the leg's altitude where they lie) stay on one slope.
+    let mut flown = Vec::with_capacity(chosen.len());
+    let mut last = start.xy();
+    let mut total = 0.0;
+    for p in &chosen {
+        total += (p - last).norm();
+        flown.push(total);
+        last = *p;
+    }
+    total += (goal.xy() - last).norm();
     let waypoints = chosen
         .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let u = (i + 1) as f64 / total as f64;
+        .zip(&flown)
+        .map(|(p, d)| {
+            let u = if total > 0.0 { d / total } else { 0.0 };
             let along = start.z + (goal.z - start.z) * u;
             let height = corridor_height(corridor, *p)
                 .unwrap_or(along)

@@ -133,6 +133,8 @@ struct Inspection {
     /// formation flies the whole pass on a constant heading.
     half: f64,
     z_range: [f64; 2],
+    /// A footprint's outline, anticlockwise: its pass runs along a face.
+    face: Option<std::sync::Arc<[Point2<f64>]>>,
 }
 
 /// Number of angles a particle has for a mission: three per free waypoint,
@@ -201,6 +203,7 @@ impl PathBuilder {
                 z_range: mission
                     .inspection_altitudes(&mission.obstacles[k])
                     .unwrap_or_else(|| band_for(vertical_half_height(nominal))),
+                face: anticlockwise(&mission.obstacles[k].footprint),
             })
             .collect();
         // The centroid searches a box shrunk by r_F so every UAV stays inside
@@ -260,6 +263,18 @@ impl PathBuilder {
         self.crossings.iter().map(|c| c.iwp).collect()
     }
 
+    /// Whether crossings `a` and `b` overlap: `b`'s gap is within `a`'s
+    /// straight's reach along it and within `a`'s gate across it.
+    pub fn crossings_overlap(&self, a: usize, b: usize) -> bool {
+        let (x, y) = (&self.crossings[a], &self.crossings[b]);
+        let reach = x.reach.norm();
+        let n = x.reach / reach.max(1e-12);
+        let d = y.center - x.center;
+        let along = d.dot(&n).abs();
+        let across = (d.x * n.y - d.y * n.x).abs();
+        along < reach + y.reach.norm() && across < x.gate
+    }
+
     /// Each crossing's gate: the gap line widened by the formation's safe
     /// radius into the obstacles on either side. A leg across it is taken
     /// through the crossing (`crossing_leg`).
@@ -300,14 +315,29 @@ impl PathBuilder {
     /// with the obstacle on the formation's left or right.
     pub fn pass_ends(&self, i: usize, phi: f64, on_left: bool) -> [Point2<f64>; 2] {
         let ins = &self.inspections[i];
+        let radius = if on_left {
+            ins.geometry.radius_left
+        } else {
+            ins.geometry.radius_right
+        };
+        if let Some(outline) = &ins.face {
+            return face_pass(
+                outline,
+                phi,
+                radius,
+                ins.geometry.pass_length,
+                ins.half,
+                on_left,
+            );
+        }
         let (sin, cos) = phi.sin_cos();
         let radial = Vector2::new(cos, sin);
         // Anticlockwise round the axis: the obstacle is on the left.
         let anticlockwise = Vector2::new(-sin, cos);
-        let (radius, direction) = if on_left {
-            (ins.geometry.radius_left, anticlockwise)
+        let direction = if on_left {
+            anticlockwise
         } else {
-            (ins.geometry.radius_right, -anticlockwise)
+            -anticlockwise
         };
         let center = ins.axis + radial * radius;
         [center - direction * ins.half, center + direction * ins.half]
@@ -402,6 +432,13 @@ impl PathBuilder {
         let mut crossings: Vec<(usize, usize)> = Vec::with_capacity(self.crossings.len());
         let mut passes: Vec<(usize, usize, bool)> = Vec::with_capacity(self.inspections.len());
         for (i, c) in self.crossings.iter().enumerate() {
+            // A gap whose crossing would overlap one already placed (the
+            // next post pair along a lane, the gap beside it in the same
+            // wall) is passed within that one's straight: flying both in
+            // turn would double back.
+            if crossings.iter().any(|&(j, _)| self.crossings_overlap(j, i)) {
+                continue;
+            }
             if let Some((leg, triple)) = self.crossing_leg(&points, &locked, c) {
                 insert(&mut points, &mut locked, leg, &triple);
                 shift(&mut crossings, &mut passes, leg, 3);
@@ -506,27 +543,33 @@ impl PathBuilder {
         let (g0, g1) = (via.center - across, via.center + across);
         points.windows(2).enumerate().find_map(|(i, leg)| {
             let (a, b) = (leg[0], leg[1]);
-            if locked[i] || !segments_cross(&a.xy(), &b.xy(), &g0, &g1) {
+            if locked[i] || !crate::base::geometry::segments_cross(&a.xy(), &b.xy(), &g0, &g1) {
                 return None;
             }
             // Over (or under) the gap's obstacles the leg needs no crossing.
-            let mid = (a.z + b.z) / 2.0;
-            if !(via.window[0] < mid && mid < via.window[1]) {
+            let there = altitude_along(a, b, via.center);
+            if !(via.window[0] < there && there < via.window[1]) {
                 return None;
             }
-            let z = mid.clamp(via.z_range[0], via.z_range[1]);
             let sign = if (b.xy() - a.xy()).dot(&via.reach) >= 0.0 {
                 1.0
             } else {
                 -1.0
             };
             let reach = via.reach * sign;
+            // Each point at the leg's altitude where it lies (in the band
+            // the shape allows there): no step up or down joins the
+            // crossing to the leg.
+            let at = |p: Point2<f64>| {
+                let z = altitude_along(a, b, p).clamp(via.z_range[0], via.z_range[1]);
+                Point3::new(p.x, p.y, z)
+            };
             Some((
                 i,
                 [
-                    Point3::new(via.center.x - reach.x, via.center.y - reach.y, z),
-                    Point3::new(via.center.x, via.center.y, z),
-                    Point3::new(via.center.x + reach.x, via.center.y + reach.y, z),
+                    at(via.center - reach),
+                    at(via.center),
+                    at(via.center + reach),
                 ],
             ))
         })
@@ -549,10 +592,13 @@ impl PathBuilder {
                 continue;
             }
             let (a, b) = (leg[0], leg[1]);
-            let z = ((a.z + b.z) / 2.0).clamp(ins.z_range[0], ins.z_range[1]);
             for (on_left, [p, q]) in sides {
-                let first = Point3::new(p.x, p.y, z);
-                let last = Point3::new(q.x, q.y, z);
+                // At the leg's altitude where each end lies, in the pass's band.
+                let at = |p: Point2<f64>| {
+                    let z = altitude_along(a, b, p).clamp(ins.z_range[0], ins.z_range[1]);
+                    Point3::new(p.x, p.y, z)
+                };
+                let (first, last) = (at(p), at(q));
                 let added =
                     (first - a).norm() + (last - first).norm() + (b - last).norm() - (b - a).norm();
                 if added < best.3 {
@@ -562,6 +608,63 @@ impl PathBuilder {
         }
         (best.0, best.1, best.2)
     }
+}
+
+/// The altitude of the leg `a` → `b` where `p` projects onto it in the plane.
+fn altitude_along(a: Point3<f64>, b: Point3<f64>, p: Point2<f64>) -> f64 {
+    let t = crate::base::geometry::segment_projection(&a.xy(), &b.xy(), &p).0;
+    a.z + (b.z - a.z) * t
+}
+
+/// A footprint's vertices anticlockwise (`None` for a cylinder).
+fn anticlockwise(outline: &[Point2<f64>]) -> Option<std::sync::Arc<[Point2<f64>]>> {
+    if outline.len() < 3 {
+        return None;
+    }
+    let n = outline.len();
+    let area: f64 = (0..n)
+        .map(|i| outline[i].coords.perp(&outline[(i + 1) % n].coords))
+        .sum();
+    let mut v = outline.to_vec();
+    if area < 0.0 {
+        v.reverse();
+    }
+    Some(v.into())
+}
+
+/// The ends of a pass along a face of the anticlockwise `outline`: `phi`
+/// (radians in [-π, π]) picks the place along its perimeter, the face
+/// there is the one passed, the pass centred on that place (kept on the
+/// face as far as the pass's length allows), its line `radius` out from
+/// the face, `half` either way, the footprint on the formation's left or
+/// right.
+fn face_pass(
+    outline: &[Point2<f64>],
+    phi: f64,
+    radius: f64,
+    pass: f64,
+    half: f64,
+    on_left: bool,
+) -> [Point2<f64>; 2] {
+    let n = outline.len();
+    let edge = |i: usize| (outline[i], outline[(i + 1) % n]);
+    let perimeter: f64 = (0..n).map(|i| (edge(i).1 - edge(i).0).norm()).sum();
+    let mut at = ((phi + std::f64::consts::PI) / std::f64::consts::TAU).clamp(0.0, 1.0) * perimeter;
+    let mut i = 0;
+    while i + 1 < n && at > (edge(i).1 - edge(i).0).norm() {
+        at -= (edge(i).1 - edge(i).0).norm();
+        i += 1;
+    }
+    let (a, b) = edge(i);
+    let length = (b - a).norm().max(1e-12);
+    let along = (b - a) / length;
+    // Anticlockwise: the outside is on the edge's right.
+    let outward = Vector2::new(along.y, -along.x);
+    let room = (pass / 2.0).min(length / 2.0);
+    let centre = a + along * at.clamp(room, length - room) + outward * radius;
+    // Along the edge the footprint is on the left.
+    let direction = if on_left { along } else { -along };
+    [centre - direction * half, centre + direction * half]
 }
 
 /// Puts `via` into leg `leg` (after its first point), locking the via's own legs.
@@ -594,14 +697,6 @@ fn shift(
             *first += k;
         }
     }
-}
-
-/// Whether the plane segments a-b and c-d intersect (touching counts).
-fn segments_cross(a: &Point2<f64>, b: &Point2<f64>, c: &Point2<f64>, d: &Point2<f64>) -> bool {
-    let orient = |p: &Point2<f64>, q: &Point2<f64>, r: &Point2<f64>| (q - p).perp(&(r - p));
-    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
-    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
-    d1 * d2 <= 0.0 && d3 * d4 <= 0.0 && !(d1 == 0.0 && d2 == 0.0 && d3 == 0.0 && d4 == 0.0)
 }
 
 #[cfg(test)]

@@ -51,7 +51,7 @@ use self::levels::Levels;
 use self::search::{Graph, Jump, LAYERS, Step, bit, climb_bit};
 use super::iwp::{Iwp, Shape as FormationShape, column_spacing, min_pair_distance};
 use super::path::{PathBuilder, SqueezeMap};
-use crate::base::geometry::segment_point_distance;
+use crate::base::geometry::segments_cross;
 use crate::mission::{Mission, Obstacle};
 
 /// Angles tried round each inspected obstacle.
@@ -329,28 +329,6 @@ impl Site {
                 for layer in 0..LAYERS {
                     if c >= need[layer] + slack + run && inside(p, boxes[layer]) {
                         *bits |= climb_bit(pair, layer);
-                    }
-                }
-            }
-        }
-        // Through an IWP's gap only by its crossing: the path builder takes
-        // every leg across a crossing's gate through the crossing, so a
-        // corridor that slipped through in single file on free cells would
-        // be flown doubling back over the crossing's straight. The gate's
-        // cells are closed at the levels where the gap stands in the way.
-        let windows = builder.crossing_windows();
-        for (gate, window) in builder.crossing_gates().iter().zip(&windows) {
-            for l in (0..levels.len()).filter(|&l| {
-                let span = levels.span(l);
-                window[0] <= span[1] + 1e-9 && span[0] <= window[1] + 1e-9
-            }) {
-                let closed = !(0..LAYERS).fold(0u64, |bits, layer| bits | bit(l, layer));
-                let mid = nalgebra::center(&gate[0], &gate[1]);
-                let half = (gate[1] - gate[0]).norm() / 2.0 + cell;
-                for i in geometry.cells_within(mid, half) {
-                    let p = geometry.center(i);
-                    if segment_point_distance(&gate[0], &gate[1], &p) <= cell {
-                        open[i] &= closed;
                     }
                 }
             }
@@ -637,6 +615,7 @@ fn find_at(
         &candidates,
         builder.inspections().len(),
     );
+    through_crossings(&site, builder, &mut corridor);
     corridor.squeeze = site.squeeze_of(&corridor, mission);
     Ok(corridor)
 }
@@ -931,29 +910,133 @@ fn assemble(
             }
         }
     }
-    let length = points
-        .iter()
-        .zip(&heights)
-        .collect::<Vec<_>>()
-        .windows(2)
-        .map(|w| {
-            let (a, za) = w[0];
-            let (b, zb) = w[1];
-            (b - a).norm().hypot(zb - za)
-        })
-        .sum();
-    Corridor {
+    let mut corridor = Corridor {
         points,
         legs,
         passes,
-        length,
+        length: 0.0,
         heights: if levels.is_flat() {
             Vec::new()
         } else {
             heights
         },
         squeeze: None,
+    };
+    corridor.length = polyline_length(&corridor);
+    corridor
+}
+
+/// The corridor's free legs across an IWP's gate, taken through its
+/// crossing as the path builder will fly them (`PathBuilder::crossing_leg`
+/// puts a crossing into every leg across its gate, at the altitudes where
+/// the gap stands in the way): the crossing's straight put in, and the
+/// corridor's points standing on that straight (a run pulled tight through a
+/// gap in single file bends at its ends) left out, so the path does not
+/// double back over the straight. A crossing whose approach or exit the
+/// site closes is left as it was.
+fn through_crossings(site: &Site, builder: &PathBuilder, corridor: &mut Corridor) {
+    let crossings = builder.crossings();
+    let gates = builder.crossing_gates();
+    let windows = builder.crossing_windows();
+    let field = site.field();
+    let height = |corridor: &Corridor, i: usize| corridor.heights.get(i).copied();
+    let level_of = |z: Option<f64>| z.and_then(|z| site.levels.level_of(z)).unwrap_or(0);
+    let mut placed: Vec<usize> = corridor
+        .legs
+        .iter()
+        .filter_map(|l| match l {
+            Leg::Crossing(c) => Some(*c),
+            _ => None,
+        })
+        .collect();
+    let mut k = 0;
+    while k < corridor.legs.len() {
+        let Leg::Free { layer } = corridor.legs[k] else {
+            k += 1;
+            continue;
+        };
+        let (a, b) = (corridor.points[k], corridor.points[k + 1]);
+        let level = level_of(height(corridor, k));
+        let span = site.levels.span(level);
+        // The first gate the leg crosses, from its start.
+        let hit = (0..crossings.len())
+            .filter(|&c| windows[c][0] <= span[1] + 1e-9 && span[0] <= windows[c][1] + 1e-9)
+            .filter(|&c| {
+                // As the path builder: once each, none within another's straight.
+                !placed.iter().any(|&p| {
+                    p == c || builder.crossings_overlap(p, c) || builder.crossings_overlap(c, p)
+                })
+            })
+            .filter(|&c| segments_cross(&a, &b, &gates[c][0], &gates[c][1]))
+            .min_by(|&c, &d| {
+                let at = |g: &[Point2<f64>; 2]| (nalgebra::center(&g[0], &g[1]) - a).norm();
+                at(&gates[c]).total_cmp(&at(&gates[d]))
+            });
+        let Some(c) = hit else {
+            k += 1;
+            continue;
+        };
+        let [p, q] = crossings[c];
+        let (enter, leave) = if (q - p).dot(&(b - a)) >= 0.0 {
+            (p, q)
+        } else {
+            (q, p)
+        };
+        let centre = nalgebra::center(&p, &q);
+        let n = (leave - enter) / (leave - enter).norm().max(1e-12);
+        let reach = (leave - enter).norm() / 2.0;
+        let half_gate = (gates[c][1] - gates[c][0]).norm() / 2.0;
+        let on_straight = |x: Point2<f64>| {
+            let d = x - centre;
+            d.dot(&n).abs() <= reach && (d.x * n.y - d.y * n.x).abs() <= half_gate
+        };
+        // Points on the straight before the leg's end, and after its start.
+        let mut first = k;
+        while first > 0
+            && matches!(corridor.legs[first - 1], Leg::Free { .. })
+            && on_straight(corridor.points[first])
+        {
+            first -= 1;
+        }
+        let mut last = k + 1;
+        while last + 1 < corridor.points.len()
+            && matches!(corridor.legs[last], Leg::Free { .. })
+            && on_straight(corridor.points[last])
+        {
+            last += 1;
+        }
+        let open = |x: Point2<f64>, y: Point2<f64>| {
+            search::visible(field, &site.open, bit(level, layer), x, y)
+        };
+        let (from, to) = (corridor.points[first], corridor.points[last]);
+        if !(open(from, enter) && open(leave, to)) {
+            k += 1;
+            continue;
+        }
+        let z = height(corridor, k);
+        placed.push(c);
+        corridor.points.splice(first + 1..last, [enter, leave]);
+        corridor.legs.splice(
+            first..last,
+            [Leg::Free { layer }, Leg::Crossing(c), Leg::Free { layer }],
+        );
+        if let Some(z) = z {
+            corridor.heights.splice(first + 1..last, [z, z]);
+        }
+        k = first + 2;
     }
+    corridor.length = polyline_length(corridor);
+}
+
+/// The corridor's length, metres (its heights' climbs included).
+fn polyline_length(corridor: &Corridor) -> f64 {
+    let z = |i: usize| corridor.heights.get(i).copied().unwrap_or(0.0);
+    corridor
+        .points
+        .windows(2)
+        .enumerate()
+        .map(|(i, w)| (w[1] - w[0]).norm().hypot(z(i + 1) - z(i)))
+        .sum()
 }
 
 /// The run's points with every corner removed that a straight line on open
