@@ -12,7 +12,9 @@
 //! more shapes, r_Q from 0.3 to 0.7 m, sites mirrored and transposed);
 //! `--3d` the sites in three dimensions (`sites::three_d`: walls of posts
 //! and segments, decoy pockets, rows of footprints, decks, low fences, walls
-//! to fly over or climb, short towers and trees near a bound, 30 shapes).
+//! to fly over or climb, short towers and trees near a bound, 30 shapes);
+//! `--3d-hard` their hard variant (more and closer barriers, narrower sites
+//! and bands, uneven posts, more decoys, inspections and clutter).
 //! `write DIR N [FIRST]` writes N sites of the chosen family as mission
 //! files, to run them from the command line.
 
@@ -183,7 +185,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut raw: Vec<String> = std::env::args().skip(1).collect();
     let wide = raw.iter().any(|a| a == "--wide");
     let three_d = raw.iter().any(|a| a == "--3d");
-    raw.retain(|a| a != "--wide" && a != "--3d");
+    let hard = raw.iter().any(|a| a == "--3d-hard");
+    raw.retain(|a| a != "--wide" && a != "--3d" && a != "--3d-hard");
     let generated = if wide {
         sites::generated_wide
     } else {
@@ -196,8 +199,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Vec<(&'static str, String)>,
         Option<String>,
     ) {
-        if three_d {
-            let site = sites::three_d::generated_3d(i);
+        if three_d || hard {
+            let site = if hard {
+                sites::three_d::generated_3d_hard(i)
+            } else {
+                sites::three_d::generated_3d(i)
+            };
             let mut dims = site.dims;
             dims.push(("route", heading(&site.mission).to_owned()));
             return (site.mission, dims, Some(site.toml));

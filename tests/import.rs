@@ -536,3 +536,64 @@ fn a_bad_survey_in_the_designer_changes_nothing_and_says_why() {
     assert!(app.status().expect("a status line").error);
     assert_eq!(app.mission(), &m);
 }
+
+/// Issue 37: a survey of two transformer bays (8 × 6 m, 4 m apart) and a
+/// gantry beam, written with their tops and undersides as properties
+/// (`height`, OSM's `min_height`, `overfly`): the footprints come in as
+/// surveyed with their heights, and the report names the narrowest aisle
+/// between the footprints and what the formation makes of it.
+#[test]
+fn footprints_come_in_with_their_heights_and_the_narrowest_aisle_is_named() {
+    use skyform::mission::geodesy::Frame;
+    let m = bridge();
+    let frame = Frame::new(m.origin.as_ref().expect("the bridge has an origin"));
+    let ring = |corners: &[(f64, f64)]| -> String {
+        let mut points: Vec<String> = corners
+            .iter()
+            .chain(corners.first())
+            .map(|&(x, y)| {
+                let g = frame.ground_to_geodetic(&Point2::new(x, y));
+                format!("[{:.10}, {:.10}]", g.longitude, g.latitude)
+            })
+            .collect();
+        points.dedup();
+        format!("[[{}]]", points.join(", "))
+    };
+    let feature = |name: &str, corners: &[(f64, f64)], properties: &str| {
+        format!(
+            "{{\"type\": \"Feature\", \"properties\": {{\"name\": \"{name}\", {properties}}}, \
+             \"geometry\": {{\"type\": \"Polygon\", \"coordinates\": {}}}}}",
+            ring(corners)
+        )
+    };
+    let t1 = [(20.0, 70.0), (28.0, 70.0), (28.0, 76.0), (20.0, 76.0)];
+    let t2 = [(32.0, 70.0), (40.0, 70.0), (40.0, 76.0), (32.0, 76.0)];
+    let beam = [(20.0, 80.0), (40.0, 80.0), (40.0, 81.0), (20.0, 81.0)];
+    let text = format!(
+        "{{\"type\": \"FeatureCollection\", \"features\": [{}, {}, {}]}}",
+        feature("T1", &t1, "\"height\": 7.5, \"overfly\": false"),
+        feature("T2", &t2, "\"height\": 7.5, \"overfly\": \"no\""),
+        feature("gantry", &beam, "\"height\": 13.0, \"min_height\": 12.0"),
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("bays.geojson");
+    std::fs::write(&file, text).unwrap();
+    let imported = import_into(&m, &file);
+    let (a, b) = (
+        named(&imported.mission, "T1"),
+        named(&imported.mission, "T2"),
+    );
+    assert_footprint(&t1, a);
+    assert_footprint(&t2, b);
+    assert!(a.height == 7.5 && a.base == 0.0 && !a.overfly && !b.overfly);
+    let gantry = named(&imported.mission, "gantry");
+    assert!(gantry.base == 12.0 && gantry.height == 13.0 && gantry.overfly);
+    let (x, y, width) = imported.aisle.clone().expect("an aisle between the bays");
+    assert_eq!((x.as_str(), y.as_str()), ("T1", "T2"));
+    assert!((width - 4.0).abs() < 0.01, "{width}");
+    let report = imported.report();
+    assert!(
+        report.contains("narrowest aisle between footprints: 'T1' | 'T2', 4.00 m"),
+        "{report}"
+    );
+}

@@ -1656,3 +1656,73 @@ fn live_planning_follows_edits_pauses_on_errors_and_stops_when_off() {
     assert_eq!(app.board().live().revision(), 3);
     assert!(app.shown().is_some_and(|j| app.is_stale(j)));
 }
+
+/// Issue 37, a footprint's vertices edited with undo: `c` selects the
+/// first corner of a selected footprint, `n` steps to the next, a nudge
+/// moves it (its bounding circle follows), `d` adds a vertex halfway to the
+/// next, `Del` removes one (never below three), the inspector types one;
+/// each is one undo step (the refused third deletion none), and undoing
+/// them all gives the footprint back.
+#[test]
+fn a_footprints_vertices_are_moved_added_and_deleted_with_undo() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = default_mission().mission;
+    let mut bay = skyform::mission::Obstacle::standing("T1", Point2::new(0.0, 0.0), 1.0, 7.5);
+    bay.footprint = vec![
+        Point2::new(60.0, 70.0),
+        Point2::new(68.0, 70.0),
+        Point2::new(68.0, 76.0),
+        Point2::new(60.0, 76.0),
+    ];
+    bay.settle();
+    m.obstacles.push(bay);
+    let k = m.obstacles.len() - 1;
+    let path = dir.path().join("bay.toml");
+    mission::save(&m, &path).unwrap();
+    let mut app = App::new(Document::new(m, Some(path)), dir.path().to_path_buf());
+    let original = app.mission().clone();
+
+    app.update(Action::Select(Item::Obstacle(k)));
+    app.update(Action::FocusOn(Focus::Map));
+    app.update(Action::ToggleVertices);
+    assert_eq!(app.selected(), &Item::Vertex(k, 0));
+    app.update(Action::SelectNext);
+    assert_eq!(app.selected(), &Item::Vertex(k, 1));
+    app.update(Action::Nudge(1.0, 0.0)); // 1 m east
+    let o = &app.mission().obstacles[k];
+    assert_eq!(o.footprint[1], Point2::new(69.0, 70.0));
+    assert_eq!(
+        o.center,
+        Point2::new(64.5, 73.0),
+        "the bounding circle follows"
+    );
+    app.update(Action::Duplicate); // halfway to vertex 3
+    assert_eq!(app.selected(), &Item::Vertex(k, 2));
+    assert_eq!(app.mission().obstacles[k].footprint.len(), 5);
+    assert_eq!(
+        app.mission().obstacles[k].footprint[2],
+        Point2::new(68.5, 73.0)
+    );
+    type_into(&mut app, "x (m)", "70");
+    assert_eq!(
+        app.mission().obstacles[k].footprint[2],
+        Point2::new(70.0, 73.0)
+    );
+    app.update(Action::Delete);
+    assert_eq!(app.mission().obstacles[k].footprint.len(), 4);
+    // Down to three, and no further.
+    app.update(Action::Delete);
+    assert_eq!(app.mission().obstacles[k].footprint.len(), 3);
+    app.update(Action::Delete);
+    assert_eq!(app.mission().obstacles[k].footprint.len(), 3);
+    app.update(Action::ToggleVertices);
+    assert_eq!(app.selected(), &Item::Obstacle(k));
+    for _ in 0..5 {
+        app.update(Action::Undo);
+    }
+    assert_eq!(
+        app.mission(),
+        &original,
+        "five undos give the footprint back"
+    );
+}

@@ -4,10 +4,11 @@
 //! A file is read into a [`Survey`] of features in WGS-84 (`geojson.rs`,
 //! `kml.rs`: the georust readers, then the checks a survey must pass:
 //! closed rings, coordinates in range, near the mission's origin). Each
-//! feature becomes cylinders in the mission's ENU frame (`obstacles.rs`):
-//! a point one cylinder, a line a row of them, a polygon a cover whose union
-//! contains it (`cover.rs`), clipped to the bounds, with what the cover adds
-//! stated. They join the mission by name (`merge.rs`): importing the same
+//! feature becomes obstacles in the mission's ENU frame (`obstacles.rs`):
+//! a point one cylinder, a line a row of them (`cover.rs`), a polygon a
+//! footprint as surveyed, clipped to the bounds; its top, base and whether
+//! it may be flown over read from its properties. The report names the
+//! narrowest aisle between the footprints imported. They join the mission by name (`merge.rs`): importing the same
 //! file again changes nothing, an updated survey updates its obstacles.
 //! Reading the file is the only I/O; the CLI and the designer write.
 
@@ -110,6 +111,9 @@ pub struct Imported {
     pub skipped: Vec<String>,
     /// Defaults assumed (no radius, no height), grouped.
     pub warnings: Vec<String>,
+    /// The narrowest aisle between two imported footprints that stand at a
+    /// common altitude: their names and the width, metres.
+    pub aisle: Option<(String, String, f64)>,
 }
 
 /// Reads a survey file: GeoJSON (`.geojson`, `.json`), KML (`.kml`) or KMZ
@@ -239,6 +243,7 @@ pub fn import(mission: &Mission, survey: &Survey, stem: &str) -> Result<Imported
         }
     })?;
     let (merged, changes) = merge::merge(mission, &made.features);
+    let aisle = narrowest_aisle(made.features.iter().flat_map(|f| f.obstacles.iter()));
     Ok(Imported {
         mission: merged,
         format: survey.format,
@@ -247,7 +252,41 @@ pub fn import(mission: &Mission, survey: &Survey, stem: &str) -> Result<Imported
         notes: made.notes,
         skipped: made.skipped,
         warnings: made.warnings,
+        aisle,
     })
+}
+
+/// The narrowest gap between two of `obstacles`' footprints that stand at
+/// a common altitude (their outlines' nearest points: the aisle a
+/// formation would fly), with their names; none when fewer than two
+/// footprints, or none apart.
+fn narrowest_aisle<'a>(
+    obstacles: impl Iterator<Item = &'a crate::mission::Obstacle>,
+) -> Option<(String, String, f64)> {
+    let footprints: Vec<&crate::mission::Obstacle> =
+        obstacles.filter(|o| !o.footprint.is_empty()).collect();
+    let mut best: Option<(String, String, f64)> = None;
+    for (i, a) in footprints.iter().enumerate() {
+        for b in &footprints[i + 1..] {
+            let apart = (a.center - b.center).norm() - a.radius - b.radius;
+            if best.as_ref().is_some_and(|(_, _, w)| apart >= *w)
+                || a.base >= b.height
+                || b.base >= a.height
+            {
+                continue;
+            }
+            let (pa, pb) = (a.prism(), b.prism());
+            let (p, q) = crate::base::geometry::nearest_points(&pa, &pb);
+            if pa.outward(&q) <= 0.0 || pb.outward(&p) <= 0.0 {
+                continue; // touching or overlapping: one building
+            }
+            let width = (q - p).norm();
+            if best.as_ref().is_none_or(|(_, _, w)| width < *w) {
+                best = Some((a.name.clone(), b.name.clone(), width));
+            }
+        }
+    }
+    best
 }
 
 /// The stem of a survey file's name, for unnamed features.
@@ -291,6 +330,23 @@ impl Imported {
         }
         for s in &self.skipped {
             out.push_str(&format!("  skipped {s}\n"));
+        }
+        if let Some((a, b, width)) = &self.aisle {
+            let f = &self.mission.formation;
+            let r_q = f.least_clearance();
+            let nominal = 2.0 * (f.slots.iter().map(|s| s.y.abs()).fold(0.0, f64::max) + r_q);
+            let fits = if *width >= nominal {
+                "the formation passes it as it is"
+            } else if *width >= 2.0 * r_q {
+                "narrower than the formation: it passes in a narrower shape (a shrink or a column)"
+            } else {
+                "narrower than one UAV: no way through"
+            };
+            out.push_str(&format!(
+                "  narrowest aisle between footprints: '{a}' | '{b}', {width:.2} m (the formation \
+                 is {nominal:.2} m wide, one UAV {:.2} m): {fits}\n",
+                2.0 * r_q
+            ));
         }
         for w in &self.warnings {
             out.push_str(&format!("warning: {w}\n"));

@@ -151,7 +151,21 @@ pub fn make(
             continue;
         }
         let radius = property(f, "radius", &mut problems);
-        let height = property(f, "height", &mut problems);
+        // Its top (`height`, or `top`) and its underside (`base`, or OSM's
+        // `min_height`): a deck, a gantry beam.
+        let height =
+            property(f, "height", &mut problems).or_else(|| property(f, "top", &mut problems));
+        let base = ground_property(f, "base", &mut problems)
+            .or_else(|| ground_property(f, "min_height", &mut problems));
+        let overfly = flag(f, "overfly", &mut problems);
+        if let (Some(b), Some(h)) = (base, height)
+            && b >= h
+        {
+            problems.push(format!(
+                "{}: its base {b} m is at or above its top {h} m",
+                f.label()
+            ));
+        }
         let mut discs: Vec<Disc> = Vec::new();
         let mut footprints: Vec<Vec<Point2<f64>>> = Vec::new();
         let mut outside_points = 0;
@@ -265,8 +279,8 @@ pub fn make(
                 radius,
                 height: height.unwrap_or(default_height),
                 footprint,
-                base: 0.0,
-                overfly: true,
+                base: base.unwrap_or(0.0),
+                overfly: overfly.unwrap_or(true),
                 clearance_above: 0.0,
                 kind: kind.clone(),
                 inspect: false,
@@ -366,6 +380,49 @@ fn property(f: &Feature, key: &str, problems: &mut Vec<String>) -> Option<f64> {
             None
         }
     }
+}
+
+/// A height above the ground (0 allowed), metres.
+fn ground_property(f: &Feature, key: &str, problems: &mut Vec<String>) -> Option<f64> {
+    let value = f.property(key)?;
+    let number = match value {
+        Value::Number(n) => n.as_f64(),
+        Value::String(s) => s.trim().parse::<f64>().ok(),
+        Value::Null => return None,
+        _ => None,
+    };
+    match number {
+        Some(v) if v.is_finite() && v >= 0.0 => Some(v),
+        _ => {
+            problems.push(format!(
+                "{}: its `{key}` must be a number of metres, 0 or more, got {value}",
+                f.label()
+            ));
+            None
+        }
+    }
+}
+
+/// A yes/no property (`true`, `false`, or their words).
+fn flag(f: &Feature, key: &str, problems: &mut Vec<String>) -> Option<bool> {
+    let value = f.property(key)?;
+    let read = match value {
+        Value::Bool(b) => Some(*b),
+        Value::String(s) => match s.trim().to_ascii_lowercase().as_str() {
+            "true" | "yes" | "1" => Some(true),
+            "false" | "no" | "0" => Some(false),
+            _ => None,
+        },
+        Value::Null => return None,
+        _ => None,
+    };
+    if read.is_none() {
+        problems.push(format!(
+            "{}: its `{key}` must be true or false, got {value}",
+            f.label()
+        ));
+    }
+    read
 }
 
 /// The x-y box of the bounds as a polygon.

@@ -86,6 +86,9 @@ pub enum Action {
     ToggleWaypoint,
     /// Inspect (eq. 8) the selected obstacle, or stop inspecting it.
     ToggleInspect,
+    /// From a footprint to its first vertex, or from a vertex back to its
+    /// footprint (vertices are then moved, added and deleted).
+    ToggleVertices,
 
     FieldUp,
     FieldDown,

@@ -362,9 +362,9 @@ impl App {
             }
             SelectNext | SelectPrevious | Select(_) | Nudge(..) | AddObstacle(_)
             | ToggleAddTool | Duplicate | Delete | AddSlot | CyclePreset | CycleShape
-            | ToggleWaypoint | ToggleInspect | FieldUp | FieldDown | EditStart(_)
-            | EditInput(_) | EditBackspace | EditClear | EditCommit | EditCancel | Undo | Redo
-            | DragStart(..) | DragTo(_) | DragEnd => self.update_editor(action),
+            | ToggleWaypoint | ToggleInspect | ToggleVertices | FieldUp | FieldDown
+            | EditStart(_) | EditInput(_) | EditBackspace | EditClear | EditCommit | EditCancel
+            | Undo | Redo | DragStart(..) | DragTo(_) | DragEnd => self.update_editor(action),
         }
         // Whatever changed the mission (an edit, an undo, an import, an
         // open), live planning follows it.

@@ -203,6 +203,7 @@ impl Editor {
             }
             Duplicate => self.duplicate(status),
             ToggleInspect => self.toggle_inspect(status),
+            ToggleVertices => self.toggle_vertices(status),
             Delete => self.delete(status),
             AddSlot => self.add_slot(status),
             CyclePreset => self.cycle_preset(status),
@@ -266,7 +267,8 @@ impl Editor {
         self.iwps = iwps_despite_choices(m, self.doc.diagnostics());
         if !self.selected.exists(m) {
             self.selected = match self.selected {
-                Item::Obstacle(_) if !m.obstacles.is_empty() => {
+                Item::Vertex(i, _) if i < m.obstacles.len() => Item::Obstacle(i),
+                Item::Obstacle(_) | Item::Vertex(_, _) if !m.obstacles.is_empty() => {
                     Item::Obstacle(m.obstacles.len() - 1)
                 }
                 Item::Slot(_) | Item::Waypoint(_) => Item::Formation,
@@ -292,8 +294,25 @@ impl Editor {
         self.selected = item;
     }
 
-    /// The next (or previous) item of those `pane` shows.
+    /// The next (or previous) item of those `pane` shows; from a vertex,
+    /// the next (previous) vertex of its footprint.
     fn select_step(&mut self, pane: Pane, forward: bool) {
+        if let Item::Vertex(i, v) = self.selected {
+            let n = self
+                .mission()
+                .obstacles
+                .get(i)
+                .map_or(0, |o| o.footprint.len());
+            if n > 0 {
+                let next = if forward {
+                    (v + 1) % n
+                } else {
+                    (v + n - 1) % n
+                };
+                self.select(Item::Vertex(i, next));
+            }
+            return;
+        }
         let items = match pane {
             Pane::Map => fields::map_items(self.mission()),
             Pane::Formation => fields::formation_items(self.mission(), &self.iwps),
@@ -346,7 +365,53 @@ impl Editor {
                     self.select(Item::Obstacle(self.mission().obstacles.len() - 1));
                 }
             }
+            Item::Vertex(i, v) => {
+                let Some(o) = self.mission().obstacles.get(i) else {
+                    return;
+                };
+                let n = o.footprint.len();
+                if n == 0 || v >= n {
+                    return;
+                }
+                // Halfway to the next vertex: the outline keeps its shape.
+                let mid = nalgebra::center(&o.footprint[v], &o.footprint[(v + 1) % n])
+                    .map(mission::round_mm);
+                self.edit(status, |m| {
+                    let o = &mut m.obstacles[i];
+                    o.footprint.insert(v + 1, mid);
+                    o.settle();
+                });
+                self.select(Item::Vertex(i, v + 1));
+                status.say(format!(
+                    "vertex {} added at ({:.1}, {:.1})",
+                    v + 2,
+                    mid.x,
+                    mid.y
+                ));
+            }
             _ => {}
+        }
+    }
+
+    /// A footprint's first vertex, or from a vertex its footprint.
+    fn toggle_vertices(&mut self, status: &mut StatusLine) {
+        match self.selected {
+            Item::Obstacle(i) => {
+                let Some(o) = self.mission().obstacles.get(i) else {
+                    return;
+                };
+                if o.footprint.is_empty() {
+                    status.say("a cylinder has no corners: select a footprint (a building, a bay)");
+                    return;
+                }
+                let (n, name) = (o.footprint.len(), o.name.clone());
+                self.select(Item::Vertex(i, 0));
+                status.say(format!(
+                    "vertex 1 of {n} of '{name}': n/p step, arrows or drag move, d adds one, Del deletes, c back"
+                ));
+            }
+            Item::Vertex(i, _) => self.select(Item::Obstacle(i)),
+            _ => status.say("select a footprint to edit its corners"),
         }
     }
 
@@ -551,7 +616,11 @@ impl Editor {
     fn nudge(&mut self, dx: f64, dy: f64, s: f64, status: &mut StatusLine) {
         let item = self.selected.clone();
         match &item {
-            Item::Obstacle(_) | Item::Start | Item::Goal | Item::FleetTarget(_) => {
+            Item::Obstacle(_)
+            | Item::Vertex(_, _)
+            | Item::Start
+            | Item::Goal
+            | Item::FleetTarget(_) => {
                 if let Some(p) = self.position_of(&item) {
                     let to = p + Vector2::new(dx * s, dy * s);
                     self.edit(status, |m| set_position(m, &item, to));
@@ -567,7 +636,9 @@ impl Editor {
                     }
                 });
             }
-            _ => status.say("select an obstacle, the start, the goal or a slot to move it"),
+            _ => {
+                status.say("select an obstacle, a vertex, the start, the goal or a slot to move it")
+            }
         }
     }
 
@@ -577,6 +648,7 @@ impl Editor {
         let m = self.mission();
         match item {
             Item::Obstacle(i) => m.obstacles.get(*i).map(|o| o.center),
+            Item::Vertex(i, v) => m.obstacles.get(*i)?.footprint.get(*v).copied(),
             Item::Start => Some(m.route.start.xy()),
             Item::Goal => Some(m.route.goal.xy()),
             Item::Slot(i) => m.formation.slots.get(*i).map(|s| Point2::new(s.x, s.y)),
@@ -597,6 +669,26 @@ impl Editor {
                 if let Some(name) = name {
                     status.say(format!("deleted '{name}' (u to undo)"));
                 }
+            }
+            Item::Vertex(i, v) => {
+                let n = self
+                    .mission()
+                    .obstacles
+                    .get(i)
+                    .map_or(0, |o| o.footprint.len());
+                if n <= 3 {
+                    status.error("a footprint needs at least three vertices (c, then Del deletes the obstacle)");
+                    return;
+                }
+                self.edit(status, |m| {
+                    let o = &mut m.obstacles[i];
+                    if v < o.footprint.len() {
+                        o.footprint.remove(v);
+                        o.settle();
+                    }
+                });
+                self.select(Item::Vertex(i, v.min(n - 2)));
+                status.say(format!("vertex {} deleted (u to undo)", v + 1));
             }
             Item::Slot(i) => {
                 if self.mission().formation.slots.len() <= 1 {
@@ -628,7 +720,7 @@ impl Editor {
                     "IWP back to the mission's default shape: the route may cross between '{a}' and '{b}' or not"
                 ));
             }
-            _ => status.say("only obstacles, slots and IWP choices can be deleted"),
+            _ => status.say("only obstacles, vertices, slots and IWP choices can be deleted"),
         }
     }
 
@@ -747,6 +839,14 @@ fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
         Item::Obstacle(i) => {
             if let Some(o) = m.obstacles.get_mut(*i) {
                 o.move_to(p);
+            }
+        }
+        Item::Vertex(i, v) => {
+            if let Some(o) = m.obstacles.get_mut(*i)
+                && let Some(q) = o.footprint.get_mut(*v)
+            {
+                *q = p;
+                o.settle();
             }
         }
         Item::Start => {

@@ -28,6 +28,8 @@ pub enum Item {
     /// The `[terrain]` height map (listed when the mission has one).
     Terrain,
     Obstacle(usize),
+    /// Vertex `1` of obstacle `0`'s footprint.
+    Vertex(usize, usize),
     Formation,
     Slot(usize),
     /// The IWP between these two obstacles (eq. 9): its reconfiguration choice.
@@ -53,6 +55,10 @@ impl Item {
                 Some(o) => format!("Obstacle {} '{}'", i + 1, o.name),
                 None => format!("Obstacle {}", i + 1),
             },
+            Item::Vertex(i, v) => match mission.obstacles.get(*i) {
+                Some(o) => format!("Vertex {} of '{}'", v + 1, o.name),
+                None => format!("Vertex {} of obstacle {}", v + 1, i + 1),
+            },
             Item::Formation => "Formation".into(),
             Item::Slot(i) => format!("Slot {} (UAV {})", i + 1, i + 1),
             Item::Waypoint([a, b]) => format!("IWP {a} ↔ {b}"),
@@ -67,6 +73,10 @@ impl Item {
     pub fn exists(&self, mission: &Mission) -> bool {
         match self {
             Item::Obstacle(i) => *i < mission.obstacles.len(),
+            Item::Vertex(i, v) => mission
+                .obstacles
+                .get(*i)
+                .is_some_and(|o| *v < o.footprint.len()),
             Item::Slot(i) => *i < mission.formation.slots.len(),
             Item::FleetTarget(i) => *i < mission.fleet.targets.len(),
             Item::Terrain => mission.terrain.is_some(),
@@ -89,6 +99,7 @@ impl Item {
                 .key("waypoints")
                 .index(self.index(m)?),
             Item::Obstacle(i) => root.key("obstacles").index(*i),
+            Item::Vertex(i, v) => root.key("obstacles").index(*i).key("footprint").index(*v),
             Item::Bounds => root.key("bounds"),
             Item::Start => root.key("route").key("start"),
             Item::Goal => root.key("route").key("goal"),
@@ -107,7 +118,9 @@ impl Item {
     /// `reconfiguration.waypoints`, if it has one yet).
     fn index(&self, m: &Mission) -> Option<usize> {
         match self {
-            Item::Obstacle(i) | Item::Slot(i) | Item::FleetTarget(i) => Some(*i),
+            Item::Obstacle(i) | Item::Slot(i) | Item::FleetTarget(i) | Item::Vertex(i, _) => {
+                Some(*i)
+            }
             Item::Waypoint([a, b]) => m.reconfiguration.position(a, b),
             _ => None,
         }
@@ -153,6 +166,8 @@ pub fn formation_items(mission: &Mission, iwps: &[Iwp]) -> Vec<Item> {
 enum Step {
     Key(&'static str),
     Index,
+    /// The selected vertex's index in its footprint.
+    Vertex,
 }
 
 /// One field of the inspector, declared once.
@@ -195,6 +210,10 @@ impl Table {
                 Step::Index => {
                     path.index(item.index(m).unwrap_or(m.reconfiguration.waypoints.len()))
                 }
+                Step::Vertex => match item {
+                    Item::Vertex(_, v) => path.index(*v),
+                    _ => path,
+                },
             };
         }
         let path = spec.keys.iter().fold(path, |p, key| p.key(key));

@@ -258,6 +258,17 @@ fn hit(
                     consider(d, Item::Obstacle(i));
                 }
             }
+            // The corners of the footprint being edited win over its outline.
+            if let Item::Obstacle(i) | Item::Vertex(i, _) = *app.selected()
+                && let Some(o) = m.obstacles.get(i)
+            {
+                for (v, q) in o.footprint.iter().enumerate() {
+                    let d = (q - p).norm();
+                    if d <= tolerance * 1.5 {
+                        consider(d - tolerance * 3.0, Item::Vertex(i, v));
+                    }
+                }
+            }
             for (i, t) in m.fleet.targets.iter().enumerate() {
                 let d = (t.position - p).norm();
                 if d <= tolerance * 1.5 {

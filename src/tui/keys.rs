@@ -342,8 +342,14 @@ pub static KEYS: &[KeyRow] = &[
     KeyRow {
         group: "Edit",
         keys: "d",
-        help: "duplicate the selected obstacle",
+        help: "duplicate the selected obstacle (a vertex: add one halfway to the next)",
         bindings: &[bind(Key::Char('d'), When::Always, Action::Duplicate)],
+    },
+    KeyRow {
+        group: "Edit",
+        keys: "c",
+        help: "a footprint's corners: select its first vertex (n/p step, arrows or drag move, d adds, Del deletes), again back to the footprint",
+        bindings: &[bind(Key::Char('c'), When::Always, Action::ToggleVertices)],
     },
     KeyRow {
         group: "Edit",
@@ -354,7 +360,7 @@ pub static KEYS: &[KeyRow] = &[
     KeyRow {
         group: "Edit",
         keys: "Del  D",
-        help: "delete the selected obstacle / slot / IWP choice",
+        help: "delete the selected obstacle / vertex / slot / IWP choice",
         bindings: &[
             bind(Key::Code(KeyCode::Delete), When::Always, Action::Delete),
             bind(Key::Char('D'), When::Always, Action::Delete),

@@ -271,12 +271,24 @@ impl Barrier {
 /// `check` would refuse (a rare collision of the generator's choices) are
 /// drawn again from the next sub-seed, so every index is a valid site.
 pub fn generated_3d(index: u64) -> Site3d {
-    for attempt in 0..50u64 {
-        if let Some(site) = attempt_site(index, attempt) {
+    generate(index, false)
+}
+
+/// Site `index` of the hard variant: two to four barriers, most 10-14 m
+/// apart, narrower sites, a band 8-12 m deep, r_Q up to 0.7 m, decoys and
+/// inspections more often (half of them near a bound), posts of uneven
+/// heights (±0.5 m), more clutter.
+pub fn generated_3d_hard(index: u64) -> Site3d {
+    generate(index, true)
+}
+
+fn generate(index: u64, hard: bool) -> Site3d {
+    for attempt in 0..80u64 {
+        if let Some(site) = attempt_site(index, attempt, hard) {
             return site;
         }
     }
-    panic!("site {index}: no valid site in 50 draws")
+    panic!("site {index}: no valid site in 80 draws")
 }
 
 /// Heights of a barrier: a top above the sky (`Full`), a top the formation
@@ -289,16 +301,26 @@ enum Height {
     Climb,
 }
 
-fn attempt_site(index: u64, attempt: u64) -> Option<Site3d> {
+fn attempt_site(index: u64, attempt: u64, hard: bool) -> Option<Site3d> {
+    let salt = if hard { 0x4a2d_0000 } else { 0 };
     let mut rng = ChaCha8Rng::seed_from_u64(
-        0x3d_5172 ^ index.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ attempt.wrapping_mul(0xabcd_ef01),
+        0x3d_5172
+            ^ salt
+            ^ index.wrapping_mul(0x9e37_79b9_7f4a_7c15)
+            ^ attempt.wrapping_mul(0xabcd_ef01),
     );
+    // The hard variant's odds and ranges.
+    let (close_odds, decoy_odds, inspect_odds, bound_odds) = if hard {
+        (0.7, 0.75, 0.8, 0.5)
+    } else {
+        (0.4, 0.45, 0.5, 0.3)
+    };
     let shape_index = rng.random_range(0..shapes());
     let (shape_name, slots) = shape(shape_index);
     let r_q: f64 = if shape_name == "grid 2x2 tight" {
         0.5
     } else {
-        rng.random_range(0.3..0.6)
+        rng.random_range(0.3..if hard { 0.7 } else { 0.6 })
     };
     let r_f = slots.iter().map(|o| o.norm()).fold(0.0, f64::max);
     let lateral = slots.iter().map(|o| o.y.abs()).fold(0.0, f64::max) + r_q;
@@ -315,20 +337,33 @@ fn attempt_site(index: u64, attempt: u64) -> Option<Site3d> {
 
     // The band: its floor, its ceiling, the flight's altitude.
     let floor: f64 = rng.random_range(2.0..8.0);
-    let ceiling = floor + rng.random_range(10.0..20.0);
+    let ceiling = floor
+        + if hard {
+            rng.random_range(8.0..12.0)
+        } else {
+            rng.random_range(10.0..20.0)
+        };
     let usable = [floor + half_height + 0.5, ceiling - half_height - 0.5];
-    let barriers = rng.random_range(1..=3usize);
-    let width: f64 = rng.random_range(50.0..90.0);
+    let barriers = if hard {
+        rng.random_range(2..=4usize)
+    } else {
+        rng.random_range(1..=3usize)
+    };
+    let width: f64 = if hard {
+        rng.random_range(40.0..70.0)
+    } else {
+        rng.random_range(50.0..90.0)
+    };
     let spacing: Vec<f64> = (1..barriers)
         .map(|_| {
-            if rng.random_bool(0.4) {
+            if rng.random_bool(close_odds) {
                 rng.random_range(10.0..14.0)
             } else {
                 rng.random_range(14.0..35.0)
             }
         })
         .collect();
-    let inspected = rng.random_bool(0.5);
+    let inspected = rng.random_bool(inspect_odds);
     // Open ground before the first barrier and after the last: at least
     // room for the formation at the start and the goal, more for a pass.
     let approach: f64 =
@@ -519,7 +554,7 @@ fn attempt_site(index: u64, attempt: u64) -> Option<Site3d> {
                 let decoy = height == Height::Full
                     && !gaps.is_empty()
                     && kind != Barrier::Fence
-                    && rng.random_bool(0.45)
+                    && rng.random_bool(decoy_odds)
                     && ((close_next && wall_next) || b + 1 == barriers);
                 let mut pocket: Option<(f64, f64)> = None;
                 if decoy {
@@ -551,7 +586,14 @@ fn attempt_site(index: u64, attempt: u64) -> Option<Site3d> {
                     &line,
                     &gaps,
                     flat,
-                    top,
+                    (
+                        top,
+                        if hard && height != Height::Full {
+                            0.5
+                        } else {
+                            0.0
+                        },
+                    ),
                     &prefix,
                     kind,
                 );
@@ -752,7 +794,7 @@ fn attempt_site(index: u64, attempt: u64) -> Option<Site3d> {
     let mut inspect_dim = String::from("none");
     if inspected {
         let short = rng.random_bool(0.5);
-        let near_bound = rng.random_bool(0.3);
+        let near_bound = rng.random_bool(bound_odds);
         let r = rng.random_range(0.4..2.0);
         let room = r + band[1] + 2.0 * lateral + 1.0;
         let top = if short {
@@ -819,7 +861,7 @@ fn attempt_site(index: u64, attempt: u64) -> Option<Site3d> {
     }
 
     // Clutter off the way, the inspected obstacle and the start and goal.
-    let clutter = rng.random_range(0..=6usize);
+    let clutter = rng.random_range(0..=if hard { 12usize } else { 6 });
     let mut placed = 0;
     for _ in 0..3000 {
         if placed >= clutter {
@@ -1033,8 +1075,8 @@ impl Line {
 }
 
 /// A wall along `line` closed but for `gaps` (centre, width along the line):
-/// posts (radius 0.3-1.5 m, touching) or flat segments (thin rectangles
-/// 3-8 m long), its ends past the bounds.
+/// posts (radius 0.3-1.5 m, touching, their tops `top` ± `jitter`) or flat
+/// segments (thin rectangles 3-8 m long), its ends past the bounds.
 #[allow(clippy::too_many_arguments)]
 fn build_wall(
     rng: &mut ChaCha8Rng,
@@ -1042,7 +1084,7 @@ fn build_wall(
     line: &Line,
     gaps: &[(f64, f64)],
     flat: bool,
-    top: f64,
+    (top, jitter): (f64, f64),
     prefix: &str,
     kind: Barrier,
 ) {
@@ -1116,12 +1158,17 @@ fn build_wall(
             }
             for (c, r) in posts {
                 k += 1;
+                let uneven = if jitter > 0.0 {
+                    rng.random_range(-jitter..jitter)
+                } else {
+                    0.0
+                };
                 bodies.push(Body {
                     name: format!("{prefix} post {k}"),
                     kind: "post",
                     outline: Outline::Circle(line.at(c), r),
                     base: 0.0,
-                    height: top,
+                    height: top + uneven,
                     overfly: true,
                     inspect: false,
                 });

@@ -5,7 +5,7 @@
 
 use nalgebra::{Point2, Vector3};
 
-use super::Step::{Index, Key};
+use super::Step::{Index, Key, Vertex};
 use super::{Item, Spec, Table, fmt_num, number, shape_name, waypoint_choice};
 use crate::base::terrain::Lookup;
 use crate::mission::geodesy::Frame;
@@ -23,6 +23,7 @@ pub(super) fn of(item: &Item) -> &'static Table {
         Item::Goal => &GOAL,
         Item::Terrain => &TERRAIN,
         Item::Obstacle(_) => &OBSTACLE,
+        Item::Vertex(_, _) => &VERTEX,
         Item::Formation => &FORMATION,
         Item::Slot(_) => &SLOT,
         Item::Waypoint(_) => &WAYPOINT,
@@ -100,6 +101,14 @@ static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], derived: &[],
     Spec { name: "base", unit: "m", keys: &["base"], get: |m, i| num(obstacle_at(m, i)?.base), set: |m, i, t| put(&mut obstacle(m, i)?.base, number(t)) },
     Spec { name: "overfly", unit: "", keys: &["overfly"], get: |m, i| yes(obstacle_at(m, i)?.overfly), set: |m, i, t| put(&mut obstacle(m, i)?.overfly, yes_no(t)) },
     Spec { name: "clearance above", unit: "m", keys: &["clearance_above"], get: |m, i| num(obstacle_at(m, i)?.clearance_above), set: |m, i, t| put(&mut obstacle(m, i)?.clearance_above, number(t)) },
+]};
+
+/// A footprint's vertex: moving it reshapes the footprint, whose centre and
+/// radius follow (its bounding circle, `Obstacle::settle`).
+#[rustfmt::skip]
+static VERTEX: Table = Table { base: &[Key("obstacles"), Index, Key("footprint"), Vertex], derived: &[], fields: &[
+    Spec { name: "x", unit: "m", keys: &[], get: |m, i| num(vertex_at(m, i)?.x), set: |m, i, t| set_vertex(m, i, 0, t) },
+    Spec { name: "y", unit: "m", keys: &[], get: |m, i| num(vertex_at(m, i)?.y), set: |m, i, t| set_vertex(m, i, 1, t) },
 ]};
 
 #[rustfmt::skip]
@@ -557,6 +566,27 @@ fn set_stand_off(m: &mut Mission, item: &Item, end: usize, t: &str) -> Result<()
     let mut band = o.stand_off.unwrap_or(default);
     band[end] = number(t)?;
     o.stand_off = Some(band);
+    Ok(())
+}
+
+fn vertex_at(m: &Mission, item: &Item) -> Option<Point2<f64>> {
+    match item {
+        Item::Vertex(i, v) => m.obstacles.get(*i)?.footprint.get(*v).copied(),
+        _ => None,
+    }
+}
+
+/// One coordinate (0: x, 1: y) of the selected vertex, the footprint's
+/// bounding circle following.
+fn set_vertex(m: &mut Mission, item: &Item, axis: usize, t: &str) -> Result<(), String> {
+    let Item::Vertex(i, v) = item else {
+        return Err("not a vertex".into());
+    };
+    let value = number(t)?;
+    let o = m.obstacles.get_mut(*i).ok_or("no such obstacle")?;
+    let p = o.footprint.get_mut(*v).ok_or("no such vertex")?;
+    p[axis] = value;
+    o.settle();
     Ok(())
 }
 

@@ -557,6 +557,17 @@ impl PathBuilder {
                 -1.0
             };
             let reach = via.reach * sign;
+            // A leg that starts (or ends) on the crossing's straight, more
+            // than a metre past its end, would be flown doubling back over
+            // it: the gap is then passed as the leg flies it (and the cost
+            // judges that), so the swarm moves the leg's ends off it.
+            let half = reach.norm();
+            let unit = reach / half.max(1e-12);
+            let back_a = (a.xy() - via.center).dot(&unit) + half;
+            let back_b = half - (b.xy() - via.center).dot(&unit);
+            if back_a > DOUBLING_BACK || back_b > DOUBLING_BACK {
+                return None;
+            }
             // Each point at the leg's altitude where it lies (in the band
             // the shape allows there): no step up or down joins the
             // crossing to the leg.
@@ -609,6 +620,10 @@ impl PathBuilder {
         (best.0, best.1, best.2)
     }
 }
+
+/// How far (metres) a leg may start past a crossing's entry (or end short
+/// of its exit) and still be flown through it.
+const DOUBLING_BACK: f64 = 1.0;
 
 /// The altitude of the leg `a` → `b` where `p` projects onto it in the plane.
 fn altitude_along(a: Point3<f64>, b: Point3<f64>, p: Point2<f64>) -> f64 {

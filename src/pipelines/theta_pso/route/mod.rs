@@ -249,17 +249,25 @@ impl Site {
         squeeze_map(self, corridor, mission)
     }
 
-    fn new(mission: &Mission, builder: &PathBuilder, margin: f64, levels: Levels) -> Self {
+    /// The site searched at `levels` for a route with `stops` stops (the
+    /// passes and the crossings asked for by name).
+    fn new(
+        mission: &Mission,
+        builder: &PathBuilder,
+        margin: f64,
+        levels: Levels,
+        stops: usize,
+    ) -> Self {
         let shape = Shape::new(mission, margin);
         let need = shape.need();
         let b = &mission.bounds;
         let area = (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]);
         // The search holds a state per cell, layer, level and stage: the grid
-        // shares its states among the stages (a stop per pass and requested
-        // crossing) and the levels, never finer than 0.2 m. A large site gets
+        // shares its states among the stages (one more than the stops) and
+        // the levels, never finer than 0.2 m. A large site gets
         // coarse cells rather than gigabytes (the refusal then speaks for
         // that resolution).
-        let stops = builder.inspections().len() + builder.crossing_iwps().len();
+
         let budget = if levels.is_flat() {
             MAX_STATES
         } else {
@@ -462,7 +470,7 @@ fn with_altitudes(mission: &Mission, blocked: Blocked, z_box: [f64; 2]) -> Block
                 .fold(f64::NEG_INFINITY, f64::max);
             if z > z_box[1] {
                 format!(
-                    "over them the formation's centroid would fly at {z:.1} m, above the {:.1} m                      the band's ceiling leaves it",
+                    "over them the formation's centroid would fly at {z:.1} m, above the {:.1} m the band's ceiling leaves it",
                     z_box[1]
                 )
             } else {
@@ -502,9 +510,6 @@ fn find_at(
     margin: f64,
     levels: Levels,
 ) -> Result<Corridor, Blocked> {
-    let site = Site::new(mission, builder, margin, levels);
-    let field = site.field();
-    let levels = &site.levels;
     let (start, goal) = (mission.route.start.xy(), mission.route.goal.xy());
     let overlaps = |a: [f64; 2], b: [f64; 2]| a[0] <= b[1] + 1e-9 && b[0] <= a[1] + 1e-9;
 
@@ -513,15 +518,11 @@ fn find_at(
     // waypoints]]` entry): the route must take those; the others it may.
     let crossings = builder.crossings();
     let windows = builder.crossing_windows();
-    let requested: Vec<bool> = builder
-        .crossing_iwps()
-        .iter()
-        .map(|&i| {
-            let [a, b] = &iwps[i].between;
-            mission.reconfiguration.choice(a, b).is_some()
-        })
-        .collect();
+    let requested = requested_crossings(mission, builder, iwps);
     let order = stop_order(builder, &crossings, &requested, start, goal);
+    let site = Site::new(mission, builder, margin, levels, order.len());
+    let field = site.field();
+    let levels = &site.levels;
     let stage_of_crossing = |c: usize| order.iter().position(|s| *s == Stop::Crossing(c));
     let mut jumps = Vec::new();
     for (c, [a, z]) in crossings.iter().enumerate() {
@@ -676,6 +677,19 @@ fn explain(
 fn dx_dy(builder: &PathBuilder) -> [[f64; 2]; 2] {
     let [x, y, _] = builder.decoding_box();
     [x, y]
+}
+
+/// Per crossing of the path builder: whether the user asked for it by name
+/// (a `[[reconfiguration.waypoints]]` entry), which makes it a stop.
+fn requested_crossings(mission: &Mission, builder: &PathBuilder, iwps: &[Iwp]) -> Vec<bool> {
+    builder
+        .crossing_iwps()
+        .iter()
+        .map(|&i| {
+            let [a, b] = &iwps[i].between;
+            mission.reconfiguration.choice(a, b).is_some()
+        })
+        .collect()
 }
 
 /// A stop the route must make, in order.

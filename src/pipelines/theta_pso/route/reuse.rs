@@ -39,7 +39,12 @@ pub fn reuse(
     {
         return None;
     }
-    let site = Site::new(mission, builder, margin, Levels::flat(mission));
+    let stops = builder.inspections().len()
+        + super::requested_crossings(mission, builder, iwps)
+            .iter()
+            .filter(|r| **r)
+            .count();
+    let site = Site::new(mission, builder, margin, Levels::flat(mission), stops);
     let field = site.field();
     let crossings = builder.crossings();
     let windows = builder.crossing_windows();

@@ -428,7 +428,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
         }
     }
     for (i, o) in m.obstacles.iter().enumerate() {
-        let selected = *app.selected() == Item::Obstacle(i);
+        let selected = matches!(*app.selected(), Item::Obstacle(k) | Item::Vertex(k, _) if k == i);
         let color = if selected {
             Color::Yellow
         } else if o.inspect {
@@ -459,7 +459,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
                 color,
             });
         }
-        if selected {
+        if selected && o.footprint.is_empty() {
             // A filled centre so a small selected obstacle is easy to see.
             ctx.draw(&Ring {
                 x: o.center.x,
@@ -468,6 +468,18 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
                 color,
                 dot,
             });
+        } else if selected {
+            // A selected footprint's corners, the one being edited filled.
+            for (v, q) in o.footprint.iter().enumerate() {
+                let edited = *app.selected() == Item::Vertex(i, v);
+                ctx.draw(&Ring {
+                    x: q.x,
+                    y: q.y,
+                    radius: dot * if edited { 1.5 } else { 0.8 },
+                    color: if edited { Color::White } else { color },
+                    dot,
+                });
+            }
         }
     }
     ctx.layer();
