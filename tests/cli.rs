@@ -335,3 +335,37 @@ fn a_warm_started_run_is_recorded_and_can_be_repeated() {
         "{err}"
     );
 }
+
+/// Issue 37, "an answer a person can read": `check` on a valid maze of 150
+/// posts in three walls 12 m apart (each with a gap the formation's column
+/// takes) prints at most 12 lines: the IWPs between posts of two walls that
+/// no route uses are counted, not listed one per pair (235 lines at the
+/// issue's filing).
+#[test]
+fn check_on_a_maze_of_150_posts_is_a_few_lines() {
+    let mut maze = String::from(
+        "name = \"maze\"\n[bounds]\nx = [0.0, 80.0]\ny = [0.0, 80.0]\nz = [5.0, 20.0]\n\
+         [route]\nstart = [5.0, 40.0, 10.0]\ngoal = [75.0, 40.0, 10.0]\n",
+    );
+    for (w, x) in [28.0, 40.0, 52.0].iter().enumerate() {
+        // 50 posts of 0.5 m, 1.54 m apart, leaving out two for a gap.
+        let gap = [10, 25, 40][w];
+        for k in (0..52).filter(|k| *k != gap && *k != gap + 1) {
+            maze.push_str(&format!(
+                "[[obstacles]]\nname = \"wall {} post {}\"\ncenter = [{x}, {:.2}]\nradius = 0.5\nheight = 30.0\n",
+                w + 1,
+                k + 1,
+                0.6 + 1.54 * k as f64
+            ));
+        }
+    }
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let path = dir.path().join("maze.toml");
+    std::fs::write(&path, &maze).unwrap_or_else(|e| panic!("{e}"));
+    let out = skyform(&["check", &path.display().to_string()]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    assert_eq!(maze.matches("[[obstacles]]").count(), 150);
+    let lines = stdout.lines().count();
+    assert!(lines <= 12, "{lines} lines:\n{stdout}");
+}

@@ -58,9 +58,14 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
             "the route stage's corridor (every run of the swarm failed)"
         }
     };
+    let coarse = o.corridor.coarse_cell.map_or_else(String::new, |cell| {
+        format!(
+            " (a large site, searched at {cell:.2} m cells: a way narrower than that may be missed)"
+        )
+    });
     let _ = writeln!(
         s,
-        "  route        corridor {:.1} m; the plan is {source}",
+        "  route        corridor {:.1} m; the plan is {source}{coarse}",
         o.route_length
     );
     iwps(&mut s, o, verbose);

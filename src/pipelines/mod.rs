@@ -239,6 +239,10 @@ pub mod limits {
     /// θ-PSO cost evaluations: particles × iterations × (1 + restarts)
     /// (about 10 µs each on one core: 2e7 is a few minutes on two).
     pub const THETA_PSO_EVALUATIONS: f64 = 2e7;
+    /// θ-PSO broad-phase obstacle checks: cost evaluations × legs of a
+    /// path (free waypoints + 1) × obstacles (a few nanoseconds each: 1e10
+    /// is a few minutes on two cores, as the evaluations' limit).
+    pub const THETA_PSO_OBSTACLE_CHECKS: f64 = 1e10;
     /// Trajectory samples kept for every UAV together (duration / 0.1 s × UAVs).
     pub const TRAJECTORY_SAMPLES: f64 = 1e7;
     /// FLATLO aircraft.

@@ -6,6 +6,10 @@ use super::*;
 /// Most vertices a footprint may have.
 pub const MAX_FOOTPRINT_VERTICES: usize = 500;
 
+/// Most obstacles a mission may have: every planner pairs them (θ-PSO's
+/// IWPs, eq. 9, look at every pair), so 20,000 is 2·10⁸ pairs, seconds.
+pub const MAX_OBSTACLES: usize = 20_000;
+
 impl Checker {
     pub(super) fn origin(&mut self, path: &FieldPath, origin: &GeoOrigin) {
         if origin.latitude.abs() > 90.0 {
@@ -160,6 +164,26 @@ impl Checker {
 
     pub(super) fn obstacles(&mut self, path: &FieldPath, mission: &Mission) {
         let (obstacles, bounds) = (&mission.obstacles, &mission.bounds);
+        if obstacles.len() > MAX_OBSTACLES {
+            self.error(
+                path.clone(),
+                format!(
+                    "{} obstacles, more than {MAX_OBSTACLES}: the planners look at every pair; \
+                     merge the rows of posts into footprints (a wall is one polygon)",
+                    obstacles.len()
+                ),
+            );
+            return;
+        }
+        // Each name's first obstacle, to name the other of a duplicate.
+        let mut first: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+        for (i, o) in obstacles.iter().enumerate() {
+            first.entry(o.name.as_str()).or_insert(i);
+        }
+        let mut last: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+        for (i, o) in obstacles.iter().enumerate() {
+            last.insert(o.name.as_str(), i);
+        }
         for (i, o) in obstacles.iter().enumerate() {
             let at = path.index(i);
             if let Some(band) = o.stand_off
@@ -192,10 +216,9 @@ impl Checker {
             }
             if o.name.trim().is_empty() {
                 self.error(at.key("name"), "must not be empty");
-            } else if let Some(j) = obstacles
-                .iter()
-                .enumerate()
-                .position(|(j, p)| j != i && p.name == o.name)
+            } else if let Some(j) = [first[o.name.as_str()], last[o.name.as_str()]]
+                .into_iter()
+                .find(|&j| j != i)
             {
                 // Both carry the error: the one just renamed shows it too.
                 self.error(

@@ -152,6 +152,7 @@ pub fn plan(
             passes: Vec::new(),
             length: 0.0,
             heights: Vec::new(),
+            coarse_cell: None,
             squeeze: None,
         },
         trajectories: flight.trajectories,

@@ -413,6 +413,23 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
             ),
         ));
     }
+    // Every evaluation looks at every obstacle from every leg of its path.
+    let legs = (p.waypoints + 1) as f64;
+    let checks = evaluations * legs * mission.obstacles.len() as f64;
+    if crate::pipelines::exceeds(checks, limits::THETA_PSO_OBSTACLE_CHECKS) {
+        out.push(Diagnostic::error(
+            FieldPath::root().key("obstacles"),
+            format!(
+                "{} obstacles × {} cost evaluations × {} legs make {} obstacle checks (limit {}): \
+                 fewer obstacles (a row of posts as one footprint) or a smaller swarm",
+                mission.obstacles.len(),
+                figure(evaluations),
+                figure(legs),
+                figure(checks),
+                figure(limits::THETA_PSO_OBSTACLE_CHECKS)
+            ),
+        ));
+    }
     let (field, value, unit, duration) = shortest_flight(mission);
     let samples = trajectory_samples(duration, mission.formation.slots.len());
     if crate::pipelines::exceeds(samples, limits::TRAJECTORY_SAMPLES) {

@@ -95,6 +95,11 @@ pub struct Corridor {
     /// seeding spreads it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub heights: Vec<f64>,
+    /// The search's cell, metres, when coarser than the finest (a large
+    /// site: a way that fits by less than about a cell may not be seen);
+    /// `None` at the finest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coarse_cell: Option<f64>,
     /// Where the formation flies squeezed, for every path the swarm tries
     /// (worked out from the site for each run, never written).
     #[serde(skip)]
@@ -618,6 +623,7 @@ fn find_at(
     );
     through_crossings(&site, builder, &mut corridor);
     corridor.squeeze = site.squeeze_of(&corridor, mission);
+    corridor.coarse_cell = (field.cell() > 1.5 * FINEST_CELL).then_some(field.cell());
     Ok(corridor)
 }
 
@@ -934,6 +940,7 @@ fn assemble(
         } else {
             heights
         },
+        coarse_cell: None,
         squeeze: None,
     };
     corridor.length = polyline_length(&corridor);
