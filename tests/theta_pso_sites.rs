@@ -109,18 +109,22 @@ fn every_site_of_the_wide_share_is_planned_feasible() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// A 3-D site's run: its name, its dimensions, feasible or refused (why),
+/// the first failure.
+type Run3d = (
+    String,
+    Vec<(&'static str, String)>,
+    Result<bool, String>,
+    String,
+);
+
 /// Sites 400-423 of the family in three dimensions (`sites::three_d`:
 /// walls of posts and of segments with decoy pockets, rows of footprints
 /// with aisles, decks, low fences, walls to fly over or climb, short
 /// towers, trees near a bound), one seed each: every one planned feasible.
 #[test]
 fn every_site_of_the_three_dimensional_share_is_planned_feasible() {
-    let runs: Vec<(
-        String,
-        Vec<(&'static str, String)>,
-        Result<bool, String>,
-        String,
-    )> = (400..424u64)
+    let runs: Vec<Run3d> = (400..424u64)
         .into_par_iter()
         .map(|i| {
             let site = sites::three_d::generated_3d(i);

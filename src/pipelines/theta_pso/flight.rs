@@ -18,7 +18,8 @@
 //! The time law plans a little inside the vehicle's limits
 //! (`timing::PLANNED_SHARE`); where the samples still show a UAV over a
 //! limit (the grid misses a peak), the flight is timed again that much
-//! further inside them (at most half as fast each time).
+//! further inside them (not when the samples are a hundred times over: that is a
+//! kink no pace smooths).
 
 use super::iwp::Iwp;
 use super::path::CentroidPath;
@@ -34,6 +35,10 @@ const RETRIES: usize = 2;
 pub const MAX_TOLERANCE: f64 = 1.0;
 /// Times the flight is timed again further inside the vehicle's limits.
 const RETIMES: usize = 3;
+/// How far over a limit the samples may be for a slower timing to help:
+/// the grid misses a peak by a few tens of percent (more where the pace
+/// is held at its floor, `timing::MIN_PACE`), a kink by thousands.
+const KINK: f64 = 100.0;
 
 /// `path` flown and verified (see the module's doc). `names`: the mission's
 /// obstacle names. `OverBudget` when a timing of it needs more samples
@@ -82,13 +87,13 @@ pub fn fly(
             .filter(|c| verify::is_dynamics(c.name) && !c.ok)
             .filter_map(|c| c.worst.map(|w| w / c.limit))
             .fold(1.0, f64::max);
-        if over <= 1.0 {
+        // A peak far over a limit is a kink in a UAV's path, which a slower
+        // flight does not smooth: timed that much slower the whole flight
+        // would crawl (hours for a few hundred metres) and still break it.
+        if over <= 1.0 || over > KINK {
             break;
         }
-        // At most halved each time: a peak far over a limit is a kink in a
-        // UAV's path, which a slower flight does not smooth; the whole
-        // flight crawling (hours for a few hundred metres) helps nobody.
-        share *= (0.98 / over).max(0.5);
+        share *= 0.98 / over;
         flight = generate(&tolerances, share)?;
         verification = verify::verify(mission, &flight.trajectories);
     }

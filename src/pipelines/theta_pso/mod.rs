@@ -416,9 +416,13 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
     // Every evaluation looks at every obstacle from every leg of its path.
     let legs = (p.waypoints + 1) as f64;
     let checks = evaluations * legs * mission.obstacles.len() as f64;
-    if crate::pipelines::exceeds(checks, limits::THETA_PSO_OBSTACLE_CHECKS) {
+    // Named on the swarm (the count of obstacles is no field to edit), and
+    // only when the evaluations alone are within their limit.
+    if !crate::pipelines::exceeds(evaluations, limits::THETA_PSO_EVALUATIONS)
+        && crate::pipelines::exceeds(checks, limits::THETA_PSO_OBSTACLE_CHECKS)
+    {
         out.push(Diagnostic::error(
-            FieldPath::root().key("obstacles"),
+            at("swarm_size"),
             format!(
                 "{} obstacles × {} cost evaluations × {} legs make {} obstacle checks (limit {}): \
                  fewer obstacles (a row of posts as one footprint) or a smaller swarm",

@@ -20,7 +20,7 @@
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 
 use super::inspection::PassGeometry;
-use super::iwp::{Iwp, Shape, vertical_half_height};
+use super::iwp::{Iwp, Shape, lateral_half_width, vertical_half_height};
 pub use crate::base::swarm::{decode_angle, encode_angle};
 use crate::mission::Mission;
 
@@ -113,6 +113,11 @@ struct Crossing {
     /// Half width of the gate a leg must pass to be taken through the gap:
     /// half the gap plus the formation's safe radius.
     gate: f64,
+    /// The gap's width, metres.
+    gap: f64,
+    /// Left to `auto` (no choice of the user's for it): a squeeze may carry
+    /// the formation through instead.
+    auto: bool,
     hold: f64,
     transition: f64,
     /// Altitudes the centroid may take at the IWP so every UAV of the shape
@@ -184,6 +189,12 @@ impl PathBuilder {
                     center: iwp.position,
                     reach: iwp.normal * straight,
                     gate: iwp.gap / 2.0 + f.safe_radius(),
+                    gap: iwp.gap,
+                    auto: iwp.choice == crate::mission::ShapeChoice::Auto
+                        && mission
+                            .reconfiguration
+                            .choice(&iwp.between[0], &iwp.between[1])
+                            .is_none(),
                     hold,
                     transition: mission.reconfiguration.transition_distance,
                     z_range: band_for(half_height),
@@ -439,7 +450,15 @@ impl PathBuilder {
             if crossings.iter().any(|&(j, _)| self.crossings_overlap(j, i)) {
                 continue;
             }
-            if let Some((leg, triple)) = self.crossing_leg(&points, &locked, c) {
+            if let Some((leg, triple, [snap_a, snap_b])) = self.crossing_leg(&points, &locked, c) {
+                // A free waypoint standing on the straight is taken to its
+                // end, so the path does not double back over it.
+                if snap_a {
+                    points[leg] = triple[0];
+                }
+                if snap_b {
+                    points[leg + 1] = triple[2];
+                }
                 insert(&mut points, &mut locked, leg, &triple);
                 shift(&mut crossings, &mut passes, leg, 3);
                 crossings.push((i, leg + 1));
@@ -537,7 +556,7 @@ impl PathBuilder {
         points: &[Point3<f64>],
         locked: &[bool],
         via: &Crossing,
-    ) -> Option<(usize, [Point3<f64>; 3])> {
+    ) -> Option<(usize, [Point3<f64>; 3], [bool; 2])> {
         let along = Vector2::new(via.reach.y, -via.reach.x);
         let across = along * (via.gate / along.norm().max(1e-12));
         let (g0, g1) = (via.center - across, via.center + across);
@@ -551,6 +570,7 @@ impl PathBuilder {
             if !(via.window[0] < there && there < via.window[1]) {
                 return None;
             }
+
             let sign = if (b.xy() - a.xy()).dot(&via.reach) >= 0.0 {
                 1.0
             } else {
@@ -559,29 +579,50 @@ impl PathBuilder {
             let reach = via.reach * sign;
             // A leg that starts (or ends) on the crossing's straight, more
             // than a metre past its end, would be flown doubling back over
-            // it: the gap is then passed as the leg flies it (and the cost
-            // judges that), so the swarm moves the leg's ends off it.
+            // it: a free waypoint there is taken to the straight's end; a
+            // fixed point (the start, the goal, a via's end) leaves the gap
+            // to be passed as the leg flies it (and the cost judges that).
             let half = reach.norm();
             let unit = reach / half.max(1e-12);
             let back_a = (a.xy() - via.center).dot(&unit) + half;
             let back_b = half - (b.xy() - via.center).dot(&unit);
-            if back_a > DOUBLING_BACK || back_b > DOUBLING_BACK {
+            let movable = |j: usize| j > 0 && j + 1 < points.len() && !locked[j - 1] && !locked[j];
+            let snap = [back_a > DOUBLING_BACK, back_b > DOUBLING_BACK];
+            if (snap[0] && !movable(i)) || (snap[1] && !movable(i + 1)) {
                 return None;
             }
-            // Each point at the leg's altitude where it lies (in the band
-            // the shape allows there): no step up or down joins the
-            // crossing to the leg.
-            let at = |p: Point2<f64>| {
-                let z = altitude_along(a, b, p).clamp(via.z_range[0], via.z_range[1]);
-                Point3::new(p.x, p.y, z)
-            };
+            // Unless, on an IWP left to `auto`, the leg runs through a
+            // squeezed stretch (a lane between walls, an aisle) in a shape
+            // that already fits the gap: the squeeze carries it through, no
+            // crossing needed.
+            if (snap[0] || snap[1])
+                && via.auto
+                && let Some(map) = &self.squeeze
+            {
+                let at = crate::base::geometry::segment_projection(&a.xy(), &b.xy(), &via.center).0;
+                let through = a.xy() + (b.xy() - a.xy()) * at;
+                if let Some((_, shape)) = map.at(through)
+                    && lateral_half_width(&shape.offsets(&self.slots, 1.0), self.uav_radius)
+                        <= via.gap / 2.0
+                {
+                    return None;
+                }
+            }
+            // Its ends at the leg's altitude where they lie (in the band the
+            // shape allows there), so no step up or down joins the crossing
+            // to the leg, and straight between them.
+            let height =
+                |p: Point2<f64>| altitude_along(a, b, p).clamp(via.z_range[0], via.z_range[1]);
+            let (enter, leave) = (via.center - reach, via.center + reach);
+            let (z0, z1) = (height(enter), height(leave));
             Some((
                 i,
                 [
-                    at(via.center - reach),
-                    at(via.center),
-                    at(via.center + reach),
+                    Point3::new(enter.x, enter.y, z0),
+                    Point3::new(via.center.x, via.center.y, (z0 + z1) / 2.0),
+                    Point3::new(leave.x, leave.y, z1),
                 ],
+                snap,
             ))
         })
     }

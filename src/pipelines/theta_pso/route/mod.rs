@@ -947,10 +947,12 @@ fn assemble(
     corridor
 }
 
-/// The corridor's free legs across an IWP's gate, taken through its
-/// crossing as the path builder will fly them (`PathBuilder::crossing_leg`
-/// puts a crossing into every leg across its gate, at the altitudes where
-/// the gap stands in the way): the crossing's straight put in, and the
+/// The corridor's free legs in the nominal shape across an IWP's gate,
+/// taken through its crossing as the path builder will fly them
+/// (`PathBuilder::crossing_leg` puts a crossing into every leg across its
+/// gate, at the altitudes where the gap stands in the way, unless a squeeze
+/// already carries the formation through in a shape that fits): the
+/// crossing's straight put in, and the
 /// corridor's points standing on that straight (a run pulled tight through a
 /// gap in single file bends at its ends) left out, so the path does not
 /// double back over the straight. A crossing whose approach or exit the
@@ -972,10 +974,13 @@ fn through_crossings(site: &Site, builder: &PathBuilder, corridor: &mut Corridor
         .collect();
     let mut k = 0;
     while k < corridor.legs.len() {
-        let Leg::Free { layer } = corridor.legs[k] else {
+        // Only in the nominal shape: a leg flown squeezed (shrunk, in a
+        // column) passes the gaps its shape fits as the squeeze carries it.
+        let Leg::Free { layer: 0 } = corridor.legs[k] else {
             k += 1;
             continue;
         };
+        let layer = 0;
         let (a, b) = (corridor.points[k], corridor.points[k + 1]);
         let level = level_of(height(corridor, k));
         let span = site.levels.span(level);

@@ -1,6 +1,6 @@
 use super::*;
 use crate::pipelines::theta_pso::route::guide::Guide;
-use crate::pipelines::theta_pso::route::search::{self, Graph, Jump, Step};
+use crate::pipelines::theta_pso::route::search::{self, Graph, Jump, LEVEL_BITS, Step};
 
 /// The room `at_with_room` reports is never wrong: within it of the
 /// sampled point no point is in a region, so the path builder may skip
@@ -80,7 +80,12 @@ fn the_room_round_a_sample_holds_no_squeezed_region() {
 /// changes at `switch` each, its jumps at their length.
 fn route_cost(field: &Field, jumps: &[Jump], steps: &[Step], switch: f64) -> f64 {
     let at = |s: &Step| match *s {
-        Step::Cell { cell, layer } | Step::Jump { cell, layer, .. } => (cell, layer),
+        Step::Cell {
+            cell, layer, level, ..
+        }
+        | Step::Jump {
+            cell, layer, level, ..
+        } => (cell, level * LAYERS + layer),
     };
     steps
         .windows(2)
@@ -120,11 +125,11 @@ fn the_guided_search_finds_a_route_as_short_as_dijkstras() {
     let field = Field::new([[0.0, 45.0], [0.0, 30.0]], &discs, 0.25, 6.0);
     // Nominal needs 2.5 m of clearance, the shrink 1.2 m, the column 0.6 m.
     let need = [2.5, 1.2, 0.6];
-    let open: Vec<u8> = (0..field.len())
+    let open: Vec<u64> = (0..field.len())
         .map(|i| {
             (0..LAYERS)
                 .filter(|&l| field.clearance(i) >= need[l])
-                .fold(0, |bits, l| bits | bit(l))
+                .fold(0, |bits, l| bits | bit(0, l))
         })
         .collect();
     // The second wall's gap is also a crossing edge of its own.
@@ -135,6 +140,7 @@ fn the_guided_search_finds_a_route_as_short_as_dijkstras() {
         pass_at: None,
         crossing: true,
         tag: 0,
+        level: 0,
     }];
     let graph = Graph {
         field: &field,
@@ -142,6 +148,9 @@ fn the_guided_search_finds_a_route_as_short_as_dijkstras() {
         jumps: &jumps,
         stages: 0,
         switch_cost: 5.0,
+        climb_cost: &[],
+        start_level: 0,
+        goal_level: 0,
     };
     let (s, g) = (
         field.index_of(Point2::new(3.0, 25.0)),
@@ -183,4 +192,108 @@ fn the_guided_search_finds_a_route_as_short_as_dijkstras() {
     // A start walled in by the relaxation has no bound at all.
     let boxed = field.index_of(Point2::new(15.0, 3.0));
     assert_eq!(guide.bound(boxed, 0, 0), None);
+}
+
+/// The search in levels: a wall across the site closes level 0 (the
+/// altitude the route starts and ends at) and stands below level 1, where a
+/// deck closes the way further on. The route climbs to level 1 where the
+/// climb bits allow (clear of both), passes the wall, comes back down
+/// before the deck and ends at level 0; the guided search finds it as short
+/// as Dijkstra's, and the climbs cost what the graph says.
+#[test]
+fn the_search_climbs_between_levels_where_every_altitude_between_is_clear() {
+    use crate::pipelines::theta_pso::route::search::climb_bit;
+    let (x_wall, x_deck) = (12.0, 28.0);
+    let field = Field::new([[0.0, 40.0], [0.0, 20.0]], &[], 0.5, 5.0);
+    let open: Vec<u64> = (0..field.len())
+        .map(|i| {
+            let x = field.center(i).x;
+            let wall = (x - x_wall).abs() < 1.0;
+            let deck = (x - x_deck).abs() < 2.0;
+            // Level 0 is closed by the wall, level 1 by the deck; a climb
+            // is clear away from both (and the deck stands between the
+            // levels, so not under it either).
+            let mut bits = 0;
+            for layer in 0..LAYERS {
+                if !wall {
+                    bits |= bit(0, layer);
+                }
+                if !deck {
+                    bits |= bit(1, layer);
+                }
+                if (x - x_wall).abs() > 2.0 && (x - x_deck).abs() > 3.0 {
+                    bits |= climb_bit(0, layer);
+                }
+            }
+            bits
+        })
+        .collect();
+    let climb = [4.0];
+    let graph = Graph {
+        field: &field,
+        open: &open,
+        jumps: &[],
+        stages: 0,
+        switch_cost: 5.0,
+        climb_cost: &climb,
+        start_level: 0,
+        goal_level: 0,
+    };
+    let (s, g) = (
+        field.index_of(Point2::new(2.0, 10.0)),
+        field.index_of(Point2::new(38.0, 10.0)),
+    );
+    let guide = Guide::new(&graph, g);
+    let guided = search::search(&graph, s, g, |c, m, st| guide.bound(c, m, st));
+    let plain = search::search(&graph, s, g, |_, _, _| Some(0.0));
+    let (Ok(guided), Ok(plain)) = (guided, plain) else {
+        panic!("both searches climb over the wall and come down before the deck");
+    };
+    let level_at = |steps: &[Step], x: f64| {
+        steps
+            .iter()
+            .find_map(|st| match *st {
+                Step::Cell { cell, level, .. } if (field.center(cell).x - x).abs() < 0.3 => {
+                    Some(level)
+                }
+                _ => None,
+            })
+            .unwrap_or(usize::MAX)
+    };
+    for steps in [&guided, &plain] {
+        assert_eq!(level_at(steps, x_wall), 1, "over the wall at level 1");
+        assert_eq!(level_at(steps, x_deck), 0, "under the deck at level 0");
+    }
+    // Two climbs (up, down) at 4 each on a 36 m route.
+    let cost = |steps: &[Step]| -> f64 {
+        steps
+            .windows(2)
+            .map(|w| match (w[0], w[1]) {
+                (
+                    Step::Cell {
+                        cell: a, level: la, ..
+                    },
+                    Step::Cell {
+                        cell: b, level: lb, ..
+                    },
+                ) if a == b && la != lb => climb[0],
+                (a, b) => {
+                    let at = |s: Step| match s {
+                        Step::Cell { cell, .. } | Step::Jump { cell, .. } => cell,
+                    };
+                    (field.center(at(a)) - field.center(at(b))).norm()
+                }
+            })
+            .sum()
+    };
+    let (a, b) = (cost(&guided), cost(&plain));
+    assert!(a >= b - 1e-9 && a <= b * 1.02, "guided {a}, Dijkstra {b}");
+    assert!(b >= 36.0 + 8.0 - 1e-9, "{b}: the climbs were charged");
+    // Without climb bits there is no way at all.
+    let flat: Vec<u64> = open.iter().map(|b| b & LEVEL_BITS).collect();
+    let closed = Graph {
+        open: &flat,
+        ..graph
+    };
+    assert!(search::search(&closed, s, g, |_, _, _| Some(0.0)).is_err());
 }
