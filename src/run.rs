@@ -1,7 +1,7 @@
 //! One run, the same for every front end: the CLI's `run`, `export` and
 //! `sweep` and the designer's jobs all carry out a [`Run`] here. It logs the
 //! mission to the recorder (if any), hands the pipeline's events to the
-//! caller's observer and the recorder, plans through `outcome::run`, logs
+//! caller's observer and the recorder, plans through `outcome::run_warm`, logs
 //! the outcome and finishes the recording; what the caller does with the
 //! [`Ran`] (print, export, count, show) is its own.
 
@@ -94,22 +94,12 @@ impl Run {
         if let (Kind::Fleet, Some(d)) = (self.kind, self.distributed) {
             return distributed(mission, self.seed, d, observer, cancel);
         }
-        if let (Kind::ThetaPso, Some(warm)) = (self.kind, &self.warm) {
-            let plan = crate::pipelines::theta_pso::plan_warm(
-                mission,
-                self.seed,
-                self.options,
-                Some(warm),
-                observer,
-                cancel,
-            )?;
-            return Ok(Outcome::ThetaPso(Box::new(plan)));
-        }
-        outcome::run(
+        outcome::run_warm(
             self.kind,
             mission,
             self.seed,
             self.options,
+            self.warm.as_deref(),
             observer,
             cancel,
         )

@@ -126,3 +126,235 @@ fn every_module_in_src_is_named_in_the_architecture() {
         "in src/ but not in docs/architecture.md: {missing:?}"
     );
 }
+
+/// The module table in order: (module, floor, the imports column). A bold
+/// row (`| **base** |`) starts a floor.
+fn table() -> Vec<(String, usize, String)> {
+    let doc = std::fs::read_to_string("docs/architecture.md")
+        .unwrap_or_else(|e| panic!("docs/architecture.md: {e}"));
+    let mut floor = 0;
+    let mut table = Vec::new();
+    for line in doc.lines() {
+        if line.starts_with("| **") {
+            floor += 1;
+        } else if let Some(rest) = line.strip_prefix("| `") {
+            let Some((name, _)) = rest.split_once('`') else {
+                continue;
+            };
+            let body = line.trim_end().trim_end_matches('|');
+            let imports = body.rsplit_once('|').map_or("", |(_, last)| last).trim();
+            table.push((name.to_owned(), floor, imports.to_owned()));
+        }
+    }
+    table
+}
+
+/// The backticked module paths of an imports column (`mission` (the
+/// diagnostics), `base::ode`, …).
+fn listed(column: &str) -> Vec<String> {
+    column
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_owned)
+        .collect()
+}
+
+/// The module path of a source file (`src/a/b/mod.rs` and `src/a/b.rs` are
+/// `a::b`).
+fn module_of(file: &Path) -> Vec<String> {
+    let rel = file.strip_prefix("src").unwrap_or(file).with_extension("");
+    let mut parts: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    if parts.last().is_some_and(|p| p == "mod") {
+        parts.pop();
+    }
+    parts
+}
+
+/// The `.rs` files of a module row: its file, its folder, without the
+/// sub-modules that have rows of their own and without test files.
+fn files_of(module: &str, rows: &BTreeMap<String, String>) -> Vec<PathBuf> {
+    let rel: PathBuf = module.split("::").collect();
+    let mut files = Vec::new();
+    let file = Path::new("src").join(&rel).with_extension("rs");
+    if file.is_file() {
+        files.push(file);
+    }
+    let folder = Path::new("src").join(&rel);
+    let mut stack = vec![folder];
+    while let Some(dir) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries.filter_map(Result::ok) {
+            let path = entry.path();
+            let owner = module_of(&path).join("::");
+            if owner != module && rows.contains_key(&owner) {
+                continue;
+            }
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs")
+                && path.file_name().is_some_and(|n| n != "tests.rs")
+            {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+/// The modules of ours a file's code names (`crate::a::b::…`, `super::…`
+/// resolved against the file's own path), comments and its `#[cfg(test)]`
+/// tail left out: what it imports, not what its tests or its prose do.
+fn referenced(file: &Path) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    let here = module_of(file);
+    // `x.rs` is the module `x`; `super` from it is its parent (for
+    // `x/mod.rs` too: the module path already names the folder).
+    let mut found = Vec::new();
+    for line in text.lines() {
+        if line.starts_with("#[cfg(test)]") {
+            break;
+        }
+        let code = line.split("//").next().unwrap_or("");
+        let mut rest = code;
+        while let Some(at) = rest.find(|c: char| c.is_ascii_alphabetic()) {
+            rest = &rest[at..];
+            let end = rest
+                .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == ':'))
+                .unwrap_or(rest.len());
+            let word = &rest[..end];
+            rest = &rest[end..];
+            let parts: Vec<&str> = word.split("::").filter(|p| !p.is_empty()).collect();
+            let path = match parts.first() {
+                Some(&"crate") => parts[1..].iter().map(|p| p.to_string()).collect(),
+                Some(&"super") => {
+                    let ups = parts.iter().take_while(|p| **p == "super").count();
+                    let mut base = here.clone();
+                    for _ in 0..ups {
+                        base.pop();
+                    }
+                    base.extend(parts[ups..].iter().map(|p| p.to_string()));
+                    base
+                }
+                _ => continue,
+            };
+            if !path.is_empty() {
+                found.push(path);
+            }
+        }
+    }
+    found
+}
+
+/// The row a module path belongs to: the longest row that prefixes it.
+fn row_of<'a>(
+    path: &[String],
+    rows: &'a [(String, usize, String)],
+) -> Option<&'a (String, usize, String)> {
+    rows.iter()
+        .filter(|(name, _, _)| {
+            let name: Vec<&str> = name.split("::").collect();
+            name.len() <= path.len() && name.iter().zip(path).all(|(a, b)| a == b)
+        })
+        .max_by_key(|(name, _, _)| name.split("::").count())
+}
+
+fn within(inner: &str, outer: &str) -> bool {
+    inner == outer || inner.starts_with(&format!("{outer}::"))
+}
+
+/// Each row's imports column is what its code imports: every module of ours
+/// its files name is listed (or is the row's own, or below it), every module
+/// listed is named by its files, and nothing is imported from a higher floor.
+#[test]
+fn each_rows_imports_are_what_its_code_imports() {
+    let table = table();
+    let rows: BTreeMap<String, String> = table
+        .iter()
+        .map(|(m, _, i)| (m.clone(), i.clone()))
+        .collect();
+    let mut wrong = Vec::new();
+    for (module, floor, column) in &table {
+        let files = files_of(module, &rows);
+        assert!(!files.is_empty(), "no source files for `{module}`");
+        let anything = column.contains("everything above");
+        let allowed = listed(column);
+        let mut used = std::collections::BTreeSet::new();
+        for file in &files {
+            for path in referenced(file) {
+                let Some((target, target_floor, _)) = row_of(&path, &table) else {
+                    continue;
+                };
+                if within(target, module) {
+                    continue;
+                }
+                if target_floor > floor {
+                    wrong.push(format!(
+                        "{}: `{module}` (floor {floor}) imports `{}` from the higher floor {target_floor}",
+                        file.display(),
+                        path.join("::")
+                    ));
+                }
+                let full = path.join("::");
+                match allowed.iter().find(|e| within(target, e) || within(e, target) && within(&full, e)) {
+                    Some(entry) => {
+                        used.insert(entry.clone());
+                    }
+                    None if anything => {}
+                    None => wrong.push(format!(
+                        "{}: `{module}` imports `{full}`, which its imports column ({column:?}) does not list",
+                        file.display()
+                    )),
+                }
+            }
+        }
+        for entry in allowed.iter().filter(|e| !used.contains(*e)) {
+            wrong.push(format!(
+                "`{module}`'s imports column lists `{entry}`, which none of its files imports"
+            ));
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "docs/architecture.md's imports columns disagree with the code:\n  {}",
+        wrong.join("\n  ")
+    );
+}
+
+/// The floors stand in the table's order: `base` first, the front ends last.
+#[test]
+fn the_floors_stand_in_order() {
+    let floors: Vec<(String, usize)> = table().into_iter().map(|(m, f, _)| (m, f)).collect();
+    let first = |layer: &str| {
+        floors
+            .iter()
+            .find(|(m, _)| within(m, layer))
+            .map(|(_, f)| *f)
+            .unwrap_or_else(|| panic!("no row for `{layer}`"))
+    };
+    let order = [
+        "base",
+        "mission",
+        "pipelines",
+        "outcome",
+        "run",
+        "tui",
+        "cli",
+    ];
+    for pair in order.windows(2) {
+        assert!(
+            first(pair[0]) <= first(pair[1]),
+            "`{}` stands above `{}` in docs/architecture.md",
+            pair[0],
+            pair[1]
+        );
+    }
+    assert!(first("base") < first("mission") && first("mission") < first("pipelines"));
+    assert!(first("pipelines") < first("outcome") && first("outcome") < first("run"));
+}

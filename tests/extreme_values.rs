@@ -32,41 +32,9 @@ const CANCEL_GRACE: Duration = Duration::from_secs(30);
 const FLOATS: [f64; 8] = [0.0, -1.0, 1e-9, 1e9, 1e300, -1e300, f64::NAN, f64::INFINITY];
 const INTEGERS: [i64; 4] = [0, -1, 1 << 31, i64::MAX];
 
-/// Where a numeric leaf is: keys and array indices from the root.
-#[derive(Debug, Clone)]
-enum Step {
-    Key(String),
-    Index(usize),
-}
-
-fn leaves(value: &toml::Value, at: &mut Vec<Step>, out: &mut Vec<(Vec<Step>, bool)>) {
-    match value {
-        toml::Value::Integer(_) => out.push((at.clone(), true)),
-        toml::Value::Float(_) => out.push((at.clone(), false)),
-        toml::Value::Array(items) => {
-            for (i, item) in items.iter().enumerate() {
-                at.push(Step::Index(i));
-                leaves(item, at, out);
-                at.pop();
-            }
-        }
-        toml::Value::Table(table) => {
-            for (key, item) in table {
-                at.push(Step::Key(key.clone()));
-                leaves(item, at, out);
-                at.pop();
-            }
-        }
-        _ => {}
-    }
-}
-
-fn leaf_mut<'a>(value: &'a mut toml::Value, at: &[Step]) -> &'a mut toml::Value {
-    at.iter().fold(value, |v, step| match step {
-        Step::Key(k) => &mut v[k.as_str()],
-        Step::Index(i) => &mut v[*i],
-    })
-}
+#[path = "common/toml_leaves.rs"]
+mod toml_leaves;
+use toml_leaves::{Step, leaf_mut, leaves};
 
 fn name(at: &[Step]) -> String {
     let mut s = String::new();

@@ -50,41 +50,9 @@ fn sources() -> Vec<Source> {
     out
 }
 
-/// Where a numeric leaf is in a TOML tree.
-#[derive(Debug, Clone)]
-enum Step {
-    Key(String),
-    Index(usize),
-}
-
-fn leaves(value: &toml::Value, at: &mut Vec<Step>, out: &mut Vec<(Vec<Step>, bool)>) {
-    match value {
-        toml::Value::Integer(_) => out.push((at.clone(), true)),
-        toml::Value::Float(_) => out.push((at.clone(), false)),
-        toml::Value::Array(items) => {
-            for (i, item) in items.iter().enumerate() {
-                at.push(Step::Index(i));
-                leaves(item, at, out);
-                at.pop();
-            }
-        }
-        toml::Value::Table(table) => {
-            for (key, item) in table {
-                at.push(Step::Key(key.clone()));
-                leaves(item, at, out);
-                at.pop();
-            }
-        }
-        _ => {}
-    }
-}
-
-fn leaf_mut<'a>(value: &'a mut toml::Value, at: &[Step]) -> &'a mut toml::Value {
-    at.iter().fold(value, |v, step| match step {
-        Step::Key(k) => &mut v[k.as_str()],
-        Step::Index(i) => &mut v[*i],
-    })
-}
+#[path = "common/toml_leaves.rs"]
+mod toml_leaves;
+use toml_leaves::{leaf_mut, leaves};
 
 /// The mission `text` (read as `file`), as the designer opens it: `None`
 /// when it is not a mission at all (the designer refuses to open those).

@@ -286,6 +286,47 @@ fn the_benchmark_mission_plans_with_theta_pso() {
     assert!(stdout.contains("altitude"), "{stdout}");
 }
 
+/// Every input bounded (issue 37): `seeded_particles` far over the swarm
+/// (2^63 − 1 once overflowed a capacity and aborted; 10^9 ran past 30 s)
+/// seeds the whole swarm and no more: the same plan as seeding exactly the
+/// swarm, figure for figure.
+#[test]
+fn seeding_more_particles_than_the_swarm_seeds_the_swarm() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mission = small_benchmark(dir.path(), 30, 10);
+    let text = std::fs::read_to_string(&mission).expect("read");
+    let mut plans = Vec::new();
+    for seeded in ["30", "9223372036854775807"] {
+        let file = dir.path().join(format!("seeded-{seeded}.toml"));
+        let changed = text.replace(
+            "seeded_particles = 10",
+            &format!("seeded_particles = {seeded}"),
+        );
+        assert_ne!(changed, text, "the mission sets seeded_particles = 10");
+        std::fs::write(&file, changed).expect("write");
+        let out = common::skyform(&[
+            "run",
+            "theta-pso",
+            &file.display().to_string(),
+            "--seed",
+            "3",
+        ]);
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            matches!(out.status.code(), Some(0) | Some(2)),
+            "seeded_particles = {seeded}: {stdout}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let cost = stdout
+            .lines()
+            .find(|l| l.trim_start().starts_with("cost"))
+            .map(str::to_owned);
+        assert!(cost.is_some(), "{stdout}");
+        plans.push(cost);
+    }
+    assert_eq!(plans[0], plans[1]);
+}
+
 /// The README's reference table (issue 15): at 500 × 200 the numpy port's
 /// mean best J is 4795 for SPSO and 6593 for θ-PSO. The shipped mission
 /// (10 seeded particles, same evaluation budget) does better on every seed

@@ -217,17 +217,8 @@ pub struct Words {
 
 impl Words {
     pub fn of(pipeline: Kind) -> Words {
-        match pipeline {
-            Kind::ThetaPso => Words {
-                completed: "J finite",
-                verdict: "feasible",
-            },
-            // A flown run (FLATLO, the fleet) passes or fails.
-            _ => Words {
-                completed: "finished",
-                verdict: "passed",
-            },
-        }
+        let (completed, verdict) = pipeline.tally_words();
+        Words { completed, verdict }
     }
 
     /// The CSV column names: `j_finite`, `feasible`, …

@@ -188,11 +188,11 @@ fn advice(f: &Failure, pipeline: Kind, tolerance: f64, deviation: f64) -> String
     let (name, slug) = (pipeline.name(), pipeline.slug());
     let c = f.constraint.as_str();
     if f.unit == "m/s" {
-        let field = match (pipeline, c) {
-            (Kind::Flatlo, _) => "flatlo.airspeed_range",
-            (_, "climb rate") => "vehicle.max_climb_rate",
-            (_, "descent rate") => "vehicle.max_descent_rate",
-            _ => "vehicle.max_speed",
+        let field = match (pipeline.speed_field(), c) {
+            (Some(field), _) => field,
+            (None, "climb rate") => "vehicle.max_climb_rate",
+            (None, "descent rate") => "vehicle.max_descent_rate",
+            (None, _) => "vehicle.max_speed",
         };
         return format!(
             "{c}: the {name} plan needs {:.2} m/s on that leg and its {} is limited to {} m/s: \
@@ -209,13 +209,9 @@ fn advice(f: &Failure, pipeline: Kind, tolerance: f64, deviation: f64) -> String
         );
     }
     let fix = if c.starts_with("distance inside the x-y bounds") {
-        match pipeline {
-            Kind::Flatlo => {
-                "widen bounds.x and bounds.y to hold the squadron's manoeuvre (flatlo.spacing, \
-                 flatlo.turn_radius and flatlo.start set its extent)"
-            }
-            _ => "widen bounds.x and bounds.y, or move the route inside them",
-        }
+        pipeline
+            .bounds_advice()
+            .unwrap_or("widen bounds.x and bounds.y, or move the route inside them")
     } else if c.starts_with("altitude") {
         "widen bounds.z, or plan the heights inside it"
     } else {

@@ -113,7 +113,7 @@ pub fn budget(kind: Kind, mission: &Mission) -> Vec<crate::mission::Diagnostic> 
     }
 }
 
-/// Runs `kind` on `mission` with `seed`. `options` only matters to θ-PSO.
+/// Runs `kind` on `mission` with `seed`, cold. `options` only matters to θ-PSO.
 pub fn run(
     kind: Kind,
     mission: &Mission,
@@ -122,9 +122,24 @@ pub fn run(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<Outcome, PipelineError> {
+    run_warm(kind, mission, seed, options, None, observer, cancel)
+}
+
+/// [`run`], θ-PSO started in part from `warm`'s plan (the designer's live
+/// re-plans); the other pipelines have no warm start and ignore it. The one
+/// place a run is handed to its pipeline.
+pub fn run_warm(
+    kind: Kind,
+    mission: &Mission,
+    seed: u64,
+    options: PlanOptions,
+    warm: Option<&theta_pso::WarmStart>,
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> Result<Outcome, PipelineError> {
     Ok(match kind {
-        Kind::ThetaPso => Outcome::ThetaPso(Box::new(theta_pso::plan(
-            mission, seed, options, observer, cancel,
+        Kind::ThetaPso => Outcome::ThetaPso(Box::new(theta_pso::plan_warm(
+            mission, seed, options, warm, observer, cancel,
         )?)),
         Kind::Flatlo => Outcome::Flatlo(Box::new(flatlo::plan(mission, seed, observer, cancel)?)),
         Kind::Fleet => Outcome::Fleet(Box::new(fleet::plan(mission, seed, observer, cancel)?)),
@@ -301,7 +316,7 @@ impl Outcome {
     pub fn convergence(&self) -> &[f64] {
         match self {
             Outcome::ThetaPso(o) => &o.convergence,
-            _ => &[],
+            Outcome::Flatlo(_) | Outcome::Fleet(_) => &[],
         }
     }
 
@@ -367,7 +382,7 @@ impl Outcome {
     pub fn reference_tracks(&self) -> Vec<Track> {
         match self {
             Outcome::Flatlo(o) => tracks::flatlo(o),
-            _ => self.tracks(),
+            Outcome::ThetaPso(_) | Outcome::Fleet(_) => self.tracks(),
         }
     }
 

@@ -49,6 +49,55 @@ impl Kind {
     pub fn fixed_wing(self) -> bool {
         matches!(self, Kind::Flatlo)
     }
+
+    /// What a run's two tallies are called (a sweep's columns): θ-PSO plans,
+    /// so a run is complete when its J is finite and good when feasible; a
+    /// flown run (FLATLO, the fleet) finishes, and passes or fails.
+    pub fn tally_words(self) -> (&'static str, &'static str) {
+        match self {
+            Kind::ThetaPso => ("J finite", "feasible"),
+            Kind::Flatlo | Kind::Fleet => ("finished", "passed"),
+        }
+    }
+
+    /// The designer can re-plan it after every edit (a live run is short
+    /// and deterministic); the fleet's run is a flight, re-run by hand.
+    pub fn live(self) -> bool {
+        match self {
+            Kind::ThetaPso | Kind::Flatlo => true,
+            Kind::Fleet => false,
+        }
+    }
+
+    /// The mission field that limits its vehicles' speed, when that is not
+    /// the `[vehicle]` section's (FLATLO's airspeed range).
+    pub fn speed_field(self) -> Option<&'static str> {
+        match self {
+            Kind::Flatlo => Some("flatlo.airspeed_range"),
+            Kind::ThetaPso | Kind::Fleet => None,
+        }
+    }
+
+    /// What to change when its flight leaves the bounds, where its own
+    /// fields set the flight's extent; `None`: the route, which the user
+    /// draws, sets it.
+    pub fn bounds_advice(self) -> Option<&'static str> {
+        match self {
+            Kind::Flatlo => Some(
+                "widen bounds.x and bounds.y to hold the squadron's manoeuvre (flatlo.spacing, \
+                 flatlo.turn_radius and flatlo.start set its extent)",
+            ),
+            Kind::ThetaPso | Kind::Fleet => None,
+        }
+    }
+}
+
+/// The pipeline a front end starts with when nothing else is chosen (the
+/// designer's live planning, a recording that names none): θ-PSO.
+impl Default for Kind {
+    fn default() -> Kind {
+        Kind::ThetaPso
+    }
 }
 
 /// One timed sample of a vehicle's track, planned or flown: seconds,
@@ -282,4 +331,16 @@ pub fn figure(x: f64) -> String {
 /// A predicted figure over its limit; NaN or infinite figures are over.
 pub fn exceeds(figure: f64, limit: f64) -> bool {
     !figure.is_finite() || figure > limit
+}
+
+/// The field a budget over its limit names: its largest factor, which is
+/// the one the user most likely mistyped (the first of equals).
+pub fn largest_factor<'a>(factors: &[(&'a str, f64)]) -> &'a str {
+    let mut best: Option<(&str, f64)> = None;
+    for &(field, value) in factors {
+        if best.is_none_or(|(_, b)| value > b) {
+            best = Some((field, value));
+        }
+    }
+    best.map_or("", |(field, _)| field)
 }

@@ -3,7 +3,7 @@
 use rerun::RecordingStream;
 
 use super::paths::{self, flatlo::aircraft};
-use super::{f32x3, log_moving_point, log_series, uav_color};
+use super::{f32x3, log_closest, log_moving_point, log_series, uav_color};
 use crate::pipelines::Kind;
 use crate::pipelines::flatlo::FlatloOutcome;
 
@@ -106,21 +106,17 @@ pub fn log_outcome(
         &o.pairs
     };
     for p in pairs {
-        stream.set_duration_secs("sim_time", p.time);
-        let level = if p.min_distance < min_separation {
-            rerun::TextLogLevel::WARN
-        } else {
-            rerun::TextLogLevel::INFO
-        };
-        stream.log(
+        log_closest(
+            stream,
             events.as_str(),
-            &rerun::TextLog::new(format!(
+            p.time,
+            p.min_distance < min_separation,
+            format!(
                 "closest approach of aircraft {} and {}: {:.0} m",
                 p.a + 1,
                 p.b + 1,
                 p.min_distance
-            ))
-            .with_level(level),
+            ),
         )?;
     }
     // The first limit of the flight broken, at its time.

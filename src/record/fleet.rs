@@ -3,7 +3,7 @@
 use rerun::RecordingStream;
 
 use super::paths::{self, fleet as at};
-use super::{f32x3, log_moving_point, log_series, uav_color};
+use super::{f32x3, log_closest, log_moving_point, log_series, uav_color};
 use crate::pipelines::Kind;
 use crate::pipelines::fleet::FleetOutcome;
 
@@ -98,21 +98,17 @@ pub fn log_outcome(stream: &RecordingStream, o: &FleetOutcome) -> rerun::Recordi
         ("obstacle", &o.closest_obstacle),
     ] {
         if let Some(c) = closest {
-            stream.set_duration_secs("sim_time", c.time);
-            let level = if c.distance < o.safety_distance {
-                rerun::TextLogLevel::WARN
-            } else {
-                rerun::TextLogLevel::INFO
-            };
-            stream.log(
+            log_closest(
+                stream,
                 events.as_str(),
-                &rerun::TextLog::new(format!(
+                c.time,
+                c.distance < o.safety_distance,
+                format!(
                     "closest approach ({label}): agent {} and {} at {:.3} m",
                     c.a + 1,
                     c.b,
                     c.distance
-                ))
-                .with_level(level),
+                ),
             )?;
         }
     }

@@ -171,7 +171,7 @@ impl Recorder {
             .map_err(|e| RecordError::Stream(e.to_string()))?;
         let _ = stream.send_recording_name(name);
         // A layout that shows the plan large: not essential, so a failure is ignored.
-        let _ = layout::layout(pipeline.unwrap_or(Kind::ThetaPso))
+        let _ = layout::layout(pipeline.unwrap_or_default())
             .send(&stream, rerun::blueprint::BlueprintActivation::default());
         let (queue, inbox) = crossbeam_channel::bounded(QUEUE_CAPACITY);
         let oldest = inbox.clone();
@@ -310,6 +310,25 @@ fn log_moving_point(
     )
 }
 
+/// A closest approach in the events log at its time: a warning under its
+/// limit, information otherwise (FLATLO's pairs, the fleet's agents and
+/// obstacles).
+fn log_closest(
+    stream: &RecordingStream,
+    events: &str,
+    time: f64,
+    below_limit: bool,
+    text: String,
+) -> rerun::RecordingStreamResult<()> {
+    stream.set_duration_secs("sim_time", time);
+    let level = if below_limit {
+        rerun::TextLogLevel::WARN
+    } else {
+        rerun::TextLogLevel::INFO
+    };
+    stream.log(events, &rerun::TextLog::new(text).with_level(level))
+}
+
 /// A scalar series over `times`, as one `send_columns`.
 fn log_series(
     stream: &RecordingStream,
@@ -403,7 +422,7 @@ fn spawn_viewer() -> Result<String, String> {
 /// θ-PSO iterations that arrive together into one `send_columns` per series.
 fn run_worker(stream: RecordingStream, inbox: Receiver<Message>, pipeline: Option<Kind>) {
     // Only a pipeline logs lines; the scene alone never does.
-    let log = paths::log(pipeline.unwrap_or(Kind::ThetaPso));
+    let log = paths::log(pipeline.unwrap_or_default());
     let mut pending: Vec<(usize, CostTerms, Vec<[f32; 3]>)> = Vec::new();
     // The mission of the scene, for what an outcome is measured against.
     let mut scene: Option<Box<Mission>> = None;

@@ -87,18 +87,19 @@ impl JobBoard {
         &self.live
     }
 
-    /// Turns live planning on for the pipeline shown (θ-PSO or FLATLO; θ-PSO
-    /// when nothing is), or off.
+    /// Turns live planning on for the pipeline shown when it can plan live
+    /// (`Kind::live`), otherwise for the default one (θ-PSO), or off.
     pub fn toggle_live(&mut self, now: Instant, status: &mut StatusLine) {
         if self.live.is_on() {
             self.live.stop();
             status.say("live planning off: press r to plan");
             return;
         }
-        let pipeline = match self.shown().map(|j| j.pipeline) {
-            Some(Kind::Flatlo) => Kind::Flatlo,
-            _ => Kind::ThetaPso,
-        };
+        let pipeline = self
+            .shown()
+            .map(|j| j.pipeline)
+            .filter(|k| k.live())
+            .unwrap_or_default();
         match self.live.start(pipeline, now) {
             Ok(()) => status.say(format!(
                 "live planning on: {} re-plans after every edit (L turns it off)",
@@ -251,7 +252,7 @@ impl JobBoard {
                     .map_or(seed.wrapping_add(1), |s| s.wrapping_add(1));
                 let last = self.jobs.last();
                 let mut run =
-                    crate::run::Run::new(last.map_or(Kind::ThetaPso, |j| j.pipeline), seed);
+                    crate::run::Run::new(last.map_or_else(Kind::default, |j| j.pipeline), seed);
                 run.distributed = last.and_then(|j| j.distributed);
                 self.run(run, doc, cwd, status);
             }

@@ -391,10 +391,11 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
     if crate::pipelines::exceeds(evaluations, limits::FLEET_EVALUATIONS) {
         let key = if p.replan_period < 1e-3 {
             "replan_period"
-        } else if p.swarm_size >= p.iterations {
-            "swarm_size"
         } else {
-            "iterations"
+            crate::pipelines::largest_factor(&[
+                ("swarm_size", p.swarm_size as f64),
+                ("iterations", p.iterations as f64),
+            ])
         };
         out.push(Diagnostic::error(
             at(key),

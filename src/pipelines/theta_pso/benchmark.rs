@@ -44,7 +44,9 @@ pub fn plan(
     let p = &mission.theta_pso;
     observer.on_event(Event::Stage("planning"));
     let mut last_cost = f64::NAN;
-    let starts = spso::seeding::particles(&model, &decoder, p.seeded_particles, seed);
+    // Only a swarm's worth can start anywhere: more is the swarm, seeded.
+    let seeded = p.seeded_particles.min(p.swarm_size);
+    let starts = spso::seeding::particles(&model, &decoder, seeded, seed);
     let run = spso::optimise(
         &model,
         &decoder,

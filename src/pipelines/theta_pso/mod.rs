@@ -393,14 +393,11 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
     }
     let evaluations = p.swarm_size as f64 * p.iterations as f64 * (1.0 + p.restarts as f64);
     if crate::pipelines::exceeds(evaluations, limits::THETA_PSO_EVALUATIONS) {
-        // Name the largest factor: that is the field the user most likely mistyped.
-        let key = if p.restarts as f64 >= p.swarm_size.max(p.iterations) as f64 {
-            "restarts"
-        } else if p.swarm_size >= p.iterations {
-            "swarm_size"
-        } else {
-            "iterations"
-        };
+        let key = crate::pipelines::largest_factor(&[
+            ("restarts", p.restarts as f64),
+            ("swarm_size", p.swarm_size as f64),
+            ("iterations", p.iterations as f64),
+        ]);
         out.push(Diagnostic::error(
             at(key),
             format!(
