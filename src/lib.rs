@@ -12,6 +12,7 @@ pub mod cli;
 #[cfg(feature = "zenoh")]
 pub mod distributed;
 pub mod export;
+pub mod flight;
 pub mod import;
 pub mod mission;
 pub mod outcome;

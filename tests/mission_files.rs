@@ -216,6 +216,7 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                 theta_pso: Default::default(),
                 flatlo: Default::default(),
                 fleet: Default::default(),
+                flight: Default::default(),
                 obstacles,
                 terrain: None,
             };

@@ -40,6 +40,9 @@ pub struct Mission {
     pub flatlo: FlatloParams,
     #[serde(default)]
     pub fleet: FleetParams,
+    /// The air `skyform fly` flies a plan in (`[flight]`).
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub flight: FlightParams,
     /// Vertical cylinders standing on the ground (z = 0).
     #[serde(default)]
     pub obstacles: Vec<Obstacle>,
@@ -401,6 +404,91 @@ pub struct VehicleOverride {
     pub max_acceleration_up: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_acceleration_down: Option<f64>,
+}
+
+/// `[flight]`: the air and the autopilots a plan is flown by in the Monte
+/// Carlo flight check (`skyform fly`, docs/flight-check.md). Each flight
+/// draws its own gusts, GNSS errors and take-off times; the vehicle is the
+/// fleet's quadrotor (`[fleet]`'s body) flown by a cascaded position and
+/// velocity controller within `[vehicle]`, along the exported waypoints.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FlightParams {
+    /// Flights per check (`--flights` overrides).
+    pub flights: usize,
+    /// Mean wind speed, m/s, the same at every altitude.
+    pub wind_speed: f64,
+    /// Where the wind blows from, degrees clockwise from north (270: a
+    /// westerly, blowing east).
+    pub wind_from_deg: f64,
+    /// Dryden turbulence (MIL-F-8785C, low altitude): `none`, `light`,
+    /// `moderate` or `severe` (the wind at 6 m of 15, 30, 45 kt).
+    pub turbulence: Turbulence,
+    /// GNSS position error, σ of each horizontal axis, metres (1-2 m
+    /// without RTK).
+    pub gnss_sigma_horizontal: f64,
+    /// GNSS altitude error σ, metres.
+    pub gnss_sigma_vertical: f64,
+    /// Correlation time of the GNSS error (first-order Gauss-Markov), s.
+    pub gnss_correlation_time: f64,
+    /// The share of the GNSS error's variance that is each receiver's own
+    /// (multipath, receiver noise); the rest (satellite orbits and clocks,
+    /// the atmosphere) is common to receivers a few metres apart.
+    pub gnss_own_share: f64,
+    /// σ of each vehicle's take-off time about the plan's, seconds.
+    pub takeoff_skew: f64,
+    /// The autopilot takes a waypoint as reached within this distance, m
+    /// (PX4 NAV_ACC_RAD).
+    pub acceptance_radius: f64,
+    /// Linear drag per unit mass, 1/s: the force of the air moving past
+    /// the airframe is drag × mass × (wind − velocity).
+    pub drag: f64,
+    /// Integration and control step, seconds.
+    pub step: f64,
+}
+
+impl Default for FlightParams {
+    fn default() -> Self {
+        FlightParams {
+            flights: 1000,
+            wind_speed: 0.0,
+            wind_from_deg: 270.0,
+            turbulence: Turbulence::None,
+            gnss_sigma_horizontal: 1.0,
+            gnss_sigma_vertical: 1.5,
+            gnss_correlation_time: 60.0,
+            gnss_own_share: 0.16,
+            takeoff_skew: 0.3,
+            acceptance_radius: 2.0,
+            drag: 0.3,
+            step: 0.01,
+        }
+    }
+}
+
+/// Dryden turbulence intensity (MIL-F-8785C: the wind 20 ft above the
+/// ground that sets σ_w = 0.1 W20 at low altitude).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Turbulence {
+    #[default]
+    None,
+    Light,
+    Moderate,
+    Severe,
+}
+
+impl Turbulence {
+    /// W20, m/s: 15, 30 and 45 knots; 0 without turbulence.
+    pub fn wind_at_20_ft(self) -> f64 {
+        const KNOT: f64 = 0.514_444;
+        match self {
+            Turbulence::None => 0.0,
+            Turbulence::Light => 15.0 * KNOT,
+            Turbulence::Moderate => 30.0 * KNOT,
+            Turbulence::Severe => 45.0 * KNOT,
+        }
+    }
 }
 
 /// The limits one UAV flies within: `[vehicle]` with its own entry applied.

@@ -41,6 +41,8 @@ pub enum Item {
     Fleet,
     /// One target of the fleet's timed sequence.
     FleetTarget(usize),
+    /// The air and autopilots of the flight check (`[flight]`).
+    Flight,
 }
 
 impl Item {
@@ -66,6 +68,7 @@ impl Item {
             Item::Squadron => "Squadron (FLATLO)".into(),
             Item::Fleet => "Fleet".into(),
             Item::FleetTarget(i) => format!("Fleet target {}", i + 1),
+            Item::Flight => "Flight check (air, GNSS)".into(),
         }
     }
 
@@ -109,6 +112,7 @@ impl Item {
             Item::ThetaPso => root.key("theta_pso"),
             Item::Squadron => root.key("flatlo"),
             Item::Fleet => root.key("fleet"),
+            Item::Flight => root.key("flight"),
             Item::FleetTarget(i) => root.key("fleet").key("targets").index(*i),
             Item::Mission => return None,
         })
@@ -138,6 +142,7 @@ pub fn map_items(mission: &Mission) -> Vec<Item> {
     items.push(Item::Squadron);
     items.push(Item::Fleet);
     items.extend((0..mission.fleet.targets.len()).map(Item::FleetTarget));
+    items.push(Item::Flight);
     items
 }
 

@@ -16,6 +16,7 @@ use crate::mission::model::{
 
 use crate::mission::model::GRAVITY as G;
 
+mod flight;
 mod formation;
 mod pipelines;
 mod site;
@@ -43,6 +44,7 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
     c.theta_pso(&root.key("theta_pso"), &mission.theta_pso);
     c.flatlo(&root.key("flatlo"), &mission.flatlo);
     c.fleet(&root.key("fleet"), &mission.fleet, mission);
+    c.flight(&root.key("flight"), &mission.flight);
     c.obstacles(&root.key("obstacles"), mission);
     c.terrain(&root.key("terrain"), mission);
     c.physical(mission);

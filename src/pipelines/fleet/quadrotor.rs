@@ -76,7 +76,15 @@ impl Body {
         let [kp, kv] = self.position_gains;
         // Eq. 11, plus gravity: the thrust vector wanted.
         let u_pos = -(position(x) - reference) * kp - velocity(x) * kv;
-        let mut f = (u_pos + Vector3::new(0.0, 0.0, G)) * self.mass;
+        self.command_for(x, &u_pos)
+    }
+
+    /// Eqs. 12-13: the thrust and torque that give the acceleration
+    /// `acceleration` (m/s², gravity not included), within the tilt and
+    /// thrust limits. The fleet's eq. 11 and the flight check's cascaded
+    /// controller both end here.
+    pub fn command_for(&self, x: &State, acceleration: &Vector3<f64>) -> Command {
+        let mut f = (acceleration + Vector3::new(0.0, 0.0, G)) * self.mass;
         // Tilt and thrust limits: keep the vertical part, shorten the horizontal.
         f.z = f.z.max(0.1 * self.mass * G);
         let horizontal = f.xy().norm();

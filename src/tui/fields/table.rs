@@ -11,7 +11,7 @@ use crate::base::terrain::Lookup;
 use crate::mission::geodesy::Frame;
 use crate::mission::{
     CostKind, Encoding, FleetTarget, GeoOrigin, Mission, Obstacle, Preset, ShapeChoice, Terrain,
-    WaypointChoice, spacing_of,
+    Turbulence, WaypointChoice, spacing_of,
 };
 
 /// The table of `item`'s kind.
@@ -31,6 +31,45 @@ pub(super) fn of(item: &Item) -> &'static Table {
         Item::Squadron => &SQUADRON,
         Item::Fleet => &FLEET,
         Item::FleetTarget(_) => &FLEET_TARGET,
+        Item::Flight => &FLIGHT,
+    }
+}
+
+/// `[flight]`: the air, the fixes and the autopilot of `skyform fly`.
+#[rustfmt::skip]
+static FLIGHT: Table = Table { base: &[Key("flight")], derived: &[], fields: &[
+    Spec { name: "flights", unit: "", keys: &["flights"], get: |m, _| text(m.flight.flights), set: |m, _, t| put(&mut m.flight.flights, count(t)) },
+    Spec { name: "wind speed", unit: "m/s", keys: &["wind_speed"], get: |m, _| num(m.flight.wind_speed), set: |m, _, t| put(&mut m.flight.wind_speed, number(t)) },
+    Spec { name: "wind from", unit: "°", keys: &["wind_from_deg"], get: |m, _| num(m.flight.wind_from_deg), set: |m, _, t| put(&mut m.flight.wind_from_deg, number(t)) },
+    Spec { name: "turbulence", unit: "", keys: &["turbulence"], get: |m, _| text(turbulence_name(m.flight.turbulence)), set: |m, _, t| put(&mut m.flight.turbulence, turbulence(t)) },
+    Spec { name: "GNSS σ horiz.", unit: "m", keys: &["gnss_sigma_horizontal"], get: |m, _| num(m.flight.gnss_sigma_horizontal), set: |m, _, t| put(&mut m.flight.gnss_sigma_horizontal, number(t)) },
+    Spec { name: "GNSS σ vert.", unit: "m", keys: &["gnss_sigma_vertical"], get: |m, _| num(m.flight.gnss_sigma_vertical), set: |m, _, t| put(&mut m.flight.gnss_sigma_vertical, number(t)) },
+    Spec { name: "GNSS τ", unit: "s", keys: &["gnss_correlation_time"], get: |m, _| num(m.flight.gnss_correlation_time), set: |m, _, t| put(&mut m.flight.gnss_correlation_time, number(t)) },
+    Spec { name: "GNSS own share", unit: "", keys: &["gnss_own_share"], get: |m, _| num(m.flight.gnss_own_share), set: |m, _, t| put(&mut m.flight.gnss_own_share, number(t)) },
+    Spec { name: "take-off skew σ", unit: "s", keys: &["takeoff_skew"], get: |m, _| num(m.flight.takeoff_skew), set: |m, _, t| put(&mut m.flight.takeoff_skew, number(t)) },
+    Spec { name: "acceptance", unit: "m", keys: &["acceptance_radius"], get: |m, _| num(m.flight.acceptance_radius), set: |m, _, t| put(&mut m.flight.acceptance_radius, number(t)) },
+    Spec { name: "drag", unit: "1/s", keys: &["drag"], get: |m, _| num(m.flight.drag), set: |m, _, t| put(&mut m.flight.drag, number(t)) },
+    Spec { name: "step", unit: "s", keys: &["step"], get: |m, _| num(m.flight.step), set: |m, _, t| put(&mut m.flight.step, number(t)) },
+]};
+
+fn turbulence_name(t: Turbulence) -> &'static str {
+    match t {
+        Turbulence::None => "none",
+        Turbulence::Light => "light",
+        Turbulence::Moderate => "moderate",
+        Turbulence::Severe => "severe",
+    }
+}
+
+fn turbulence(text: &str) -> Result<Turbulence, String> {
+    match text.to_ascii_lowercase().as_str() {
+        "none" | "calm" => Ok(Turbulence::None),
+        "light" => Ok(Turbulence::Light),
+        "moderate" => Ok(Turbulence::Moderate),
+        "severe" => Ok(Turbulence::Severe),
+        _ => Err(format!(
+            "'{text}' is not a turbulence: none, light, moderate or severe"
+        )),
     }
 }
 

@@ -1,0 +1,49 @@
+//! Flight check speed (issue 39): 1,000 flights of the bridge in its shipped
+//! weather (5 m/s, light Dryden turbulence, GNSS σ 1 m, skew σ 0.3 s) in at
+//! most 10 s on two cores. Measured here: 100 flights on one thread and on
+//! two (the same report either way), so flights per second and the scaling
+//! from one thread to two are read off one run.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use skyform::export::Planned;
+use skyform::flight::{self, Options, Setup};
+use skyform::mission;
+use skyform::outcome;
+use skyform::pipelines::theta_pso::PlanOptions;
+use skyform::pipelines::{CancelToken, Kind, Silent};
+
+fn benches(c: &mut Criterion) {
+    let m = mission::default_mission().mission;
+    let o = outcome::run(
+        Kind::ThetaPso,
+        &m,
+        1,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let planned = Planned::from_outcome(&m, &o);
+    let setup = Setup::new(&m, &planned).unwrap_or_else(|e| panic!("{e}"));
+    let mut group = c.benchmark_group("flight");
+    group.sample_size(10);
+    for threads in [1, 2] {
+        group.bench_function(format!("bridge_100_flights/{threads}_threads"), |b| {
+            b.iter(|| {
+                let options = Options {
+                    flights: 100,
+                    seed: 1,
+                    threads: Some(threads),
+                };
+                flight::check(black_box(&setup), options, &|_, _| {}, &CancelToken::new())
+                    .map(|r| r.break_any.count)
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(flight_benches, benches);
+criterion_main!(flight_benches);

@@ -1,0 +1,292 @@
+//! `skyform fly`: plan, then fly the plan's exported missions many times in
+//! wind, on GNSS fixes, with take-off skew, and report what that does to
+//! its margins (docs/flight-check.md).
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use super::{cancel_on_ctrl_c, exit, load_reporting};
+use crate::base::atomic;
+use crate::export::Planned;
+use crate::flight::{self, FlightError, Options, Setup};
+use crate::mission::Mission;
+use crate::pipelines::{CancelToken, Kind, Silent};
+use crate::run::Run;
+
+/// The arguments of `skyform fly` (its help is on `Command::Fly`).
+#[derive(Debug, clap::Args)]
+pub struct FlyArgs {
+    /// Mission TOML file (its `[flight]` section sets the air; defaults:
+    /// calm, GNSS σ 1 m / 1.5 m, take-off skew σ 0.3 s).
+    pub mission: PathBuf,
+    /// The pipeline that plans the mission (θ-PSO or the fleet: their
+    /// multicopters; FLATLO's fixed wings are not flown here).
+    #[arg(long, value_enum, default_value = "theta-pso")]
+    pub pipeline: Kind,
+    /// Flights (default: flight.flights, 1000).
+    #[arg(long)]
+    pub flights: Option<usize>,
+    /// Seed of the plan and of the flights (default: the mission's `seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Fly only flight K again and print it (the report names its worst).
+    #[arg(long, value_name = "K")]
+    pub flight: Option<usize>,
+    /// Write the report as JSON to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Worker threads (default: one per CPU); the report does not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// List every pair and every obstacle, not the five tightest.
+    #[arg(long)]
+    pub verbose: bool,
+    /// Find the smallest extra clearance m from the obstacles (θ-PSO:
+    /// theta_pso.clearance_margin + m; fleet: fleet.safety_distance + m)
+    /// whose plan breaks 2 r_Q or r_Q in at most this share of the flights
+    /// (0.001: one flight in a thousand), re-planning as needed, and report
+    /// that plan.
+    #[arg(long, value_name = "SHARE")]
+    pub target: Option<f64>,
+}
+
+/// `skyform fly`. Exit status: 0 no flight broke a limit, 1 error, 2 some
+/// flight broke 2 r_Q or r_Q, 130 cancelled.
+pub fn fly_command(args: &FlyArgs) -> u8 {
+    let Some(mut mission) = load_reporting(&args.mission) else {
+        return exit::ERROR;
+    };
+    if args.pipeline.fixed_wing() {
+        eprintln!(
+            "error: {}'s aircraft fly on their own model; the flight check flies multicopters \
+             (--pipeline theta-pso or fleet)",
+            args.pipeline.name()
+        );
+        return exit::ERROR;
+    }
+    if let Some(n) = args.flights {
+        mission.flight.flights = n;
+        let problems: Vec<_> = crate::mission::validate(&mission)
+            .into_iter()
+            .filter(|d| d.is_error() && d.path.to_string().starts_with("flight"))
+            .collect();
+        if let Some(d) = problems.first() {
+            eprintln!("error: --flights {n}: {}", d.message);
+            return exit::ERROR;
+        }
+    }
+    let seed = args.seed.unwrap_or(mission.seed);
+    let planned = match super::export_cmd::planned(&mission, args.pipeline, seed) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let setup = match Setup::new(&mission, &planned) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return exit::ERROR;
+        }
+    };
+    if let Some(k) = args.flight {
+        return replay(&setup, seed, k);
+    }
+    let cancel = cancel_on_ctrl_c();
+    if let Some(target) = args.target {
+        return margin(args, &mission, seed, target, &cancel);
+    }
+    let terminal = std::io::stderr().is_terminal();
+    let progress = |done: usize, total: usize| {
+        if terminal && (done.is_multiple_of(50) || done == total) {
+            eprint!("\rflights: {done} / {total}");
+        }
+    };
+    let options = Options {
+        flights: mission.flight.flights,
+        seed,
+        threads: args.threads,
+    };
+    let report = flight::check(&setup, options, &progress, &cancel);
+    if terminal {
+        eprintln!();
+    }
+    let report = match report {
+        Ok(r) => r,
+        Err(FlightError::Cancelled) => {
+            eprintln!("cancelled");
+            return exit::CANCELLED;
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            return exit::ERROR;
+        }
+    };
+    print!("{}", report.text(args.verbose));
+    if let Some(path) = &args.json {
+        let text = match serde_json::to_string_pretty(&report) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("error: the report as JSON: {e}");
+                return exit::ERROR;
+            }
+        };
+        if let Err(e) = atomic::write(path, text.as_bytes()) {
+            eprintln!("error: {}: {e}", path.display());
+            return exit::ERROR;
+        }
+    }
+    if report.break_separation.count > 0 || report.break_clearance.count > 0 {
+        exit::INFEASIBLE
+    } else {
+        exit::OK
+    }
+}
+
+/// `--target`: the margin search, then the report of the plan it found.
+fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &CancelToken) -> u8 {
+    if !(target.is_finite() && (0.0..1.0).contains(&target)) {
+        eprintln!("error: --target {target}: a share of flights in [0, 1)");
+        return exit::ERROR;
+    }
+    let options = Options {
+        flights: mission.flight.flights,
+        seed,
+        threads: args.threads,
+    };
+    let pipeline = args.pipeline;
+    let mut plan = |m: &Mission| -> Result<Planned, String> {
+        let outcome = Run::new(pipeline, seed)
+            .carry_out(m, None, &mut Silent, cancel)
+            .result
+            .map_err(|e| e.to_string())?;
+        if !outcome.ok() {
+            return Err(outcome.headline());
+        }
+        Ok(Planned::from_outcome(m, &outcome))
+    };
+    eprintln!(
+        "searching the margin: {} flights per try (0, then 0.25 m doubling, then halving to {} m)",
+        options.flights,
+        flight::MARGIN_RESOLUTION
+    );
+    let search = match flight::find_margin(pipeline, mission, target, options, &mut plan, cancel) {
+        Ok(s) => s,
+        Err(FlightError::Cancelled) => {
+            eprintln!("cancelled");
+            return exit::CANCELLED;
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            return exit::ERROR;
+        }
+    };
+    let tried: Vec<String> = search
+        .tried
+        .iter()
+        .map(|t| format!("{:.2} m: {}", t.margin, t.note))
+        .collect();
+    let code = match (&search.margin, &search.report) {
+        (Some(m), Some(report)) => {
+            let (field, now) = match pipeline {
+                Kind::Fleet => ("fleet.safety_distance", mission.fleet.safety_distance),
+                Kind::ThetaPso | Kind::Flatlo => (
+                    "theta_pso.clearance_margin",
+                    mission.theta_pso.clearance_margin,
+                ),
+            };
+            println!(
+                "margin       {m:.2} m keeps {} of flights within 2 r_Q and r_Q (target {:.2} %): \
+                 plan with {field} = {:.2} m (now {now:.2} m)",
+                format_share(report.break_any.share),
+                100.0 * target,
+                now + m,
+            );
+            println!("tried        {}", tried.join("; "));
+            print!("{}", report.text(args.verbose));
+            exit::OK
+        }
+        _ => {
+            println!(
+                "margin       none up to {} m meets {:.2} %: {}",
+                flight::MAX_MARGIN,
+                100.0 * target,
+                tried.join("; ")
+            );
+            exit::INFEASIBLE
+        }
+    };
+    if let (Some(path), Ok(text)) = (&args.json, serde_json::to_string_pretty(&search))
+        && let Err(e) = atomic::write(path, text.as_bytes())
+    {
+        eprintln!("error: {}: {e}", path.display());
+        return exit::ERROR;
+    }
+    code
+}
+
+/// 1 − share as a percentage of flights kept ("99.9 %").
+fn format_share(share: f64) -> String {
+    format!("{:.1} %", 100.0 * (1.0 - share))
+}
+
+/// Flight `k` alone: its take-off times and, per vehicle, its closest
+/// approaches and its tightest obstacle.
+fn replay(setup: &Setup, seed: u64, k: usize) -> u8 {
+    let f = flight::fly(setup, seed, k, false);
+    println!(
+        "flight {k} of the {} plan for \"{}\" (seed {seed})",
+        setup.pipeline, setup.mission.name
+    );
+    let n = setup.plans.len();
+    let vehicle = |v: usize| setup.plans[v].vehicle + 1;
+    let mut broke = false;
+    let mut pair = 0;
+    for i in 0..n {
+        for j in i + 1..n {
+            let c = f.pairs[pair];
+            let mark = if c.distance < setup.closest {
+                "BREAKS"
+            } else {
+                "ok"
+            };
+            broke |= c.distance < setup.closest;
+            println!(
+                "  {mark:<6} UAV {} - UAV {}: closest {:.2} m at t = {:.1} s (2 r_Q = {:.2} m)",
+                vehicle(i),
+                vehicle(j),
+                c.distance,
+                c.t,
+                setup.closest
+            );
+            pair += 1;
+        }
+    }
+    for (v, near) in setup.near.iter().enumerate() {
+        let tightest = near
+            .iter()
+            .zip(&f.obstacles[v])
+            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance));
+        if let Some((&o, c)) = tightest {
+            let mark = if c.distance < setup.clearance {
+                "BREAKS"
+            } else {
+                "ok"
+            };
+            broke |= c.distance < setup.clearance;
+            println!(
+                "  {mark:<6} UAV {} took off {:+.2} s late; nearest '{}' at {:.2} m, t = {:.1} s \
+                 (r_Q = {:.2} m); cross-track at most {:.2} m",
+                vehicle(v),
+                f.takeoff[v],
+                setup.mission.obstacles[o].name,
+                c.distance,
+                c.t,
+                setup.clearance,
+                f.cross_track[v]
+            );
+        }
+    }
+    if !f.finished {
+        println!("  a vehicle had not reached its last waypoint at the horizon");
+    }
+    if broke { exit::INFEASIBLE } else { exit::OK }
+}

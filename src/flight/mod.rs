@@ -1,0 +1,529 @@
+//! The Monte Carlo flight check (`skyform fly`): a plan flown many times as
+//! its autopilots will fly the exported files, in wind and gusts, on GNSS
+//! fixes, taking off a little apart, and what that does to its margins.
+//!
+//! Each flight is a plain function of the plan, the mission's `[flight]`
+//! and (seed, flight number): its random numbers are one ChaCha8 stream per
+//! flight, so a flight is the same whichever thread flies it and whatever
+//! the thread count, and `--flight K` flies flight K again. The report is
+//! read from the flights in their order. Models, sources and limits:
+//! docs/flight-check.md.
+
+pub mod air;
+pub mod autopilot;
+mod report;
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use nalgebra::{Point3, Vector3};
+use rand::rngs::ChaCha8Rng;
+use rand::{RngExt, SeedableRng};
+use rand_distr::StandardNormal;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::base::geometry::{Prism, segment_point_distance_3d};
+use crate::export::reverify::Flight;
+use crate::export::{Placement, Planned, VehiclePlan, reduce};
+use crate::mission::Mission;
+use crate::pipelines::fleet::quadrotor::Body;
+use crate::pipelines::{CancelToken, Kind};
+
+pub use report::{Report, Share, Spread, wilson};
+
+use autopilot::Autopilot;
+
+/// Flights are sampled for distances every this many steps (20 Hz at the
+/// default 0.01 s step): a vehicle at 3 m/s moves 15 cm between samples.
+const SAMPLE_EVERY: usize = 5;
+
+/// Obstacles farther than this from every waypoint line of a vehicle are
+/// not followed for it, metres: no gust or fix error moves it that far.
+const NEAR: f64 = 25.0;
+
+/// The most vehicle-steps one check may simulate (flights × vehicles ×
+/// steps): about 20 s on two cores (the bridge's 1,000 flights are 3.3e7).
+pub const MAX_VEHICLE_STEPS: f64 = 2e8;
+
+/// What goes wrong before a check flies.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FlightError {
+    #[error("the plan has no vehicle with two waypoints to fly")]
+    Empty,
+    #[error(
+        "{flights} flights × {vehicles} vehicles × {steps} steps of {step} s make {total:.3e} \
+         vehicle-steps, over the limit of {limit:.0e}: fewer flights (--flights, flight.flights) \
+         or a longer flight.step"
+    )]
+    OverBudget {
+        flights: usize,
+        vehicles: usize,
+        steps: usize,
+        step: f64,
+        total: f64,
+        limit: f64,
+    },
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// A plan made ready to fly: each vehicle's waypoints as the export writes
+/// them, the limits its verification holds, the obstacles near each vehicle.
+#[derive(Debug, Clone)]
+pub struct Setup<'m> {
+    pub mission: &'m Mission,
+    /// The pipeline that planned it (`Kind::name`).
+    pub pipeline: &'static str,
+    pub plans: Vec<VehiclePlan>,
+    /// Least clearance to an obstacle's surface (r_Q) and between two
+    /// vehicles (2 r_Q), metres.
+    pub clearance: f64,
+    pub closest: f64,
+    /// Each vehicle's obstacles to follow (indices into the mission's).
+    pub near: Vec<Vec<usize>>,
+    pub prisms: Vec<Prism>,
+    /// When the last vehicle, flown as written, reaches its last waypoint.
+    pub planned_end: f64,
+    /// Flights stop here even when a vehicle has not finished.
+    pub horizon: f64,
+}
+
+impl<'m> Setup<'m> {
+    /// The files an export would write for `planned`, read back as the
+    /// vehicles' missions (stored coordinates, written speeds and holds).
+    pub fn new(mission: &'m Mission, planned: &Planned) -> Result<Self, FlightError> {
+        let placement = Placement::new(mission);
+        let (tolerance, _) = planned.default_tolerance(mission);
+        let plans = reduce(planned, placement.as_ref(), tolerance);
+        if plans.iter().all(|p| p.waypoints.len() < 2) {
+            return Err(FlightError::Empty);
+        }
+        let prisms: Vec<Prism> = mission.obstacles.iter().map(|o| mission.prism(o)).collect();
+        let near = plans
+            .iter()
+            .map(|p| {
+                (0..prisms.len())
+                    .filter(|&k| {
+                        p.waypoints.windows(2).any(|w| {
+                            let (a, b) = (w[0].position, w[1].position);
+                            let mid = a + (b - a) * 0.5;
+                            prisms[k].clearance(&mid) - 0.5 * (b - a).norm() < NEAR
+                        }) || p.waypoints.len() == 1
+                            && prisms[k].clearance(&p.waypoints[0].position) < NEAR
+                    })
+                    .collect()
+            })
+            .collect();
+        let planned_end = plans
+            .iter()
+            .filter_map(|p| Flight::new(p).arrivals().last().copied())
+            .fold(0.0, f64::max);
+        let skew = mission.flight.takeoff_skew;
+        Ok(Setup {
+            mission,
+            pipeline: planned.pipeline.name(),
+            clearance: planned.limits.clearance,
+            closest: planned.limits.closest,
+            plans,
+            near,
+            prisms,
+            planned_end,
+            horizon: planned_end * 1.5 + 6.0 * skew + 30.0,
+        })
+    }
+
+    /// Steps of one flight.
+    pub fn steps(&self) -> usize {
+        (self.horizon / self.mission.flight.step).ceil() as usize
+    }
+
+    /// Refuses a check larger than [`MAX_VEHICLE_STEPS`].
+    pub fn within_budget(&self, flights: usize) -> Result<(), FlightError> {
+        let steps = self.steps();
+        let total = flights as f64 * self.plans.len() as f64 * steps as f64;
+        if crate::pipelines::exceeds(total, MAX_VEHICLE_STEPS) {
+            return Err(FlightError::OverBudget {
+                flights,
+                vehicles: self.plans.len(),
+                steps,
+                step: self.mission.flight.step,
+                total,
+                limit: MAX_VEHICLE_STEPS,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// One vehicle's sampled positions: (seconds on the plan's clock, ENU).
+pub type Track = Vec<(f64, Point3<f64>)>;
+
+/// The closest two things came in one flight.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Closest {
+    /// Metres (vehicle to vehicle, or vehicle to the obstacle's surface).
+    pub distance: f64,
+    /// Seconds on the plan's clock.
+    pub t: f64,
+}
+
+impl Closest {
+    const FAR: Closest = Closest {
+        distance: f64::INFINITY,
+        t: 0.0,
+    };
+
+    fn keep(&mut self, distance: f64, t: f64) {
+        if distance < self.distance {
+            *self = Closest { distance, t };
+        }
+    }
+}
+
+/// One flight: each pair's closest approach, each vehicle's least
+/// clearance to each obstacle near it, each vehicle's largest cross-track
+/// error, and whether every vehicle finished.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Flown {
+    pub flight: usize,
+    /// Pairs (i, j), i < j, in order.
+    pub pairs: Vec<Closest>,
+    /// `obstacles[v][k]`: vehicle v and its `Setup::near[v][k]`.
+    pub obstacles: Vec<Vec<Closest>>,
+    /// Metres from the line its mission has it on, the largest.
+    pub cross_track: Vec<f64>,
+    /// Seconds each vehicle took off after the plan's start (the skew).
+    pub takeoff: Vec<f64>,
+    pub finished: bool,
+    /// Every vehicle's sampled track (only when asked).
+    #[serde(skip)]
+    pub tracks: Option<Vec<Track>>,
+}
+
+/// Flies flight `k` of the check seeded `seed`.
+pub fn fly(setup: &Setup, seed: u64, k: usize, keep_tracks: bool) -> Flown {
+    let p = &setup.mission.flight;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(k as u64);
+    let body = Body::from_params(&setup.mission.fleet);
+    let n = setup.plans.len();
+    let mut takeoff = Vec::with_capacity(n);
+    let mut fixes = Vec::with_capacity(n);
+    let mut pilots: Vec<Autopilot> = Vec::with_capacity(n);
+    let mut air = air::Air::new(p, &mut rng);
+    let mut common = air::Gnss::new(p, false, &mut rng);
+    for plan in &setup.plans {
+        let skew: f64 = rng.sample::<f64, _>(StandardNormal) * p.takeoff_skew;
+        let start = plan.waypoints.first().map_or(0.0, |w| w.t) + skew;
+        takeoff.push(skew);
+        fixes.push(air::Gnss::new(p, true, &mut rng));
+        pilots.push(Autopilot::new(
+            plan,
+            setup.mission.vehicle.limits(plan.vehicle),
+            body,
+            p.acceptance_radius,
+            start,
+        ));
+    }
+    let mut pairs = vec![Closest::FAR; n * n.saturating_sub(1) / 2];
+    let mut obstacles: Vec<Vec<Closest>> = setup
+        .near
+        .iter()
+        .map(|near| vec![Closest::FAR; near.len()])
+        .collect();
+    let mut cross_track = vec![0.0f64; n];
+    let mut tracks = keep_tracks.then(|| vec![Vec::new(); n]);
+    let dt = p.step;
+    let steps = setup.steps();
+    let start = setup
+        .plans
+        .iter()
+        .filter_map(|p| p.waypoints.first().map(|w| w.t))
+        .fold(f64::INFINITY, f64::min);
+    let start = if start.is_finite() { start } else { 0.0 };
+    let mut positions = vec![Point3::origin(); n];
+    let mut finished = false;
+    for step in 0..=steps {
+        let t = start + step as f64 * dt;
+        if step % SAMPLE_EVERY == 0 || step == steps {
+            for (v, pilot) in pilots.iter().enumerate() {
+                positions[v] = pilot.position();
+            }
+            measure(setup, t, &positions, &mut pairs, &mut obstacles);
+            for (v, pilot) in pilots.iter().enumerate() {
+                let (a, b) = pilot.line();
+                cross_track[v] =
+                    cross_track[v].max(segment_point_distance_3d(&a, &b, &positions[v]));
+                if let Some(tracks) = tracks.as_mut() {
+                    tracks[v].push((t, positions[v]));
+                }
+            }
+            if pilots.iter().all(Autopilot::done) {
+                finished = true;
+                break;
+            }
+        }
+        // The formation's air, at its mean height and velocity.
+        let (mut height, mut velocity) = (0.0, Vector3::zeros());
+        for pilot in &pilots {
+            let here = pilot.position();
+            height += (here.z - setup.mission.ground(here.x, here.y)) / n as f64;
+            velocity += pilot.velocity() / n as f64;
+        }
+        let wind = air.step(&mut rng, dt, height, &velocity);
+        let shared = common.step(&mut rng, dt);
+        for (pilot, own) in pilots.iter_mut().zip(&mut fixes) {
+            let gnss = shared + own.step(&mut rng, dt);
+            pilot.step(t, dt, &gnss, &wind, p.drag);
+        }
+    }
+    Flown {
+        flight: k,
+        pairs,
+        obstacles,
+        cross_track,
+        takeoff,
+        finished,
+        tracks,
+    }
+}
+
+/// Each pair's distance and each vehicle's clearance to its near
+/// obstacles at one instant, kept where closer than before.
+fn measure(
+    setup: &Setup,
+    t: f64,
+    positions: &[Point3<f64>],
+    pairs: &mut [Closest],
+    obstacles: &mut [Vec<Closest>],
+) {
+    let n = positions.len();
+    let mut k = 0;
+    for i in 0..n {
+        for j in i + 1..n {
+            pairs[k].keep((positions[i] - positions[j]).norm(), t);
+            k += 1;
+        }
+    }
+    for (v, near) in setup.near.iter().enumerate() {
+        for (slot, &o) in near.iter().enumerate() {
+            obstacles[v][slot].keep(setup.prisms[o].clearance(&positions[v]), t);
+        }
+    }
+}
+
+/// The plan as its files fly it with an ideal vehicle (the export's
+/// re-verification: straight legs at the written speeds, on time), sampled
+/// as the flights are: the figures a calm flight should reproduce.
+pub fn as_written(setup: &Setup) -> Flown {
+    let flights: Vec<Flight> = setup.plans.iter().map(Flight::new).collect();
+    let n = flights.len();
+    let mut pairs = vec![Closest::FAR; n * n.saturating_sub(1) / 2];
+    let mut obstacles: Vec<Vec<Closest>> = setup
+        .near
+        .iter()
+        .map(|near| vec![Closest::FAR; near.len()])
+        .collect();
+    let dt = setup.mission.flight.step * SAMPLE_EVERY as f64;
+    let start = setup
+        .plans
+        .iter()
+        .filter_map(|p| p.waypoints.first().map(|w| w.t))
+        .fold(f64::INFINITY, f64::min);
+    let start = if start.is_finite() { start } else { 0.0 };
+    let steps = ((setup.planned_end - start).max(0.0) / dt).ceil() as usize;
+    let mut positions = vec![Point3::origin(); n];
+    for step in 0..=steps {
+        let t = start + step as f64 * dt;
+        for (v, f) in flights.iter().enumerate() {
+            positions[v] = f.at(t).0;
+        }
+        measure(setup, t, &positions, &mut pairs, &mut obstacles);
+    }
+    Flown {
+        flight: 0,
+        pairs,
+        obstacles,
+        cross_track: vec![0.0; n],
+        takeoff: vec![0.0; n],
+        finished: true,
+        tracks: None,
+    }
+}
+
+/// How a check is run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Options {
+    pub flights: usize,
+    pub seed: u64,
+    /// Worker threads (`None`: one per CPU). The report does not depend on it.
+    pub threads: Option<usize>,
+}
+
+/// Flies `options.flights` flights of `setup` and reports them;
+/// `progress(done, total)` is called as flights finish (from any thread).
+pub fn check(
+    setup: &Setup,
+    options: Options,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &CancelToken,
+) -> Result<Report, FlightError> {
+    setup.within_budget(options.flights)?;
+    let done = AtomicUsize::new(0);
+    let fly_all = || -> Vec<Option<Flown>> {
+        (0..options.flights)
+            .into_par_iter()
+            .map(|k| {
+                if cancel.is_cancelled() {
+                    return None;
+                }
+                let flown = fly(setup, options.seed, k, false);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, options.flights);
+                Some(flown)
+            })
+            .collect()
+    };
+    let flown = match options.threads {
+        Some(threads) => rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.max(1))
+            .build()
+            .map(|pool| pool.install(fly_all))
+            .unwrap_or_else(|_| fly_all()),
+        None => fly_all(),
+    };
+    let flown: Option<Vec<Flown>> = flown.into_iter().collect();
+    let flown = flown.ok_or(FlightError::Cancelled)?;
+    Ok(Report::new(setup, options, &flown, &as_written(setup)))
+}
+
+/// The wind's mean vector, m/s ENU (for the reports).
+pub fn mean_wind(p: &crate::mission::FlightParams) -> Vector3<f64> {
+    let to = (p.wind_from_deg + 180.0).to_radians();
+    Vector3::new(to.sin(), to.cos(), 0.0) * p.wind_speed
+}
+
+/// One margin tried by [`find_margin`]: the extra clearance, and the share
+/// of flights that broke a limit (`None`: no plan with it).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Tried {
+    pub margin: f64,
+    pub share: Option<f64>,
+    pub note: String,
+}
+
+/// What [`find_margin`] found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MarginSearch {
+    /// The target share of flights that may break 2 r_Q or r_Q.
+    pub target: f64,
+    /// The smallest extra clearance found that meets it (to
+    /// [`MARGIN_RESOLUTION`]), metres; `None`: none up to [`MAX_MARGIN`].
+    pub margin: Option<f64>,
+    /// The check of the plan made with it.
+    pub report: Option<Report>,
+    pub tried: Vec<Tried>,
+}
+
+/// `mission` asked to keep `m` more from the obstacles ([`find_margin`]).
+pub fn with_margin(mission: &mut Mission, pipeline: Kind, m: f64) {
+    match pipeline {
+        Kind::ThetaPso | Kind::Flatlo => mission.theta_pso.clearance_margin += m,
+        Kind::Fleet => mission.fleet.safety_distance += m,
+    }
+}
+
+/// The margin search stops refining at this width, metres.
+pub const MARGIN_RESOLUTION: f64 = 0.05;
+/// The largest extra clearance tried, metres.
+pub const MAX_MARGIN: f64 = 8.0;
+
+/// The smallest extra clearance m whose plan, flown `options.flights`
+/// times, breaks a limit in at most `target` of the flights: 0, then
+/// doubling from 0.25 m, then halving the interval between the last that
+/// failed and the first that met it. θ-PSO plans with
+/// `theta_pso.clearance_margin` + m (every UAV keeps r_Q + m from the
+/// obstacles where the site leaves room: an IWP's gap keeps what it has),
+/// the fleet with `fleet.safety_distance` + m; the formation's spacing is
+/// the user's slots, which no margin changes. `plan` plans a mission
+/// (`Err`: no plan, and why). The share is the flights' own (its 95 %
+/// interval is in the report).
+pub fn find_margin(
+    pipeline: Kind,
+    mission: &Mission,
+    target: f64,
+    options: Options,
+    plan: &mut dyn FnMut(&Mission) -> Result<Planned, String>,
+    cancel: &CancelToken,
+) -> Result<MarginSearch, FlightError> {
+    let mut tried = Vec::new();
+    let mut attempt = |m: f64, tried: &mut Vec<Tried>| -> Result<Option<Report>, FlightError> {
+        if cancel.is_cancelled() {
+            return Err(FlightError::Cancelled);
+        }
+        let mut changed = mission.clone();
+        with_margin(&mut changed, pipeline, m);
+        let planned = match plan(&changed) {
+            Ok(p) => p,
+            Err(why) => {
+                tried.push(Tried {
+                    margin: m,
+                    share: None,
+                    note: why,
+                });
+                return Ok(None);
+            }
+        };
+        let setup = Setup::new(&changed, &planned)?;
+        let report = check(&setup, options, &|_, _| {}, cancel)?;
+        tried.push(Tried {
+            margin: m,
+            share: Some(report.break_any.share),
+            note: match &report.worst {
+                Some(w) if report.break_any.count > 0 => format!(
+                    "{} of {} flights break a limit (worst: {})",
+                    report.break_any.count, report.break_any.of, w.what
+                ),
+                _ => format!(
+                    "{} of {} flights break a limit",
+                    report.break_any.count, report.break_any.of
+                ),
+            },
+        });
+        Ok((report.break_any.share <= target).then_some(report))
+    };
+    // Bracket: the largest margin known to fail, the smallest known to meet.
+    let mut failed = None;
+    let mut met: Option<(f64, Report)> = None;
+    let mut m = 0.0;
+    while m <= MAX_MARGIN {
+        match attempt(m, &mut tried)? {
+            Some(report) => {
+                met = Some((m, report));
+                break;
+            }
+            None => failed = Some(m),
+        }
+        m = if m == 0.0 { 0.25 } else { 2.0 * m };
+    }
+    if let Some(mut low) = failed
+        && let Some((mut high, mut best)) = met.take()
+    {
+        while high - low > MARGIN_RESOLUTION {
+            let mid = 0.5 * (low + high);
+            match attempt(mid, &mut tried)? {
+                Some(report) => {
+                    high = mid;
+                    best = report;
+                }
+                None => low = mid,
+            }
+        }
+        met = Some((high, best));
+    }
+    Ok(MarginSearch {
+        target,
+        margin: met.as_ref().map(|(m, _)| *m),
+        report: met.map(|(_, r)| r),
+        tried,
+    })
+}
