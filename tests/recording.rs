@@ -562,3 +562,70 @@ fn recorded(
     recorder.finish();
     chunks(&rrd)
 }
+
+/// Issue 39, item 4: `skyform fly --rrd` records the plan as written, each
+/// UAV's p99 envelope as a tube (balls whose radii are the p99 cross-track
+/// error) and the worst flights as flown, read back here; the report says
+/// which flight was worst, and that flight is among those recorded.
+#[test]
+fn a_flight_check_recording_holds_the_worst_flights_and_the_envelope() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let rrd = dir.path().join("fly.rrd");
+    let json = dir.path().join("fly.json");
+    let out = skyform(&[
+        "fly",
+        "missions/bridge-inspection.toml",
+        "--seed",
+        "1",
+        "--flights",
+        "24",
+        "--rrd",
+        &rrd.display().to_string(),
+        "--json",
+        &json.display().to_string(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        matches!(out.status.code(), Some(0) | Some(2)),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("a report");
+    let worst = report["worst"]["flight"].as_u64().expect("a worst flight");
+    let chunks = chunks(&rrd);
+    let paths = entity_paths(&chunks);
+    for uav in 1..=3 {
+        for path in [
+            format!("/flight/written/uav_{uav}"),
+            format!("/flight/envelope/uav_{uav}"),
+            format!("/flight/worst/flight_{worst}/uav_{uav}"),
+        ] {
+            assert!(paths.contains(&path), "{path} not in {paths:?}");
+        }
+        let radii: Vec<f32> = values(
+            &chunks,
+            &format!("/flight/envelope/uav_{uav}"),
+            "Points3D:radii",
+        );
+        assert!(radii.len() > 50, "{} balls", radii.len());
+        // The tube is the p99 of cross-track errors that GNSS alone (σ 1 m)
+        // keeps above a few decimetres almost everywhere.
+        let median = {
+            let mut r = radii.clone();
+            r.sort_by(f32::total_cmp);
+            r[r.len() / 2]
+        };
+        assert!(median > 0.3 && median < 10.0, "median radius {median} m");
+    }
+    let recorded_worst = paths
+        .iter()
+        .filter(|p| p.starts_with("/flight/worst/"))
+        .count();
+    assert_eq!(
+        recorded_worst,
+        3 * 3,
+        "three flights of three UAVs: {paths:?}"
+    );
+    assert!(paths.contains(&"/flight/report".to_owned()));
+}

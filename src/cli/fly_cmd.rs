@@ -11,6 +11,7 @@ use crate::export::Planned;
 use crate::flight::{self, FlightError, Options, Setup};
 use crate::mission::Mission;
 use crate::pipelines::{CancelToken, Kind, Silent};
+use crate::record::Recorder;
 use crate::run::Run;
 
 /// The arguments of `skyform fly` (its help is on `Command::Fly`).
@@ -48,6 +49,10 @@ pub struct FlyArgs {
     /// that plan.
     #[arg(long, value_name = "SHARE")]
     pub target: Option<f64>,
+    /// A Rerun recording of the check: the plan as written, the p99
+    /// envelope of each UAV as a tube, the worst flights as flown.
+    #[command(flatten)]
+    pub record: super::RecordArgs,
 }
 
 /// `skyform fly`. Exit status: 0 no flight broke a limit, 1 error, 2 some
@@ -121,6 +126,13 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
         }
     };
     print!("{}", report.text(args.verbose));
+    let sinks = args.record.sinks();
+    if !sinks.is_empty() {
+        let code = record(&setup, options, &report, args, &cancel);
+        if code != exit::OK {
+            return code;
+        }
+    }
     if let Some(path) = &args.json {
         let text = match serde_json::to_string_pretty(&report) {
             Ok(t) => t,
@@ -139,6 +151,46 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
     } else {
         exit::OK
     }
+}
+
+/// The recording of a check (`--rrd`, `--connect`, `--spawn`): the
+/// flights flown again keeping their envelope and the worst tracks.
+fn record(
+    setup: &Setup,
+    options: Options,
+    report: &flight::Report,
+    args: &FlyArgs,
+    cancel: &CancelToken,
+) -> u8 {
+    let mut warnings = Vec::new();
+    let recorder = match Recorder::start(
+        &setup.mission.name,
+        Some(args.pipeline),
+        &args.record.sinks(),
+        &mut warnings,
+    ) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return exit::ERROR;
+        }
+    };
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+    let Some(mut recorder) = recorder else {
+        return exit::OK;
+    };
+    recorder.log_mission(setup.mission);
+    match flight::recording(setup, options, report, cancel) {
+        Ok(recording) => recorder.log_flights(recording, report.text(true)),
+        Err(e) => {
+            eprintln!("error: the recording: {e}");
+            return exit::ERROR;
+        }
+    }
+    super::report_recording(Some(&recorder.finish()));
+    exit::OK
 }
 
 /// `--target`: the margin search, then the report of the plan it found.

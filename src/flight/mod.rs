@@ -198,10 +198,19 @@ pub struct Flown {
     /// Every vehicle's sampled track (only when asked).
     #[serde(skip)]
     pub tracks: Option<Vec<Track>>,
+    /// Every vehicle's cross-track error at each sample (only when asked:
+    /// the envelope of a recording).
+    #[serde(skip)]
+    pub spread: Option<Vec<Vec<f32>>>,
 }
 
 /// Flies flight `k` of the check seeded `seed`.
 pub fn fly(setup: &Setup, seed: u64, k: usize, keep_tracks: bool) -> Flown {
+    fly_keeping(setup, seed, k, keep_tracks, false)
+}
+
+/// [`fly`], keeping each sample's cross-track error when `keep_spread`.
+fn fly_keeping(setup: &Setup, seed: u64, k: usize, keep_tracks: bool, keep_spread: bool) -> Flown {
     let p = &setup.mission.flight;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(k as u64);
@@ -233,6 +242,7 @@ pub fn fly(setup: &Setup, seed: u64, k: usize, keep_tracks: bool) -> Flown {
         .collect();
     let mut cross_track = vec![0.0f64; n];
     let mut tracks = keep_tracks.then(|| vec![Vec::new(); n]);
+    let mut spread: Option<Vec<Vec<f32>>> = keep_spread.then(|| vec![Vec::new(); n]);
     let dt = p.step;
     let steps = setup.steps();
     let start = setup
@@ -252,8 +262,11 @@ pub fn fly(setup: &Setup, seed: u64, k: usize, keep_tracks: bool) -> Flown {
             measure(setup, t, &positions, &mut pairs, &mut obstacles);
             for (v, pilot) in pilots.iter().enumerate() {
                 let (a, b) = pilot.line();
-                cross_track[v] =
-                    cross_track[v].max(segment_point_distance_3d(&a, &b, &positions[v]));
+                let off = segment_point_distance_3d(&a, &b, &positions[v]);
+                cross_track[v] = cross_track[v].max(off);
+                if let Some(spread) = spread.as_mut() {
+                    spread[v].push(off as f32);
+                }
                 if let Some(tracks) = tracks.as_mut() {
                     tracks[v].push((t, positions[v]));
                 }
@@ -285,6 +298,7 @@ pub fn fly(setup: &Setup, seed: u64, k: usize, keep_tracks: bool) -> Flown {
         takeoff,
         finished,
         tracks,
+        spread,
     }
 }
 
@@ -348,6 +362,7 @@ pub fn as_written(setup: &Setup) -> Flown {
         takeoff: vec![0.0; n],
         finished: true,
         tracks: None,
+        spread: None,
     }
 }
 
@@ -358,6 +373,128 @@ pub struct Options {
     pub seed: u64,
     /// Worker threads (`None`: one per CPU). The report does not depend on it.
     pub threads: Option<usize>,
+}
+
+/// What a recording of a check shows (`record::flight`): each vehicle's
+/// plan as written, the p99 of its cross-track error along it (the
+/// envelope: a tube of that radius), and the worst flights as flown.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    pub mission: String,
+    /// The instants of the samples, seconds on the plan's clock.
+    pub times: Vec<f64>,
+    /// Per vehicle (1-based number, its as-written positions at `times`).
+    pub written: Vec<(usize, Vec<Point3<f64>>)>,
+    /// Per vehicle, the p99 cross-track error at each of `times`, metres.
+    pub envelope: Vec<Vec<f64>>,
+    /// The worst flights: (flight, its vehicles' tracks).
+    pub worst: Vec<(usize, Vec<Track>)>,
+}
+
+/// The flights recorded as the worst: this many.
+pub const RECORDED_WORST: usize = 3;
+
+/// Runs `work` on `threads` worker threads (`None`: rayon's pool).
+fn on_threads<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> T {
+    match threads.and_then(|n| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build()
+            .ok()
+    }) {
+        Some(pool) => pool.install(work),
+        None => work(),
+    }
+}
+
+/// Flies the check again keeping what a recording shows: every flight's
+/// cross-track samples for the envelope, the [`RECORDED_WORST`] worst
+/// flights' tracks (the report's worst, then the flights where the
+/// tightest pairs and obstacles were worst).
+pub fn recording(
+    setup: &Setup,
+    options: Options,
+    report: &Report,
+    cancel: &CancelToken,
+) -> Result<Recording, FlightError> {
+    setup.within_budget(options.flights)?;
+    let spreads: Vec<Option<Vec<Vec<f32>>>> = on_threads(options.threads, || {
+        (0..options.flights)
+            .into_par_iter()
+            .map(|k| {
+                if cancel.is_cancelled() {
+                    return None;
+                }
+                fly_keeping(setup, options.seed, k, false, true).spread
+            })
+            .collect()
+    });
+    let spreads: Option<Vec<Vec<Vec<f32>>>> = spreads.into_iter().collect();
+    let spreads = spreads.ok_or(FlightError::Cancelled)?;
+    let dt = setup.mission.flight.step * SAMPLE_EVERY as f64;
+    let samples = spreads.iter().flatten().map(Vec::len).max().unwrap_or(0);
+    let start = setup
+        .plans
+        .iter()
+        .filter_map(|p| p.waypoints.first().map(|w| w.t))
+        .fold(f64::INFINITY, f64::min);
+    let start = if start.is_finite() { start } else { 0.0 };
+    let times: Vec<f64> = (0..samples).map(|k| start + k as f64 * dt).collect();
+    let envelope = (0..setup.plans.len())
+        .map(|v| {
+            (0..samples)
+                .map(|k| {
+                    // A flight that finished early holds its last sample.
+                    let mut at: Vec<f64> = spreads
+                        .iter()
+                        .filter_map(|f| f[v].get(k).or(f[v].last()).map(|x| f64::from(*x)))
+                        .collect();
+                    at.sort_by(f64::total_cmp);
+                    report::quantile(&at, 0.99)
+                })
+                .collect()
+        })
+        .collect();
+    let written = setup
+        .plans
+        .iter()
+        .map(|p| {
+            let schedule = Flight::new(p);
+            (
+                p.vehicle + 1,
+                times.iter().map(|&t| schedule.at(t).0).collect(),
+            )
+        })
+        .collect();
+    let mut chosen: Vec<usize> = Vec::new();
+    let candidates = report.worst.iter().map(|w| w.flight).chain(
+        report
+            .pairs
+            .iter()
+            .map(|p| p.closest.worst_flight)
+            .chain(report.obstacles.iter().map(|o| o.clearance.worst_flight)),
+    );
+    for k in candidates {
+        if chosen.len() < RECORDED_WORST && !chosen.contains(&k) {
+            chosen.push(k);
+        }
+    }
+    let worst = chosen
+        .into_iter()
+        .map(|k| {
+            (
+                k,
+                fly(setup, options.seed, k, true).tracks.unwrap_or_default(),
+            )
+        })
+        .collect();
+    Ok(Recording {
+        mission: setup.mission.name.clone(),
+        times,
+        written,
+        envelope,
+        worst,
+    })
 }
 
 /// Flies `options.flights` flights of `setup` and reports them;
@@ -383,14 +520,7 @@ pub fn check(
             })
             .collect()
     };
-    let flown = match options.threads {
-        Some(threads) => rayon::ThreadPoolBuilder::new()
-            .num_threads(threads.max(1))
-            .build()
-            .map(|pool| pool.install(fly_all))
-            .unwrap_or_else(|_| fly_all()),
-        None => fly_all(),
-    };
+    let flown = on_threads(options.threads, fly_all);
     let flown: Option<Vec<Flown>> = flown.into_iter().collect();
     let flown = flown.ok_or(FlightError::Cancelled)?;
     Ok(Report::new(setup, options, &flown, &as_written(setup)))

@@ -35,6 +35,7 @@ use crate::pipelines::{Event, Kind, Level, Observer};
 
 mod flatlo;
 mod fleet;
+mod flight;
 mod layout;
 pub mod paths;
 mod scene;
@@ -87,6 +88,8 @@ enum Message {
     Outcome(Box<Outcome>),
     /// A live plan, the `revision`-th of the designer's session.
     Live(u64, Box<Outcome>),
+    /// A flight check and its report's text.
+    Flights(Box<crate::flight::Recording>, String),
 }
 
 /// A recording in progress. `finish` (or drop) flushes it and closes the file.
@@ -211,6 +214,12 @@ impl Recorder {
     /// Logs a pipeline's result in its layout.
     pub fn log_outcome(&mut self, outcome: &Outcome) {
         self.send(Message::Outcome(Box::new(outcome.clone())));
+    }
+
+    /// Logs a flight check (`skyform fly --rrd`): the plan as written, the
+    /// envelope, the worst flights, the report.
+    pub fn log_flights(&mut self, recording: crate::flight::Recording, report: String) {
+        self.send(Message::Flights(Box::new(recording), report));
     }
 
     /// Logs a live plan of the designer as revision `revision`: its plan
@@ -468,6 +477,7 @@ fn log_message(stream: &RecordingStream, message: Message, scene: Option<&Missio
             stream.log(log, &rerun::TextLog::new(text).with_level(level))
         }
         Message::Iteration { .. } => Ok(()),
+        Message::Flights(recording, report) => flight::log_flights(stream, &recording, &report),
         Message::Live(revision, outcome) => log_live(stream, revision, &outcome),
     };
     // A logging error (a sink gone) must not stop the run; the recording is

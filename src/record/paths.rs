@@ -93,6 +93,25 @@ pub mod flatlo {
     }
 }
 
+/// A flight check's entities (`skyform fly --rrd`), per vehicle named from 1.
+pub mod flight {
+    /// The report, as text.
+    pub const REPORT: &str = "flight/report";
+
+    pub fn written(vehicle: usize) -> String {
+        format!("flight/written/uav_{vehicle}")
+    }
+
+    /// The p99 cross-track envelope along the plan.
+    pub fn envelope(vehicle: usize) -> String {
+        format!("flight/envelope/uav_{vehicle}")
+    }
+
+    pub fn worst(flight: usize, vehicle: usize) -> String {
+        format!("flight/worst/flight_{flight}/uav_{vehicle}")
+    }
+}
+
 /// The fleet's entities, per agent (0-based, as `agent_0`).
 pub mod fleet {
     pub const DISTANCES: &str = "fleet/distances";
