@@ -1031,3 +1031,50 @@ fn the_shape_and_the_crossing_the_route_must_make_are_said() {
     assert_eq!(chosen(&app), None);
     assert!(said(&app).contains("the route may cross between 'light pole 4' and 'pier 5' or not"));
 }
+
+/// Issue 39, item 4: `G` flies the shown plan in the mission's `[flight]`
+/// air as a background job; its verdict and its worst place stand under the
+/// plan's verdict, and the map draws each UAV's p99 envelope and marks the
+/// worst place, at 80 × 24 and at 140 × 42.
+#[test]
+fn the_flight_check_shows_its_verdict_the_worst_place_and_the_envelope() {
+    let mut m = default_mission().mission;
+    m.flight.flights = 40;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut app = App::new(Document::new(m, None), dir.path().to_path_buf());
+    app.update(Action::Run(Kind::ThetaPso));
+    assert!(app.wait_for_jobs(Duration::from_secs(120)));
+    app.update(Action::FlightCheck);
+    let job = &app.jobs()[0];
+    assert!(
+        matches!(
+            job.flight,
+            Some(skyform::tui::jobs::FlightCheck::Running { .. })
+        ),
+        "{:?}",
+        job.flight
+    );
+    assert!(app.wait_for_jobs(Duration::from_secs(120)));
+    let job = &app.jobs()[0];
+    let Some(skyform::tui::jobs::FlightCheck::Done(r)) = &job.flight else {
+        panic!("{:?}", job.flight);
+    };
+    assert_eq!(r.envelope.len(), 3, "one envelope a UAV");
+    assert!(
+        r.envelope
+            .iter()
+            .all(|e| e.len() > 100 && e.iter().all(|(_, radius)| radius.is_finite()))
+    );
+    let (worst, _) = r.worst.as_ref().expect("a worst place");
+    assert!(worst.starts_with("flight "), "{worst}");
+    app.update(Action::FocusOn(Focus::Jobs));
+    for size in [(80, 24), (140, 42)] {
+        let screen = render_at(&app, Instant::now(), size);
+        assert!(screen.contains("flight check:"), "{size:?}\n{screen}");
+        assert!(screen.contains("worst"), "{size:?}\n{screen}");
+    }
+    // Wide enough, the map marks the worst place itself (its ✕ may sit
+    // under an IWP's ◆: the word stays).
+    let screen = render_at(&app, Instant::now(), (140, 42));
+    assert!(screen.matches("worst").count() >= 2, "{screen}");
+}

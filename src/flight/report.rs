@@ -113,6 +113,8 @@ pub struct CrossTrack {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Worst {
     pub flight: usize,
+    /// The vehicle (1-based; of a pair, the first).
+    pub vehicle: usize,
     /// Metres left to the limit (negative: broken by that much).
     pub margin: f64,
     pub what: String,
@@ -360,6 +362,7 @@ fn worst(setup: &Setup, flown: &[Flown]) -> Option<Worst> {
                 let c = f.pairs[k];
                 consider(Worst {
                     flight: f.flight,
+                    vehicle: vehicle(i),
                     margin: c.distance - setup.closest,
                     what: format!(
                         "UAV {} and UAV {} {:.2} m apart",
@@ -377,6 +380,7 @@ fn worst(setup: &Setup, flown: &[Flown]) -> Option<Worst> {
                 let c = f.obstacles[v][slot];
                 consider(Worst {
                     flight: f.flight,
+                    vehicle: vehicle(v),
                     margin: c.distance - setup.clearance,
                     what: if c.distance < 0.0 {
                         format!(

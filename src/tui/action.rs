@@ -111,6 +111,8 @@ pub enum Action {
     /// Run the fleet with its agents in processes of their own, over Zenoh
     /// (lockstep: the same result as `Run(Kind::Fleet)`).
     RunDistributed,
+    /// Fly the shown plan in the mission's `[flight]` air (`skyform fly`).
+    FlightCheck,
     /// Move the fleet replay by this many seconds (and pause it).
     Scrub(f64),
     /// Play or pause the fleet replay.

@@ -190,7 +190,9 @@ impl JobBoard {
     }
 
     pub fn any_running(&self) -> bool {
-        self.jobs.iter().any(Job::is_running)
+        self.jobs
+            .iter()
+            .any(|j| j.is_running() || matches!(j.flight, Some(jobs::FlightCheck::Running { .. })))
     }
 
     /// Lists a job that runs elsewhere (a run planned synchronously for a
@@ -256,6 +258,7 @@ impl JobBoard {
                 run.distributed = last.and_then(|j| j.distributed);
                 self.run(run, doc, cwd, status);
             }
+            FlightCheck => self.flight_check(status),
             Cancel => self.cancel(status),
             JobUp => self.cursor = self.cursor.saturating_sub(1),
             JobDown => self.cursor = (self.cursor + 1).min(self.jobs.len().saturating_sub(1)),
@@ -270,6 +273,42 @@ impl JobBoard {
             CycleViewer => self.cycle_viewer(status),
             _ => {}
         }
+    }
+
+    /// `G`: flies the shown job's plan (θ-PSO or the fleet) in the
+    /// mission's `[flight]` air on a worker thread.
+    fn flight_check(&mut self, status: &mut StatusLine) {
+        let Some(id) = self.shown.filter(|id| !Live::owns(*id)) else {
+            status.error("flight check: run a plan first (r), then G flies it");
+            return;
+        };
+        let Some(job) = self.jobs.iter_mut().find(|j| j.id == id) else {
+            return;
+        };
+        let Some(outcome) = job.outcome.clone() else {
+            status.error(format!("flight check: job {id} has no plan"));
+            return;
+        };
+        if job.pipeline.fixed_wing() {
+            status.error("flight check: FLATLO's aircraft fly on their own model; G flies θ-PSO and fleet plans");
+            return;
+        }
+        if matches!(job.flight, Some(jobs::FlightCheck::Running { .. })) {
+            status.say(format!("flight check of job {id} is under way"));
+            return;
+        }
+        let total = job.mission.flight.flights;
+        job.flight = Some(jobs::FlightCheck::Running { done: 0, total });
+        jobs::spawn_flight_check(
+            id,
+            job.mission.clone(),
+            outcome,
+            job.cancel.clone(),
+            self.tx.clone(),
+        );
+        status.say(format!(
+            "flight check of job {id}: {total} flights in the mission's [flight] air…"
+        ));
     }
 
     fn cancel(&self, status: &mut StatusLine) {
@@ -377,6 +416,19 @@ impl JobBoard {
                 ),
             )),
             JobMsg::Done(_, Err(e)) => Some((true, format!("job {id} failed: {e}"))),
+            JobMsg::Flight(_, jobs::FlightUpdate::Done(Ok(r))) => Some((
+                false,
+                format!(
+                    "job {id} flight check: {}{}",
+                    r.verdict,
+                    r.worst
+                        .as_ref()
+                        .map_or(String::new(), |(w, _)| format!("; worst {w}"))
+                ),
+            )),
+            JobMsg::Flight(_, jobs::FlightUpdate::Done(Err(e))) => {
+                Some((true, format!("job {id} flight check failed: {e}")))
+            }
             _ => None,
         };
         let done = matches!(msg, JobMsg::Done(_, Ok(_)));

@@ -85,6 +85,37 @@ pub enum JobMsg {
     },
     /// The run ended with an outcome, or an error (or a caught panic).
     Done(JobId, Result<Outcome, JobError>),
+    /// The flight check of the job's plan moved on, or ended.
+    Flight(JobId, FlightUpdate),
+}
+
+/// A flight check's news (`G`).
+#[derive(Debug)]
+pub enum FlightUpdate {
+    /// Flights flown, of how many.
+    Progress(usize, usize),
+    Done(Result<Box<FlightResult>, String>),
+}
+
+/// A job's flight check as the designer shows it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FlightCheck {
+    Running { done: usize, total: usize },
+    Done(Box<FlightResult>),
+    Failed(String),
+}
+
+/// What the designer keeps of a flight check: the verdict in words, the
+/// worst place, and each UAV's p99 envelope along its plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlightResult {
+    /// "4.5 % break 2 r_Q, 99.0 % break r_Q (of 1000 flights)".
+    pub verdict: String,
+    /// The worst flight in words, and where its UAV was then.
+    pub worst: Option<(String, Point3<f64>)>,
+    /// Per UAV (0-based): points along its plan as written with the p99
+    /// cross-track error there, metres.
+    pub envelope: Vec<Vec<(Point3<f64>, f64)>>,
 }
 
 /// Why a job produced no outcome.
@@ -141,6 +172,8 @@ pub struct Job {
     pub distributed: Option<Distribution>,
     /// Its agents still flying, of how many (once the processes are ready).
     pub agents: Option<(usize, usize)>,
+    /// Its plan's flight check (`G`), when one was asked for.
+    pub flight: Option<FlightCheck>,
 }
 
 impl Job {
@@ -164,6 +197,7 @@ impl Job {
             recorded: None,
             distributed: None,
             agents: None,
+            flight: None,
         }
     }
 
@@ -200,6 +234,15 @@ impl Job {
             JobMsg::Recorded { path, bytes, .. } => self.recorded = Some((path, bytes)),
             JobMsg::Log(_, Level::Info, _) => {}
             JobMsg::Agents { alive, total, .. } => self.agents = Some((alive, total)),
+            JobMsg::Flight(_, FlightUpdate::Progress(done, total)) => {
+                self.flight = Some(FlightCheck::Running { done, total });
+            }
+            JobMsg::Flight(_, FlightUpdate::Done(result)) => {
+                self.flight = Some(match result {
+                    Ok(r) => FlightCheck::Done(r),
+                    Err(e) => FlightCheck::Failed(e),
+                });
+            }
             JobMsg::Done(_, result) => {
                 self.ended = Some(now);
                 match result {
@@ -231,7 +274,8 @@ impl JobMsg {
             JobMsg::Stage(id, _)
             | JobMsg::Progress(id, _)
             | JobMsg::Log(id, _, _)
-            | JobMsg::Done(id, _) => *id,
+            | JobMsg::Done(id, _)
+            | JobMsg::Flight(id, _) => *id,
             JobMsg::Iteration { id, .. }
             | JobMsg::Recorded { id, .. }
             | JobMsg::Agents { id, .. } => *id,
@@ -379,6 +423,91 @@ fn start_recording(
         let _ = tx.send(JobMsg::Log(id, Level::Warn, text));
     }
     None
+}
+
+/// Flies the plan of `outcome` in `mission`'s `[flight]` air on a worker
+/// thread: progress every 5 % of the flights, then the verdict, the worst
+/// place and the p99 envelope (`flight::check`, `flight::recording`). A
+/// panic is reported as a failed check.
+pub fn spawn_flight_check(
+    id: JobId,
+    mission: Mission,
+    outcome: Outcome,
+    cancel: CancelToken,
+    tx: Sender<JobMsg>,
+) {
+    let worker_tx = tx.clone();
+    let spawned = thread::Builder::new()
+        .name(format!("skyform-flight-{id}"))
+        .spawn(move || {
+            let work = || flight_check(id, &mission, &outcome, &cancel, &worker_tx);
+            let result = catch_unwind(AssertUnwindSafe(work))
+                .unwrap_or_else(|panic| Err(panic_message(&*panic).to_string()));
+            let _ = worker_tx.send(JobMsg::Flight(id, FlightUpdate::Done(result)));
+        });
+    if let Err(e) = spawned {
+        let _ = tx.send(JobMsg::Flight(id, FlightUpdate::Done(Err(e.to_string()))));
+    }
+}
+
+fn flight_check(
+    id: JobId,
+    mission: &Mission,
+    outcome: &Outcome,
+    cancel: &CancelToken,
+    tx: &Sender<JobMsg>,
+) -> Result<Box<FlightResult>, String> {
+    use crate::flight::{self, Options, Setup};
+    let planned = crate::export::Planned::from_outcome(mission, outcome);
+    let setup = Setup::new(mission, &planned).map_err(|e| e.to_string())?;
+    let options = Options {
+        flights: mission.flight.flights,
+        seed: outcome.seed(),
+        threads: None,
+    };
+    let step = (options.flights / 20).max(1);
+    let progress = |done: usize, total: usize| {
+        if done.is_multiple_of(step) || done == total {
+            let _ = tx.send(JobMsg::Flight(id, FlightUpdate::Progress(done, total)));
+        }
+    };
+    let report = flight::check(&setup, options, &progress, cancel).map_err(|e| e.to_string())?;
+    let recording =
+        flight::recording(&setup, options, &report, cancel).map_err(|e| e.to_string())?;
+    let pct = |s: &flight::Share| format!("{:.1} %", 100.0 * s.share);
+    let verdict = format!(
+        "{} break 2 r_Q, {} break r_Q (of {} flights)",
+        pct(&report.break_separation),
+        pct(&report.break_clearance),
+        report.flights
+    );
+    let worst = report.worst.as_ref().map(|w| {
+        let k = recording
+            .times
+            .partition_point(|&t| t < w.t)
+            .min(recording.times.len().saturating_sub(1));
+        let at = recording
+            .written
+            .iter()
+            .find(|(v, _)| *v == w.vehicle)
+            .and_then(|(_, p)| p.get(k).copied())
+            .unwrap_or_else(Point3::origin);
+        (
+            format!("flight {}: {} at t = {:.1} s", w.flight, w.what, w.t),
+            at,
+        )
+    });
+    let envelope = recording
+        .written
+        .iter()
+        .zip(&recording.envelope)
+        .map(|((_, points), radii)| points.iter().copied().zip(radii.iter().copied()).collect())
+        .collect();
+    Ok(Box::new(FlightResult {
+        verdict,
+        worst,
+        envelope,
+    }))
 }
 
 fn panic_message(panic: &(dyn std::any::Any + Send)) -> JobError {

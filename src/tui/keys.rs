@@ -431,8 +431,14 @@ pub static KEYS: &[KeyRow] = &[
     },
     KeyRow {
         group: "Run",
+        keys: "G",
+        help: "flight check of the shown plan ([flight])",
+        bindings: &[bind(Key::Char('G'), When::Always, Action::FlightCheck)],
+    },
+    KeyRow {
+        group: "Run",
         keys: "Z",
-        help: "run the fleet with its agents as processes over Zenoh (lockstep: the result of T)",
+        help: "run the fleet as agent processes over Zenoh (same as T)",
         bindings: &[bind(Key::Char('Z'), When::Always, Action::RunDistributed)],
     },
     KeyRow {

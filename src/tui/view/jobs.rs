@@ -232,14 +232,20 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         facts.push(Line::styled(format!("error: {e}"), Style::default().red()));
     }
     if let Some(o) = job.outcome.as_ref().and_then(|o| o.theta_pso()) {
+        let verdict_at = facts.len() + 1;
         facts.extend(theta_pso_table(
             o,
             &job.state,
             app.is_stale(job),
             detail.width,
         ));
+        // The flight check under the verdict it qualifies.
+        let at = verdict_at.min(facts.len());
+        facts.splice(at..at, flight_lines(job));
     } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.fleet()) {
-        let lines = fleet_table(o, app.is_stale(job));
+        let mut lines = fleet_table(o, app.is_stale(job));
+        let at = lines.len().min(1);
+        lines.splice(at..at, flight_lines(job));
         frame.render_widget(Paragraph::new(lines), detail);
         return;
     } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.flatlo()) {
@@ -277,6 +283,36 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
     .areas(detail);
     frame.render_widget(Paragraph::new(facts).wrap(Wrap { trim: false }), facts_area);
     draw_chart(frame, job, chart_area);
+}
+
+/// The job's flight check (`G`): under way, or its verdict and the worst
+/// place (the map draws the envelope).
+fn flight_lines(job: &Job) -> Vec<Line<'static>> {
+    use crate::tui::jobs::FlightCheck;
+    match &job.flight {
+        None => Vec::new(),
+        Some(FlightCheck::Running { done, total }) => vec![Line::styled(
+            format!("flight check: {done} of {total} flights…"),
+            Style::default().cyan(),
+        )],
+        Some(FlightCheck::Failed(e)) => vec![Line::styled(
+            format!("flight check failed: {e}"),
+            Style::default().red(),
+        )],
+        Some(FlightCheck::Done(r)) => {
+            let mut lines = vec![Line::styled(
+                format!("flight check: {}", r.verdict),
+                Style::default().cyan().bold(),
+            )];
+            if let Some((worst, _)) = &r.worst {
+                lines.push(Line::styled(
+                    format!("worst: {worst}"),
+                    Style::default().red(),
+                ));
+            }
+            lines
+        }
+    }
 }
 
 /// Under a result's verdict once the mission changed after its run.

@@ -591,6 +591,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     if let Some((o, stale)) = shown_outcome(app, Outcome::fleet) {
         paint_fleet(ctx, app, o, stale, dot);
     }
+    paint_flight_check(ctx, app, dot);
 
     // At a FLATLO result's kilometre scale the formation is a dot.
     if shown_outcome(app, Outcome::flatlo).is_none() {
@@ -817,6 +818,37 @@ fn centroid_between(o: &ThetaPsoOutcome, t0: f64, t1: f64) -> Vec<(f64, f64)> {
 
 /// FLATLO: each aircraft's reference (grey) and flight (its colour), where it
 /// started and where it ended.
+/// The shown job's flight check (`G`): each UAV's p99 envelope as rings
+/// along its plan (a ring of that radius every second or so, in the UAV's
+/// colour), and the worst place marked.
+fn paint_flight_check(ctx: &mut Context, app: &App, dot: f64) {
+    let Some(crate::tui::jobs::FlightCheck::Done(r)) = app.shown().and_then(|j| j.flight.as_ref())
+    else {
+        return;
+    };
+    for (v, points) in r.envelope.iter().enumerate() {
+        // At 20 Hz, every 20th sample: one ring a second of flight.
+        for &(p, radius) in points.iter().step_by(20) {
+            if radius > dot {
+                ctx.draw(&Ring {
+                    x: p.x,
+                    y: p.y,
+                    radius,
+                    color: uav_color(v),
+                    dot,
+                });
+            }
+        }
+    }
+    if let Some((_, at)) = &r.worst {
+        ctx.print(
+            at.x,
+            at.y,
+            Span::styled("✕ worst", Style::default().red().bold()),
+        );
+    }
+}
+
 fn paint_squadron(ctx: &mut Context, o: &FlatloOutcome, stale: bool, dot: f64) {
     for a in &o.aircraft {
         let reference = decimate(
