@@ -70,6 +70,34 @@ fn a_calm_flight_is_the_files_as_written_to_5_cm() {
         worst.0,
         worst.2
     );
+    // And in every figure: each pair, each obstacle, each inspection (eq. 8)
+    // is the plan's as written, and every flight still inspects both piers.
+    let options = flight::Options {
+        flights: 3,
+        seed: 1,
+        threads: None,
+    };
+    let report = flight::check(&setup, options, &|_, _| {}, &CancelToken::new())
+        .unwrap_or_else(|e| panic!("{e}"));
+    for p in &report.pairs {
+        assert!(
+            (p.closest.worst - p.closest.as_written).abs() <= 0.05,
+            "{p:?}"
+        );
+    }
+    for o in &report.obstacles {
+        assert!(
+            (o.clearance.worst - o.clearance.as_written).abs() <= 0.05,
+            "{o:?}"
+        );
+    }
+    assert_eq!(report.inspections.len(), 2, "pier 1 and pier 6");
+    for s in &report.inspections {
+        assert!(
+            (s.p5 - s.as_written).abs() <= 0.05 && s.inspected.count == 3,
+            "{s:?}"
+        );
+    }
 }
 
 /// The bridge in the weather: 5 m/s from the west, light Dryden

@@ -86,6 +86,9 @@ pub struct Setup<'m> {
     pub planned_end: f64,
     /// Flights stop here even when a vehicle has not finished.
     pub horizon: f64,
+    /// The inspected obstacles (eq. 8): index, stand-off band [d_min,
+    /// d_max] from the surface, metres, and the pass length asked.
+    pub inspected: Vec<(usize, [f64; 2], f64)>,
 }
 
 impl<'m> Setup<'m> {
@@ -119,7 +122,21 @@ impl<'m> Setup<'m> {
             .filter_map(|p| Flight::new(p).arrivals().last().copied())
             .fold(0.0, f64::max);
         let skew = mission.flight.takeoff_skew;
+        let inspected = mission
+            .obstacles
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.inspect)
+            .map(|(k, o)| {
+                (
+                    k,
+                    o.stand_off_band(&mission.formation),
+                    mission.formation.inspection_pass,
+                )
+            })
+            .collect();
         Ok(Setup {
+            inspected,
             mission,
             pipeline: planned.pipeline.name(),
             clearance: planned.limits.clearance,
@@ -194,6 +211,9 @@ pub struct Flown {
     pub cross_track: Vec<f64>,
     /// Seconds each vehicle took off after the plan's start (the skew).
     pub takeoff: Vec<f64>,
+    /// Per inspected obstacle (`Setup::inspected`), the longest stretch any
+    /// vehicle flew within its eq. 8 band, metres.
+    pub inspections: Vec<f64>,
     pub finished: bool,
     /// Every vehicle's sampled track (only when asked).
     #[serde(skip)]
@@ -252,6 +272,7 @@ fn fly_keeping(setup: &Setup, seed: u64, k: usize, keep_tracks: bool, keep_sprea
         .fold(f64::INFINITY, f64::min);
     let start = if start.is_finite() { start } else { 0.0 };
     let mut positions = vec![Point3::origin(); n];
+    let mut passes = Passes::new(setup, n);
     let mut finished = false;
     for step in 0..=steps {
         let t = start + step as f64 * dt;
@@ -260,6 +281,7 @@ fn fly_keeping(setup: &Setup, seed: u64, k: usize, keep_tracks: bool, keep_sprea
                 positions[v] = pilot.position();
             }
             measure(setup, t, &positions, &mut pairs, &mut obstacles);
+            passes.sample(setup, &positions);
             for (v, pilot) in pilots.iter().enumerate() {
                 let (a, b) = pilot.line();
                 let off = segment_point_distance_3d(&a, &b, &positions[v]);
@@ -296,9 +318,47 @@ fn fly_keeping(setup: &Setup, seed: u64, k: usize, keep_tracks: bool, keep_sprea
         obstacles,
         cross_track,
         takeoff,
+        inspections: passes.best,
         finished,
         tracks,
         spread,
+    }
+}
+
+/// Eq. 8 along a flight: for each inspected obstacle and vehicle, the
+/// stretch flown so far without leaving the band, and the longest.
+struct Passes {
+    run: Vec<Vec<f64>>,
+    best: Vec<f64>,
+    last: Vec<Point3<f64>>,
+}
+
+impl Passes {
+    fn new(setup: &Setup, n: usize) -> Self {
+        Passes {
+            run: vec![vec![0.0; n]; setup.inspected.len()],
+            best: vec![0.0; setup.inspected.len()],
+            last: Vec::new(),
+        }
+    }
+
+    /// One sample: a vehicle inside the band at this sample and the last
+    /// adds the way between them to its stretch; outside, its stretch ends.
+    fn sample(&mut self, setup: &Setup, positions: &[Point3<f64>]) {
+        for (k, &(o, [lo, hi], _)) in setup.inspected.iter().enumerate() {
+            for (v, p) in positions.iter().enumerate() {
+                let d = setup.prisms[o].clearance(p);
+                if (lo..=hi).contains(&d) {
+                    if let Some(last) = self.last.get(v) {
+                        self.run[k][v] += (p - last).norm();
+                    }
+                    self.best[k] = self.best[k].max(self.run[k][v]);
+                } else {
+                    self.run[k][v] = 0.0;
+                }
+            }
+        }
+        self.last = positions.to_vec();
     }
 }
 
@@ -347,12 +407,14 @@ pub fn as_written(setup: &Setup) -> Flown {
     let start = if start.is_finite() { start } else { 0.0 };
     let steps = ((setup.planned_end - start).max(0.0) / dt).ceil() as usize;
     let mut positions = vec![Point3::origin(); n];
+    let mut passes = Passes::new(setup, n);
     for step in 0..=steps {
         let t = start + step as f64 * dt;
         for (v, f) in flights.iter().enumerate() {
             positions[v] = f.at(t).0;
         }
         measure(setup, t, &positions, &mut pairs, &mut obstacles);
+        passes.sample(setup, &positions);
     }
     Flown {
         flight: 0,
@@ -360,6 +422,7 @@ pub fn as_written(setup: &Setup) -> Flown {
         obstacles,
         cross_track: vec![0.0; n],
         takeoff: vec![0.0; n],
+        inspections: passes.best,
         finished: true,
         tracks: None,
         spread: None,

@@ -100,6 +100,21 @@ pub struct ObstacleSpread {
     pub clearance: Spread,
 }
 
+/// Eq. 8 on one inspected obstacle over the flights: the longest stretch
+/// flown within its band, and the share of flights that still inspect it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct InspectionSpread {
+    pub obstacle: String,
+    /// The band [d_min, d_max] from the surface and the pass asked, metres.
+    pub band: [f64; 2],
+    pub required: f64,
+    /// Flights whose stretch was at least `required`.
+    pub inspected: Share,
+    pub p50: f64,
+    pub p5: f64,
+    pub as_written: f64,
+}
+
 /// One vehicle's largest cross-track error per flight, over the flights.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CrossTrack {
@@ -144,6 +159,8 @@ pub struct Report {
     pub pairs: Vec<PairSpread>,
     pub obstacles: Vec<ObstacleSpread>,
     pub cross_track: Vec<CrossTrack>,
+    /// Eq. 8 on each inspected obstacle.
+    pub inspections: Vec<InspectionSpread>,
     /// The conditions, in words.
     pub conditions: String,
 }
@@ -225,7 +242,27 @@ impl Report {
                         .any(|c| c.distance < setup.clearance)
             })
             .count();
+        let inspections = setup
+            .inspected
+            .iter()
+            .enumerate()
+            .map(|(k, &(o, band, required))| {
+                let mut stretch: Vec<f64> = flown.iter().map(|f| f.inspections[k]).collect();
+                stretch.sort_by(f64::total_cmp);
+                let kept = stretch.iter().filter(|&&s| s >= required).count();
+                InspectionSpread {
+                    obstacle: setup.mission.obstacles[o].name.clone(),
+                    band,
+                    required,
+                    inspected: wilson(kept, flown.len()),
+                    p50: quantile(&stretch, 0.5),
+                    p5: quantile(&stretch, 0.05),
+                    as_written: ideal.inspections[k],
+                }
+            })
+            .collect();
         Report {
+            inspections,
             mission: setup.mission.name.clone(),
             pipeline: setup.pipeline,
             seed: options.seed,
@@ -327,6 +364,23 @@ impl Report {
                 "  {:<12} … {} more (--verbose, --json)\n",
                 "",
                 self.obstacles.len() - listed
+            );
+        }
+        for (i, s) in self.inspections.iter().enumerate() {
+            let label = if i == 0 { "inspections" } else { "" };
+            out += &format!(
+                "  {label:<12} '{}': within [{}, {}] m for p50 {:.1} m, p5 {:.1} m (≥ {} m in {:.1} % of flights, \
+                 95 % CI {:.1}-{:.1} %); as written {:.1} m\n",
+                s.obstacle,
+                s.band[0],
+                s.band[1],
+                s.p50,
+                s.p5,
+                s.required,
+                100.0 * s.inspected.share,
+                100.0 * s.inspected.low,
+                100.0 * s.inspected.high,
+                s.as_written
             );
         }
         let tracks: Vec<String> = self
