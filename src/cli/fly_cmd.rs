@@ -116,14 +116,7 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
     }
     let report = match report {
         Ok(r) => r,
-        Err(FlightError::Cancelled) => {
-            eprintln!("cancelled");
-            return exit::CANCELLED;
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            return exit::ERROR;
-        }
+        Err(e) => return said(&e),
     };
     print!("{}", report.text(args.verbose));
     let sinks = args.record.sinks();
@@ -222,14 +215,7 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
     );
     let search = match flight::find_margin(pipeline, mission, target, options, &mut plan, cancel) {
         Ok(s) => s,
-        Err(FlightError::Cancelled) => {
-            eprintln!("cancelled");
-            return exit::CANCELLED;
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            return exit::ERROR;
-        }
+        Err(e) => return said(&e),
     };
     let tried: Vec<String> = search
         .tried
@@ -273,6 +259,17 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
         return exit::ERROR;
     }
     code
+}
+
+/// A check that did not end, said on stderr: its exit status.
+fn said(e: &FlightError) -> u8 {
+    if *e == FlightError::Cancelled {
+        eprintln!("cancelled");
+        exit::CANCELLED
+    } else {
+        eprintln!("error: {e}");
+        exit::ERROR
+    }
 }
 
 /// 1 − share as a percentage of flights kept ("99.9 %").

@@ -149,6 +149,29 @@ impl<'m> Setup<'m> {
         })
     }
 
+    /// When the first vehicle's plan starts, seconds on the plan's clock.
+    pub fn start(&self) -> f64 {
+        let start = self
+            .plans
+            .iter()
+            .filter_map(|p| p.waypoints.first().map(|w| w.t))
+            .fold(f64::INFINITY, f64::min);
+        if start.is_finite() { start } else { 0.0 }
+    }
+
+    /// A flight's closest approaches before it flies: every pair and every
+    /// vehicle's near obstacles at infinity.
+    fn no_approach_yet(&self) -> (Vec<Closest>, Vec<Vec<Closest>>) {
+        let n = self.plans.len();
+        let pairs = vec![Closest::FAR; n * n.saturating_sub(1) / 2];
+        let obstacles = self
+            .near
+            .iter()
+            .map(|near| vec![Closest::FAR; near.len()])
+            .collect();
+        (pairs, obstacles)
+    }
+
     /// Steps of one flight.
     pub fn steps(&self) -> usize {
         (self.horizon / self.mission.flight.step).ceil() as usize
@@ -254,23 +277,13 @@ fn fly_keeping(setup: &Setup, seed: u64, k: usize, keep_tracks: bool, keep_sprea
             start,
         ));
     }
-    let mut pairs = vec![Closest::FAR; n * n.saturating_sub(1) / 2];
-    let mut obstacles: Vec<Vec<Closest>> = setup
-        .near
-        .iter()
-        .map(|near| vec![Closest::FAR; near.len()])
-        .collect();
+    let (mut pairs, mut obstacles) = setup.no_approach_yet();
     let mut cross_track = vec![0.0f64; n];
     let mut tracks = keep_tracks.then(|| vec![Vec::new(); n]);
     let mut spread: Option<Vec<Vec<f32>>> = keep_spread.then(|| vec![Vec::new(); n]);
     let dt = p.step;
     let steps = setup.steps();
-    let start = setup
-        .plans
-        .iter()
-        .filter_map(|p| p.waypoints.first().map(|w| w.t))
-        .fold(f64::INFINITY, f64::min);
-    let start = if start.is_finite() { start } else { 0.0 };
+    let start = setup.start();
     let mut positions = vec![Point3::origin(); n];
     let mut passes = Passes::new(setup, n);
     let mut finished = false;
@@ -392,19 +405,9 @@ fn measure(
 pub fn as_written(setup: &Setup) -> Flown {
     let flights: Vec<Flight> = setup.plans.iter().map(Flight::new).collect();
     let n = flights.len();
-    let mut pairs = vec![Closest::FAR; n * n.saturating_sub(1) / 2];
-    let mut obstacles: Vec<Vec<Closest>> = setup
-        .near
-        .iter()
-        .map(|near| vec![Closest::FAR; near.len()])
-        .collect();
+    let (mut pairs, mut obstacles) = setup.no_approach_yet();
     let dt = setup.mission.flight.step * SAMPLE_EVERY as f64;
-    let start = setup
-        .plans
-        .iter()
-        .filter_map(|p| p.waypoints.first().map(|w| w.t))
-        .fold(f64::INFINITY, f64::min);
-    let start = if start.is_finite() { start } else { 0.0 };
+    let start = setup.start();
     let steps = ((setup.planned_end - start).max(0.0) / dt).ceil() as usize;
     let mut positions = vec![Point3::origin(); n];
     let mut passes = Passes::new(setup, n);
@@ -496,12 +499,7 @@ pub fn recording(
     let spreads = spreads.ok_or(FlightError::Cancelled)?;
     let dt = setup.mission.flight.step * SAMPLE_EVERY as f64;
     let samples = spreads.iter().flatten().map(Vec::len).max().unwrap_or(0);
-    let start = setup
-        .plans
-        .iter()
-        .filter_map(|p| p.waypoints.first().map(|w| w.t))
-        .fold(f64::INFINITY, f64::min);
-    let start = if start.is_finite() { start } else { 0.0 };
+    let start = setup.start();
     let times: Vec<f64> = (0..samples).map(|k| start + k as f64 * dt).collect();
     let envelope = (0..setup.plans.len())
         .map(|v| {
