@@ -1074,7 +1074,13 @@ fn the_flight_check_shows_its_verdict_the_worst_place_and_the_envelope() {
         assert!(screen.contains("worst"), "{size:?}\n{screen}");
     }
     // Wide enough, the map marks the worst place itself (its ✕ may sit
-    // under an IWP's ◆: the word stays).
+    // under an IWP's ◆: the word stays), and so does the side view.
     let screen = render_at(&app, Instant::now(), (140, 42));
     assert!(screen.matches("worst").count() >= 2, "{screen}");
+    app.update(Action::ToggleSideView);
+    let side = render_at(&app, Instant::now(), (140, 42));
+    assert!(
+        side.contains("Side view") && side.contains("✕ worst"),
+        "{side}"
+    );
 }

@@ -5,7 +5,8 @@ use super::*;
 /// Distance along the path vs altitude, with the altitude band and the
 /// obstacles the path passes.
 ///
-/// Long (~130 lines): the side view's layers in drawing order (band, obstacles, path, vehicles).
+/// Long (~150 lines): the side view's layers in drawing order (band, obstacles, vehicles, the
+/// flight check's envelope, path).
 pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
     let m = app.mission();
     let result = result_of(app);
@@ -124,6 +125,28 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
                         points: &pts,
                         color,
                     });
+                }
+            }
+            // The flight check's p99 envelope (`G`): a bar of its radius
+            // above and below each UAV's plan, one a second, and the worst place.
+            if let Some(crate::tui::jobs::FlightCheck::Done(r)) =
+                app.shown().and_then(|j| j.flight.as_ref())
+            {
+                for (v, points) in r.envelope.iter().enumerate() {
+                    for &(p, radius) in points.iter().step_by(20) {
+                        if let Some((s, _)) = closest_along(&centroid, &along, &p.xy()) {
+                            ctx.draw(&Line::new(s, p.z - radius, s, p.z + radius, uav_color(v)));
+                        }
+                    }
+                }
+                if let Some((_, at)) = &r.worst
+                    && let Some((s, _)) = closest_along(&centroid, &along, &at.xy())
+                {
+                    ctx.print(
+                        s,
+                        at.z,
+                        Span::styled("✕ worst", Style::default().red().bold()),
+                    );
                 }
             }
             let pts: Vec<(f64, f64)> = along
