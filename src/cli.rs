@@ -580,6 +580,25 @@ fn load_reporting(path: &std::path::Path) -> Option<mission::Mission> {
     }
 }
 
+/// Opens `sinks` for a recording of a `kind` run on `mission`, each viewer
+/// that cannot be reached a warning on stderr; `None` when nothing records.
+/// A sink that cannot start is said, and its exit status returned.
+fn start_recorder(
+    mission: &mission::Mission,
+    kind: Kind,
+    sinks: &Sinks,
+) -> Result<Option<Recorder>, u8> {
+    let mut warnings = Vec::new();
+    let started = Recorder::start(&mission.name, Some(kind), sinks, &mut warnings);
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+    started.map_err(|e| {
+        eprintln!("error: {e}");
+        exit::ERROR
+    })
+}
+
 /// One line about the file a recording left.
 fn report_recording(finished: Option<&record::Finished>) {
     let Some(f) = finished else { return };
@@ -739,17 +758,10 @@ fn run_pipeline(
     };
     let run = run(seed.unwrap_or(mission.seed));
     let kind = run.kind;
-    let mut warnings = Vec::new();
-    let recorder = match Recorder::start(&mission.name, Some(kind), sinks, &mut warnings) {
+    let recorder = match start_recorder(&mission, kind, sinks) {
         Ok(r) => r,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return exit::ERROR;
-        }
+        Err(code) => return code,
     };
-    for w in warnings {
-        eprintln!("warning: {w}");
-    }
     let cancel = cancel_on_ctrl_c();
     let mut progress = StderrProgress::new();
     let ran = run.carry_out(&mission, recorder, &mut progress, &cancel);

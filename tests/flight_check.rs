@@ -51,13 +51,6 @@ fn a_calm_flight_is_the_files_as_written_to_5_cm() {
         let schedule = Flight::new(plan);
         for &(t, p) in &tracks[v] {
             let d = (schedule.at(t).0 - p).norm();
-            if v == 0 && d > 0.05 && std::env::var("DBG").is_ok() {
-                let (q, vel) = schedule.at(t);
-                eprintln!(
-                    "t {t:.2} d {d:.3} ref {:.2} {:.2} {:.2} v {:.2} {:.2} {:.2} at {:.2} {:.2} {:.2}",
-                    q.x, q.y, q.z, vel.x, vel.y, vel.z, p.x, p.y, p.z
-                );
-            }
             if d > worst.0 {
                 worst = (d, v, t);
             }

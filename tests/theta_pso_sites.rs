@@ -24,27 +24,31 @@ const WIDE_SHARE: std::ops::Range<u64> = 400..416;
 
 type Run = (sites::Site, Result<bool, String>, String);
 
+/// A site planned with the paper's swarm on one core: feasible or refused
+/// (why), and the first failure of its verification.
+fn judged(mission: &skyform::mission::Mission, seed: u64) -> (Result<bool, String>, String) {
+    match plan(
+        mission,
+        seed,
+        PlanOptions { parallel: false },
+        &mut Silent,
+        &CancelToken::new(),
+    ) {
+        Ok(o) => (
+            Ok(o.feasible()),
+            o.verification.first_failure().unwrap_or_default(),
+        ),
+        Err(e) => (Err(e.to_string()), String::new()),
+    }
+}
+
 /// Plans each site of `share` with the paper's swarm on one core.
 fn plan_share(share: std::ops::Range<u64>, generate: fn(u64) -> sites::Site) -> Vec<Run> {
     share
         .into_par_iter()
         .map(|i| {
             let site = generate(i);
-            let seed = i % 3;
-            let result = plan(
-                &site.mission,
-                seed,
-                PlanOptions { parallel: false },
-                &mut Silent,
-                &CancelToken::new(),
-            );
-            let (feasible, why) = match result {
-                Ok(o) => (
-                    Ok(o.feasible()),
-                    o.verification.first_failure().unwrap_or_default(),
-                ),
-                Err(e) => (Err(e.to_string()), String::new()),
-            };
+            let (feasible, why) = judged(&site.mission, i % 3);
             (site, feasible, why)
         })
         .collect()
@@ -128,20 +132,7 @@ fn every_site_of_the_three_dimensional_share_is_planned_feasible() {
         .into_par_iter()
         .map(|i| {
             let site = sites::three_d::generated_3d(i);
-            let result = plan(
-                &site.mission,
-                i % 3,
-                PlanOptions { parallel: false },
-                &mut Silent,
-                &CancelToken::new(),
-            );
-            let (feasible, why) = match result {
-                Ok(o) => (
-                    Ok(o.feasible()),
-                    o.verification.first_failure().unwrap_or_default(),
-                ),
-                Err(e) => (Err(e.to_string()), String::new()),
-            };
+            let (feasible, why) = judged(&site.mission, i % 3);
             (site.mission.name.clone(), site.dims, feasible, why)
         })
         .collect();

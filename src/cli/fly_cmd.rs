@@ -11,7 +11,6 @@ use crate::export::Planned;
 use crate::flight::{self, FlightError, Options, Setup};
 use crate::mission::Mission;
 use crate::pipelines::{CancelToken, Kind, Silent};
-use crate::record::Recorder;
 use crate::run::Run;
 
 /// The arguments of `skyform fly` (its help is on `Command::Fly`).
@@ -81,6 +80,11 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
         }
     }
     let seed = args.seed.unwrap_or(mission.seed);
+    let cancel = cancel_on_ctrl_c();
+    // The margin search plans for itself, from no margin up.
+    if let Some(target) = args.target {
+        return margin(args, &mission, seed, target, &cancel);
+    }
     let planned = match super::export_cmd::planned(&mission, args.pipeline, seed) {
         Ok(p) => p,
         Err(code) => return code,
@@ -95,10 +99,6 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
     if let Some(k) = args.flight {
         return replay(&setup, seed, k);
     }
-    let cancel = cancel_on_ctrl_c();
-    if let Some(target) = args.target {
-        return margin(args, &mission, seed, target, &cancel);
-    }
     let terminal = std::io::stderr().is_terminal();
     let progress = |done: usize, total: usize| {
         if terminal && (done.is_multiple_of(50) || done == total) {
@@ -110,18 +110,22 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
         seed,
         threads: args.threads,
     };
-    let report = flight::check(&setup, options, &progress, &cancel);
+    // A recording needs each flight's cross-track samples: kept as they fly.
+    let checked = if args.record.sinks().is_empty() {
+        flight::check(&setup, options, &progress, &cancel).map(|r| (r, None))
+    } else {
+        flight::check_recorded(&setup, options, &progress, &cancel).map(|(r, rec)| (r, Some(rec)))
+    };
     if terminal {
         eprintln!();
     }
-    let report = match report {
+    let (report, recording) = match checked {
         Ok(r) => r,
         Err(e) => return said(&e),
     };
     print!("{}", report.text(args.verbose));
-    let sinks = args.record.sinks();
-    if !sinks.is_empty() {
-        let code = record(&setup, options, &report, args, &cancel);
+    if let Some(recording) = recording {
+        let code = record(&setup, recording, &report, args);
         if code != exit::OK {
             return code;
         }
@@ -146,42 +150,22 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
     }
 }
 
-/// The recording of a check (`--rrd`, `--connect`, `--spawn`): the
-/// flights flown again keeping their envelope and the worst tracks.
+/// The recording of a check (`--rrd`, `--connect`, `--spawn`): the scene,
+/// the plan as written, the envelope, the worst flights, the report.
 fn record(
     setup: &Setup,
-    options: Options,
+    recording: flight::Recording,
     report: &flight::Report,
     args: &FlyArgs,
-    cancel: &CancelToken,
 ) -> u8 {
-    let mut warnings = Vec::new();
-    let recorder = match Recorder::start(
-        &setup.mission.name,
-        Some(args.pipeline),
-        &args.record.sinks(),
-        &mut warnings,
-    ) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return exit::ERROR;
-        }
-    };
-    for w in warnings {
-        eprintln!("warning: {w}");
-    }
-    let Some(mut recorder) = recorder else {
-        return exit::OK;
-    };
+    let mut recorder =
+        match super::start_recorder(setup.mission, args.pipeline, &args.record.sinks()) {
+            Ok(Some(r)) => r,
+            Ok(None) => return exit::OK,
+            Err(code) => return code,
+        };
     recorder.log_mission(setup.mission);
-    match flight::recording(setup, options, report, cancel) {
-        Ok(recording) => recorder.log_flights(recording, report.text(true)),
-        Err(e) => {
-            eprintln!("error: the recording: {e}");
-            return exit::ERROR;
-        }
-    }
+    recorder.log_flights(recording, report.text(true));
     super::report_recording(Some(&recorder.finish()));
     exit::OK
 }
@@ -288,26 +272,21 @@ fn replay(setup: &Setup, seed: u64, k: usize) -> u8 {
     let n = setup.plans.len();
     let vehicle = |v: usize| setup.plans[v].vehicle + 1;
     let mut broke = false;
-    let mut pair = 0;
-    for i in 0..n {
-        for j in i + 1..n {
-            let c = f.pairs[pair];
-            let mark = if c.distance < setup.closest {
-                "BREAKS"
-            } else {
-                "ok"
-            };
-            broke |= c.distance < setup.closest;
-            println!(
-                "  {mark:<6} UAV {} - UAV {}: closest {:.2} m at t = {:.1} s (2 r_Q = {:.2} m)",
-                vehicle(i),
-                vehicle(j),
-                c.distance,
-                c.t,
-                setup.closest
-            );
-            pair += 1;
-        }
+    for ((i, j), c) in flight::vehicle_pairs(n).zip(&f.pairs) {
+        let mark = if c.distance < setup.closest {
+            "BREAKS"
+        } else {
+            "ok"
+        };
+        broke |= c.distance < setup.closest;
+        println!(
+            "  {mark:<6} UAV {} - UAV {}: closest {:.2} m at t = {:.1} s (2 r_Q = {:.2} m)",
+            vehicle(i),
+            vehicle(j),
+            c.distance,
+            c.t,
+            setup.closest
+        );
     }
     for (v, near) in setup.near.iter().enumerate() {
         let tightest = near

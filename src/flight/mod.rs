@@ -195,6 +195,12 @@ impl<'m> Setup<'m> {
     }
 }
 
+/// The pairs (i, j), i < j, of `n` vehicles in the order a flight keeps
+/// them (`Flown::pairs`): (0, 1), (0, 2), …, (1, 2), …
+pub fn vehicle_pairs(n: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..n).flat_map(move |i| (i + 1..n).map(move |j| (i, j)))
+}
+
 /// One vehicle's sampled positions: (seconds on the plan's clock, ENU).
 pub type Track = Vec<(f64, Point3<f64>)>;
 
@@ -384,13 +390,8 @@ fn measure(
     pairs: &mut [Closest],
     obstacles: &mut [Vec<Closest>],
 ) {
-    let n = positions.len();
-    let mut k = 0;
-    for i in 0..n {
-        for j in i + 1..n {
-            pairs[k].keep((positions[i] - positions[j]).norm(), t);
-            k += 1;
-        }
+    for ((i, j), closest) in vehicle_pairs(positions.len()).zip(pairs.iter_mut()) {
+        closest.keep((positions[i] - positions[j]).norm(), t);
     }
     for (v, near) in setup.near.iter().enumerate() {
         for (slot, &o) in near.iter().enumerate() {
@@ -473,32 +474,20 @@ fn on_threads<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) 
     }
 }
 
-/// Flies the check again keeping what a recording shows: every flight's
-/// cross-track samples for the envelope, the [`RECORDED_WORST`] worst
-/// flights' tracks (the report's worst, then the flights where the
-/// tightest pairs and obstacles were worst).
-pub fn recording(
-    setup: &Setup,
-    options: Options,
-    report: &Report,
-    cancel: &CancelToken,
-) -> Result<Recording, FlightError> {
-    setup.within_budget(options.flights)?;
-    let spreads: Vec<Option<Vec<Vec<f32>>>> = on_threads(options.threads, || {
-        (0..options.flights)
-            .into_par_iter()
-            .map(|k| {
-                if cancel.is_cancelled() {
-                    return None;
-                }
-                fly_keeping(setup, options.seed, k, false, true).spread
-            })
-            .collect()
-    });
-    let spreads: Option<Vec<Vec<Vec<f32>>>> = spreads.into_iter().collect();
-    let spreads = spreads.ok_or(FlightError::Cancelled)?;
+/// What a recording shows, from the flights of a check flown with their
+/// cross-track samples kept ([`check_recorded`]): the envelope, and the
+/// [`RECORDED_WORST`] worst flights' tracks (the report's worst, then the
+/// flights where the tightest pairs and obstacles were worst), flown again.
+fn recording(setup: &Setup, options: Options, report: &Report, flown: &[Flown]) -> Recording {
+    let spreads: Vec<&Vec<Vec<f32>>> = flown.iter().filter_map(|f| f.spread.as_ref()).collect();
     let dt = setup.mission.flight.step * SAMPLE_EVERY as f64;
-    let samples = spreads.iter().flatten().map(Vec::len).max().unwrap_or(0);
+    let samples = spreads
+        .iter()
+        .copied()
+        .flatten()
+        .map(Vec::len)
+        .max()
+        .unwrap_or(0);
     let start = setup.start();
     let times: Vec<f64> = (0..samples).map(|k| start + k as f64 * dt).collect();
     let envelope = (0..setup.plans.len())
@@ -549,13 +538,13 @@ pub fn recording(
             )
         })
         .collect();
-    Ok(Recording {
+    Recording {
         mission: setup.mission.name.clone(),
         times,
         written,
         envelope,
         worst,
-    })
+    }
 }
 
 /// Flies `options.flights` flights of `setup` and reports them;
@@ -566,31 +555,51 @@ pub fn check(
     progress: &(dyn Fn(usize, usize) + Sync),
     cancel: &CancelToken,
 ) -> Result<Report, FlightError> {
+    let flown = fly_all(setup, options, false, progress, cancel)?;
+    Ok(Report::new(setup, options, &flown, &as_written(setup)))
+}
+
+/// [`check`], and what a recording of it shows, from the same flights
+/// (their cross-track samples kept: about 5 kB a vehicle-minute).
+pub fn check_recorded(
+    setup: &Setup,
+    options: Options,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &CancelToken,
+) -> Result<(Report, Recording), FlightError> {
+    let flown = fly_all(setup, options, true, progress, cancel)?;
+    let report = Report::new(setup, options, &flown, &as_written(setup));
+    let recording = recording(setup, options, &report, &flown);
+    Ok((report, recording))
+}
+
+/// Every flight of a check, in flight order, on `options.threads`.
+fn fly_all(
+    setup: &Setup,
+    options: Options,
+    keep_spread: bool,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &CancelToken,
+) -> Result<Vec<Flown>, FlightError> {
     setup.within_budget(options.flights)?;
     let done = AtomicUsize::new(0);
-    let fly_all = || -> Vec<Option<Flown>> {
+    let flown: Vec<Option<Flown>> = on_threads(options.threads, || {
         (0..options.flights)
             .into_par_iter()
             .map(|k| {
                 if cancel.is_cancelled() {
                     return None;
                 }
-                let flown = fly(setup, options.seed, k, false);
+                let flown = fly_keeping(setup, options.seed, k, false, keep_spread);
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, options.flights);
                 Some(flown)
             })
             .collect()
-    };
-    let flown = on_threads(options.threads, fly_all);
-    let flown: Option<Vec<Flown>> = flown.into_iter().collect();
-    let flown = flown.ok_or(FlightError::Cancelled)?;
-    Ok(Report::new(setup, options, &flown, &as_written(setup)))
-}
-
-/// The wind's mean vector, m/s ENU (for the reports).
-pub fn mean_wind(p: &crate::mission::FlightParams) -> Vector3<f64> {
-    let to = (p.wind_from_deg + 180.0).to_radians();
-    Vector3::new(to.sin(), to.cos(), 0.0) * p.wind_speed
+    });
+    flown
+        .into_iter()
+        .collect::<Option<Vec<Flown>>>()
+        .ok_or(FlightError::Cancelled)
 }
 
 /// One margin tried by [`find_margin`]: the extra clearance, and the share

@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use super::{Flown, Options, Setup};
+use super::{Flown, Options, Setup, vehicle_pairs};
 use crate::mission::Turbulence;
 
 /// Lines of pairs and of obstacles the text lists (the tightest); the
@@ -169,22 +169,20 @@ impl Report {
     pub fn new(setup: &Setup, options: Options, flown: &[Flown], ideal: &Flown) -> Report {
         let n = setup.plans.len();
         let vehicle = |v: usize| setup.plans[v].vehicle + 1;
-        let mut pairs = Vec::new();
-        let mut k = 0;
-        for i in 0..n {
-            for j in i + 1..n {
+        let mut pairs: Vec<PairSpread> = vehicle_pairs(n)
+            .enumerate()
+            .map(|(k, (i, j))| {
                 let values: Vec<(f64, usize, f64)> = flown
                     .iter()
                     .map(|f| (f.pairs[k].distance, f.flight, f.pairs[k].t))
                     .collect();
-                pairs.push(PairSpread {
+                PairSpread {
                     a: vehicle(i),
                     b: vehicle(j),
                     closest: spread(&values, ideal.pairs[k].distance),
-                });
-                k += 1;
-            }
-        }
+                }
+            })
+            .collect();
         let mut obstacles = Vec::new();
         for (v, near) in setup.near.iter().enumerate() {
             for (slot, &o) in near.iter().enumerate() {
@@ -410,24 +408,19 @@ fn worst(setup: &Setup, flown: &[Flown]) -> Option<Worst> {
         }
     };
     for f in flown {
-        let mut k = 0;
-        for i in 0..n {
-            for j in i + 1..n {
-                let c = f.pairs[k];
-                consider(Worst {
-                    flight: f.flight,
-                    vehicle: vehicle(i),
-                    margin: c.distance - setup.closest,
-                    what: format!(
-                        "UAV {} and UAV {} {:.2} m apart",
-                        vehicle(i),
-                        vehicle(j),
-                        c.distance
-                    ),
-                    t: c.t,
-                });
-                k += 1;
-            }
+        for ((i, j), c) in vehicle_pairs(n).zip(&f.pairs) {
+            consider(Worst {
+                flight: f.flight,
+                vehicle: vehicle(i),
+                margin: c.distance - setup.closest,
+                what: format!(
+                    "UAV {} and UAV {} {:.2} m apart",
+                    vehicle(i),
+                    vehicle(j),
+                    c.distance
+                ),
+                t: c.t,
+            });
         }
         for (v, near) in setup.near.iter().enumerate() {
             for (slot, &o) in near.iter().enumerate() {

@@ -363,27 +363,29 @@ fn text(value: &Value) -> Option<String> {
 /// number, or text as KML's extended data holds it); a problem when it is
 /// there but not one.
 fn property(f: &Feature, key: &str, problems: &mut Vec<String>) -> Option<f64> {
-    let value = f.property(key)?;
-    let number = match value {
-        Value::Number(n) => n.as_f64(),
-        Value::String(s) => s.trim().parse::<f64>().ok(),
-        Value::Null => return None,
-        _ => None,
-    };
-    match number {
-        Some(v) if v.is_finite() && v > 0.0 => Some(v),
-        _ => {
-            problems.push(format!(
-                "{}: its `{key}` must be a positive number of metres, got {value}",
-                f.label()
-            ));
-            None
-        }
-    }
+    metres(f, key, |v| v > 0.0, "a positive number of metres", problems)
 }
 
 /// A height above the ground (0 allowed), metres.
 fn ground_property(f: &Feature, key: &str, problems: &mut Vec<String>) -> Option<f64> {
+    metres(
+        f,
+        key,
+        |v| v >= 0.0,
+        "a number of metres, 0 or more",
+        problems,
+    )
+}
+
+/// The finite number of property `key` that `fits`; a problem saying it
+/// must be `what` when it is there but not one.
+fn metres(
+    f: &Feature,
+    key: &str,
+    fits: impl Fn(f64) -> bool,
+    what: &str,
+    problems: &mut Vec<String>,
+) -> Option<f64> {
     let value = f.property(key)?;
     let number = match value {
         Value::Number(n) => n.as_f64(),
@@ -392,10 +394,10 @@ fn ground_property(f: &Feature, key: &str, problems: &mut Vec<String>) -> Option
         _ => None,
     };
     match number {
-        Some(v) if v.is_finite() && v >= 0.0 => Some(v),
+        Some(v) if v.is_finite() && fits(v) => Some(v),
         _ => {
             problems.push(format!(
-                "{}: its `{key}` must be a number of metres, 0 or more, got {value}",
+                "{}: its `{key}` must be {what}, got {value}",
                 f.label()
             ));
             None

@@ -427,7 +427,7 @@ fn start_recording(
 
 /// Flies the plan of `outcome` in `mission`'s `[flight]` air on a worker
 /// thread: progress every 5 % of the flights, then the verdict, the worst
-/// place and the p99 envelope (`flight::check`, `flight::recording`). A
+/// place and the p99 envelope (`flight::check_recorded`). A
 /// panic is reported as a failed check.
 pub fn spawn_flight_check(
     id: JobId,
@@ -471,9 +471,8 @@ fn flight_check(
             let _ = tx.send(JobMsg::Flight(id, FlightUpdate::Progress(done, total)));
         }
     };
-    let report = flight::check(&setup, options, &progress, cancel).map_err(|e| e.to_string())?;
-    let recording =
-        flight::recording(&setup, options, &report, cancel).map_err(|e| e.to_string())?;
+    let (report, recording) =
+        flight::check_recorded(&setup, options, &progress, cancel).map_err(|e| e.to_string())?;
     let pct = |s: &flight::Share| format!("{:.1} %", 100.0 * s.share);
     let verdict = format!(
         "{} break 2 r_Q, {} break r_Q (of {} flights)",
