@@ -343,3 +343,67 @@ fn flight_settings_are_checked_and_the_check_is_bounded() {
         other => panic!("{:?}", other.map(|r| r.flights)),
     }
 }
+
+/// Issue 39, item 3: the margin goes where verification holds it
+/// (`formation.safety_margin`), so the user's slots bound it: the search
+/// tries no margin the mission is invalid with, tries the largest valid
+/// one before it gives up, and names the field that stops it. Here two
+/// slots 3.6 m apart allow 3.6 − (2 r_Q + 0.1) = 2.5 m, and fixes off by
+/// 3 m break r_Q whatever the plan keeps.
+#[test]
+fn the_margin_search_stops_at_what_the_slots_allow_and_says_so() {
+    let mut m = pole_field();
+    m.formation.slots = vec![
+        nalgebra::Vector3::new(0.0, 1.8, 0.0),
+        nalgebra::Vector3::new(0.0, -1.8, 0.0),
+    ];
+    m.formation.uav_radius = 0.5;
+    m.formation.safety_margin = 0.1;
+    m.flight.gnss_sigma_horizontal = 3.0;
+    let options = flight::Options {
+        flights: 12,
+        seed: 1,
+        threads: None,
+    };
+    let mut plan = |m: &Mission| -> Result<Planned, String> {
+        let o = outcome::run(
+            Kind::ThetaPso,
+            m,
+            1,
+            PlanOptions::default(),
+            &mut Silent,
+            &CancelToken::new(),
+        )
+        .map_err(|e| e.to_string())?;
+        if !o.ok() {
+            return Err(o.headline());
+        }
+        Ok(Planned::from_outcome(m, &o))
+    };
+    let search = flight::find_margin(
+        Kind::ThetaPso,
+        &m,
+        0.0,
+        options,
+        &mut plan,
+        &CancelToken::new(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(search.margin, None, "{:?}", search.tried);
+    let limit = search.limit.as_ref().expect("the slots limit the margin");
+    assert!(
+        (limit.margin - 2.5).abs() <= flight::MARGIN_RESOLUTION,
+        "{limit:?}"
+    );
+    assert!(limit.why.starts_with("formation.slots"), "{limit:?}");
+    let tried: Vec<f64> = search.tried.iter().map(|t| t.margin).collect();
+    assert_eq!(tried[..5], [0.0, 0.25, 0.5, 1.0, 2.0], "{tried:?}");
+    assert_eq!(tried.last(), Some(&limit.margin), "{tried:?}");
+    // Each try planned with the margin as a hard limit: its flights'
+    // breaks are counted, the plan as written kept it.
+    assert!(
+        search.tried.iter().all(|t| t.share.is_some()),
+        "{:?}",
+        search.tried
+    );
+}

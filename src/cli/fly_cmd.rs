@@ -42,7 +42,7 @@ pub struct FlyArgs {
     #[arg(long)]
     pub verbose: bool,
     /// Find the smallest extra clearance m from the obstacles (θ-PSO:
-    /// theta_pso.clearance_margin + m; fleet: fleet.safety_distance + m)
+    /// formation.safety_margin + m; fleet: fleet.safety_distance + m)
     /// whose plan breaks 2 r_Q or r_Q in at most this share of the flights
     /// (0.001: one flight in a thousand), re-planning as needed, and report
     /// that plan.
@@ -208,13 +208,7 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
         .collect();
     let code = match (&search.margin, &search.report) {
         (Some(m), Some(report)) => {
-            let (field, now) = match pipeline {
-                Kind::Fleet => ("fleet.safety_distance", mission.fleet.safety_distance),
-                Kind::ThetaPso | Kind::Flatlo => (
-                    "theta_pso.clearance_margin",
-                    mission.theta_pso.clearance_margin,
-                ),
-            };
+            let (field, now) = flight::margin_field(mission, pipeline);
             println!(
                 "margin       {m:.2} m keeps {} of flights within 2 r_Q and r_Q (target {:.2} %): \
                  plan with {field} = {:.2} m (now {now:.2} m)",
@@ -227,12 +221,21 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
             exit::OK
         }
         _ => {
+            let highest = search
+                .limit
+                .as_ref()
+                .map_or(flight::MAX_MARGIN, |l| l.margin);
             println!(
-                "margin       none up to {} m meets {:.2} %: {}",
-                flight::MAX_MARGIN,
-                100.0 * target,
-                tried.join("; ")
+                "margin       none up to {highest:.2} m meets {:.2} %",
+                100.0 * target
             );
+            if let Some(limit) = &search.limit {
+                println!(
+                    "limit        no margin above {:.2} m is valid: {}",
+                    limit.margin, limit.why
+                );
+            }
+            println!("tried        {}", tried.join("; "));
             exit::INFEASIBLE
         }
     };

@@ -622,13 +622,41 @@ pub struct MarginSearch {
     /// The check of the plan made with it.
     pub report: Option<Report>,
     pub tried: Vec<Tried>,
+    /// The largest margin the mission stays valid with, when that is
+    /// below [`MAX_MARGIN`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit: Option<MarginLimit>,
 }
 
-/// `mission` asked to keep `m` more from the obstacles ([`find_margin`]).
+/// What stops the margin search short of [`MAX_MARGIN`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MarginLimit {
+    /// The largest valid margin, metres.
+    pub margin: f64,
+    /// The validator's message just above it.
+    pub why: String,
+}
+
+/// `mission` asked to keep `m` more ([`find_margin`]): θ-PSO plans with
+/// `formation.safety_margin` + m, which verification holds as hard limits
+/// (every UAV r_Q + the safety margin from every obstacle, every pair
+/// 2 r_Q + the safety margin apart, eq. 7), so a plan that passes keeps
+/// the margin everywhere, in a named IWP's gap too (a gap too narrow for
+/// it is gone round or refused); the fleet with `fleet.safety_distance` + m.
 pub fn with_margin(mission: &mut Mission, pipeline: Kind, m: f64) {
     match pipeline {
-        Kind::ThetaPso | Kind::Flatlo => mission.theta_pso.clearance_margin += m,
+        Kind::ThetaPso | Kind::Flatlo => mission.formation.safety_margin += m,
         Kind::Fleet => mission.fleet.safety_distance += m,
+    }
+}
+
+/// The field [`with_margin`] adds to, and its value in `mission`.
+pub fn margin_field(mission: &Mission, pipeline: Kind) -> (&'static str, f64) {
+    match pipeline {
+        Kind::ThetaPso | Kind::Flatlo => {
+            ("formation.safety_margin", mission.formation.safety_margin)
+        }
+        Kind::Fleet => ("fleet.safety_distance", mission.fleet.safety_distance),
     }
 }
 
@@ -637,16 +665,46 @@ pub const MARGIN_RESOLUTION: f64 = 0.05;
 /// The largest extra clearance tried, metres.
 pub const MAX_MARGIN: f64 = 8.0;
 
+/// Why no margin above a value can be tried: the mission with it is no
+/// longer valid (θ-PSO's slots closer than 2 r_Q + the safety margin), in
+/// the validator's words; `None` when `m` is valid.
+fn invalid_with(mission: &Mission, pipeline: Kind, m: f64) -> Option<String> {
+    let mut changed = mission.clone();
+    with_margin(&mut changed, pipeline, m);
+    crate::mission::validate(&changed)
+        .into_iter()
+        .find(|d| d.severity == crate::mission::Severity::Error)
+        .map(|d| format!("{}: {}", d.path, d.message))
+}
+
+/// The largest margin in [0, `high`] the mission stays valid with, a
+/// [`MARGIN_RESOLUTION`] step inside the boundary, and why not more;
+/// `None` when `high` is valid.
+fn margin_cap(mission: &Mission, pipeline: Kind, high: f64) -> Option<(f64, String)> {
+    let mut why = invalid_with(mission, pipeline, high)?;
+    let (mut low, mut high) = (0.0, high);
+    while high - low > MARGIN_RESOLUTION / 4.0 {
+        let mid = 0.5 * (low + high);
+        match invalid_with(mission, pipeline, mid) {
+            Some(message) => (high, why) = (mid, message),
+            None => low = mid,
+        }
+    }
+    // A step inside the boundary: a plan keeps its limits with a little
+    // room (a pair exactly at 2 r_Q + the margin fails verification).
+    let step = MARGIN_RESOLUTION;
+    Some((((low / step).ceil() - 1.0).max(0.0) * step, why))
+}
+
 /// The smallest extra clearance m whose plan, flown `options.flights`
 /// times, breaks a limit in at most `target` of the flights: 0, then
 /// doubling from 0.25 m, then halving the interval between the last that
-/// failed and the first that met it. θ-PSO plans with
-/// `theta_pso.clearance_margin` + m (every UAV keeps r_Q + m from the
-/// obstacles where the site leaves room: an IWP's gap keeps what it has),
-/// the fleet with `fleet.safety_distance` + m; the formation's spacing is
-/// the user's slots, which no margin changes. `plan` plans a mission
-/// (`Err`: no plan, and why). The share is the flights' own (its 95 %
-/// interval is in the report).
+/// failed and the first that met it (see [`with_margin`] for what m is
+/// added to). Margins that make the mission invalid (θ-PSO: the user's
+/// slots closer than 2 r_Q + the safety margin + m) are not tried beyond
+/// the largest valid one, and the search says so ([`MarginSearch::limit`]).
+/// `plan` plans a mission (`Err`: no plan, and why). The share is the
+/// flights' own (its 95 % interval is in the report).
 pub fn find_margin(
     pipeline: Kind,
     mission: &Mission,
@@ -655,6 +713,7 @@ pub fn find_margin(
     plan: &mut dyn FnMut(&Mission) -> Result<Planned, String>,
     cancel: &CancelToken,
 ) -> Result<MarginSearch, FlightError> {
+    let cap = margin_cap(mission, pipeline, MAX_MARGIN);
     let mut tried = Vec::new();
     let mut attempt = |m: f64, tried: &mut Vec<Tried>| -> Result<Option<Report>, FlightError> {
         if cancel.is_cancelled() {
@@ -678,15 +737,20 @@ pub fn find_margin(
         tried.push(Tried {
             margin: m,
             share: Some(report.break_any.share),
-            note: match &report.worst {
-                Some(w) if report.break_any.count > 0 => format!(
-                    "{} of {} flights break a limit (worst: {})",
-                    report.break_any.count, report.break_any.of, w.what
-                ),
-                _ => format!(
-                    "{} of {} flights break a limit",
-                    report.break_any.count, report.break_any.of
-                ),
+            note: {
+                let counts = format!(
+                    "{} of {} flights break a limit ({} 2 r_Q, {} r_Q",
+                    report.break_any.count,
+                    report.break_any.of,
+                    report.break_separation.count,
+                    report.break_clearance.count
+                );
+                match &report.worst {
+                    Some(w) if report.break_any.count > 0 => {
+                        format!("{counts}; worst: {})", w.what)
+                    }
+                    _ => format!("{counts})"),
+                }
             },
         });
         Ok((report.break_any.share <= target).then_some(report))
@@ -694,8 +758,9 @@ pub fn find_margin(
     // Bracket: the largest margin known to fail, the smallest known to meet.
     let mut failed = None;
     let mut met: Option<(f64, Report)> = None;
-    let mut m = 0.0;
-    while m <= MAX_MARGIN {
+    let highest = cap.as_ref().map_or(MAX_MARGIN, |(m, _)| *m);
+    let mut m: f64 = 0.0;
+    loop {
         match attempt(m, &mut tried)? {
             Some(report) => {
                 met = Some((m, report));
@@ -703,7 +768,11 @@ pub fn find_margin(
             }
             None => failed = Some(m),
         }
-        m = if m == 0.0 { 0.25 } else { 2.0 * m };
+        if m >= highest {
+            break;
+        }
+        // The largest valid margin is tried before giving up.
+        m = if m == 0.0 { 0.25 } else { 2.0 * m }.min(highest);
     }
     if let Some(mut low) = failed
         && let Some((mut high, mut best)) = met.take()
@@ -725,5 +794,6 @@ pub fn find_margin(
         margin: met.as_ref().map(|(m, _)| *m),
         report: met.map(|(_, r)| r),
         tried,
+        limit: cap.map(|(m, why)| MarginLimit { margin: m, why }),
     })
 }
