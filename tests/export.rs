@@ -56,15 +56,15 @@ fn plan_mission(m: &Mission, pipeline: &str) -> Planned {
         "theta-pso" => {
             let o = theta_pso::plan(m, m.seed, PlanOptions::default(), &mut Silent, &cancel)
                 .unwrap_or_else(|e| panic!("{e}"));
-            Planned::theta_pso(m, &o)
+            Planned::from_outcome(m, &o.into())
         }
         "flatlo" => {
             let o = flatlo::plan(m, m.seed, &mut Silent, &cancel).unwrap_or_else(|e| panic!("{e}"));
-            Planned::flatlo(m, &o)
+            Planned::from_outcome(m, &o.into())
         }
         _ => {
             let o = fleet::plan(m, m.seed, &mut Silent, &cancel).unwrap_or_else(|e| panic!("{e}"));
-            Planned::fleet(m, &o)
+            Planned::from_outcome(m, &o.into())
         }
     }
 }
@@ -995,7 +995,7 @@ fn a_plan_faster_than_its_vehicle_is_refused_naming_the_uav_the_leg_and_the_figu
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let fastest = {
-        let p = Planned::theta_pso(&m, &outcome);
+        let p = Planned::from_outcome(&m, &outcome.clone().into());
         let plans = export::reduce(&p, Placement::new(&m).as_ref(), 0.1);
         plans[1]
             .waypoints
@@ -1014,7 +1014,7 @@ fn a_plan_faster_than_its_vehicle_is_refused_naming_the_uav_the_leg_and_the_figu
         max_acceleration_up: None,
         max_acceleration_down: None,
     });
-    let p = Planned::theta_pso(&m, &outcome);
+    let p = Planned::from_outcome(&m, &outcome.clone().into());
     let err = export::export(&m, "bridge", &p, &options(dir.path(), None, false));
     let Err(ExportError::Refused(r)) = err else {
         panic!("expected a refusal, got {err:?}");

@@ -170,7 +170,7 @@ fn the_paper_case_flies_into_line_without_coming_close() {
 fn the_summary_numbers_the_final_line_from_one() {
     let m = paper_mission();
     let out = flatlo::plan(&m, m.seed, &mut Silent, &CancelToken::new()).unwrap();
-    let summary = skyform::outcome::summary::flatlo(&out);
+    let summary = skyform::pipelines::flatlo::summary::flatlo(&out);
     let line = summary
         .lines()
         .find(|l| l.contains("final line"))

@@ -1502,7 +1502,7 @@ fn a_low_wall_the_formation_clears_is_flown_over() {
         o.passed_over
     );
     assert!(o.passed_under.is_empty(), "{:?}", o.passed_under);
-    let summary = skyform::outcome::summary::theta_pso(&o, false);
+    let summary = skyform::pipelines::theta_pso::summary::theta_pso(&o, false);
     assert!(
         summary.contains(&format!("flies over   '{}'", o.passed_over[0])),
         "{summary}"
@@ -1610,7 +1610,7 @@ fn a_forests_summary_is_a_page_with_the_verdict_first() {
         .map(|(k, p)| pole(&format!("tree {}", k + 1), p.x, p.y, 0.5))
         .collect();
     let o = run(&m, 1);
-    let summary = skyform::outcome::summary::theta_pso(&o, false);
+    let summary = skyform::pipelines::theta_pso::summary::theta_pso(&o, false);
     let lines: Vec<&str> = summary.lines().collect();
     assert!(lines.len() <= 30, "{} lines:\n{summary}", lines.len());
     assert!(lines[1].starts_with("  result "), "{summary}");

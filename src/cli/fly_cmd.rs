@@ -182,6 +182,13 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
         threads: args.threads,
     };
     let pipeline = args.pipeline;
+    let Some((field, now)) = flight::margin_field(mission, pipeline) else {
+        eprintln!(
+            "error: --target: {} has no margin to widen",
+            pipeline.name()
+        );
+        return exit::ERROR;
+    };
     let mut plan = |m: &Mission| -> Result<Planned, String> {
         let outcome = Run::new(pipeline, seed)
             .carry_out(m, None, &mut Silent, cancel)
@@ -208,7 +215,6 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
         .collect();
     let code = match (&search.margin, &search.report) {
         (Some(m), Some(report)) => {
-            let (field, now) = flight::margin_field(mission, pipeline);
             println!(
                 "margin       {m:.2} m keeps {} of flights within 2 r_Q and r_Q (target {:.2} %): \
                  plan with {field} = {:.2} m (now {now:.2} m)",

@@ -350,13 +350,7 @@ pub fn sweep_command(args: &SweepArgs) -> u8 {
             return exit::ERROR;
         }
     };
-    let what = match args.pipeline {
-        Kind::ThetaPso if mission.theta_pso.cost == CostKind::Spso => format!(
-            "θ-PSO, SPSO cost, {:?} encoding, {} × {}",
-            mission.theta_pso.encoding, mission.theta_pso.swarm_size, mission.theta_pso.iterations
-        ),
-        kind => kind.name().to_owned(),
-    };
+    let what = args.pipeline.face().describe(&mission);
     eprintln!(
         "sweep: {} · {what} · seeds {a}..{b} ({} runs) · {jobs} jobs",
         mission.name,

@@ -30,12 +30,8 @@ use nalgebra::Point3;
 use serde::Serialize;
 
 use crate::mission::Mission;
-use crate::outcome::tracks::{self, Track};
-use crate::pipelines::Kind;
-use crate::pipelines::Limits;
-use crate::pipelines::flatlo::FlatloOutcome;
-use crate::pipelines::fleet::FleetOutcome;
-use crate::pipelines::theta_pso::ThetaPsoOutcome;
+use crate::outcome::tracks::Track;
+use crate::pipelines::{Airframe, Kind, Limits};
 
 pub use geodesy::{Frame, Geodetic, Home, Placement, Stored};
 pub use legs::{HOLD_STEP, LegLimits, MIN_SPEED, SPEED_STEP};
@@ -101,17 +97,7 @@ pub const MIN_TOLERANCE: f64 = 0.01;
 /// How each pipeline names its vehicles: θ-PSO's UAVs, FLATLO's
 /// aircraft, the fleet's agents.
 pub fn noun(pipeline: Kind) -> &'static str {
-    match pipeline {
-        Kind::ThetaPso => "UAV",
-        Kind::Flatlo => "aircraft",
-        Kind::Fleet => "agent",
-    }
-}
-
-/// FLATLO's airspeed range [min, max], m/s, that every commanded airspeed
-/// must keep (`flatlo.airspeed_range`).
-fn flatlo_airspeed_range(mission: &Mission) -> Option<[f64; 2]> {
-    Some(mission.flatlo.airspeed_range)
+    pipeline.face().noun()
 }
 
 /// What a pipeline's outcome gives the export: each vehicle's track, the
@@ -137,126 +123,35 @@ pub struct Planned {
 }
 
 impl Planned {
-    /// What the export needs of any pipeline's outcome.
+    /// What the export needs of any pipeline's outcome: the tracks its
+    /// vehicles fly (`Outcome::reference_tracks`) and the rules its face
+    /// holds them to (`PipelineOutcome::export_rules`).
     pub fn from_outcome(mission: &Mission, outcome: &crate::outcome::Outcome) -> Self {
-        use crate::outcome::Outcome;
-        match outcome {
-            Outcome::ThetaPso(o) => Planned::theta_pso(mission, o),
-            Outcome::Flatlo(o) => Planned::flatlo(mission, o),
-            Outcome::Fleet(o) => Planned::fleet(mission, o),
+        let rules = outcome.face().export_rules(mission);
+        let tracks = outcome.reference_tracks();
+        let legs = tracks
+            .iter()
+            .map(|t| match rules.airframe {
+                Airframe::Multicopter => LegLimits::multicopter(mission.vehicle.limits(t.vehicle)),
+                Airframe::FixedWing { airspeed } => LegLimits::fixed_wing(Some(airspeed)),
+            })
+            .collect();
+        Planned {
+            pipeline: outcome.kind(),
+            seed: outcome.seed(),
+            legs,
+            tracks,
+            limits: rules.limits,
+            margin: rules.margin,
+            margin_source: rules.margin_source.into(),
+            loiter_radius: rules.loiter_radius,
+            verdict: outcome.headline(),
         }
-    }
-
-    /// The headline of an outcome (what the designer and `skyform run` say).
-    fn headline(outcome: crate::outcome::Outcome) -> String {
-        outcome.headline()
     }
 
     /// How the pipeline names its vehicles ([`noun`]).
     pub fn noun(&self) -> &'static str {
         noun(self.pipeline)
-    }
-
-    /// The multicopters' legs: `[vehicle]`'s limits of each track's vehicle.
-    fn multicopters(mission: &Mission, tracks: &[Track]) -> Vec<LegLimits> {
-        tracks
-            .iter()
-            .map(|t| LegLimits::multicopter(mission.vehicle.limits(t.vehicle)))
-            .collect()
-    }
-
-    /// θ-PSO: the UAVs' trajectories, re-verified against the hard limits
-    /// r_Q, [2 r_Q, d_com], the band, the bounds and eq. 8: the
-    /// `formation.safety_margin` the plan keeps beyond r_Q and 2 r_Q is
-    /// room the reduction may use. The margin is
-    /// `theta_pso.clearance_margin`, the room the cost keeps for a real
-    /// autopilot; each UAV's legs are within `[vehicle]`.
-    pub fn theta_pso(mission: &Mission, outcome: &ThetaPsoOutcome) -> Self {
-        let f = &mission.formation;
-        let tracks = tracks::theta_pso(outcome);
-        Planned {
-            pipeline: Kind::ThetaPso,
-            seed: outcome.seed,
-            legs: Planned::multicopters(mission, &tracks),
-            tracks,
-            // The files are held to the hard limits r_Q and 2 r_Q: the
-            // safety margin is room the reduction may use. The written legs
-            // are flown by the autopilot's own trajectory generator: their
-            // speeds are checked (`legs`), not their accelerations.
-            limits: Limits {
-                clearance: f.uav_radius,
-                closest: 2.0 * f.uav_radius,
-                farthest: Some(f.comm_range),
-                dynamics: false,
-                ..Limits::theta_pso(mission)
-            },
-            margin: mission.theta_pso.clearance_margin,
-            margin_source: "theta_pso.clearance_margin".into(),
-            loiter_radius: 0.0,
-            verdict: Planned::headline(crate::outcome::Outcome::ThetaPso(Box::new(
-                outcome.clone(),
-            ))),
-        }
-    }
-
-    /// FLATLO: the aircraft's references, held to `min_separation` (and the
-    /// band and bounds, which the geofence enforces); the margin is the
-    /// largest tracking error of the simulated autopilot with which the
-    /// squadron was verified; the airspeeds within
-    /// [`flatlo_airspeed_range`].
-    pub fn flatlo(mission: &Mission, outcome: &FlatloOutcome) -> Self {
-        let p = &mission.flatlo;
-        let tracking = outcome
-            .aircraft
-            .iter()
-            .map(|a| a.tracking_max)
-            .fold(0.0, f64::max);
-        let tracks = tracks::flatlo(outcome);
-        Planned {
-            pipeline: Kind::Flatlo,
-            seed: outcome.seed,
-            legs: vec![LegLimits::fixed_wing(flatlo_airspeed_range(mission)); tracks.len()],
-            tracks,
-            limits: Limits {
-                clearance: 0.0,
-                closest: p.min_separation,
-                farthest: None,
-                inspections: false,
-                dynamics: false,
-            },
-            margin: tracking,
-            margin_source: "the simulated squadron's largest tracking error".into(),
-            loiter_radius: p.turn_radius,
-            verdict: Planned::headline(crate::outcome::Outcome::Flatlo(Box::new(outcome.clone()))),
-        }
-    }
-
-    /// The fleet: the quadrotors' flights, held to the safety distance c
-    /// between agents and from obstacles (and the band and bounds); the
-    /// margin is the convergence tolerance on c, shared by two agents. The
-    /// exported files are flown by a real multicopter's autopilot, so its
-    /// legs are within `[vehicle]`, as θ-PSO's are (the fleet's own
-    /// quadrotor parameters model the paper's AR.Drone in the simulation).
-    pub fn fleet(mission: &Mission, outcome: &FleetOutcome) -> Self {
-        let p = &mission.fleet;
-        let tracks = tracks::fleet(outcome);
-        Planned {
-            pipeline: Kind::Fleet,
-            seed: outcome.seed,
-            legs: Planned::multicopters(mission, &tracks),
-            tracks,
-            limits: Limits {
-                clearance: p.safety_distance,
-                closest: p.safety_distance,
-                farthest: None,
-                inspections: false,
-                dynamics: false,
-            },
-            margin: p.tolerance * p.safety_distance / 2.0,
-            margin_source: "fleet.tolerance × fleet.safety_distance / 2".into(),
-            loiter_radius: 0.0,
-            verdict: Planned::headline(crate::outcome::Outcome::Fleet(Box::new(outcome.clone()))),
-        }
     }
 
     /// The legs of the vehicle of track `i`.

@@ -637,27 +637,19 @@ pub struct MarginLimit {
     pub why: String,
 }
 
-/// `mission` asked to keep `m` more ([`find_margin`]): θ-PSO plans with
-/// `formation.safety_margin` + m, which verification holds as hard limits
-/// (every UAV r_Q + the safety margin from every obstacle, every pair
-/// 2 r_Q + the safety margin apart, eq. 7), so a plan that passes keeps
-/// the margin everywhere, in a named IWP's gap too (a gap too narrow for
-/// it is gone round or refused); the fleet with `fleet.safety_distance` + m.
+/// `mission` asked to keep `m` more ([`find_margin`]): the pipeline's
+/// margin field (`Pipeline::margin_field`: θ-PSO's
+/// `formation.safety_margin`, which verification holds as a hard limit, so
+/// a plan that passes keeps the margin everywhere, in a named IWP's gap
+/// too; the fleet's `fleet.safety_distance`).
 pub fn with_margin(mission: &mut Mission, pipeline: Kind, m: f64) {
-    match pipeline {
-        Kind::ThetaPso | Kind::Flatlo => mission.formation.safety_margin += m,
-        Kind::Fleet => mission.fleet.safety_distance += m,
-    }
+    pipeline.face().add_margin(mission, m);
 }
 
-/// The field [`with_margin`] adds to, and its value in `mission`.
-pub fn margin_field(mission: &Mission, pipeline: Kind) -> (&'static str, f64) {
-    match pipeline {
-        Kind::ThetaPso | Kind::Flatlo => {
-            ("formation.safety_margin", mission.formation.safety_margin)
-        }
-        Kind::Fleet => ("fleet.safety_distance", mission.fleet.safety_distance),
-    }
+/// The field [`with_margin`] adds to, and its value in `mission`; `None`
+/// for a pipeline the check does not fly.
+pub fn margin_field(mission: &Mission, pipeline: Kind) -> Option<(&'static str, f64)> {
+    pipeline.face().margin_field(mission)
 }
 
 /// The margin search stops refining at this width, metres.

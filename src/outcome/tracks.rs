@@ -8,13 +8,6 @@
 //! flight (its only plan: the references jump every τ). Exports, views and
 //! recordings read tracks instead of each outcome's own fields.
 
-use nalgebra::{Point3, Vector3};
-use serde::Serialize;
-
-use crate::pipelines::flatlo::FlatloOutcome;
-use crate::pipelines::fleet::FleetOutcome;
-use crate::pipelines::theta_pso::ThetaPsoOutcome;
-
 /// One colour per vehicle (RGB), in vehicle order, cycling: the designer's
 /// map and the Rerun recording draw UAV n in the same colour. Chosen to
 /// stay apart on dark terminals and in the viewer (cyan first, as the map
@@ -37,105 +30,6 @@ pub fn vehicle_color(i: usize) -> [u8; 3] {
 /// θ-PSO trajectory's, so those tracks are the trajectories themselves.
 pub use crate::pipelines::TrackSample;
 
-/// One vehicle's timed track.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Track {
-    /// 0-based vehicle index (UAV n + 1 in messages and file names).
-    pub vehicle: usize,
-    pub samples: Vec<TrackSample>,
-}
-
-impl Track {
-    /// The track from positions at `times`, velocities by central differences.
-    pub fn from_positions(vehicle: usize, times: &[f64], positions: &[Point3<f64>]) -> Self {
-        let n = times.len().min(positions.len());
-        let samples = (0..n)
-            .map(|k| {
-                let (a, b) = (k.saturating_sub(1), (k + 1).min(n - 1));
-                let dt = times[b] - times[a];
-                let velocity = if dt > 0.0 {
-                    (positions[b] - positions[a]) / dt
-                } else {
-                    Vector3::zeros()
-                };
-                TrackSample {
-                    t: times[k],
-                    position: positions[k],
-                    velocity,
-                }
-            })
-            .collect();
-        Track { vehicle, samples }
-    }
-
-    /// Seconds from the first to the last sample.
-    pub fn duration(&self) -> f64 {
-        match (self.samples.first(), self.samples.last()) {
-            (Some(a), Some(b)) => b.t - a.t,
-            _ => 0.0,
-        }
-    }
-}
-
-/// Every UAV's trajectory of a θ-PSO plan.
-pub fn theta_pso(outcome: &ThetaPsoOutcome) -> Vec<Track> {
-    outcome
-        .trajectories
-        .iter()
-        .map(|t| Track {
-            vehicle: t.uav,
-            samples: t.samples.clone(),
-        })
-        .collect()
-}
-
-/// Every aircraft's reference of a FLATLO run, on the sample grid.
-pub fn flatlo(outcome: &FlatloOutcome) -> Vec<Track> {
-    outcome
-        .aircraft
-        .iter()
-        .map(|a| {
-            let times: Vec<f64> = a.reference.iter().map(|s| s.t).collect();
-            let positions: Vec<Point3<f64>> = a.reference.iter().map(|s| s.position).collect();
-            Track::from_positions(a.index, &times, &positions)
-        })
-        .collect()
-}
-
-/// Every aircraft's simulated flight of a FLATLO run (the samples it kept:
-/// `FlatloOutcome::sample_stride`), velocity from V, γ, χ (eqs. 4-6).
-pub fn flatlo_flown(outcome: &FlatloOutcome) -> Vec<Track> {
-    outcome
-        .aircraft
-        .iter()
-        .map(|a| Track {
-            vehicle: a.index,
-            samples: a
-                .flown
-                .iter()
-                .map(|s| {
-                    let (sg, cg) = s.gamma.sin_cos();
-                    let (sc, cc) = s.chi.sin_cos();
-                    TrackSample {
-                        t: s.t,
-                        position: s.position,
-                        velocity: nalgebra::Vector3::new(cg * cc, cg * sc, sg) * s.airspeed,
-                    }
-                })
-                .collect(),
-        })
-        .collect()
-}
-
-/// Every quadrotor's flight of a fleet run.
-pub fn fleet(outcome: &FleetOutcome) -> Vec<Track> {
-    outcome
-        .agents
-        .iter()
-        .map(|a| {
-            let times: Vec<f64> = a.samples.iter().map(|s| s.t).collect();
-            let positions: Vec<Point3<f64>> = a.samples.iter().map(|s| s.position).collect();
-            Track::from_positions(a.index, &times, &positions)
-        })
-        .collect()
-}
+/// One vehicle's timed track; each pipeline's face gives its own
+/// (`PipelineOutcome::tracks`).
+pub use crate::pipelines::Track;

@@ -9,7 +9,9 @@
 pub mod aircraft;
 pub mod algorithm;
 pub mod envelope;
+pub mod face;
 pub mod maneuver;
+pub mod summary;
 
 use nalgebra::{Point3, Vector3};
 use rand::rngs::ChaCha8Rng;

@@ -14,9 +14,11 @@
 
 pub mod agent;
 pub mod cost;
+pub mod face;
 pub mod network;
 pub mod quadrotor;
 pub mod simulation;
+pub mod summary;
 
 use std::collections::HashMap;
 

@@ -6,6 +6,7 @@
 
 pub mod benchmark;
 pub mod cost;
+pub mod face;
 pub mod flight;
 pub mod inspection;
 pub mod iwp;
@@ -16,6 +17,7 @@ pub mod repair;
 pub mod route;
 pub mod seeding;
 pub mod spso;
+pub mod summary;
 pub mod timing;
 pub mod trajectory;
 pub mod unusable;

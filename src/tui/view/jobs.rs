@@ -340,7 +340,7 @@ fn collapsed(text: &str) -> String {
 /// θ-PSO's result as the CLI prints it: the verdict and its first failing
 /// check on top, the figures (on one row of `width`), the unusable IWPs
 /// grouped by reason, then the whole verification table
-/// (`outcome::summary::verification_rows`).
+/// (`theta_pso::summary::verification_rows`).
 fn theta_pso_table(
     o: &crate::pipelines::theta_pso::ThetaPsoOutcome,
     state: &JobState,
@@ -348,7 +348,7 @@ fn theta_pso_table(
     width: u16,
 ) -> Vec<Line<'static>> {
     let v = &o.verification;
-    let rows = crate::outcome::summary::verification_rows(o);
+    let rows = crate::pipelines::theta_pso::summary::verification_rows(o);
     let mut lines = Vec::new();
     let verdict = match (state, v.feasible) {
         (JobState::Cancelled, _) => Line::styled(
@@ -458,7 +458,7 @@ fn fleet_table(o: &crate::pipelines::fleet::FleetOutcome, stale: bool) -> Vec<Li
                     .and_then(|e| e.pair.filter(|d| !d.within()).or(e.to_target))
                     .map_or_else(String::new, |d| format!(
                         ": {}",
-                        crate::outcome::summary::deviation(&d)
+                        crate::pipelines::fleet::summary::deviation(&d)
                     ))
             ),
         };

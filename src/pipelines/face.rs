@@ -1,0 +1,249 @@
+//! One face per pipeline: what a front end may ask of any pipeline
+//! ([`Pipeline`]) and of any pipeline's outcome ([`PipelineOutcome`]).
+//!
+//! Each pipeline implements both in its own `face.rs`; the registration in
+//! `pipelines/mod.rs` hands a [`super::Kind`] its face and an
+//! [`super::Outcome`] its outcome's, in the only two matches over the
+//! pipelines. The CLI, the designer, the sweep, the recorder and the exports
+//! read a pipeline through these two traits, so a new pipeline's words,
+//! verdict, summary, tracks and budget live with it, not in the front ends.
+
+use nalgebra::{Point3, Vector3};
+use serde::Serialize;
+
+use super::theta_pso::{PlanOptions, WarmStart};
+use super::{CancelToken, Completion, Kind, Limits, Observer, Outcome, PipelineError, TrackSample};
+use crate::mission::{Diagnostic, Mission};
+
+/// What a run says of its plan.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Verdict {
+    /// Every hard constraint holds.
+    Passed,
+    /// The first broken constraint, in words.
+    Failed(String),
+    /// Cancelled: a partial result gets no verdict.
+    Cancelled,
+}
+
+/// One vehicle's timed track: the common shape of every pipeline's result
+/// (`PipelineOutcome::tracks`), which exports, views and recordings read
+/// instead of each outcome's own fields.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Track {
+    /// 0-based vehicle index (UAV n + 1 in messages and file names).
+    pub vehicle: usize,
+    pub samples: Vec<TrackSample>,
+}
+
+impl Track {
+    /// The track from positions at `times`, velocities by central differences.
+    pub fn from_positions(vehicle: usize, times: &[f64], positions: &[Point3<f64>]) -> Self {
+        let n = times.len().min(positions.len());
+        let samples = (0..n)
+            .map(|k| {
+                let (a, b) = (k.saturating_sub(1), (k + 1).min(n - 1));
+                let dt = times[b] - times[a];
+                let velocity = if dt > 0.0 {
+                    (positions[b] - positions[a]) / dt
+                } else {
+                    Vector3::zeros()
+                };
+                TrackSample {
+                    t: times[k],
+                    position: positions[k],
+                    velocity,
+                }
+            })
+            .collect();
+        Track { vehicle, samples }
+    }
+
+    /// Seconds from the first to the last sample.
+    pub fn duration(&self) -> f64 {
+        match (self.samples.first(), self.samples.last()) {
+            (Some(a), Some(b)) => b.t - a.t,
+            _ => 0.0,
+        }
+    }
+}
+
+/// What flies a pipeline's exported files.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Airframe {
+    /// A multicopter within the mission's `[vehicle]` limits.
+    Multicopter,
+    /// A fixed-wing aircraft whose commanded airspeeds keep this range, m/s.
+    FixedWing { airspeed: [f64; 2] },
+}
+
+/// What the exports hold a pipeline's files to (`export::Planned`): the
+/// tracks they write are its `reference_tracks`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExportRules {
+    /// The hard limits the files are re-verified against.
+    pub limits: Limits,
+    pub airframe: Airframe,
+    /// The most the pipeline lets a vehicle stray from its track, metres,
+    /// before the plan's own slack is considered.
+    pub margin: f64,
+    /// Where `margin` comes from, in words.
+    pub margin_source: &'static str,
+    /// Fixed-wing loiter radius at the end, metres.
+    pub loiter_radius: f64,
+}
+
+/// What a front end asks of one run beyond the mission: its seed, and what
+/// only θ-PSO reads (its plan options and the designer's warm start; the
+/// other pipelines ignore them).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Request<'a> {
+    pub seed: u64,
+    pub options: PlanOptions,
+    pub warm: Option<&'a WarmStart>,
+}
+
+impl Request<'_> {
+    /// A cold run with default options.
+    pub fn seeded(seed: u64) -> Request<'static> {
+        Request {
+            seed,
+            ..Request::default()
+        }
+    }
+}
+
+/// A pipeline: its words, its limits and its run. One unit value per
+/// pipeline (`Kind::face`).
+pub trait Pipeline: Sync {
+    /// For people: `θ-PSO`.
+    fn name(&self) -> &'static str;
+    /// On the command line and in file names: `theta-pso`.
+    fn slug(&self) -> &'static str;
+    /// What it calls a vehicle in files and messages: `UAV`.
+    fn noun(&self) -> &'static str;
+    /// Its vehicles fly with fixed wings.
+    fn fixed_wing(&self) -> bool {
+        false
+    }
+    /// The one figure a sweep tabulates, as its column is headed.
+    fn figure_name(&self) -> &'static str;
+    /// What a run's two tallies are called (a sweep's columns): complete
+    /// and good.
+    fn tally_words(&self) -> (&'static str, &'static str);
+    /// The verdict in one word, passed and failed (the job list).
+    fn verdict_words(&self) -> (&'static str, &'static str);
+    /// The headline's verdict when every hard constraint holds.
+    fn passed_phrase(&self) -> &'static str;
+    /// The designer may re-plan it after every edit.
+    fn live(&self) -> bool;
+    /// The mission field that limits its vehicles' speed, when that is not
+    /// the `[vehicle]` section's.
+    fn speed_field(&self) -> Option<&'static str> {
+        None
+    }
+    /// What to change when its flight leaves the bounds, where its own
+    /// fields set the flight's extent; `None`: the route sets it.
+    fn bounds_advice(&self) -> Option<&'static str> {
+        None
+    }
+    /// The run in a few words for a sweep's first line (`θ-PSO`).
+    fn describe(&self, _mission: &Mission) -> String {
+        self.name().to_owned()
+    }
+    /// The mission field a flight check's margin is added to (`skyform fly
+    /// --target`: what its verification holds as the least clearance), and
+    /// its value in `mission`; `None` when the check does not fly its
+    /// vehicles.
+    fn margin_field(&self, _mission: &Mission) -> Option<(&'static str, f64)> {
+        None
+    }
+    /// `mission` asked to keep `m` more (the field of [`Pipeline::margin_field`]).
+    fn add_margin(&self, _mission: &mut Mission, _m: f64) {}
+    /// Its predicted size against the documented limits (`limits`).
+    fn budget(&self, mission: &Mission) -> Vec<Diagnostic>;
+    /// The sizes that keep a run on `mission` from being planned live
+    /// (each with its figure and the limit); none when it may be.
+    fn over_live_limits(&self, mission: &Mission) -> Vec<String>;
+    /// Runs it on `mission`.
+    fn run(
+        &self,
+        mission: &Mission,
+        request: Request<'_>,
+        observer: &mut dyn Observer,
+        cancel: &CancelToken,
+    ) -> Result<Outcome, PipelineError>;
+}
+
+/// A pipeline's outcome, as every front end reads it.
+pub trait PipelineOutcome {
+    fn kind(&self) -> Kind;
+    fn seed(&self) -> u64;
+    fn completion(&self) -> Completion;
+    /// Pass, or fail with the first broken constraint.
+    fn verdict(&self) -> Verdict;
+    /// The headline's figures around `verdict` (the verdict in words).
+    fn headline(&self, verdict: &str) -> String;
+    /// The multi-line summary `skyform run` prints; `verbose` lists
+    /// everything a summary would count.
+    fn summary(&self, verbose: bool) -> String;
+    /// The best cost after each iteration, where there is one.
+    fn convergence(&self) -> &[f64] {
+        &[]
+    }
+    /// The run gave a result to judge.
+    fn judged(&self) -> bool;
+    /// The one figure a sweep tabulates (`Pipeline::figure_name`); NaN
+    /// when there is none.
+    fn figure(&self) -> f64;
+    /// Cost evaluations made.
+    fn evaluations(&self) -> usize;
+    /// Every vehicle's timed track as planned and flown.
+    fn tracks(&self) -> Vec<Track>;
+    /// The references the vehicles tracked, where they differ from the
+    /// tracks (what the exports fly); `None`: the tracks themselves.
+    fn reference_tracks(&self) -> Option<Vec<Track>> {
+        None
+    }
+    /// What its exported files are held to.
+    fn export_rules(&self, mission: &Mission) -> ExportRules;
+}
+
+/// A kind's words and rules, read from its face.
+impl Kind {
+    /// For people: `θ-PSO`, `FLATLO`, `fleet`.
+    pub fn name(self) -> &'static str {
+        self.face().name()
+    }
+
+    /// As on the command line and in file names: `theta-pso`, `flatlo`, `fleet`.
+    pub fn slug(self) -> &'static str {
+        self.face().slug()
+    }
+
+    /// The vehicles it plans fly with fixed wings (FLATLO's aircraft).
+    pub fn fixed_wing(self) -> bool {
+        self.face().fixed_wing()
+    }
+
+    /// What a run's two tallies are called (a sweep's columns).
+    pub fn tally_words(self) -> (&'static str, &'static str) {
+        self.face().tally_words()
+    }
+
+    /// The designer can re-plan it after every edit.
+    pub fn live(self) -> bool {
+        self.face().live()
+    }
+
+    /// The mission field that limits its vehicles' speed, when that is not
+    /// the `[vehicle]` section's (FLATLO's airspeed range).
+    pub fn speed_field(self) -> Option<&'static str> {
+        self.face().speed_field()
+    }
+
+    /// What to change when its flight leaves the bounds ([`Pipeline::bounds_advice`]).
+    pub fn bounds_advice(self) -> Option<&'static str> {
+        self.face().bounds_advice()
+    }
+}

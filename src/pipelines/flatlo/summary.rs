@@ -1,0 +1,104 @@
+//! The human summary of a FLATLO outcome (`skyform run flatlo`). Aircraft
+//! are numbered from 1 here as everywhere a person reads them; the JSON
+//! keeps the 0-based indices.
+
+use super::FlatloOutcome;
+
+/// The human summary of a FLATLO outcome.
+pub fn flatlo(o: &FlatloOutcome) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "FLATLO transition for \"{}\" (seed {})",
+        o.mission, o.seed
+    );
+    let _ = writeln!(
+        s,
+        "  run          {:?}, {:.1} s simulated; every aircraft on the line at t = {:.1} s",
+        o.completion, o.duration, o.arrival_time
+    );
+    for a in &o.aircraft {
+        let _ = writeln!(
+            s,
+            "  aircraft {:<3} {:<6} Δm {:>8.0} m  Δ {:>7.0} m  transition {:>8.0} m at {:>6.2} m/s  tracking max {:>7.1} m, RMS {:>6.1} m",
+            a.index + 1,
+            format!("{:?}", a.side).to_lowercase(),
+            a.advance,
+            a.lateral_distance,
+            a.transition_length,
+            a.airspeed,
+            a.tracking_max,
+            a.tracking_rms
+        );
+    }
+    for p in &o.pairs {
+        let _ = writeln!(
+            s,
+            "  pair {:>2}-{:<2}    closest {:>9.1} m at t = {:.0} s",
+            p.a + 1,
+            p.b + 1,
+            p.min_distance,
+            p.time
+        );
+    }
+    let closest = o.closest.map_or("-".to_owned(), |c| {
+        format!(
+            "aircraft {} and {} at {:.1} m (t = {:.0} s)",
+            c.a + 1,
+            c.b + 1,
+            c.min_distance,
+            c.time
+        )
+    });
+    let Some(v) = &o.verification else {
+        let _ = writeln!(
+            s,
+            "  result       CANCELLED: no verdict on a partial flight; closest so far {closest}"
+        );
+        return s;
+    };
+    let spacing: Vec<String> = v
+        .final_spacing
+        .iter()
+        .map(|x| format!("{}→{} {:.1} m", x.front + 1, x.back + 1, x.spacing))
+        .collect();
+    let _ = writeln!(s, "  final line   {}", spacing.join(", "));
+    let _ = writeln!(
+        s,
+        "               spacing error {:.3} % of Δd, lateral spread {:.1} m",
+        v.max_spacing_error * 100.0,
+        v.lateral_spread
+    );
+    let [slowest, fastest] = v.airspeed_flown;
+    let [lo, hi] = v.airspeed_range;
+    let _ = writeln!(
+        s,
+        "  flight       airspeed {slowest:.2}-{fastest:.2} m/s flown (airspeed_range [{lo}, {hi}] m/s); \
+         bank at most {:.1}° (max_bank_deg {}°)",
+        v.bank_flown_deg, v.max_bank_deg
+    );
+    let bounds = if v.bounds_margin >= 0.0 {
+        format!(
+            "every aircraft and its reference inside the x-y bounds and the altitude band, {:.0} m from the nearest edge at least",
+            v.bounds_margin
+        )
+    } else {
+        format!(
+            "an aircraft left them: {:.0} m outside at worst",
+            -v.bounds_margin
+        )
+    };
+    let _ = writeln!(s, "  bounds       {bounds}");
+    let verdict = match (&v.violation, v.passed) {
+        (_, true) => "PASS:".to_owned(),
+        (Some(x), false) => format!("FAIL: not flyable, {};", x.describe()),
+        (None, false) => "FAIL:".to_owned(),
+    };
+    let _ = writeln!(
+        s,
+        "  result       {verdict} closest {closest}, minimum separation {:.0} m",
+        v.min_separation
+    );
+    s
+}

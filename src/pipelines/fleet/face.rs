@@ -1,0 +1,210 @@
+//! The fleet's face: what every front end reads of it (`pipelines::face`).
+
+use nalgebra::Point3;
+
+use super::{FleetOutcome, summary};
+use crate::mission::{Diagnostic, Mission};
+use crate::pipelines::{Airframe, ExportRules, Limits};
+use crate::pipelines::{
+    CancelToken, Completion, Kind, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome,
+    Request, Track, Verdict,
+};
+
+/// The distributed fleet (`Kind::Fleet`).
+pub struct Fleet;
+
+impl Pipeline for Fleet {
+    fn name(&self) -> &'static str {
+        "fleet"
+    }
+
+    fn slug(&self) -> &'static str {
+        "fleet"
+    }
+
+    fn noun(&self) -> &'static str {
+        "agent"
+    }
+
+    fn figure_name(&self) -> &'static str {
+        "closest agents (m)"
+    }
+
+    /// A flown run finishes, and passes or fails.
+    fn tally_words(&self) -> (&'static str, &'static str) {
+        ("finished", "passed")
+    }
+
+    fn verdict_words(&self) -> (&'static str, &'static str) {
+        ("pass", "FAIL")
+    }
+
+    fn passed_phrase(&self) -> &'static str {
+        "formed, safety distance kept"
+    }
+
+    /// Its run is a flight of seconds, re-run by hand.
+    fn live(&self) -> bool {
+        false
+    }
+
+    /// The safety distance c, which every agent keeps from the others and
+    /// from the obstacles.
+    fn margin_field(&self, mission: &Mission) -> Option<(&'static str, f64)> {
+        Some(("fleet.safety_distance", mission.fleet.safety_distance))
+    }
+
+    fn add_margin(&self, mission: &mut Mission, m: f64) {
+        mission.fleet.safety_distance += m;
+    }
+
+    fn budget(&self, mission: &Mission) -> Vec<Diagnostic> {
+        super::budget(mission)
+    }
+
+    fn over_live_limits(&self, _: &Mission) -> Vec<String> {
+        vec!["the fleet simulates for seconds: never live".to_owned()]
+    }
+
+    fn run(
+        &self,
+        mission: &Mission,
+        request: Request<'_>,
+        observer: &mut dyn Observer,
+        cancel: &CancelToken,
+    ) -> Result<Outcome, PipelineError> {
+        super::plan(mission, request.seed, observer, cancel).map(Outcome::from)
+    }
+}
+
+impl PipelineOutcome for FleetOutcome {
+    fn kind(&self) -> Kind {
+        self.pipeline
+    }
+
+    fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    fn completion(&self) -> Completion {
+        self.completion
+    }
+
+    /// Every pair (a lost agent where it was last heard) and every obstacle
+    /// kept at c, no agent lost, every target's formation reached. Fails on
+    /// the first broken one, in words; when agents were lost and that is
+    /// not the first, they are named after it. A cancelled run has flown
+    /// only part of the way: no verdict.
+    fn verdict(&self) -> Verdict {
+        if self.completion == Completion::Cancelled {
+            return Verdict::Cancelled;
+        }
+        let lost = summary::lost_agents(self);
+        let first = if let Some(c) = self.closest_agents.as_ref().filter(|_| !self.kept_apart()) {
+            summary::too_close(self, c)
+        } else if let Some(c) = self
+            .closest_obstacle
+            .as_ref()
+            .filter(|_| !self.obstacles_clear())
+        {
+            format!(
+                "agent {} came {:.3} m from {} (t = {:.2} s), closer than c = {} m",
+                c.a + 1,
+                c.distance,
+                c.b,
+                c.time,
+                self.safety_distance
+            )
+        } else if let Some(lost) = &lost {
+            return Verdict::Failed(lost.clone());
+        } else if let Some((k, t)) = self
+            .targets
+            .iter()
+            .enumerate()
+            .find(|(_, t)| t.converged_after.is_none())
+        {
+            let how_far = t
+                .end
+                .as_ref()
+                .map_or_else(String::new, |e| format!(": {}", summary::shortfall(e)));
+            format!("target {}'s formation was never reached{how_far}", k + 1)
+        } else {
+            return Verdict::Passed;
+        };
+        Verdict::Failed(match lost {
+            Some(lost) => format!("{first}; {lost}"),
+            None => first,
+        })
+    }
+
+    fn headline(&self, verdict: &str) -> String {
+        format!(
+            "{} of {} targets formed, closest {}, {verdict}",
+            self.targets
+                .iter()
+                .filter(|t| t.converged_after.is_some())
+                .count(),
+            self.targets.len(),
+            self.closest_agents
+                .as_ref()
+                .map_or("-".into(), |c| format!("{:.2} m", c.distance)),
+        )
+    }
+
+    fn summary(&self, _verbose: bool) -> String {
+        summary::fleet(self, &self.verdict())
+    }
+
+    /// A finished flight.
+    fn judged(&self) -> bool {
+        self.completion == Completion::Finished
+    }
+
+    /// The closest two agents, metres.
+    fn figure(&self) -> f64 {
+        self.closest_agents
+            .as_ref()
+            .map_or(f64::NAN, |c| c.distance)
+    }
+
+    /// Every agent's PSO.
+    fn evaluations(&self) -> usize {
+        self.agents.iter().map(|a| a.evaluations).sum()
+    }
+
+    /// Every quadrotor's flight (its only plan: the references jump every
+    /// τ), velocities by central differences.
+    fn tracks(&self) -> Vec<Track> {
+        self.agents
+            .iter()
+            .map(|a| {
+                let times: Vec<f64> = a.samples.iter().map(|s| s.t).collect();
+                let positions: Vec<Point3<f64>> = a.samples.iter().map(|s| s.position).collect();
+                Track::from_positions(a.index, &times, &positions)
+            })
+            .collect()
+    }
+
+    /// The quadrotors' flights, held to the safety distance c between
+    /// agents and from obstacles (and the band and bounds); the margin is
+    /// the convergence tolerance on c, shared by two agents. The files are
+    /// flown by a real multicopter's autopilot, within `[vehicle]`, as
+    /// θ-PSO's are (the fleet's own quadrotor parameters model the paper's
+    /// AR.Drone in the simulation).
+    fn export_rules(&self, mission: &Mission) -> ExportRules {
+        let p = &mission.fleet;
+        ExportRules {
+            limits: Limits {
+                clearance: p.safety_distance,
+                closest: p.safety_distance,
+                farthest: None,
+                inspections: false,
+                dynamics: false,
+            },
+            airframe: Airframe::Multicopter,
+            margin: p.tolerance * p.safety_distance / 2.0,
+            margin_source: "fleet.tolerance × fleet.safety_distance / 2",
+            loiter_radius: 0.0,
+        }
+    }
+}

@@ -1,0 +1,200 @@
+//! θ-PSO's face: what every front end reads of it (`pipelines::face`).
+
+use super::{ThetaPsoOutcome, summary};
+use crate::mission::{Diagnostic, Mission};
+use crate::pipelines::{Airframe, ExportRules, Limits};
+use crate::pipelines::{
+    CancelToken, Completion, Kind, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome,
+    Request, Track, Verdict,
+};
+
+/// θ-PSO (`Kind::ThetaPso`).
+pub struct ThetaPso;
+
+impl Pipeline for ThetaPso {
+    fn name(&self) -> &'static str {
+        "θ-PSO"
+    }
+
+    fn slug(&self) -> &'static str {
+        "theta-pso"
+    }
+
+    fn noun(&self) -> &'static str {
+        "UAV"
+    }
+
+    fn figure_name(&self) -> &'static str {
+        "best J"
+    }
+
+    /// θ-PSO plans: a run is complete when its J is finite, good when
+    /// feasible.
+    fn tally_words(&self) -> (&'static str, &'static str) {
+        ("J finite", "feasible")
+    }
+
+    fn verdict_words(&self) -> (&'static str, &'static str) {
+        ("feasible", "INFEASIBLE")
+    }
+
+    fn passed_phrase(&self) -> &'static str {
+        "feasible"
+    }
+
+    /// A live run is short and deterministic.
+    fn live(&self) -> bool {
+        true
+    }
+
+    /// The SPSO benchmark names its cost, encoding and swarm.
+    fn describe(&self, mission: &Mission) -> String {
+        let p = &mission.theta_pso;
+        if p.cost == crate::mission::CostKind::Spso {
+            format!(
+                "θ-PSO, SPSO cost, {:?} encoding, {} × {}",
+                p.encoding, p.swarm_size, p.iterations
+            )
+        } else {
+            self.name().to_owned()
+        }
+    }
+
+    /// The safety margin, which verification holds as a hard limit (every
+    /// UAV r_Q + it from every obstacle, every pair 2 r_Q + it apart,
+    /// eq. 7), so a plan that passes keeps it everywhere, in a named IWP's
+    /// gap too. (`theta_pso.clearance_margin`, the room the cost asks for,
+    /// is capped site-wide by the narrowest IWP gap.)
+    fn margin_field(&self, mission: &Mission) -> Option<(&'static str, f64)> {
+        Some(("formation.safety_margin", mission.formation.safety_margin))
+    }
+
+    fn add_margin(&self, mission: &mut Mission, m: f64) {
+        mission.formation.safety_margin += m;
+    }
+
+    fn budget(&self, mission: &Mission) -> Vec<Diagnostic> {
+        super::budget(mission)
+    }
+
+    /// Up to 20,000 cost evaluations per run (the paper's 100 × 150 is
+    /// 15,000), 6 UAVs, 60 obstacles and a site of 40,000 m² (the bridge
+    /// plans in about 0.2 s cold on two cores).
+    fn over_live_limits(&self, mission: &Mission) -> Vec<String> {
+        let p = &mission.theta_pso;
+        let b = &mission.bounds;
+        let evaluations = p.swarm_size.saturating_mul(p.iterations) as f64;
+        let area = (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]);
+        crate::pipelines::live_limits(&[
+            (evaluations, 20_000.0, "# cost evaluations per run"),
+            (mission.formation.slots.len() as f64, 6.0, "# UAVs"),
+            (mission.obstacles.len() as f64, 60.0, "# obstacles"),
+            (area, 40_000.0, "a site of # m²"),
+        ])
+    }
+
+    fn run(
+        &self,
+        mission: &Mission,
+        request: Request<'_>,
+        observer: &mut dyn Observer,
+        cancel: &CancelToken,
+    ) -> Result<Outcome, PipelineError> {
+        super::plan_warm(
+            mission,
+            request.seed,
+            request.options,
+            request.warm,
+            observer,
+            cancel,
+        )
+        .map(Outcome::from)
+    }
+}
+
+impl PipelineOutcome for ThetaPsoOutcome {
+    fn kind(&self) -> Kind {
+        self.pipeline
+    }
+
+    fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    fn completion(&self) -> Completion {
+        self.completion
+    }
+
+    /// A cancelled run still has a verdict on its best plan so far: it is a
+    /// whole plan.
+    fn verdict(&self) -> Verdict {
+        match self.verification.first_failure() {
+            None if self.feasible() => Verdict::Passed,
+            None => Verdict::Failed("a constraint is broken".into()),
+            Some(reason) => Verdict::Failed(reason),
+        }
+    }
+
+    fn headline(&self, verdict: &str) -> String {
+        format!(
+            "J = {:.2}, {:.1} m, {verdict}",
+            self.cost.total, self.path_length
+        )
+    }
+
+    fn summary(&self, verbose: bool) -> String {
+        summary::theta_pso(self, verbose)
+    }
+
+    fn convergence(&self) -> &[f64] {
+        &self.convergence
+    }
+
+    /// A finite J.
+    fn judged(&self) -> bool {
+        self.cost.total.is_finite()
+    }
+
+    /// The best J.
+    fn figure(&self) -> f64 {
+        self.cost.total
+    }
+
+    fn evaluations(&self) -> usize {
+        self.evaluations
+    }
+
+    /// Every UAV's trajectory (eqs. 12-15).
+    fn tracks(&self) -> Vec<Track> {
+        self.trajectories
+            .iter()
+            .map(|t| Track {
+                vehicle: t.uav,
+                samples: t.samples.clone(),
+            })
+            .collect()
+    }
+
+    /// The hard limits r_Q, [2 r_Q, d_com], the band, the bounds and eq. 8:
+    /// the `formation.safety_margin` the plan keeps beyond r_Q and 2 r_Q is
+    /// room the reduction may use. The written legs are flown by the
+    /// autopilot's own trajectory generator: their speeds are checked, not
+    /// their accelerations. The margin is `theta_pso.clearance_margin`, the
+    /// room the cost keeps for a real autopilot.
+    fn export_rules(&self, mission: &Mission) -> ExportRules {
+        let f = &mission.formation;
+        ExportRules {
+            limits: Limits {
+                clearance: f.uav_radius,
+                closest: 2.0 * f.uav_radius,
+                farthest: Some(f.comm_range),
+                dynamics: false,
+                ..Limits::theta_pso(mission)
+            },
+            airframe: Airframe::Multicopter,
+            margin: mission.theta_pso.clearance_margin,
+            margin_source: "theta_pso.clearance_margin",
+            loiter_radius: 0.0,
+        }
+    }
+}
