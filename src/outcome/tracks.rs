@@ -8,23 +8,9 @@
 //! flight (its only plan: the references jump every τ). Exports, views and
 //! recordings read tracks instead of each outcome's own fields.
 
-/// One colour per vehicle (RGB), in vehicle order, cycling: the designer's
-/// map and the Rerun recording draw UAV n in the same colour. Chosen to
-/// stay apart on dark terminals and in the viewer (cyan first, as the map
-/// always drew UAV 1).
-pub const VEHICLE_COLORS: [[u8; 3]; 6] = [
-    [23, 190, 207],
-    [227, 119, 194],
-    [44, 200, 44],
-    [80, 140, 255],
-    [255, 200, 60],
-    [240, 80, 70],
-];
-
-/// Vehicle `i`'s colour (0-based).
-pub fn vehicle_color(i: usize) -> [u8; 3] {
-    VEHICLE_COLORS[i % VEHICLE_COLORS.len()]
-}
+/// One colour per vehicle, the same on the designer's map and in the
+/// recording (`pipelines::sketch`).
+pub use crate::pipelines::sketch::{VEHICLE_COLORS, vehicle_color};
 
 /// One instant of a track (seconds, metres ENU, m/s): the same sample as a
 /// θ-PSO trajectory's, so those tracks are the trajectories themselves.

@@ -11,6 +11,7 @@
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
+use super::sketch::{Plot, Sketch};
 use super::theta_pso::{PlanOptions, WarmStart};
 use super::{CancelToken, Completion, Kind, Limits, Observer, Outcome, PipelineError, TrackSample};
 use crate::mission::{Diagnostic, Mission};
@@ -160,6 +161,9 @@ pub trait Pipeline: Sync {
     }
     /// `mission` asked to keep `m` more (the field of [`Pipeline::margin_field`]).
     fn add_margin(&self, _mission: &mut Mission, _m: f64) {}
+    /// The plots its viewer layout puts beside the scene, a column of
+    /// panels (a panel of several plots is a set of tabs).
+    fn plots(&self) -> &'static [&'static [Plot]];
     /// Its predicted size against the documented limits (`limits`).
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic>;
     /// The sizes that keep a run on `mission` from being planned live
@@ -207,6 +211,17 @@ pub trait PipelineOutcome {
     }
     /// What its exported files are held to.
     fn export_rules(&self, mission: &Mission) -> ExportRules;
+    /// Draws the outcome in a recording; `scene` is the mission when the
+    /// recording has it.
+    fn sketch(&self, scene: Option<&Mission>, out: &mut dyn Sketch);
+    /// What a live plan adds to its vehicles' tracks in a recording, under
+    /// `root` (θ-PSO: its centroid path).
+    fn sketch_live(&self, _root: &str, _out: &mut dyn Sketch) {}
+    /// The plan it was started from, in words, when not from scratch
+    /// (θ-PSO's warm start: "warm from revision 3").
+    fn warm_from(&self) -> Option<String> {
+        None
+    }
 }
 
 /// A kind's words and rules, read from its face.

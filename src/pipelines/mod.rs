@@ -10,6 +10,7 @@
 
 pub mod face;
 pub mod interface;
+pub mod sketch;
 
 pub mod flatlo;
 pub mod fleet;

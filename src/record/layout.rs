@@ -13,34 +13,21 @@ pub fn layout(kind: Kind) -> rerun::blueprint::Blueprint {
         Blueprint, BlueprintPanel, ContainerLike, Horizontal, SelectionPanel, Spatial3DView, Tabs,
         TextDocumentView, TextLogView, TimePanel, TimeSeriesView, Vertical,
     };
-    let series: Vec<ContainerLike> = match kind {
-        // The clearance plays with the flight on `sim_time`, the timeline
-        // the viewer opens on; the cost is on `iteration`, in the tab behind.
-        Kind::ThetaPso => vec![
-            Tabs::new([
-                TimeSeriesView::new("clearance to obstacles, m")
-                    .with_origin(origin(paths::theta_pso::CLEARANCE))
-                    .into(),
-                TimeSeriesView::new("θ-PSO cost (timeline: iteration)")
-                    .with_origin(origin(paths::theta_pso::COST))
-                    .into(),
-            ])
-            .into(),
-        ],
-        Kind::Flatlo => vec![
-            TimeSeriesView::new("airspeed, m/s")
-                .with_origin(origin(paths::flatlo::AIRSPEED))
-                .into(),
-            TimeSeriesView::new("load factor")
-                .with_origin(origin(paths::flatlo::LOAD_FACTOR))
-                .into(),
-        ],
-        Kind::Fleet => vec![
-            TimeSeriesView::new("inter-agent distances, m (Fig. 13)")
-                .with_origin(origin(paths::fleet::DISTANCES))
-                .into(),
-        ],
-    };
+    // The pipeline's plots (`Pipeline::plots`), a panel of several as tabs.
+    let series: Vec<ContainerLike> = kind
+        .face()
+        .plots()
+        .iter()
+        .map(|panel| {
+            let views = panel.iter().map(|plot| {
+                ContainerLike::from(TimeSeriesView::new(plot.title).with_origin(origin(plot.path)))
+            });
+            match panel {
+                [_] => views.collect::<Vec<_>>().remove(0),
+                _ => Tabs::new(views).into(),
+            }
+        })
+        .collect();
     let mut column = series;
     column.push(
         TextLogView::new("events")

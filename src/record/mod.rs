@@ -33,13 +33,12 @@ use crate::outcome::Outcome;
 use crate::pipelines::theta_pso::CostTerms;
 use crate::pipelines::{Event, Kind, Level, Observer};
 
-mod flatlo;
-mod fleet;
 mod flight;
 mod layout;
 pub mod paths;
 mod scene;
-mod theta_pso;
+mod sketch;
+mod swarm;
 
 /// The viewer's standard local address.
 pub const DEFAULT_VIEWER_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
@@ -300,44 +299,6 @@ fn uav_color(n: usize) -> rerun::Color {
     rerun::Color::from_rgb(r, g, b)
 }
 
-/// A point that moves on `sim_time`: its style (colour, radius, label)
-/// logged once, its positions as one `send_columns`.
-fn log_moving_point(
-    stream: &RecordingStream,
-    entity: &str,
-    times: &rerun::TimeColumn,
-    style: rerun::Points3D,
-    positions: Vec<[f32; 3]>,
-) -> rerun::RecordingStreamResult<()> {
-    stream.log_static(entity, &style)?;
-    stream.send_columns(
-        entity,
-        [times.clone()],
-        rerun::Points3D::update_fields()
-            .with_positions(positions)
-            .columns_of_unit_batches()?,
-    )
-}
-
-/// A closest approach in the events log at its time: a warning under its
-/// limit, information otherwise (FLATLO's pairs, the fleet's agents and
-/// obstacles).
-fn log_closest(
-    stream: &RecordingStream,
-    events: &str,
-    time: f64,
-    below_limit: bool,
-    text: String,
-) -> rerun::RecordingStreamResult<()> {
-    stream.set_duration_secs("sim_time", time);
-    let level = if below_limit {
-        rerun::TextLogLevel::WARN
-    } else {
-        rerun::TextLogLevel::INFO
-    };
-    stream.log(events, &rerun::TextLog::new(text).with_level(level))
-}
-
 /// A scalar series over `times`, as one `send_columns`.
 fn log_series(
     stream: &RecordingStream,
@@ -446,7 +407,7 @@ fn run_worker(stream: RecordingStream, inbox: Receiver<Message>, pipeline: Optio
                     path,
                 } => pending.push((iteration, cost, path)),
                 other => {
-                    theta_pso::flush_iterations(&stream, &mut pending);
+                    swarm::flush_iterations(&stream, &mut pending);
                     if let Message::Scene(m) = &other {
                         scene = Some(m.clone());
                     }
@@ -454,7 +415,7 @@ fn run_worker(stream: RecordingStream, inbox: Receiver<Message>, pipeline: Optio
                 }
             }
         }
-        theta_pso::flush_iterations(&stream, &mut pending);
+        swarm::flush_iterations(&stream, &mut pending);
     }
     let _ = stream.flush_with_timeout(Duration::from_secs(10));
     drop(stream);
@@ -464,11 +425,7 @@ fn run_worker(stream: RecordingStream, inbox: Receiver<Message>, pipeline: Optio
 fn log_message(stream: &RecordingStream, message: Message, scene: Option<&Mission>, log: &str) {
     let result = match message {
         Message::Scene(mission) => scene::log_scene(stream, &mission),
-        Message::Outcome(outcome) => match *outcome {
-            Outcome::ThetaPso(o) => theta_pso::log_outcome(stream, &o, scene),
-            Outcome::Flatlo(o) => flatlo::log_outcome(stream, &o),
-            Outcome::Fleet(o) => fleet::log_outcome(stream, &o),
-        },
+        Message::Outcome(outcome) => log_outcome(stream, &outcome, scene),
         Message::Log(level, text) => {
             let level = match level {
                 Level::Info => rerun::TextLogLevel::INFO,
@@ -483,6 +440,18 @@ fn log_message(stream: &RecordingStream, message: Message, scene: Option<&Missio
     // A logging error (a sink gone) must not stop the run; the recording is
     // best effort from here on.
     let _ = result;
+}
+
+/// An outcome as its pipeline draws itself (`PipelineOutcome::sketch`).
+fn log_outcome(
+    stream: &RecordingStream,
+    outcome: &Outcome,
+    scene: Option<&Mission>,
+) -> rerun::RecordingStreamResult<()> {
+    let mut sketch = sketch::RerunSketch::new(stream);
+    outcome.face().sketch(scene, &mut sketch);
+    stream.reset_time();
+    sketch.result
 }
 
 /// A live plan on the `revision` timeline: the centroid path, each UAV's
@@ -506,13 +475,13 @@ fn log_live(
             &rerun::LineStrips3D::new([points]).with_colors([uav_color(k)]),
         )?;
     }
-    if let Some(o) = outcome.theta_pso() {
-        stream.log(paths::LIVE_CENTROID, &theta_pso::centroid_strip(o))?;
-    }
+    let mut sketch = sketch::RerunSketch::at_current_time(stream);
+    outcome.face().sketch_live(paths::LIVE_PLAN, &mut sketch);
+    sketch.result?;
     let warm = outcome
-        .theta_pso()
-        .and_then(|o| o.warm_start.as_ref())
-        .map_or_else(|| "cold".to_owned(), |w| format!("warm from {}", w.from));
+        .face()
+        .warm_from()
+        .unwrap_or_else(|| "cold".to_owned());
     stream.log(
         paths::LIVE_EVENTS,
         &rerun::TextLog::new(format!(

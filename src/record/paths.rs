@@ -39,58 +39,15 @@ pub fn origin(path: &str) -> String {
     format!("/{path}")
 }
 
-/// θ-PSO's entities.
-/// The designer's live plans, one per `revision`.
-pub const LIVE_CENTROID: &str = "live/plan/centroid";
+/// The designer's live plans, one per `revision`: each vehicle's track,
+/// and what its pipeline adds (`PipelineOutcome::sketch_live`: θ-PSO's
+/// centroid at `live/plan/centroid`).
+pub const LIVE_PLAN: &str = "live/plan";
 pub const LIVE_EVENTS: &str = "live/events";
 
 /// Vehicle `k` (0-based) of a live plan, named from 1.
 pub fn live_track(k: usize) -> String {
     format!("live/plan/vehicle_{}", k + 1)
-}
-
-pub mod theta_pso {
-    /// The cost terms on the `iteration` timeline.
-    pub const COST: &str = "theta_pso/cost";
-    pub const COST_TOTAL: &str = "theta_pso/cost/J_total";
-    pub const COST_LENGTH: &str = "theta_pso/cost/J1_length";
-    pub const COST_OBSTACLE: &str = "theta_pso/cost/J2_obstacle";
-    pub const COST_ALTITUDE: &str = "theta_pso/cost/J3_altitude";
-    pub const COST_WAYPOINTS: &str = "theta_pso/cost/JR_waypoints";
-    /// The swarm's best centroid path of each iteration.
-    pub const BEST_PATH: &str = "theta_pso/best_path";
-    pub const CLEARANCE: &str = "theta_pso/clearance";
-    pub const CENTROID: &str = "theta_pso/plan/centroid";
-    pub const VIOLATIONS: &str = "theta_pso/violations";
-
-    /// UAV `uav` (0-based) is named from 1.
-    pub fn clearance(uav: usize) -> String {
-        format!("{CLEARANCE}/uav_{}", uav + 1)
-    }
-
-    pub fn plan(uav: usize) -> String {
-        format!("theta_pso/plan/uav_{}", uav + 1)
-    }
-
-    pub fn uav(uav: usize) -> String {
-        format!("theta_pso/uavs/uav_{}", uav + 1)
-    }
-
-    /// The stretch of the centroid path inspecting `obstacle`.
-    pub fn pass(obstacle: &str) -> String {
-        format!("theta_pso/plan/pass_{}", obstacle.replace([' ', '/'], "_"))
-    }
-}
-
-/// FLATLO's entities, per aircraft (0-based, as `aircraft_0`).
-pub mod flatlo {
-    pub const AIRSPEED: &str = "flatlo/airspeed";
-    pub const LOAD_FACTOR: &str = "flatlo/load_factor";
-
-    /// `part` is `reference`, `flown`, `aircraft` or a series (`airspeed`, …).
-    pub fn aircraft(part: &str, index: usize) -> String {
-        format!("flatlo/{part}/aircraft_{index}")
-    }
 }
 
 /// A flight check's entities (`skyform fly --rrd`), per vehicle named from 1.
@@ -112,38 +69,21 @@ pub mod flight {
     }
 }
 
-/// The fleet's entities, per agent (0-based, as `agent_0`).
-pub mod fleet {
-    pub const DISTANCES: &str = "fleet/distances";
-    pub const SAFETY_C: &str = "fleet/distances/safety_c";
-    pub const TARGET: &str = "fleet/target";
-    /// At each sample, the agents that heard each other.
-    pub const LINKS: &str = "fleet/links";
-
-    /// `part` is `trails`, `agents` or `references`.
-    pub fn agent(part: &str, index: usize) -> String {
-        format!("fleet/{part}/agent_{index}")
-    }
-
-    /// The distance of agents `a` and `b` (0-based), named from 1.
-    pub fn distance(a: usize, b: usize) -> String {
-        format!("{DISTANCES}/{}_{}", a + 1, b + 1)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn every_pipeline_logs_under_its_own_root() {
-        for kind in [Kind::ThetaPso, Kind::Flatlo, Kind::Fleet] {
-            assert!(log(kind).starts_with(&format!("{}/", root(kind))));
-            assert!(events(kind).starts_with(&format!("{}/", root(kind))));
+    fn every_pipeline_logs_and_plots_under_its_own_root() {
+        for kind in Kind::ALL {
+            let root = format!("{}/", root(kind));
+            assert!(log(kind).starts_with(&root));
+            assert!(events(kind).starts_with(&root));
+            for plot in kind.face().plots().iter().flat_map(|panel| panel.iter()) {
+                assert!(plot.path.starts_with(&root), "{kind:?}: {plot:?}");
+            }
         }
         assert_eq!(log(Kind::Flatlo), "flatlo/log");
         assert_eq!(root(Kind::ThetaPso), "theta_pso");
-        assert_eq!(theta_pso::pass("pier 1/a"), "theta_pso/plan/pass_pier_1_a");
-        assert_eq!(fleet::distance(0, 2), "fleet/distances/1_3");
     }
 }

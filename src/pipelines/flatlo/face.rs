@@ -2,8 +2,9 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::{FlatloOutcome, summary};
+use super::{FlatloOutcome, recording, summary};
 use crate::mission::{Diagnostic, Mission};
+use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
     CancelToken, Completion, Kind, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome,
@@ -61,6 +62,10 @@ impl Pipeline for Flatlo {
             "widen bounds.x and bounds.y to hold the squadron's manoeuvre (flatlo.spacing, \
              flatlo.turn_radius and flatlo.start set its extent)",
         )
+    }
+
+    fn plots(&self) -> &'static [&'static [Plot]] {
+        recording::PLOTS
     }
 
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic> {
@@ -229,5 +234,9 @@ impl PipelineOutcome for FlatloOutcome {
             margin_source: "the simulated squadron's largest tracking error",
             loiter_radius: p.turn_radius,
         }
+    }
+
+    fn sketch(&self, _scene: Option<&Mission>, out: &mut dyn Sketch) {
+        recording::sketch(self, out);
     }
 }

@@ -11,6 +11,7 @@ pub mod algorithm;
 pub mod envelope;
 pub mod face;
 pub mod maneuver;
+pub mod recording;
 pub mod summary;
 
 use nalgebra::{Point3, Vector3};

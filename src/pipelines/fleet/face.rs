@@ -2,8 +2,9 @@
 
 use nalgebra::Point3;
 
-use super::{FleetOutcome, summary};
+use super::{FleetOutcome, recording, summary};
 use crate::mission::{Diagnostic, Mission};
+use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
     CancelToken, Completion, Kind, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome,
@@ -56,6 +57,10 @@ impl Pipeline for Fleet {
 
     fn add_margin(&self, mission: &mut Mission, m: f64) {
         mission.fleet.safety_distance += m;
+    }
+
+    fn plots(&self) -> &'static [&'static [Plot]] {
+        recording::PLOTS
     }
 
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic> {
@@ -206,5 +211,9 @@ impl PipelineOutcome for FleetOutcome {
             margin_source: "fleet.tolerance × fleet.safety_distance / 2",
             loiter_radius: 0.0,
         }
+    }
+
+    fn sketch(&self, _scene: Option<&Mission>, out: &mut dyn Sketch) {
+        recording::sketch(self, out);
     }
 }

@@ -17,6 +17,7 @@ pub mod cost;
 pub mod face;
 pub mod network;
 pub mod quadrotor;
+pub mod recording;
 pub mod simulation;
 pub mod summary;
 

@@ -1,7 +1,8 @@
 //! θ-PSO's face: what every front end reads of it (`pipelines::face`).
 
-use super::{ThetaPsoOutcome, summary};
+use super::{ThetaPsoOutcome, recording, summary};
 use crate::mission::{Diagnostic, Mission};
+use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
     CancelToken, Completion, Kind, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome,
@@ -71,6 +72,10 @@ impl Pipeline for ThetaPso {
 
     fn add_margin(&self, mission: &mut Mission, m: f64) {
         mission.formation.safety_margin += m;
+    }
+
+    fn plots(&self) -> &'static [&'static [Plot]] {
+        recording::PLOTS
     }
 
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic> {
@@ -196,5 +201,19 @@ impl PipelineOutcome for ThetaPsoOutcome {
             margin_source: "theta_pso.clearance_margin",
             loiter_radius: 0.0,
         }
+    }
+
+    fn sketch(&self, scene: Option<&Mission>, out: &mut dyn Sketch) {
+        recording::sketch(self, scene, out);
+    }
+
+    fn sketch_live(&self, root: &str, out: &mut dyn Sketch) {
+        recording::centroid(self, &format!("{root}/centroid"), out);
+    }
+
+    fn warm_from(&self) -> Option<String> {
+        self.warm_start
+            .as_ref()
+            .map(|w| format!("warm from {}", w.from))
     }
 }

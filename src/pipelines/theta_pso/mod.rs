@@ -12,6 +12,7 @@ pub mod inspection;
 pub mod iwp;
 pub mod motion;
 pub mod path;
+pub mod recording;
 pub mod reference;
 pub mod repair;
 pub mod route;
