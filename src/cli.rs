@@ -255,6 +255,63 @@ pub enum RunCommand {
         #[command(flatten)]
         record: RecordArgs,
     },
+    /// Any other registered pipeline, with the options every run has:
+    /// `skyform run NAME MISSION [--seed S] [--json FILE|-] [--verbose]
+    /// [recording options]`.
+    #[command(external_subcommand)]
+    Other(Vec<String>),
+}
+
+/// `skyform run NAME …` for a registered pipeline without a subcommand of
+/// its own (`RunCommand::Other`).
+#[derive(Debug, Parser)]
+struct PlainRunArgs {
+    /// Mission TOML file.
+    mission: PathBuf,
+    /// Seed of the run (default: the mission's `seed`).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Write the whole outcome as JSON to FILE, or to stdout with `-`.
+    #[arg(long, value_name = "FILE|-")]
+    json: Option<PathBuf>,
+    /// The summary lists everything it would count.
+    #[arg(long)]
+    verbose: bool,
+    #[command(flatten)]
+    record: RecordArgs,
+}
+
+/// A registered pipeline run through [`PlainRunArgs`]; an unknown name
+/// is an error that lists the pipelines.
+fn run_other(args: &[String]) -> u8 {
+    let name = args.first().map_or("", String::as_str);
+    let Some(kind) = Kind::ALL.into_iter().find(|k| k.slug() == name) else {
+        let known: Vec<&str> = Kind::ALL.iter().map(|k| k.slug()).collect();
+        eprintln!(
+            "error: no pipeline '{name}' to run: {} (skyform run --help)",
+            known.join(", ")
+        );
+        return exit::ERROR;
+    };
+    let plain = match PlainRunArgs::try_parse_from(args) {
+        Ok(a) => a,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() {
+                exit::ERROR
+            } else {
+                exit::OK
+            };
+        }
+    };
+    run_pipeline(
+        &plain.mission,
+        plain.seed,
+        plain.json.as_deref(),
+        &plain.record.sinks(),
+        plain.verbose,
+        |seed| Run::new(kind, seed),
+    )
 }
 
 /// The distributed fleet: one PSO per quadrotor every τ, flown by
@@ -407,6 +464,7 @@ pub fn main() -> ExitCode {
             false,
             |seed| Run::new(Kind::Flatlo, seed),
         )),
+        Command::Run(RunCommand::Other(args)) => ExitCode::from(run_other(&args)),
         Command::Record { mission, record } => {
             ExitCode::from(record_mission(&mission, &record.sinks()))
         }

@@ -358,3 +358,111 @@ fn the_floors_stand_in_order() {
     assert!(first("base") < first("mission") && first("mission") < first("pipelines"));
     assert!(first("pipelines") < first("outcome") && first("outcome") < first("run"));
 }
+
+/// The places outside `src/pipelines/` that still know a pipeline by name
+/// (a `Kind` or `Outcome` variant, an outcome type, `.theta_pso()` /
+/// `.flatlo()` / `.fleet()`), each with why. Issue 38: a pipeline is read
+/// through its face; this list only shrinks.
+const KNOWS_PIPELINES_BY_NAME: &[(&str, &str)] = &[
+    (
+        "src/cli.rs",
+        "a pipeline with options of its own has its own `run` subcommand",
+    ),
+    (
+        "src/run.rs",
+        "the fleet over agent processes goes through its transport, `distributed`",
+    ),
+    (
+        "src/distributed/coordinator.rs",
+        "the fleet's transport returns the fleet's outcome",
+    ),
+    (
+        "src/tui/board.rs",
+        "the designer's distributed fleet run (D)",
+    ),
+    ("src/tui/keys.rs", "the key table: each pipeline's run key"),
+    (
+        "src/tui/view/map/mod.rs",
+        "the map draws each pipeline's result (its own painter)",
+    ),
+    (
+        "src/tui/view/jobs.rs",
+        "the jobs panel's result table of each pipeline",
+    ),
+    (
+        "src/tui/fixtures.rs",
+        "ready-made jobs of each pipeline for the tests",
+    ),
+];
+
+/// Lines of `file` outside comments and its `#[cfg(test)]` module that name
+/// a pipeline.
+fn names_a_pipeline(file: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    let names = [
+        "Kind::ThetaPso",
+        "Kind::Flatlo",
+        "Kind::Fleet",
+        "Outcome::ThetaPso",
+        "Outcome::Flatlo",
+        "Outcome::Fleet",
+        "ThetaPsoOutcome",
+        "FlatloOutcome",
+        "FleetOutcome",
+        ".theta_pso()",
+        ".flatlo()",
+        ".fleet()",
+    ];
+    text.lines()
+        .take_while(|line| !line.starts_with("#[cfg(test)]"))
+        .map(|line| line.split("//").next().unwrap_or(""))
+        .filter(|code| names.iter().any(|n| code.contains(n)))
+        .map(str::to_owned)
+        .collect()
+}
+
+/// Issue 38's grep: outside `src/pipelines/` (where each pipeline and its
+/// one registration live), only the listed places name a pipeline, and
+/// every listed place still does (a place that no longer needs it leaves
+/// the list). A new place fails here: read the pipeline through its face
+/// (`pipelines::face`) instead.
+#[test]
+fn outside_the_pipelines_only_the_listed_places_name_a_pipeline() {
+    let mut naming = Vec::new();
+    let mut stack = vec![PathBuf::from("src")];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+            let path = entry.path();
+            if path.starts_with("src/pipelines") {
+                continue;
+            }
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs")
+                && path.file_name().is_none_or(|n| n != "tests.rs")
+                && !names_a_pipeline(&path).is_empty()
+            {
+                naming.push(path.to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    naming.sort();
+    let mut listed: Vec<String> = KNOWS_PIPELINES_BY_NAME
+        .iter()
+        .map(|(file, _)| file.to_string())
+        .collect();
+    listed.sort();
+    let new: Vec<_> = naming.iter().filter(|f| !listed.contains(f)).collect();
+    let gone: Vec<_> = listed.iter().filter(|f| !naming.contains(f)).collect();
+    assert!(
+        new.is_empty(),
+        "these files name a pipeline; read it through its face instead: {:?}",
+        new.iter()
+            .map(|f| (f, names_a_pipeline(Path::new(f.as_str()))))
+            .collect::<Vec<_>>()
+    );
+    assert!(
+        gone.is_empty(),
+        "these files no longer name a pipeline: take them off the list: {gone:?}"
+    );
+}

@@ -65,6 +65,20 @@ fn a_missing_file_is_an_error_naming_it() {
     assert!(text(&out.stdout).contains("cannot read no/such/mission.toml"));
 }
 
+/// `skyform run NAME` for a name no pipeline registers: an error that lists
+/// the registered ones (a pipeline without a subcommand of its own is run
+/// through the same generic path, `RunCommand::Other`).
+#[test]
+fn running_an_unknown_pipeline_lists_the_registered_ones() {
+    let out = skyform(&["run", "thetapso", "missions/bridge-inspection.toml"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("no pipeline 'thetapso' to run: theta-pso, flatlo, fleet"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn run_theta_pso_prints_a_summary_and_the_outcome_as_json() {
     let out = skyform(&[

@@ -663,7 +663,7 @@ pub const MAX_MARGIN: f64 = 8.0;
 fn invalid_with(mission: &Mission, pipeline: Kind, m: f64) -> Option<String> {
     let mut changed = mission.clone();
     with_margin(&mut changed, pipeline, m);
-    crate::mission::validate(&changed)
+    crate::pipelines::validate(&changed)
         .into_iter()
         .find(|d| d.severity == crate::mission::Severity::Error)
         .map(|d| format!("{}: {}", d.path, d.message))

@@ -11,7 +11,7 @@ use crate::mission::{self, Checked, Diagnostic, Mission, Report, SourceMap};
 
 /// Validation and every pipeline's own findings, errors and warnings.
 pub fn diagnose(mission: &Mission) -> Vec<Diagnostic> {
-    let mut all = mission::validate(mission);
+    let mut all = crate::pipelines::validate(mission);
     // A pipeline's findings only mean something on a mission that follows the
     // rules; on one that does not, the rules' errors are the news.
     if !all.iter().any(Diagnostic::is_error) {
@@ -22,17 +22,19 @@ pub fn diagnose(mission: &Mission) -> Vec<Diagnostic> {
 
 /// What the pipelines say of a mission that follows the rules: their budgets
 /// first (a run too large to start), then θ-PSO's IWPs and inspections,
-/// then FLATLO's airspeeds and bounds predicted from its references.
+/// then FLATLO's airspeeds and bounds predicted from its references
+/// (`Pipeline::findings`).
 fn pipeline_findings(mission: &Mission) -> Vec<Diagnostic> {
-    use clap::ValueEnum as _;
-    // Every registered pipeline's predicted size, in the order of `Kind`.
-    let mut out: Vec<Diagnostic> = crate::pipelines::Kind::value_variants()
-        .iter()
-        .flat_map(|&kind| crate::outcome::budget(kind, mission))
-        .collect();
-    out.extend(crate::pipelines::theta_pso::diagnostics(mission));
-    out.extend(crate::pipelines::flatlo::diagnostics(mission));
-    out
+    use crate::pipelines::Kind;
+    // Every registered pipeline's predicted size, then its findings, each
+    // in the order of `Kind`.
+    let budgets = Kind::ALL
+        .into_iter()
+        .flat_map(|kind| kind.face().budget(mission));
+    let findings = Kind::ALL
+        .into_iter()
+        .flat_map(|kind| kind.face().findings(mission));
+    budgets.chain(findings).collect()
 }
 
 /// `mission::check_str` with the pipelines' findings, located in `text`.
@@ -42,8 +44,20 @@ pub fn check_text(text: &str, file: Option<&str>) -> Checked {
         && !checked.report.has_errors()
     {
         let source = SourceMap::new(text);
-        let extra: Vec<Diagnostic> = pipeline_findings(m)
+        // The pipelines' own sections' rules; their findings only on a
+        // mission that follows every rule, as in `diagnose`.
+        let sections: Vec<Diagnostic> = crate::pipelines::Kind::ALL
             .into_iter()
+            .flat_map(|kind| kind.face().validate(m))
+            .collect();
+        let findings = if sections.iter().any(Diagnostic::is_error) {
+            Vec::new()
+        } else {
+            pipeline_findings(m)
+        };
+        let extra: Vec<Diagnostic> = sections
+            .into_iter()
+            .chain(findings)
             .map(|d| d.locate(file, &source))
             .collect();
         if !extra.is_empty() {

@@ -162,9 +162,10 @@ impl Outcome {
         }
     }
 
-    /// θ-PSO's best J; `None` for the pipelines without one.
+    /// The cost the run minimised (θ-PSO's best J); `None` for the
+    /// pipelines without one.
     pub fn best_cost(&self) -> Option<f64> {
-        self.theta_pso().map(|o| o.cost.total)
+        self.face().best_cost()
     }
 
     /// Every vehicle's timed track as planned and flown: θ-PSO's UAV

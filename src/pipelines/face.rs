@@ -164,6 +164,17 @@ pub trait Pipeline: Sync {
     /// The plots its viewer layout puts beside the scene, a column of
     /// panels (a panel of several plots is a set of tabs).
     fn plots(&self) -> &'static [&'static [Plot]];
+    /// The rules of its own mission section, beyond what `mission::validate`
+    /// holds (a new pipeline's section is checked here, in its module).
+    fn validate(&self, _mission: &Mission) -> Vec<Diagnostic> {
+        Vec::new()
+    }
+    /// What it says of a mission that follows the rules, before a run
+    /// (θ-PSO: IWPs no shape can pass, inspections eq. 8 cannot hold;
+    /// FLATLO: airspeeds and bounds predicted from its references).
+    fn findings(&self, _mission: &Mission) -> Vec<Diagnostic> {
+        Vec::new()
+    }
     /// Its predicted size against the documented limits (`limits`).
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic>;
     /// The sizes that keep a run on `mission` from being planned live
@@ -220,6 +231,20 @@ pub trait PipelineOutcome {
     /// The plan it was started from, in words, when not from scratch
     /// (θ-PSO's warm start: "warm from revision 3").
     fn warm_from(&self) -> Option<String> {
+        None
+    }
+    /// The cost the run minimised, where it has one (θ-PSO's best J).
+    fn best_cost(&self) -> Option<f64> {
+        None
+    }
+    /// The plan as a warm start for the next run (θ-PSO's), `from` saying
+    /// where it came from; `None` for a pipeline without warm starts.
+    fn warm_start(&self, _from: &str) -> Option<WarmStart> {
+        None
+    }
+    /// How long a flight the designer can replay on the map runs, seconds
+    /// (the fleet's); `None`: nothing to replay.
+    fn replay(&self) -> Option<f64> {
         None
     }
 }

@@ -150,12 +150,20 @@ pub enum PipelineError {
     Transport(String),
 }
 
+/// The rules of the file (`mission::validate`) and of every pipeline's own
+/// section (`Pipeline::validate`): what `check`, the designer and every run
+/// hold a mission to.
+pub fn validate(mission: &crate::mission::Mission) -> Vec<crate::mission::Diagnostic> {
+    let mut all = crate::mission::validate(mission);
+    for kind in super::Kind::ALL {
+        all.extend(kind.face().validate(mission));
+    }
+    all
+}
+
 /// Every pipeline's first step: a mission with errors is refused, naming them.
 pub fn require_valid(mission: &crate::mission::Mission) -> Result<(), PipelineError> {
-    refuse_errors(
-        crate::mission::validate(mission),
-        PipelineError::InvalidMission,
-    )
+    refuse_errors(validate(mission), PipelineError::InvalidMission)
 }
 
 /// A run's predicted size over its documented limit: refused before it starts.

@@ -213,18 +213,17 @@ impl App {
         if let Some(o) = self
             .shown()
             .and_then(|j| j.outcome.as_ref())
-            .and_then(|o| o.flatlo())
+            .filter(|o| o.kind().fixed_wing())
         {
-            for a in &o.aircraft {
-                for p in a
-                    .reference
-                    .iter()
-                    .map(|s| s.position)
-                    .chain(a.flown.iter().map(|s| s.position))
-                {
-                    x = [x[0].min(p.x), x[1].max(p.x)];
-                    y = [y[0].min(p.y), y[1].max(p.y)];
-                }
+            for p in o
+                .reference_tracks()
+                .iter()
+                .chain(&o.tracks())
+                .flat_map(|t| &t.samples)
+                .map(|s| s.position)
+            {
+                x = [x[0].min(p.x), x[1].max(p.x)];
+                y = [y[0].min(p.y), y[1].max(p.y)];
             }
         }
         (x, y)
@@ -237,8 +236,7 @@ impl App {
 
     /// Duration of the shown fleet result, if one is shown (the replay's range).
     pub fn replay_end(&self) -> Option<f64> {
-        let o = self.shown()?.outcome.as_ref()?.fleet()?;
-        Some(o.duration)
+        self.shown()?.outcome.as_ref()?.face().replay()
     }
 
     /// The fleet replay instant on the map: the replay cursor, or the end.
@@ -376,7 +374,7 @@ impl App {
     /// else off, and the status line says which size keeps it off.
     pub fn enable_live(&mut self) {
         let over =
-            crate::outcome::over_live_limits(crate::pipelines::Kind::ThetaPso, self.mission());
+            crate::outcome::over_live_limits(crate::pipelines::Kind::default(), self.mission());
         if !over.is_empty() {
             self.hold_live_off(format!("{}; L turns it on", over.join(", ")));
             return;
@@ -384,7 +382,7 @@ impl App {
         let now = Instant::now();
         if self
             .board
-            .start_live(crate::pipelines::Kind::ThetaPso, now)
+            .start_live(crate::pipelines::Kind::default(), now)
             .is_ok()
         {
             self.board.follow(self.editor.doc(), now);

@@ -529,7 +529,7 @@ mod tests {
         let msg = rx.recv_timeout(Duration::from_secs(10)).unwrap();
         let mut job = Job::new(
             4,
-            Kind::ThetaPso,
+            Kind::default(),
             0,
             crate::mission::default_mission().mission,
             Instant::now(),

@@ -93,6 +93,13 @@ pub fn lookup(key: Key, at: Context) -> Option<&'static Binding> {
     })
 }
 
+/// The keys shown for `action` in the key table (`T` for the fleet's run).
+pub fn keys_for(action: &Action) -> Option<&'static str> {
+    KEYS.iter()
+        .find(|row| row.bindings.iter().any(|b| &b.action == action))
+        .map(|row| row.keys)
+}
+
 /// Every key, grouped as the help overlay shows them. Earlier bindings win.
 pub static KEYS: &[KeyRow] = &[
     KeyRow {

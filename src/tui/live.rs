@@ -69,7 +69,7 @@ impl Default for Live {
     fn default() -> Self {
         Live {
             on: false,
-            pipeline: Kind::ThetaPso,
+            pipeline: Kind::default(),
             target: None,
             due: None,
             running: Vec::new(),
@@ -142,10 +142,13 @@ impl Live {
     /// Turns live planning on for `pipeline` (θ-PSO or FLATLO; the fleet,
     /// which simulates for seconds, is never live); a run is due at once.
     pub fn start(&mut self, pipeline: Kind, now: Instant) -> Result<(), String> {
-        if pipeline == Kind::Fleet {
-            return Err(
-                "the fleet is not planned live (it simulates for seconds): run it with T".into(),
-            );
+        if !pipeline.live() {
+            let key = crate::tui::keys::keys_for(&crate::tui::action::Action::Run(pipeline))
+                .map_or_else(String::new, |k| format!(" with {k}"));
+            return Err(format!(
+                "the {} is not planned live: run it{key}",
+                pipeline.name()
+            ));
         }
         self.on = true;
         self.held_off = None;
@@ -217,14 +220,13 @@ impl Live {
         let id = self.next_id;
         self.next_id += 1;
         let mut run = Run::new(self.pipeline, mission.seed);
-        if self.pipeline == Kind::ThetaPso {
-            run.warm = self
-                .latest
-                .as_ref()
-                .or(warm_from)
-                .and_then(warm_start)
-                .map(Arc::new);
-        }
+        // A pipeline with warm starts (θ-PSO) starts from the last plan.
+        run.warm = self
+            .latest
+            .as_ref()
+            .or(warm_from)
+            .and_then(warm_start)
+            .map(Arc::new);
         let job = Job::new(id, self.pipeline, mission.seed, mission.clone(), now);
         jobs::spawn_pipeline(id, run, mission, job.cancel.clone(), record, tx.clone());
         self.running.push(job);
@@ -262,15 +264,9 @@ impl Live {
     }
 }
 
-/// A θ-PSO job's plan as a warm start.
+/// A job's plan as a warm start, where its pipeline has them (θ-PSO's).
 fn warm_start(job: &Job) -> Option<WarmStart> {
-    let o = job.outcome.as_ref()?.theta_pso()?;
-    (!o.waypoints.is_empty()).then(|| WarmStart {
-        from: format!("the plan of run {} (J {:.2})", label(job.id), o.cost.total),
-        waypoints: o.waypoints.clone(),
-        pass_angles: o.pass_angles.clone(),
-        corridor: Some(o.corridor.clone()),
-    })
+    job.outcome.as_ref()?.face().warm_start(&label(job.id))
 }
 
 /// A run as people read its id: `job 3`, or `live 12` for a live run.

@@ -68,6 +68,10 @@ impl Pipeline for Flatlo {
         recording::PLOTS
     }
 
+    fn findings(&self, mission: &Mission) -> Vec<Diagnostic> {
+        super::diagnostics(mission)
+    }
+
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic> {
         super::budget(mission)
     }

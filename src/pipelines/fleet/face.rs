@@ -213,6 +213,11 @@ impl PipelineOutcome for FleetOutcome {
         }
     }
 
+    /// The flight, replayed on the map (`,` `.` `>`).
+    fn replay(&self) -> Option<f64> {
+        Some(self.duration)
+    }
+
     fn sketch(&self, _scene: Option<&Mission>, out: &mut dyn Sketch) {
         recording::sketch(self, out);
     }

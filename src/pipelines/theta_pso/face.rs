@@ -78,6 +78,10 @@ impl Pipeline for ThetaPso {
         recording::PLOTS
     }
 
+    fn findings(&self, mission: &Mission) -> Vec<Diagnostic> {
+        super::diagnostics(mission)
+    }
+
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic> {
         super::budget(mission)
     }
@@ -209,6 +213,19 @@ impl PipelineOutcome for ThetaPsoOutcome {
 
     fn sketch_live(&self, root: &str, out: &mut dyn Sketch) {
         recording::centroid(self, &format!("{root}/centroid"), out);
+    }
+
+    fn best_cost(&self) -> Option<f64> {
+        Some(self.cost.total)
+    }
+
+    fn warm_start(&self, from: &str) -> Option<crate::pipelines::theta_pso::WarmStart> {
+        (!self.waypoints.is_empty()).then(|| crate::pipelines::theta_pso::WarmStart {
+            from: format!("the plan of run {from} (J {:.2})", self.cost.total),
+            waypoints: self.waypoints.clone(),
+            pass_angles: self.pass_angles.clone(),
+            corridor: Some(self.corridor.clone()),
+        })
     }
 
     fn warm_from(&self) -> Option<String> {
