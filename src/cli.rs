@@ -1,4 +1,9 @@
 //! The command line: clap subcommands that call the library and print.
+//!
+//! Long (~920 lines) because it holds the clap tree of every subcommand with its help text,
+//! `main`'s dispatch, and the plumbing the commands share (loading and reporting a mission,
+//! recorders, Ctrl-C, the stderr progress, running a pipeline); the larger commands
+//! already have files of their own.
 
 use std::io::Write;
 use std::path::PathBuf;

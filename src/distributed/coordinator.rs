@@ -161,6 +161,11 @@ pub fn split(agents: usize, processes: usize) -> Vec<Vec<usize>> {
 
 /// Flies `mission`'s fleet with `seed` over agent processes, as `options`
 /// says; the outcome is the in-process run's, with the transport's figures.
+///
+/// Long (~225 lines) because it is one run's life in order (subscriptions and tokens, the
+/// agents' mission file, spawning, handshake, flight, reports, shutdown), each step holding
+/// the session, subscribers and processes the later ones need; the `Processes` guard ends
+/// the agents on every early return.
 pub fn coordinate(
     mission: &Mission,
     seed: u64,

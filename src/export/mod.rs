@@ -404,6 +404,10 @@ pub fn kml_file_name(stem: &str, pipeline: Kind) -> String {
 
 /// Reduces, re-verifies and (unless refused) writes one file per vehicle and
 /// format into `options.out_dir`, named after `stem` (the mission file's stem).
+///
+/// Long (~125 lines) because it is the export's one gate in order: the checks, the tolerance
+/// (raised to what the files hold), the reduction, the re-verification that may refuse, then
+/// each format written; every refusal must come before the first file is written.
 pub fn export(
     mission: &Mission,
     stem: &str,

@@ -17,6 +17,11 @@
 //!
 //! Take-off, landing and loitering are outside the check: they happen before
 //! the first and after the last waypoint.
+//!
+//! Long (~775 lines) because it is the one check of the written files: its findings and
+//! their advice, the flight an autopilot makes of a file, and each measure taken on it
+//! (deviation, timing, verification, leg rates, the CSV as written), all reading the same
+//! flights and limits.
 
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
@@ -346,6 +351,10 @@ pub fn deviation(plan: &VehiclePlan, track: &Track) -> f64 {
 /// count when `waypoint_files` are written) and the CSV texts (when
 /// given); measures deviation from the tracks, timing errors and the rates
 /// of the written legs.
+///
+/// Long (~130 lines) because it takes each measure in turn on the one set of flights (the
+/// instants, the deviation from the tracks, the timing errors, the verification, the leg
+/// rates, the CSV as written), each filling its fields of the one `Reverification`.
 pub fn reverify(
     mission: &Mission,
     planned: &Planned,

@@ -8,6 +8,11 @@
 //! the thread count, and `--flight K` flies flight K again. The report is
 //! read from the flights in their order. Models, sources and limits:
 //! docs/flight-check.md.
+//!
+//! Long (~790 lines) because it is the check's one run: the setup from the exported plan,
+//! one flight flown and measured, the many flights on threads with their recording, and the
+//! `--target` margin search that plans and flies them again; the air, the autopilot and the
+//! report are already submodules.
 
 pub mod air;
 pub mod autopilot;

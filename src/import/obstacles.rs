@@ -125,7 +125,9 @@ pub struct Made {
 
 /// The obstacles of every feature of `survey`, or every problem found.
 ///
-/// Long (~160 lines): one match over the survey's feature kinds (point, line, polygon), each placing and clipping in a few lines.
+/// Long (~180 lines): one match over the survey's feature kinds (point, line, polygon), each
+/// placing and clipping in a few lines; around it, each feature's properties read and its
+/// obstacles named.
 pub fn make(
     mission: &Mission,
     origin: &GeoOrigin,

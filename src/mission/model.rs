@@ -5,6 +5,10 @@
 //! Every parameter defaults to the value used in its paper, so a mission file
 //! only has to say what differs. Unknown keys are rejected (`deny_unknown_fields`)
 //! so that a typo is an error instead of a silently ignored setting.
+//!
+//! Long (~1150 lines) because it is the model of every mission section, one serde struct
+//! each (every pipeline's parameters included), with their paper defaults and the small
+//! queries on them (an obstacle's band, the formation's radius) that every stage shares.
 
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};

@@ -120,10 +120,11 @@ impl CancelToken {
 }
 
 /// How a run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Completion {
     /// Every iteration ran.
+    #[default]
     Finished,
     /// Stopped by the cancel token; the outcome holds the best found so far.
     Cancelled,

@@ -53,6 +53,10 @@ fn footprint_mesh(o: &Obstacle) -> Option<rerun::Mesh3D> {
 }
 
 /// The mission as static data.
+///
+/// Long (~125 lines) because it logs the scene's layers one after another (band, footprints,
+/// cylinders, inspected shells, route, terrain, IWPs, the mission file), each one static
+/// Rerun archetype built in place.
 pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStreamResult<()> {
     stream.log_static(paths::WORLD, &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
     let b = &m.bounds;

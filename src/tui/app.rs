@@ -12,6 +12,10 @@
 //! flows that cross components: saving, opening, showing and exporting a
 //! result, the recovery copy. `update` hands every other action to the
 //! component that owns it.
+//!
+//! Long (~970 lines) because it is the one `App`: the accessors the view draws from, the
+//! dispatch of each action to its component, and the flows that cross components (find,
+//! saving, opening, live runs, the recovery copy), which need more than one of them.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};

@@ -8,6 +8,10 @@
 //! must leave the selection valid and the IWPs current ([`Editor::refresh`]).
 //! The rest of the screen reaches it through [`Editor::update`] and reads it
 //! through its accessors.
+//!
+//! Long (~875 lines) because every edit the designer offers is a method here (add,
+//! duplicate, delete, nudge, drag, presets, shapes, undo, the inspector's typed line), each
+//! going through the selection and leaving it and the IWPs current.
 
 use std::path::PathBuf;
 

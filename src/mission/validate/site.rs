@@ -162,6 +162,11 @@ impl Checker {
         }
     }
 
+    /// The `[[obstacles]]` rows: their count, then each row's keys.
+    ///
+    /// Long (~150 lines) because it is one pass over the rows with one rule per key of an
+    /// obstacle (stand-off, inspect, name, center and radius or footprint, heights, the
+    /// bounds), each naming its field; the footprint's own rules are already `footprint`.
     pub(super) fn obstacles(&mut self, path: &FieldPath, mission: &Mission) {
         let (obstacles, bounds) = (&mission.obstacles, &mission.bounds);
         if obstacles.len() > MAX_OBSTACLES {

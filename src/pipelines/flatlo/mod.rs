@@ -5,6 +5,11 @@
 //! (eqs. 1-6) flies its reference under the autopilot, integrated by RK4 with
 //! seeded noise; finally the squadron is verified: separation, final spacing,
 //! lateral spread and tracking error.
+//!
+//! Long (~990 lines) because it holds the pipeline's three stages (references, the squadron
+//! flown in chunks, the verification), the outcome types they fill, and the budget and
+//! diagnostics that predict them from the same figures; the aircraft, the manoeuvres and
+//! the envelope are already submodules.
 
 pub mod aircraft;
 pub mod algorithm;
@@ -523,7 +528,8 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
 /// only on an invalid mission; a squadron that comes too close is a failed
 /// verification, not an error.
 ///
-/// Long (~140 lines): references, simulation and verification in order, the paper's three stages.
+/// Long (~160 lines): references, simulation and verification in order, the paper's three
+/// stages.
 pub fn plan(
     mission: &Mission,
     seed: u64,

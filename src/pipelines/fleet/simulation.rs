@@ -11,6 +11,10 @@
 //! processes each flies its own agents and every process runs the same
 //! network model on the same messages, so each knows which agents decide in
 //! a round and every agent's random stream is the one of the in-process run.
+//!
+//! Long (~980 lines) because its stages are methods on the one `Simulation` whose state they
+//! share (disturb, broadcast, exchange, record, observe, decide, fly, finish), with the
+//! `Link` it exchanges through and the clocks and logs it keeps.
 
 use nalgebra::{Point2, Point3, Vector2};
 use rayon::prelude::*;

@@ -7,6 +7,10 @@ use super::{Closest, Deviation, FleetOutcome, FormationError, Other};
 use crate::pipelines::Verdict;
 
 /// The human summary of a fleet outcome.
+///
+/// Long (~150 lines) because it writes the summary's lines top to bottom (run, targets,
+/// pairs, closest, network, distributed, per-agent traffic, lost agents, effort, result),
+/// each a few lines of formatting in the order printed.
 pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();

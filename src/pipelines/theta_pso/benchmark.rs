@@ -31,6 +31,10 @@ pub fn cost_terms(t: &spso::Terms) -> CostTerms {
 }
 
 /// Plans `mission` (cost = "spso") with `seed`.
+///
+/// Long (~130 lines) because it is the benchmark run's stages in order (the swarm with its
+/// progress and cancel callback, the path against the sample budget, the flight and its
+/// verification), and a third of it fills the outcome, most of its fields empty here.
 pub fn plan(
     mission: &Mission,
     seed: u64,

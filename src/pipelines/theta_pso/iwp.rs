@@ -466,6 +466,10 @@ fn stands_in(mission: &Mission, o: &crate::mission::Obstacle, window: [f64; 2]) 
 }
 
 /// Every IWP of the mission by eq. 9, with the operator's choices applied.
+///
+/// Long (~120 lines) because it is eq. 9 over each pair of obstacles in order (the altitudes
+/// both block, the gap and its ends, what else stands in it, the operator's choice, the shape
+/// and its hold), each test reading the figures of the one before.
 pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
     let f = &mission.formation;
     let r_q = f.least_clearance();

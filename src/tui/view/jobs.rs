@@ -1,5 +1,9 @@
 //! The jobs panel: every launched run with its progress, and the selected
 //! one's convergence chart and verification.
+//!
+//! Long (~750 lines) because each pipeline's result table is here (θ-PSO's
+//! verdict, figures, unusable IWPs and verification rows; the fleet's
+//! targets and network; FLATLO's pairs), beside the list and the chart.
 
 use std::time::Instant;
 
@@ -97,7 +101,8 @@ fn state_span(job: &Job) -> Span<'static> {
     }
 }
 
-/// Long (~135 lines): the jobs panel's parts top to bottom (title, list, progress, the shown result's table, the convergence chart).
+/// Long (~185 lines): the jobs panel's parts top to bottom (title, list,
+/// progress, the shown result's table, the convergence chart).
 pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
     let focused = app.focus() == Focus::Jobs;
     let border = if focused {

@@ -1,5 +1,10 @@
 //! Drawing: a pure function of the app state (and the clock, for elapsed
 //! times), so every screen can be snapshot-tested on a `TestBackend`.
+//!
+//! Long (~760 lines) because it is the screen's frame: the layout, the status and find
+//! lines, and every overlay (help, quit, save as, open, import, overwrite, recovery,
+//! discard) with the popup helpers they share; the map, inspector and jobs panes are
+//! submodules.
 
 pub mod inspector;
 pub mod jobs;

@@ -31,6 +31,11 @@
 //! by UAV. Along them the path of each UAV is straight between knots (the
 //! path's vertices ± the heading's span, the zones' t1..t4) except where the
 //! heading turns or the shape blends; those stretches are split finely.
+//!
+//! Long (~925 lines) because it is J's terms and the one evaluation that sums them on every
+//! UAV's path: the broad phase over the legs, the narrow phase along them, the scratch both
+//! reuse, the turning term and the closed-form violation integral; the pairs' and the
+//! passes' deficits are already submodules.
 
 use nalgebra::{Point2, Point3, SVector, Vector3};
 
@@ -305,6 +310,10 @@ impl CostModel {
     /// undiluted obstacle violation: Σ over UAVs and obstacles of the
     /// violation integral, over J1 (J2 before the paper's mean over N and K).
     /// Any band or bounds violation counts as a violation too.
+    ///
+    /// Long (~140 lines) because it is the evaluation's hot path in order (the broad phase
+    /// over the legs, the legs deepest first, each followed until the bound is reached, then
+    /// the pairs' and passes' deficits), its early exits sharing one `Scratch` and `Sums`.
     fn terms_below(&self, path: &CentroidPath, lead: Lead, bound: f64) -> (CostTerms, f64) {
         let points = &path.points;
         let p = &self.params;
@@ -508,6 +517,10 @@ impl CostModel {
     /// whole leg when `whole` (the band or the bounds are in reach), else only
     /// the windows where a UAV can touch one of `scratch.near`'s obstacles;
     /// when `stop`, only up to the first violation.
+    ///
+    /// Long (~150 lines) because it is one leg's narrow phase in order (the windows merged,
+    /// the knots where the motion changes, the pieces split where the heading turns, the UAVs
+    /// read and their violations summed), on the borrowed scratch so it allocates nothing.
     #[allow(clippy::too_many_arguments)]
     fn follow_leg(
         &self,

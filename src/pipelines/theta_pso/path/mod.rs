@@ -16,6 +16,11 @@
 //!
 //! Each via is inserted into the leg where it lengthens the path least, so the
 //! swarm still decides the route between them.
+//!
+//! Long (~760 lines) because it is the one `PathBuilder`: the decoding of a particle
+//! (eq. 1), the crossings and inspections it prepares once, and their insertion as
+//! via-points into the legs they lengthen least; the rounding, the squeeze, the walker and
+//! the zones are already submodules.
 
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 

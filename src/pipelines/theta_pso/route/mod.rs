@@ -29,6 +29,11 @@
 //! the cell size; the disc model makes it conservative (a plan the route
 //! stage finds keeps every UAV clear; a formation turned to just the right
 //! heading might squeeze through where the disc model says it cannot).
+//!
+//! Long (~1265 lines) because it holds the stage's driver and everything built around the
+//! search it runs: the site (shape, layers, levels), the stops and jumps, and the corridor
+//! assembled from the steps, pulled tight, carried through crossings and given its squeeze
+//! map; the search, the field, the guide and the refusal's words are already submodules.
 
 mod blocked;
 pub mod field;
@@ -507,7 +512,8 @@ fn with_altitudes(mission: &Mission, blocked: Blocked, z_box: [f64; 2]) -> Block
 
 /// The route search at `levels` (see [`find`]).
 ///
-/// Long (~170 lines): the stage in order (grid, open modes, stops, jumps, search, corridor, squeeze map), each step reading the one before.
+/// Long (~120 lines): the stage in order (stops, the site, crossing and pass jumps, the guided
+/// search, the corridor and its squeeze map), each step reading the one before.
 fn find_at(
     mission: &Mission,
     builder: &PathBuilder,
@@ -747,7 +753,9 @@ fn shrink([lo, hi]: [f64; 2], by: f64) -> [f64; 2] {
 /// The search's steps as a corridor: runs of cells pulled tight within their
 /// mode, the jumps kept exact, each climb a short ramp round its cell.
 ///
-/// Long (~130 lines): one walk over the steps (runs, layer changes, climbs, jumps), then the ramps laid out.
+/// Long (~195 lines): one walk over the steps (runs, layer changes, climbs, jumps), then the
+/// ramps laid out; over a quarter of it is rustfmt spreading the seven calls of its `flush`
+/// closure (which borrows the walk's vectors) over eight lines each.
 #[allow(clippy::too_many_arguments)]
 fn assemble(
     site: &Site,

@@ -158,7 +158,8 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
 /// nothing. It starts at the graph's start level and ends at its goal
 /// level.
 ///
-/// Long (~150 lines): one A* loop whose moves (steps, layer changes, climbs, crossings, passes) share its state arrays.
+/// Long (~175 lines): one A* loop whose moves (steps, layer changes, climbs, crossings, passes)
+/// share its state arrays, then the route (or the cells reached) read back from them.
 pub fn search(
     graph: &Graph<'_>,
     start: usize,

@@ -35,7 +35,8 @@ pub fn formation_split(app: &App, area: Rect) -> [Rect; 2] {
 /// `folded`: the pane has the whole width (a narrow screen, its focus):
 /// its bottom line names the selection and says Tab.
 ///
-/// Long (~135 lines): the formation's slots, their labels and the heading, in drawing order.
+/// Long (~170 lines): its two panes top to bottom, the slots' canvas (title, axes, rings,
+/// labels) then the IWP table (rows, wide or narrow, its title and header).
 pub fn draw_formation(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport, folded: bool) {
     let m = app.mission();
     let [top, bottom] = formation_split(app, area);

@@ -5,6 +5,11 @@
 //! viewport turns a mouse position back into metres for hit-testing.
 //! The side view (`side`) and the formation editor's drawing (`formation`)
 //! share this module's viewport and painters.
+//!
+//! Long (~950 lines) because it holds the viewport and every painter of the
+//! top-down map, each pipeline's result among them (θ-PSO's plan and
+//! reconfigurations, FLATLO's squadron, the fleet's replay), which the side
+//! view and the formation editor reuse.
 
 use nalgebra::{Point2, Point3};
 use ratatui::Frame;
@@ -266,6 +271,11 @@ fn paint_fleet(ctx: &mut Context, app: &App, o: &FleetOutcome, stale: bool, dot:
 ///
 /// `folded`: the map has the whole width (a narrow screen, the map
 /// focused): its bottom line names the selection and says Tab.
+///
+/// Long (~125 lines) because it is the pane top to bottom: the title's parts
+/// (scale, replay, add tool, the shown result, live state, terrain legend),
+/// the block, the canvas, then the replay's slider row; most of it is the
+/// title, whose parts give way in order on a narrow pane.
 pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport, folded: bool) {
     if app.side_view() {
         return draw_side(frame, app, area);
@@ -394,7 +404,8 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport, folded:
     }
 }
 
-/// Long (~150 lines): the map's layers in drawing order (terrain, bounds, obstacles, IWPs, plans, vehicles), each a short block.
+/// Long (~200 lines): the map's layers in drawing order (terrain, bounds,
+/// obstacles, IWPs, plans, vehicles), each a short block.
 fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     let b = &m.bounds;
     ctx.draw(&Rectangle {
