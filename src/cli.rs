@@ -747,7 +747,7 @@ impl Observer for StderrProgress {
                     eprintln!("stage: {stage}");
                 }
             }
-            Event::PathIteration { cost, .. } => self.best = cost.total,
+            Event::Iteration { cost, .. } => self.best = cost,
             Event::Progress(fraction) => {
                 let percent = (fraction * 100.0).round() as i32;
                 if self.terminal {
@@ -774,7 +774,7 @@ impl Observer for StderrProgress {
                 eprintln!("{tag}: {message}");
             }
             // The log says who was lost, and when.
-            Event::Agents { .. } => {}
+            Event::Vehicles { .. } => {}
         }
     }
 }

@@ -1103,7 +1103,7 @@ fn cancelling_returns_promptly_with_the_best_so_far() {
     let mut iterations_seen = 0;
     let trigger = cancel.clone();
     let mut observer = |e: Event<'_>| {
-        if let Event::PathIteration { iteration, .. } = e {
+        if let Event::Iteration { iteration, .. } = e {
             iterations_seen = iteration;
             if iteration == 5 {
                 trigger.cancel();
@@ -1144,9 +1144,13 @@ fn the_observer_sees_every_iteration_with_a_non_increasing_best() {
     let mut totals = Vec::new();
     let mut stages = Vec::new();
     let mut observer = |e: Event<'_>| match e {
-        Event::PathIteration { cost, path, .. } => {
+        Event::Iteration {
+            cost, terms, path, ..
+        } => {
             assert!(path.len() >= 2);
-            totals.push(cost.total);
+            // The named terms lead with the total the event carries.
+            assert_eq!(terms.first(), Some(&("J_total", cost)));
+            totals.push(cost);
         }
         Event::Stage(s) => stages.push(s.to_owned()),
         _ => {}

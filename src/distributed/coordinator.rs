@@ -327,7 +327,7 @@ pub fn coordinate(
         .put(Clock::Control(Control::Start).encode())
         .wait()
         .map_err(z("starting the run"))?;
-    observer.on_event(Event::Agents {
+    observer.on_event(Event::Vehicles {
         alive: mission.fleet.agents,
         total: mission.fleet.agents,
     });

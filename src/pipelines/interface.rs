@@ -11,8 +11,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use nalgebra::Point3;
 use serde::Serialize;
 
-use super::theta_pso;
-
 /// One timed sample of a vehicle's track, planned or flown: seconds,
 /// metres ENU, m/s. θ-PSO's trajectories are made of them, and every
 /// pipeline's tracks (`outcome::tracks`) and the exports read them.
@@ -58,17 +56,20 @@ pub enum Event<'a> {
     Stage(&'a str),
     /// Overall progress in [0, 1].
     Progress(f64),
-    /// θ-PSO: the best centroid path and its cost after an iteration.
-    PathIteration {
+    /// A search's best after an iteration: its cost, the cost's named
+    /// terms (the total first: what a recording plots on the `iteration`
+    /// timeline) and its path (θ-PSO's best centroid path).
+    Iteration {
         iteration: usize,
-        cost: &'a theta_pso::CostTerms,
+        cost: f64,
+        terms: &'a [(&'static str, f64)],
         path: &'a [Point3<f64>],
     },
     /// A message for the log.
     Log(Level, &'a str),
-    /// A distributed fleet: how many of its agents are still flying (their
-    /// processes answer), of how many.
-    Agents { alive: usize, total: usize },
+    /// Vehicles flown by processes of their own (a distributed fleet's
+    /// agents): how many still answer, of how many.
+    Vehicles { alive: usize, total: usize },
 }
 
 /// Receives a pipeline's events on the pipeline's thread. Keep it cheap: it

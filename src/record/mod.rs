@@ -30,7 +30,6 @@ use rerun::{RecordingStream, RecordingStreamBuilder};
 
 use crate::mission::Mission;
 use crate::outcome::Outcome;
-use crate::pipelines::theta_pso::CostTerms;
 use crate::pipelines::{Event, Kind, Level, Observer};
 
 mod flight;
@@ -80,7 +79,7 @@ enum Message {
     Scene(Box<Mission>),
     Iteration {
         iteration: usize,
-        cost: CostTerms,
+        terms: Vec<(&'static str, f64)>,
         path: Vec<[f32; 3]>,
     },
     Log(Level, String),
@@ -274,17 +273,18 @@ impl Drop for Recorder {
 impl Observer for Recorder {
     fn on_event(&mut self, event: Event<'_>) {
         match event {
-            Event::PathIteration {
+            Event::Iteration {
                 iteration,
-                cost,
+                terms,
                 path,
+                ..
             } => self.send(Message::Iteration {
                 iteration,
-                cost: *cost,
+                terms: terms.to_vec(),
                 path: path.iter().map(f32x3).collect(),
             }),
             Event::Log(level, text) => self.send(Message::Log(level, text.to_owned())),
-            Event::Stage(_) | Event::Progress(_) | Event::Agents { .. } => {}
+            Event::Stage(_) | Event::Progress(_) | Event::Vehicles { .. } => {}
         }
     }
 }
@@ -389,11 +389,12 @@ fn spawn_viewer() -> Result<String, String> {
 }
 
 /// The worker: takes messages until the queue is closed, batching the
-/// θ-PSO iterations that arrive together into one `send_columns` per series.
+/// iterations that arrive together into one `send_columns` per series.
 fn run_worker(stream: RecordingStream, inbox: Receiver<Message>, pipeline: Option<Kind>) {
     // Only a pipeline logs lines; the scene alone never does.
     let log = paths::log(pipeline.unwrap_or_default());
-    let mut pending: Vec<(usize, CostTerms, Vec<[f32; 3]>)> = Vec::new();
+    let root = paths::root(pipeline.unwrap_or_default());
+    let mut pending: Vec<swarm::Iteration> = Vec::new();
     // The mission of the scene, for what an outcome is measured against.
     let mut scene: Option<Box<Mission>> = None;
     while let Ok(first) = inbox.recv() {
@@ -403,11 +404,11 @@ fn run_worker(stream: RecordingStream, inbox: Receiver<Message>, pipeline: Optio
             match message {
                 Message::Iteration {
                     iteration,
-                    cost,
+                    terms,
                     path,
-                } => pending.push((iteration, cost, path)),
+                } => pending.push((iteration, terms, path)),
                 other => {
-                    swarm::flush_iterations(&stream, &mut pending);
+                    swarm::flush_iterations(&stream, &root, &mut pending);
                     if let Message::Scene(m) = &other {
                         scene = Some(m.clone());
                     }
@@ -415,7 +416,7 @@ fn run_worker(stream: RecordingStream, inbox: Receiver<Message>, pipeline: Optio
                 }
             }
         }
-        swarm::flush_iterations(&stream, &mut pending);
+        swarm::flush_iterations(&stream, &root, &mut pending);
     }
     let _ = stream.flush_with_timeout(Duration::from_secs(10));
     drop(stream);

@@ -1,42 +1,36 @@
-//! The swarm's progress on the `iteration` timeline: the cost terms and the
-//! best centroid path of each iteration, from the run's `PathIteration`
-//! events (θ-PSO's; its outcome draws itself: `theta_pso::recording`).
+//! A search's progress on the `iteration` timeline: each named term of its
+//! best cost as a series under `<root>/cost/` and its best path at
+//! `<root>/best_path`, from the run's `Event::Iteration`s (θ-PSO's swarm:
+//! `theta_pso/cost/J_total`, …).
 
 use rerun::RecordingStream;
 
 use super::log_series;
-use crate::pipelines::theta_pso::CostTerms;
-use crate::pipelines::theta_pso::recording::paths as at;
 
-/// Picks one term out of the cost breakdown.
-type CostTerm = fn(&CostTerms) -> f64;
+/// One iteration as queued: its index, its cost's named terms, its path.
+pub type Iteration = (usize, Vec<(&'static str, f64)>, Vec<[f32; 3]>);
 
-/// One `send_columns` per series for all iterations gathered so far.
-pub fn flush_iterations(
-    stream: &RecordingStream,
-    pending: &mut Vec<(usize, CostTerms, Vec<[f32; 3]>)>,
-) {
-    if pending.is_empty() {
+/// One `send_columns` per series for all iterations gathered so far, under
+/// the pipeline's `root`.
+pub fn flush_iterations(stream: &RecordingStream, root: &str, pending: &mut Vec<Iteration>) {
+    let Some((_, first, _)) = pending.first() else {
         return;
-    }
+    };
     let iterations =
         rerun::TimeColumn::new_sequence("iteration", pending.iter().map(|(i, _, _)| *i as i64));
-    let series: [(&str, CostTerm); 5] = [
-        (at::COST_TOTAL, |c| c.total),
-        (at::COST_LENGTH, |c| c.length),
-        (at::COST_OBSTACLE, |c| c.obstacle),
-        (at::COST_ALTITUDE, |c| c.altitude),
-        (at::COST_WAYPOINTS, |c| c.waypoints),
-    ];
-    for (path, term) in series {
-        let values: Vec<f64> = pending.iter().map(|(_, c, _)| term(c)).collect();
-        let _ = log_series(stream, path, &iterations, values);
+    let names: Vec<&'static str> = first.iter().map(|(name, _)| *name).collect();
+    for (k, name) in names.into_iter().enumerate() {
+        let values: Vec<f64> = pending
+            .iter()
+            .map(|(_, terms, _)| terms.get(k).map_or(f64::NAN, |(_, v)| *v))
+            .collect();
+        let _ = log_series(stream, &format!("{root}/cost/{name}"), &iterations, values);
     }
     let strips: Vec<Vec<[f32; 3]>> = pending.drain(..).map(|(_, _, p)| p).collect();
     if let Ok(columns) = rerun::LineStrips3D::update_fields()
         .with_strips(strips)
         .columns_of_unit_batches()
     {
-        let _ = stream.send_columns(at::BEST_PATH, [iterations], columns);
+        let _ = stream.send_columns(format!("{root}/best_path"), [iterations], columns);
     }
 }

@@ -64,15 +64,15 @@ impl Viewer {
 pub enum JobMsg {
     Stage(JobId, String),
     Progress(JobId, f64),
-    /// The swarm's best after an iteration; the path only when it changed.
+    /// A search's best cost after an iteration; its path only when it changed.
     Iteration {
         id: JobId,
         cost: f64,
         path: Option<Vec<Point3<f64>>>,
     },
     Log(JobId, Level, String),
-    /// A distributed fleet's agents still flying, of how many.
-    Agents {
+    /// Vehicles flown by processes of their own still answering, of how many.
+    Vehicles {
         id: JobId,
         alive: usize,
         total: usize,
@@ -233,7 +233,7 @@ impl Job {
             JobMsg::Log(_, Level::Warn, text) => self.last_warning = Some(text),
             JobMsg::Recorded { path, bytes, .. } => self.recorded = Some((path, bytes)),
             JobMsg::Log(_, Level::Info, _) => {}
-            JobMsg::Agents { alive, total, .. } => self.agents = Some((alive, total)),
+            JobMsg::Vehicles { alive, total, .. } => self.agents = Some((alive, total)),
             JobMsg::Flight(_, FlightUpdate::Progress(done, total)) => {
                 self.flight = Some(FlightCheck::Running { done, total });
             }
@@ -278,7 +278,7 @@ impl JobMsg {
             | JobMsg::Flight(id, _) => *id,
             JobMsg::Iteration { id, .. }
             | JobMsg::Recorded { id, .. }
-            | JobMsg::Agents { id, .. } => *id,
+            | JobMsg::Vehicles { id, .. } => *id,
         }
     }
 }
@@ -295,17 +295,17 @@ impl Observer for Forward {
         let msg = match event {
             Event::Stage(s) => JobMsg::Stage(self.id, s.to_owned()),
             Event::Progress(p) => JobMsg::Progress(self.id, p),
-            Event::PathIteration { cost, path, .. } => {
-                let changed = self.last_cost != Some(cost.total);
-                self.last_cost = Some(cost.total);
+            Event::Iteration { cost, path, .. } => {
+                let changed = self.last_cost != Some(cost);
+                self.last_cost = Some(cost);
                 JobMsg::Iteration {
                     id: self.id,
-                    cost: cost.total,
+                    cost,
                     path: changed.then(|| path.to_vec()),
                 }
             }
             Event::Log(level, text) => JobMsg::Log(self.id, level, text.to_owned()),
-            Event::Agents { alive, total } => JobMsg::Agents {
+            Event::Vehicles { alive, total } => JobMsg::Vehicles {
                 id: self.id,
                 alive,
                 total,

@@ -431,7 +431,7 @@ impl<'m> Simulation<'m> {
             }
         }
         if !self.lost.is_empty() && self.lost.last().is_some_and(|l| l.step == k) {
-            observer.on_event(Event::Agents {
+            observer.on_event(Event::Vehicles {
                 alive: self.alive.iter().filter(|&&a| a).count(),
                 total: self.alive.len(),
             });

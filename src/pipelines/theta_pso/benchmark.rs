@@ -63,9 +63,10 @@ pub fn plan(
                 last_cost = best;
                 let terms = cost_terms(&model.terms(nodes));
                 let points = spso::points(&model, nodes);
-                observer.on_event(Event::PathIteration {
+                observer.on_event(Event::Iteration {
                     iteration,
-                    cost: &terms,
+                    cost: terms.total,
+                    terms: &terms.named(),
                     path: &points,
                 });
             }

@@ -630,9 +630,10 @@ fn run_swarm(
                 // J of the best, not the objective (which adds the
                 // infeasibility step while the best still breaks a constraint).
                 convergence.push(cost.total);
-                observer.on_event(Event::PathIteration {
+                observer.on_event(Event::Iteration {
                     iteration: offset + report.iteration,
-                    cost,
+                    cost: cost.total,
+                    terms: &cost.named(),
                     path: &path.points,
                 });
             }

@@ -1,7 +1,7 @@
 //! θ-PSO in a recording (`pipelines::sketch`): the planned paths, the UAVs
 //! on `sim_time`, their clearances, reconfigurations, inspection passes and
 //! violations. The swarm's progress on the `iteration` timeline (cost terms,
-//! best path) is logged by the recorder from the run's events, at [`paths`].
+//! best path) is logged by the recorder from the run's events.
 
 use nalgebra::Point3;
 
@@ -15,15 +15,11 @@ pub mod paths {
     pub const ROOT: &str = "theta_pso";
     /// Events on `sim_time` (reconfigurations, passes, violations).
     pub const EVENTS: &str = "theta_pso/events";
-    /// The cost terms on the `iteration` timeline.
+    /// The cost terms on the `iteration` timeline, one series per term
+    /// (`CostTerms::named`: `theta_pso/cost/J_total`, …), and the swarm's
+    /// best centroid path of each iteration at `theta_pso/best_path`,
+    /// logged by the recorder from the run's events.
     pub const COST: &str = "theta_pso/cost";
-    pub const COST_TOTAL: &str = "theta_pso/cost/J_total";
-    pub const COST_LENGTH: &str = "theta_pso/cost/J1_length";
-    pub const COST_OBSTACLE: &str = "theta_pso/cost/J2_obstacle";
-    pub const COST_ALTITUDE: &str = "theta_pso/cost/J3_altitude";
-    pub const COST_WAYPOINTS: &str = "theta_pso/cost/JR_waypoints";
-    /// The swarm's best centroid path of each iteration.
-    pub const BEST_PATH: &str = "theta_pso/best_path";
     pub const CLEARANCE: &str = "theta_pso/clearance";
     pub const CENTROID: &str = "theta_pso/plan/centroid";
     pub const VIOLATIONS: &str = "theta_pso/violations";

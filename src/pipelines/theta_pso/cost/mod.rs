@@ -118,6 +118,20 @@ pub struct CostTerms {
     pub total: f64,
 }
 
+impl CostTerms {
+    /// The terms by name, the total first: what the run's progress reports
+    /// (`Event::Iteration`) and a recording plots under `theta_pso/cost/`.
+    pub fn named(&self) -> [(&'static str, f64); 5] {
+        [
+            ("J_total", self.total),
+            ("J1_length", self.length),
+            ("J2_obstacle", self.obstacle),
+            ("J3_altitude", self.altitude),
+            ("JR_waypoints", self.waypoints),
+        ]
+    }
+}
+
 /// What the swarm adds to J for a path that breaks a constraint anywhere
 /// (Deb's feasibility rule, IEEE TEC 2000, as a penalty step): any path that
 /// keeps every UAV clear ranks before any that does not, whatever their
