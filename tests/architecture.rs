@@ -386,10 +386,6 @@ const KNOWS_PIPELINES_BY_NAME: &[(&str, &str)] = &[
         "the map draws each pipeline's result (its own painter)",
     ),
     (
-        "src/tui/view/jobs.rs",
-        "the jobs panel's result table of each pipeline",
-    ),
-    (
         "src/tui/fixtures.rs",
         "ready-made jobs of each pipeline for the tests",
     ),

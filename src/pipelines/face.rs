@@ -12,6 +12,7 @@ use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
 use super::sketch::{Plot, Sketch};
+use super::table::Row;
 use super::theta_pso::{PlanOptions, WarmStart};
 use super::{CancelToken, Completion, Kind, Limits, Observer, Outcome, PipelineError, TrackSample};
 use crate::mission::{Diagnostic, Mission};
@@ -222,6 +223,9 @@ pub trait PipelineOutcome {
     }
     /// What its exported files are held to.
     fn export_rules(&self, mission: &Mission) -> ExportRules;
+    /// Its result as the designer's jobs panel shows it, the verdict first
+    /// (the panel adds the flight check under it and STALE).
+    fn table(&self) -> Vec<Row>;
     /// Draws the outcome in a recording; `scene` is the mission when the
     /// recording has it.
     fn sketch(&self, scene: Option<&Mission>, out: &mut dyn Sketch);
@@ -240,6 +244,11 @@ pub trait PipelineOutcome {
     /// The plan as a warm start for the next run (θ-PSO's), `from` saying
     /// where it came from; `None` for a pipeline without warm starts.
     fn warm_start(&self, _from: &str) -> Option<WarmStart> {
+        None
+    }
+    /// Its vehicles still flying at the end, of how many (the fleet's agents
+    /// not lost); `None` for a pipeline that loses none.
+    fn vehicles_alive(&self) -> Option<(usize, usize)> {
         None
     }
     /// How long a flight the designer can replay on the map runs, seconds

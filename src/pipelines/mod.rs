@@ -11,6 +11,7 @@
 pub mod face;
 pub mod interface;
 pub mod sketch;
+pub mod table;
 
 pub mod flatlo;
 pub mod fleet;

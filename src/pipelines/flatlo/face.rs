@@ -217,6 +217,10 @@ impl PipelineOutcome for FlatloOutcome {
     /// which the geofence enforces); the margin is the largest tracking
     /// error of the simulated autopilot with which the squadron was
     /// verified; the airspeeds within `flatlo.airspeed_range`.
+    fn table(&self) -> Vec<crate::pipelines::table::Row> {
+        summary::table(self)
+    }
+
     fn export_rules(&self, mission: &Mission) -> ExportRules {
         let p = &mission.flatlo;
         ExportRules {

@@ -3,6 +3,7 @@
 //! keeps the 0-based indices.
 
 use super::FlatloOutcome;
+use crate::pipelines::table::{Cell, Row, Tone, row};
 
 /// The human summary of a FLATLO outcome.
 pub fn flatlo(o: &FlatloOutcome) -> String {
@@ -101,4 +102,98 @@ pub fn flatlo(o: &FlatloOutcome) -> String {
         v.min_separation
     );
     s
+}
+
+/// FLATLO's verification in the designer's jobs panel: the verdict, every
+/// pair's closest approach (the eight closest), the first limit broken,
+/// the airspeeds and bank flown, the final line, the worst tracking.
+pub fn table(o: &FlatloOutcome) -> Vec<Row> {
+    let verdict = match &o.verification {
+        Some(v) if v.passed => Cell::new("✓ separation kept", Tone::Good),
+        Some(v) if v.violation.is_some() => Cell::new("✗ NOT FLYABLE", Tone::BadStrong),
+        Some(_) => Cell::new("✗ SEPARATION LOST", Tone::BadStrong),
+        None => Cell::new("cancelled: no verdict", Tone::Warn),
+    };
+    let mut lines = vec![vec![
+        Cell::plain(format!(
+            "{} aircraft · on the line at {:.0} s · ",
+            o.aircraft.len(),
+            o.arrival_time
+        )),
+        verdict,
+    ]];
+    let min_separation = o.verification.as_ref().map_or(0.0, |v| v.min_separation);
+    lines.push(row(
+        format!("{:<6} {:>11} {:>8}", "pair", "closest m", "at s"),
+        Tone::Strong,
+    ));
+    // Large squadrons keep only the closest pair overall.
+    let mut pairs = if o.pairs.is_empty() {
+        o.closest.into_iter().collect()
+    } else {
+        o.pairs.clone()
+    };
+    pairs.sort_by(|a, b| a.min_distance.total_cmp(&b.min_distance));
+    for p in pairs.iter().take(8) {
+        let tone = if p.min_distance < min_separation {
+            Tone::Bad
+        } else {
+            Tone::Plain
+        };
+        lines.push(row(
+            format!(
+                "{:<6} {:>11.0} {:>8.0}",
+                format!("{}-{}", p.a + 1, p.b + 1),
+                p.min_distance,
+                p.time
+            ),
+            tone,
+        ));
+    }
+    if pairs.len() > 8 {
+        lines.push(row(
+            format!("… {} more pairs", pairs.len() - 8),
+            Tone::Plain,
+        ));
+    }
+    if let Some(v) = &o.verification {
+        if let Some(x) = &v.violation {
+            lines.push(row(x.describe(), Tone::Bad));
+        }
+        lines.push(row(
+            format!(
+                "airspeed {:.1}-{:.1} m/s (range {}-{}) · bank ≤ {:.1}°",
+                v.airspeed_flown[0],
+                v.airspeed_flown[1],
+                v.airspeed_range[0],
+                v.airspeed_range[1],
+                v.bank_flown_deg
+            ),
+            Tone::Plain,
+        ));
+        lines.push(row(
+            format!(
+                "final spacing error {:.3} % · lateral spread {:.1} m",
+                v.max_spacing_error * 100.0,
+                v.lateral_spread
+            ),
+            Tone::Plain,
+        ));
+    }
+    let worst = o
+        .aircraft
+        .iter()
+        .max_by(|a, b| a.tracking_max.total_cmp(&b.tracking_max));
+    if let Some(a) = worst {
+        lines.push(row(
+            format!(
+                "worst tracking: aircraft {} max {:.1} m, RMS {:.1} m",
+                a.index + 1,
+                a.tracking_max,
+                a.tracking_rms
+            ),
+            Tone::Plain,
+        ));
+    }
+    lines
 }

@@ -196,6 +196,10 @@ impl PipelineOutcome for FleetOutcome {
     /// flown by a real multicopter's autopilot, within `[vehicle]`, as
     /// θ-PSO's are (the fleet's own quadrotor parameters model the paper's
     /// AR.Drone in the simulation).
+    fn table(&self) -> Vec<crate::pipelines::table::Row> {
+        summary::table(self)
+    }
+
     fn export_rules(&self, mission: &Mission) -> ExportRules {
         let p = &mission.fleet;
         ExportRules {
@@ -211,6 +215,10 @@ impl PipelineOutcome for FleetOutcome {
             margin_source: "fleet.tolerance × fleet.safety_distance / 2",
             loiter_radius: 0.0,
         }
+    }
+
+    fn vehicles_alive(&self) -> Option<(usize, usize)> {
+        Some((self.agents.len() - self.lost.len(), self.agents.len()))
     }
 
     /// The flight, replayed on the map (`,` `.` `>`).

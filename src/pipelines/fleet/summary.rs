@@ -5,6 +5,7 @@
 
 use super::{Closest, Deviation, FleetOutcome, FormationError, Other};
 use crate::pipelines::Verdict;
+use crate::pipelines::table::{Cell, Row, Tone, row};
 
 /// The human summary of a fleet outcome.
 ///
@@ -272,4 +273,116 @@ pub fn too_close(o: &FleetOutcome, c: &Closest) -> String {
         "{pair} (t = {:.2} s), closer than the safety distance c = {} m",
         c.time, o.safety_distance
     )
+}
+
+/// The fleet's result in the designer's jobs panel: the verdict on the
+/// safety distance, each target's formation time, the closest approaches,
+/// the final inter-agent distances, the processes, the agents lost, the
+/// PSO effort.
+pub fn table(o: &FleetOutcome) -> Vec<Row> {
+    let safe = o.kept_apart() && o.obstacles_clear();
+    let mut lines = vec![vec![
+        Cell::plain(format!(
+            "{} agents · {:.0} s · ",
+            o.agents.len(),
+            o.duration
+        )),
+        if safe {
+            Cell::new("✓ safety distance kept", Tone::Good)
+        } else {
+            Cell::new("✗ SAFETY DISTANCE LOST", Tone::BadStrong)
+        },
+    ]];
+    for (k, t) in o.targets.iter().enumerate() {
+        let text = match t.converged_after {
+            Some(a) => format!(
+                "target {} (t {:.0} s): formed after {a:.1} s",
+                k + 1,
+                t.time
+            ),
+            None => format!(
+                "target {} (t {:.0} s): NOT formed{}",
+                k + 1,
+                t.time,
+                t.end
+                    .as_ref()
+                    .and_then(|e| e.pair.filter(|d| !d.within()).or(e.to_target))
+                    .map_or_else(String::new, |d| format!(": {}", deviation(&d)))
+            ),
+        };
+        let tone = if t.converged_after.is_some() {
+            Tone::Plain
+        } else {
+            Tone::Bad
+        };
+        lines.push(row(text, tone));
+    }
+    if let Some(c) = &o.closest_agents {
+        lines.push(row(
+            format!(
+                "closest agents {}-{}: {:.3} m at {:.1} s (c {})",
+                c.a + 1,
+                c.b,
+                c.distance,
+                c.time,
+                o.safety_distance
+            ),
+            Tone::Plain,
+        ));
+    }
+    if let Some(c) = &o.closest_obstacle {
+        lines.push(row(
+            format!(
+                "closest obstacle: agent {} to {} {:.3} m",
+                c.a + 1,
+                c.b,
+                c.distance
+            ),
+            Tone::Plain,
+        ));
+    }
+    for d in o.distances.iter().take(6) {
+        lines.push(row(
+            format!(
+                "d{}{} final {:.3} m (want {:.3})",
+                d.a + 1,
+                d.b + 1,
+                d.values.last().copied().unwrap_or(f64::NAN),
+                d.desired
+            ),
+            Tone::Plain,
+        ));
+    }
+    if let Some(d) = &o.distributed {
+        lines.push(row(
+            format!(
+                "{} agent process(es) over Zenoh, {}{}",
+                d.processes,
+                d.clock,
+                if d.round_mean > 0.0 {
+                    format!(" · round {:.2} ms", 1e3 * d.round_mean)
+                } else {
+                    String::new()
+                }
+            ),
+            Tone::Plain,
+        ));
+    }
+    for l in &o.lost {
+        lines.push(row(
+            format!(
+                "agent {} LOST at {:.1} s: {}",
+                l.agent + 1,
+                l.time,
+                l.reason
+            ),
+            Tone::BadStrong,
+        ));
+    }
+    let evaluations: usize = o.agents.iter().map(|a| a.evaluations).sum();
+    lines.push(row(
+        format!("PSO: {evaluations} cost evaluations · , . > replay"),
+        Tone::Plain,
+    ));
+    lines
 }

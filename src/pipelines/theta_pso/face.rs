@@ -190,6 +190,10 @@ impl PipelineOutcome for ThetaPsoOutcome {
     /// autopilot's own trajectory generator: their speeds are checked, not
     /// their accelerations. The margin is `theta_pso.clearance_margin`, the
     /// room the cost keeps for a real autopilot.
+    fn table(&self) -> Vec<crate::pipelines::table::Row> {
+        summary::table(self)
+    }
+
     fn export_rules(&self, mission: &Mission) -> ExportRules {
         let f = &mission.formation;
         ExportRules {

@@ -4,6 +4,7 @@
 //! 0-based indices.
 
 use super::{ThetaPsoOutcome, unusable};
+use crate::pipelines::table::{Cell, Row, Tone, row};
 
 /// How many unusable IWPs the summary names (the nearest the route).
 const NAMED_UNUSABLE: usize = 3;
@@ -258,4 +259,75 @@ fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
             ""
         }
     );
+}
+
+/// θ-PSO's result in the designer's jobs panel, as the CLI prints it: the
+/// verdict and its first failing check on top, the figures on one row
+/// (the reconfigurations' word shortens on a narrow panel), the unusable
+/// IWPs grouped by reason, then the whole verification table
+/// ([`verification_rows`]).
+pub fn table(o: &ThetaPsoOutcome) -> Vec<Row> {
+    let v = &o.verification;
+    let rows = verification_rows(o);
+    let mut lines = vec![if o.completion == crate::pipelines::Completion::Cancelled {
+        row("cancelled: no verdict on the best path so far", Tone::Warn)
+    } else if v.feasible {
+        row(
+            format!("✓ FEASIBLE · all {} checks pass", rows.len()),
+            Tone::GoodStrong,
+        )
+    } else {
+        row(
+            format!(
+                "✗ INFEASIBLE · {}",
+                v.first_failure().unwrap_or_else(|| "a check failed".into())
+            ),
+            Tone::BadStrong,
+        )
+    }];
+    let n = o.reconfigurations.len();
+    lines.push(vec![
+        Cell::plain(format!(
+            "J {:.2} · {:.1} m · {:.1} s",
+            o.cost.total, o.path_length, o.duration
+        )),
+        Cell::shortened(
+            format!(" · {n} reconfiguration(s)"),
+            format!(" · {n} reconfig."),
+        ),
+    ]);
+    let enabled = o.iwps.iter().filter(|i| i.enabled).count();
+    let groups = unusable::unusable_groups(&o.iwps, &o.centroid_path, 2);
+    let unusable: usize = groups.iter().map(|g| g.count).sum();
+    let mut iwps = format!("IWPs {} found, {enabled} enabled", o.iwps.len());
+    if unusable > 0 {
+        iwps.push_str(&format!(", {unusable} unusable (all in the IWP table, 2):"));
+    }
+    lines.push(row(iwps, Tone::Plain));
+    for g in &groups {
+        let named: Vec<String> = g
+            .nearest
+            .iter()
+            .map(|b| format!("{} ↔ {}", b[0], b[1]))
+            .collect();
+        let more = if g.count > g.nearest.len() {
+            ", …"
+        } else {
+            ""
+        };
+        lines.push(row(
+            format!("  {} {}: {}{more}", g.count, g.reason, named.join(", ")),
+            Tone::Warn,
+        ));
+    }
+    for r in rows {
+        let (mark, tone) = if r.ok {
+            ("✓", Tone::Good)
+        } else {
+            ("✗", Tone::Bad)
+        };
+        let text = r.text.split_whitespace().collect::<Vec<_>>().join(" ");
+        lines.push(vec![Cell::new(format!("{mark} "), tone), Cell::plain(text)]);
+    }
+    lines
 }

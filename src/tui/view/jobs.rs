@@ -1,9 +1,7 @@
 //! The jobs panel: every launched run with its progress, and the selected
-//! one's convergence chart and verification.
-//!
-//! Long (~750 lines) because each pipeline's result table is here (θ-PSO's
-//! verdict, figures, unusable IWPs and verification rows; the fleet's
-//! targets and network; FLATLO's pairs), beside the list and the chart.
+//! one's result (its pipeline's table, `PipelineOutcome::table`, drawn
+//! here with the flight check and STALE under its verdict) and
+//! convergence chart.
 
 use std::time::Instant;
 
@@ -17,6 +15,7 @@ use ratatui::widgets::{
 };
 
 use crate::outcome::Outcome;
+use crate::pipelines::table::{Cell, Row, Tone};
 use crate::tui::action::Action;
 use crate::tui::app::{App, Focus};
 use crate::tui::jobs::{Job, JobState};
@@ -42,9 +41,8 @@ fn live_line(app: &App, job: &Job) -> Line<'static> {
     let warm = job
         .outcome
         .as_ref()
-        .and_then(|o| o.theta_pso())
-        .and_then(|o| o.warm_start.as_ref())
-        .map_or_else(|| "cold".to_owned(), |w| format!("warm from {}", w.from));
+        .and_then(|o| o.face().warm_from())
+        .unwrap_or_else(|| "cold".to_owned());
     let state = match (l.is_on(), l.paused(), l.replanning()) {
         (false, ..) => "live off (L)".to_owned(),
         (true, Some(why), _) => format!("paused: {why}"),
@@ -65,11 +63,7 @@ fn live_line(app: &App, job: &Job) -> Line<'static> {
 /// A distributed fleet's agents alive, of how many (red once one is lost).
 fn agents_span(job: &Job) -> Option<Span<'static>> {
     job.distributed?;
-    let lost = job
-        .outcome
-        .as_ref()
-        .and_then(|o| o.fleet())
-        .map(|o| (o.agents.len() - o.lost.len(), o.agents.len()));
+    let lost = job.outcome.as_ref().and_then(|o| o.face().vehicles_alive());
     let (alive, total) = lost.or(job.agents)?;
     let style = if alive < total {
         Style::default().red().bold()
@@ -236,31 +230,27 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
     if let JobState::Failed(e) = &job.state {
         facts.push(Line::styled(format!("error: {e}"), Style::default().red()));
     }
-    if let Some(o) = job.outcome.as_ref().and_then(|o| o.theta_pso()) {
-        let verdict_at = facts.len() + 1;
-        facts.extend(theta_pso_table(
-            o,
-            &job.state,
-            app.is_stale(job),
-            detail.width,
-        ));
-        // The flight check under the verdict it qualifies.
-        let at = verdict_at.min(facts.len());
-        facts.splice(at..at, flight_lines(job));
-    } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.fleet()) {
-        let mut lines = fleet_table(o, app.is_stale(job));
-        let at = lines.len().min(1);
-        lines.splice(at..at, flight_lines(job));
-        frame.render_widget(Paragraph::new(lines), detail);
-        return;
-    } else if let Some(o) = job.outcome.as_ref().and_then(|o| o.flatlo()) {
-        // FLATLO's verification table fills the panel (no convergence chart).
-        let lines: Vec<Line> = std::mem::take(&mut facts)
+    if let Some(outcome) = &job.outcome {
+        // The result as its pipeline words it (`PipelineOutcome::table`):
+        // the flight check under the verdict it qualifies, then STALE.
+        let mut table: Vec<Line> = outcome
+            .face()
+            .table()
             .into_iter()
-            .chain(flatlo_table(o, app.is_stale(job)))
+            .map(|row| table_line(row, detail.width))
             .collect();
-        frame.render_widget(Paragraph::new(lines), detail);
-        return;
+        if app.is_stale(job) {
+            // Second, under the verdict, where a short panel still shows it.
+            table.insert(table.len().min(1), stale_line());
+        }
+        let at = table.len().min(1);
+        table.splice(at..at, flight_lines(job));
+        facts.extend(table);
+        // A result without a convergence series fills the panel.
+        if outcome.convergence().is_empty() {
+            frame.render_widget(Paragraph::new(facts), detail);
+            return;
+        }
     } else if let Some(w) = &job.last_warning {
         facts.push(Line::styled(w.clone(), Style::default().yellow()));
     }
@@ -337,289 +327,47 @@ fn wrapped_rows(lines: &[Line], width: u16) -> u16 {
         .sum()
 }
 
-/// A table row with its padding collapsed, for a narrow panel.
-fn collapsed(text: &str) -> String {
-    text.split_whitespace().collect::<Vec<_>>().join(" ")
+/// How a result table's tone looks in the panel.
+fn tone_style(tone: Tone) -> Style {
+    match tone {
+        Tone::Plain => Style::default(),
+        Tone::Strong => Style::default().bold(),
+        Tone::Good => Style::default().green(),
+        Tone::GoodStrong => Style::default().green().bold(),
+        Tone::Bad => Style::default().red(),
+        Tone::BadStrong => Style::default().red().bold(),
+        Tone::Warn => Style::default().yellow(),
+    }
 }
 
-/// θ-PSO's result as the CLI prints it: the verdict and its first failing
-/// check on top, the figures (on one row of `width`), the unusable IWPs
-/// grouped by reason, then the whole verification table
-/// (`theta_pso::summary::verification_rows`).
-fn theta_pso_table(
-    o: &crate::pipelines::theta_pso::ThetaPsoOutcome,
-    state: &JobState,
-    stale: bool,
-    width: u16,
-) -> Vec<Line<'static>> {
-    let v = &o.verification;
-    let rows = crate::pipelines::theta_pso::summary::verification_rows(o);
-    let mut lines = Vec::new();
-    let verdict = match (state, v.feasible) {
-        (JobState::Cancelled, _) => Line::styled(
-            "cancelled: no verdict on the best path so far",
-            Style::default().yellow(),
-        ),
-        (_, true) => Line::styled(
-            format!("✓ FEASIBLE · all {} checks pass", rows.len()),
-            Style::default().green().bold(),
-        ),
-        (_, false) => Line::styled(
-            format!(
-                "✗ INFEASIBLE · {}",
-                v.first_failure().unwrap_or_else(|| "a check failed".into())
-            ),
-            Style::default().red().bold(),
-        ),
-    };
-    lines.push(verdict);
-    if stale {
-        lines.push(stale_line());
-    }
-    // On one row of a narrow panel: the reconfigurations' word shortens.
-    let n = o.reconfigurations.len();
-    lines.push(fit(
-        vec![
-            Part::keep(Span::raw(format!(
-                "J {:.2} · {:.1} m · {:.1} s",
-                o.cost.total, o.path_length, o.duration
-            ))),
-            Part::shortened(
-                1,
-                Span::raw(format!(" · {n} reconfiguration(s)")),
-                Span::raw(format!(" · {n} reconfig.")),
-            ),
-        ],
-        width,
-    ));
-    let enabled = o.iwps.iter().filter(|i| i.enabled).count();
-    let groups =
-        crate::pipelines::theta_pso::unusable::unusable_groups(&o.iwps, &o.centroid_path, 2);
-    let unusable: usize = groups.iter().map(|g| g.count).sum();
-    let mut iwps = format!("IWPs {} found, {enabled} enabled", o.iwps.len());
-    if unusable > 0 {
-        iwps.push_str(&format!(", {unusable} unusable (all in the IWP table, 2):"));
-    }
-    lines.push(Line::raw(iwps));
-    for g in &groups {
-        let named: Vec<String> = g
-            .nearest
-            .iter()
-            .map(|b| format!("{} ↔ {}", b[0], b[1]))
+/// A row of a pipeline's result table as a line `width` cells wide: a row
+/// with shorter forms gives way to them on a narrow panel (`title::fit`).
+fn table_line(row: Row, width: u16) -> Line<'static> {
+    if row.iter().any(|cell| cell.short.is_some()) {
+        let parts = row
+            .into_iter()
+            .map(|cell| {
+                let style = tone_style(cell.tone);
+                match cell.short {
+                    Some(short) => Part::shortened(
+                        1,
+                        Span::styled(cell.text, style),
+                        Span::styled(short, style),
+                    ),
+                    None => Part::keep(Span::styled(cell.text, style)),
+                }
+            })
             .collect();
-        let more = if g.count > g.nearest.len() {
-            ", …"
-        } else {
-            ""
-        };
-        lines.push(Line::styled(
-            format!("  {} {}: {}{more}", g.count, g.reason, named.join(", ")),
-            Style::default().yellow(),
-        ));
+        return fit(parts, width);
     }
-    for row in rows {
-        let (mark, style) = if row.ok {
-            ("✓", Style::default().green())
-        } else {
-            ("✗", Style::default().red())
-        };
-        lines.push(Line::from(vec![
-            Span::styled(format!("{mark} "), style),
-            Span::raw(collapsed(&row.text)),
-        ]));
+    match <[Cell; 1]>::try_from(row) {
+        Ok([cell]) => Line::styled(cell.text, tone_style(cell.tone)),
+        Err(row) => Line::from(
+            row.into_iter()
+                .map(|cell| Span::styled(cell.text, tone_style(cell.tone)))
+                .collect::<Vec<_>>(),
+        ),
     }
-    lines
-}
-
-/// The fleet's result: each target's formation time, the closest approaches,
-/// the final inter-agent distances, the PSO effort.
-fn fleet_table(o: &crate::pipelines::fleet::FleetOutcome, stale: bool) -> Vec<Line<'static>> {
-    let safe = o.kept_apart() && o.obstacles_clear();
-    let mut lines = vec![Line::from(vec![
-        Span::raw(format!(
-            "{} agents · {:.0} s · ",
-            o.agents.len(),
-            o.duration
-        )),
-        if safe {
-            Span::styled("✓ safety distance kept", Style::default().green())
-        } else {
-            Span::styled("✗ SAFETY DISTANCE LOST", Style::default().red().bold())
-        },
-    ])];
-    for (k, t) in o.targets.iter().enumerate() {
-        let text = match t.converged_after {
-            Some(a) => format!(
-                "target {} (t {:.0} s): formed after {a:.1} s",
-                k + 1,
-                t.time
-            ),
-            None => format!(
-                "target {} (t {:.0} s): NOT formed{}",
-                k + 1,
-                t.time,
-                t.end
-                    .as_ref()
-                    .and_then(|e| e.pair.filter(|d| !d.within()).or(e.to_target))
-                    .map_or_else(String::new, |d| format!(
-                        ": {}",
-                        crate::pipelines::fleet::summary::deviation(&d)
-                    ))
-            ),
-        };
-        let style = if t.converged_after.is_some() {
-            Style::default()
-        } else {
-            Style::default().red()
-        };
-        lines.push(Line::styled(text, style));
-    }
-    if let Some(c) = &o.closest_agents {
-        lines.push(Line::raw(format!(
-            "closest agents {}-{}: {:.3} m at {:.1} s (c {})",
-            c.a + 1,
-            c.b,
-            c.distance,
-            c.time,
-            o.safety_distance
-        )));
-    }
-    if let Some(c) = &o.closest_obstacle {
-        lines.push(Line::raw(format!(
-            "closest obstacle: agent {} to {} {:.3} m",
-            c.a + 1,
-            c.b,
-            c.distance
-        )));
-    }
-    for d in o.distances.iter().take(6) {
-        lines.push(Line::raw(format!(
-            "d{}{} final {:.3} m (want {:.3})",
-            d.a + 1,
-            d.b + 1,
-            d.values.last().copied().unwrap_or(f64::NAN),
-            d.desired
-        )));
-    }
-    if let Some(d) = &o.distributed {
-        lines.push(Line::raw(format!(
-            "{} agent process(es) over Zenoh, {}{}",
-            d.processes,
-            d.clock,
-            if d.round_mean > 0.0 {
-                format!(" · round {:.2} ms", 1e3 * d.round_mean)
-            } else {
-                String::new()
-            }
-        )));
-    }
-    for l in &o.lost {
-        lines.push(Line::styled(
-            format!(
-                "agent {} LOST at {:.1} s: {}",
-                l.agent + 1,
-                l.time,
-                l.reason
-            ),
-            Style::default().red().bold(),
-        ));
-    }
-    let evaluations: usize = o.agents.iter().map(|a| a.evaluations).sum();
-    lines.push(Line::raw(format!(
-        "PSO: {} cost evaluations · , . > replay",
-        evaluations
-    )));
-    if stale {
-        // Second, under the verdict, where a short panel still shows it.
-        lines.insert(1, stale_line());
-    }
-    lines
-}
-
-/// FLATLO's verification: every pair's closest approach, the final line, the verdict.
-fn flatlo_table(o: &crate::pipelines::flatlo::FlatloOutcome, stale: bool) -> Vec<Line<'static>> {
-    let verdict = match &o.verification {
-        Some(v) if v.passed => Span::styled("✓ separation kept", Style::default().green()),
-        Some(v) if v.violation.is_some() => {
-            Span::styled("✗ NOT FLYABLE", Style::default().red().bold())
-        }
-        Some(_) => Span::styled("✗ SEPARATION LOST", Style::default().red().bold()),
-        None => Span::styled("cancelled: no verdict", Style::default().yellow()),
-    };
-    let mut lines = vec![Line::from(vec![
-        Span::raw(format!(
-            "{} aircraft · on the line at {:.0} s · ",
-            o.aircraft.len(),
-            o.arrival_time
-        )),
-        verdict,
-    ])];
-    let min_separation = o.verification.as_ref().map_or(0.0, |v| v.min_separation);
-    lines.push(Line::styled(
-        format!("{:<6} {:>11} {:>8}", "pair", "closest m", "at s"),
-        Style::default().bold(),
-    ));
-    // Large squadrons keep only the closest pair overall.
-    let mut pairs = if o.pairs.is_empty() {
-        o.closest.into_iter().collect()
-    } else {
-        o.pairs.clone()
-    };
-    pairs.sort_by(|a, b| a.min_distance.total_cmp(&b.min_distance));
-    for p in pairs.iter().take(8) {
-        let style = if p.min_distance < min_separation {
-            Style::default().red()
-        } else {
-            Style::default()
-        };
-        lines.push(Line::styled(
-            format!(
-                "{:<6} {:>11.0} {:>8.0}",
-                format!("{}-{}", p.a + 1, p.b + 1),
-                p.min_distance,
-                p.time
-            ),
-            style,
-        ));
-    }
-    if pairs.len() > 8 {
-        lines.push(Line::raw(format!("… {} more pairs", pairs.len() - 8)));
-    }
-    if let Some(v) = &o.verification {
-        if let Some(x) = &v.violation {
-            lines.push(Line::styled(x.describe(), Style::default().red()));
-        }
-        lines.push(Line::raw(format!(
-            "airspeed {:.1}-{:.1} m/s (range {}-{}) · bank ≤ {:.1}°",
-            v.airspeed_flown[0],
-            v.airspeed_flown[1],
-            v.airspeed_range[0],
-            v.airspeed_range[1],
-            v.bank_flown_deg
-        )));
-        lines.push(Line::raw(format!(
-            "final spacing error {:.3} % · lateral spread {:.1} m",
-            v.max_spacing_error * 100.0,
-            v.lateral_spread
-        )));
-    }
-    let worst = o
-        .aircraft
-        .iter()
-        .max_by(|a, b| a.tracking_max.total_cmp(&b.tracking_max));
-    if let Some(a) = worst {
-        lines.push(Line::raw(format!(
-            "worst tracking: aircraft {} max {:.1} m, RMS {:.1} m",
-            a.index + 1,
-            a.tracking_max,
-            a.tracking_rms
-        )));
-    }
-    if stale {
-        // Second, under the verdict, where a short panel still shows it.
-        lines.insert(1, stale_line());
-    }
-    lines
 }
 
 /// Best total cost per iteration (the convergence curve).
