@@ -113,7 +113,7 @@ fn the_paper_case_flies_into_line_without_coming_close() {
     let m = paper_mission();
     assert_eq!(m.flatlo.noise, 0.0025);
     let out = flatlo::plan(&m, m.seed, &mut Silent, &CancelToken::new()).unwrap();
-    assert_eq!(out.completion, Completion::Finished);
+    assert_eq!(out.header.completion, Completion::Finished);
     let v = out.verification.as_ref().unwrap();
     assert!(v.passed);
     assert!(
@@ -237,7 +237,7 @@ fn cancel_stops_the_simulation_early() {
     let cancel = CancelToken::new();
     cancel.cancel();
     let out = flatlo::plan(&m, 1, &mut Silent, &cancel).unwrap();
-    assert_eq!(out.completion, Completion::Cancelled);
+    assert_eq!(out.header.completion, Completion::Cancelled);
     let flown = out.aircraft[0].flown.last().unwrap().t;
     assert!(flown < 120.0, "stopped after the first chunk, at {flown} s");
     // A partial flight gets no verdict, pass or fail.

@@ -170,7 +170,7 @@ fn a_killed_agent_process_is_reported_lost_and_the_run_finishes() {
     let outcome = distributed::coordinate(&m, 3, &options(3), &mut watcher, &CancelToken::new())
         .unwrap_or_else(|e| panic!("{e}"));
     assert!(watcher.killed.is_some(), "the agent was killed");
-    assert_eq!(outcome.completion, Completion::Finished);
+    assert_eq!(outcome.header.completion, Completion::Finished);
     assert_eq!(outcome.lost.len(), 1, "{:?}", outcome.lost);
     let lost = &outcome.lost[0];
     assert_eq!(lost.agent, 1, "agent 2 (the second process)");

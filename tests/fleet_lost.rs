@@ -162,7 +162,13 @@ fn designer(m: &Mission, outcome: &FleetOutcome) -> (String, String) {
         PathBuf::from("."),
     );
     let started = Instant::now();
-    app.adopt_job(Job::new(1, Kind::Fleet, outcome.seed, m.clone(), started));
+    app.adopt_job(Job::new(
+        1,
+        Kind::Fleet,
+        outcome.header.seed,
+        m.clone(),
+        started,
+    ));
     let result = Outcome::Fleet(Box::new(outcome.clone()));
     app.on_job_msg(JobMsg::Done(1, Ok(result)), started);
     let mut terminal = match Terminal::new(TestBackend::new(160, 60)) {

@@ -1112,7 +1112,7 @@ fn cancelling_returns_promptly_with_the_best_so_far() {
     };
     let o = plan(&m, 4, PlanOptions::default(), &mut observer, &cancel);
     let o = o.unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(o.completion, Completion::Cancelled);
+    assert_eq!(o.header.completion, Completion::Cancelled);
     assert_eq!(o.iterations, 5);
     assert_eq!(iterations_seen, 5);
     assert_eq!(o.convergence.len(), 6);

@@ -231,7 +231,7 @@ fn generated_missions_plan_feasibly_on_97_percent_of_runs() {
         if !o.feasible() {
             failures.push(format!(
                 "mission {i} seed {s} ({}): {}",
-                o.mission,
+                o.header.mission,
                 o.verification.first_failure().unwrap_or_default()
             ));
         }

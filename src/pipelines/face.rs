@@ -28,6 +28,16 @@ pub enum Verdict {
     Cancelled,
 }
 
+/// What every outcome starts with, the same in each pipeline's JSON:
+/// which pipeline ran which mission with which seed, and how the run ended.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Header {
+    pub pipeline: Kind,
+    pub mission: String,
+    pub seed: u64,
+    pub completion: Completion,
+}
+
 /// One vehicle's timed track: the common shape of every pipeline's result
 /// (`PipelineOutcome::tracks`), which exports, views and recordings read
 /// instead of each outcome's own fields.
@@ -193,9 +203,17 @@ pub trait Pipeline: Sync {
 
 /// A pipeline's outcome, as every front end reads it.
 pub trait PipelineOutcome {
-    fn kind(&self) -> Kind;
-    fn seed(&self) -> u64;
-    fn completion(&self) -> Completion;
+    /// The shared header: pipeline, mission, seed, completion.
+    fn header(&self) -> &Header;
+    fn kind(&self) -> Kind {
+        self.header().pipeline
+    }
+    fn seed(&self) -> u64 {
+        self.header().seed
+    }
+    fn completion(&self) -> Completion {
+        self.header().completion
+    }
     /// Pass, or fail with the first broken constraint.
     fn verdict(&self) -> Verdict;
     /// The headline's figures around `verdict` (the verdict in words).

@@ -19,7 +19,7 @@ pub mod theta_pso;
 
 use serde::{Deserialize, Serialize};
 
-pub use face::{Airframe, ExportRules, Pipeline, PipelineOutcome, Request, Track, Verdict};
+pub use face::{Airframe, ExportRules, Header, Pipeline, PipelineOutcome, Request, Track, Verdict};
 pub use interface::*;
 
 /// The planning pipelines: what `outcome::run` runs, what a track came

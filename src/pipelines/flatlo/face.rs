@@ -7,8 +7,8 @@ use crate::mission::{Diagnostic, Mission};
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
-    CancelToken, Completion, Kind, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome,
-    Request, Track, TrackSample, Verdict,
+    CancelToken, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome, Request, Track,
+    TrackSample, Verdict,
 };
 
 /// FLATLO (`Kind::Flatlo`).
@@ -99,16 +99,8 @@ impl Pipeline for Flatlo {
 }
 
 impl PipelineOutcome for FlatloOutcome {
-    fn kind(&self) -> Kind {
-        self.pipeline
-    }
-
-    fn seed(&self) -> u64 {
-        self.seed
-    }
-
-    fn completion(&self) -> Completion {
-        self.completion
+    fn header(&self) -> &crate::pipelines::Header {
+        &self.header
     }
 
     /// A cancelled run has flown only part of the way: no verdict. Else the

@@ -273,10 +273,9 @@ pub struct FlatloVerification {
 /// Everything a FLATLO run produces.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FlatloOutcome {
-    pub pipeline: crate::pipelines::Kind,
-    pub mission: String,
-    pub seed: u64,
-    pub completion: Completion,
+    /// The pipeline, the mission, the seed and how the run ended.
+    #[serde(flatten)]
+    pub header: crate::pipelines::Header,
     /// Common instant every aircraft reaches the longitudinal line, s.
     pub arrival_time: f64,
     /// Simulated time, s.
@@ -678,10 +677,12 @@ pub fn plan(
         observer.on_event(Event::Progress(1.0));
     }
     Ok(FlatloOutcome {
-        pipeline: crate::pipelines::Kind::Flatlo,
-        mission: mission.name.clone(),
-        seed,
-        completion,
+        header: crate::pipelines::Header {
+            pipeline: crate::pipelines::Kind::Flatlo,
+            mission: mission.name.clone(),
+            seed,
+            completion,
+        },
         arrival_time: plan.arrival,
         duration: plan.duration,
         sample_stride: keep,

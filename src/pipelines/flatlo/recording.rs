@@ -41,10 +41,10 @@ pub fn sketch(o: &FlatloOutcome, out: &mut dyn Sketch) {
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\naircraft: {}\n\
              arrival: {:.1} s\nduration: {:.1} s\nclosest: {}\nspacing error: {}\n\
              passed: {}\nskyform: {}",
-            o.mission,
-            o.pipeline.slug(),
-            o.seed,
-            o.completion,
+            o.header.mission,
+            o.header.pipeline.slug(),
+            o.header.seed,
+            o.header.completion,
             o.aircraft.len(),
             o.arrival_time,
             o.duration,

@@ -12,12 +12,12 @@ pub fn flatlo(o: &FlatloOutcome) -> String {
     let _ = writeln!(
         s,
         "FLATLO transition for \"{}\" (seed {})",
-        o.mission, o.seed
+        o.header.mission, o.header.seed
     );
     let _ = writeln!(
         s,
         "  run          {:?}, {:.1} s simulated; every aircraft on the line at t = {:.1} s",
-        o.completion, o.duration, o.arrival_time
+        o.header.completion, o.duration, o.arrival_time
     );
     for a in &o.aircraft {
         let _ = writeln!(

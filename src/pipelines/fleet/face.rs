@@ -7,8 +7,8 @@ use crate::mission::{Diagnostic, Mission};
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
-    CancelToken, Completion, Kind, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome,
-    Request, Track, Verdict,
+    CancelToken, Completion, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome, Request,
+    Track, Verdict,
 };
 
 /// The distributed fleet (`Kind::Fleet`).
@@ -83,16 +83,8 @@ impl Pipeline for Fleet {
 }
 
 impl PipelineOutcome for FleetOutcome {
-    fn kind(&self) -> Kind {
-        self.pipeline
-    }
-
-    fn seed(&self) -> u64 {
-        self.seed
-    }
-
-    fn completion(&self) -> Completion {
-        self.completion
+    fn header(&self) -> &crate::pipelines::Header {
+        &self.header
     }
 
     /// Every pair (a lost agent where it was last heard) and every obstacle
@@ -101,7 +93,7 @@ impl PipelineOutcome for FleetOutcome {
     /// not the first, they are named after it. A cancelled run has flown
     /// only part of the way: no verdict.
     fn verdict(&self) -> Verdict {
-        if self.completion == Completion::Cancelled {
+        if self.header.completion == Completion::Cancelled {
             return Verdict::Cancelled;
         }
         let lost = summary::lost_agents(self);
@@ -162,7 +154,7 @@ impl PipelineOutcome for FleetOutcome {
 
     /// A finished flight.
     fn judged(&self) -> bool {
-        self.completion == Completion::Finished
+        self.header.completion == Completion::Finished
     }
 
     /// The closest two agents, metres.

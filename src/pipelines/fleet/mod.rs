@@ -29,7 +29,7 @@ use rand::{RngExt, SeedableRng};
 use serde::Serialize;
 
 use crate::mission::{Diagnostic, FieldPath, Mission};
-use crate::pipelines::{CancelToken, Completion, Event, Observer, PipelineError};
+use crate::pipelines::{CancelToken, Event, Observer, PipelineError};
 
 use simulation::Simulation;
 
@@ -150,10 +150,9 @@ pub const MAX_SERIES_AGENTS: usize = 12;
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FleetOutcome {
-    pub pipeline: crate::pipelines::Kind,
-    pub mission: String,
-    pub seed: u64,
-    pub completion: Completion,
+    /// The pipeline, the mission, the seed and how the run ended.
+    #[serde(flatten)]
+    pub header: crate::pipelines::Header,
     pub duration: f64,
     /// Times of the samples (and of the distance series).
     pub times: Vec<f64>,

@@ -43,10 +43,10 @@ pub fn sketch(o: &FleetOutcome, out: &mut dyn Sketch) {
         format!(
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\nagents: {}\n\
              kept apart: {}\nconverged: {}\nskyform: {}",
-            o.mission,
-            o.pipeline.slug(),
-            o.seed,
-            o.completion,
+            o.header.mission,
+            o.header.pipeline.slug(),
+            o.header.seed,
+            o.header.completion,
             o.agents.len(),
             o.kept_apart(),
             o.converged(),

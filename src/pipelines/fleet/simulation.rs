@@ -883,10 +883,12 @@ impl<'m> Simulation<'m> {
             })
             .collect();
         FleetOutcome {
-            pipeline: crate::pipelines::Kind::Fleet,
-            mission: mission.name.clone(),
-            seed,
-            completion,
+            header: crate::pipelines::Header {
+                pipeline: crate::pipelines::Kind::Fleet,
+                mission: mission.name.clone(),
+                seed,
+                completion,
+            },
             duration: end,
             times: log.times,
             agents,

@@ -15,11 +15,15 @@ use crate::pipelines::table::{Cell, Row, Tone, row};
 pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
-    let _ = writeln!(s, "Fleet for \"{}\" (seed {})", o.mission, o.seed);
+    let _ = writeln!(
+        s,
+        "Fleet for \"{}\" (seed {})",
+        o.header.mission, o.header.seed
+    );
     let _ = writeln!(
         s,
         "  run          {:?}, {:.1} s simulated, {} agents",
-        o.completion,
+        o.header.completion,
         o.duration,
         o.agents.len()
     );

@@ -126,10 +126,12 @@ pub fn plan(
         .map(|i| nalgebra::Point3::new(run.nodes[i], run.nodes[n + i], run.nodes[2 * n + i]))
         .collect();
     Ok(ThetaPsoOutcome {
-        pipeline: crate::pipelines::Kind::ThetaPso,
-        mission: mission.name.clone(),
-        seed,
-        completion,
+        header: crate::pipelines::Header {
+            pipeline: crate::pipelines::Kind::ThetaPso,
+            mission: mission.name.clone(),
+            seed,
+            completion,
+        },
         iterations: run.swarm.iterations,
         evaluations: run.swarm.evaluations,
         restarts: 0,

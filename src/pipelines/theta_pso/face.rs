@@ -5,8 +5,8 @@ use crate::mission::{Diagnostic, Mission};
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
-    CancelToken, Completion, Kind, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome,
-    Request, Track, Verdict,
+    CancelToken, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome, Request, Track,
+    Verdict,
 };
 
 /// θ-PSO (`Kind::ThetaPso`).
@@ -122,16 +122,8 @@ impl Pipeline for ThetaPso {
 }
 
 impl PipelineOutcome for ThetaPsoOutcome {
-    fn kind(&self) -> Kind {
-        self.pipeline
-    }
-
-    fn seed(&self) -> u64 {
-        self.seed
-    }
-
-    fn completion(&self) -> Completion {
-        self.completion
+    fn header(&self) -> &crate::pipelines::Header {
+        &self.header
     }
 
     /// A cancelled run still has a verdict on its best plan so far: it is a

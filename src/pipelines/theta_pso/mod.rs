@@ -32,7 +32,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::base::swarm::SearchSpace;
 use crate::mission::{Diagnostic, FieldPath, Mission};
-use crate::pipelines::Completion;
 
 pub use cost::{CostModel, CostTerms};
 pub use inspection::PassGeometry;
@@ -87,10 +86,9 @@ const WARM_STALL: usize = 8;
 /// Everything a θ-PSO run produces.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThetaPsoOutcome {
-    pub pipeline: crate::pipelines::Kind,
-    pub mission: String,
-    pub seed: u64,
-    pub completion: Completion,
+    /// The pipeline, the mission, the seed and how the run ended.
+    #[serde(flatten)]
+    pub header: crate::pipelines::Header,
     /// Swarm iterations completed, over every run of the swarm.
     pub iterations: usize,
     /// Cost evaluations made, over every run of the swarm.

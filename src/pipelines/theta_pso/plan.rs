@@ -449,10 +449,12 @@ fn outcome(
     let reference_length = reference.map(|r| r.length);
     let [passed_over, passed_under] = passed_by_altitude(mission, &best.flight.trajectories);
     ThetaPsoOutcome {
-        pipeline: crate::pipelines::Kind::ThetaPso,
-        mission: mission.name.clone(),
-        seed,
-        completion: search.completion,
+        header: crate::pipelines::Header {
+            pipeline: crate::pipelines::Kind::ThetaPso,
+            mission: mission.name.clone(),
+            seed,
+            completion: search.completion,
+        },
         iterations: search.iterations,
         evaluations: search.evaluations,
         restarts: search.restarts,

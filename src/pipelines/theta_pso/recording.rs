@@ -78,10 +78,10 @@ pub fn sketch(o: &ThetaPsoOutcome, scene: Option<&Mission>, out: &mut dyn Sketch
         format!(
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\niterations: {}\n\
              feasible: {}\ncost J: {:.4}\nlength: {:.2} m\nduration: {:.2} s\nskyform: {}",
-            o.mission,
-            o.pipeline.slug(),
-            o.seed,
-            o.completion,
+            o.header.mission,
+            o.header.pipeline.slug(),
+            o.header.seed,
+            o.header.completion,
             o.iterations,
             o.feasible(),
             o.cost.total,

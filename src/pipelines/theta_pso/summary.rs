@@ -16,7 +16,11 @@ const NAMED_UNUSABLE: usize = 3;
 pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
-    let _ = writeln!(s, "θ-PSO plan for \"{}\" (seed {})", o.mission, o.seed);
+    let _ = writeln!(
+        s,
+        "θ-PSO plan for \"{}\" (seed {})",
+        o.header.mission, o.header.seed
+    );
     let verdict = match o.verification.first_failure() {
         None => "FEASIBLE".to_owned(),
         Some(why) => format!("INFEASIBLE: {why}"),
@@ -29,7 +33,7 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
     let _ = writeln!(
         s,
         "  run          {:?} after {} iterations, {} cost evaluations{restarts}",
-        o.completion, o.iterations, o.evaluations
+        o.header.completion, o.iterations, o.evaluations
     );
     let c = &o.cost;
     let _ = writeln!(
@@ -269,22 +273,24 @@ fn iwps(s: &mut String, o: &ThetaPsoOutcome, verbose: bool) {
 pub fn table(o: &ThetaPsoOutcome) -> Vec<Row> {
     let v = &o.verification;
     let rows = verification_rows(o);
-    let mut lines = vec![if o.completion == crate::pipelines::Completion::Cancelled {
-        row("cancelled: no verdict on the best path so far", Tone::Warn)
-    } else if v.feasible {
-        row(
-            format!("✓ FEASIBLE · all {} checks pass", rows.len()),
-            Tone::GoodStrong,
-        )
-    } else {
-        row(
-            format!(
-                "✗ INFEASIBLE · {}",
-                v.first_failure().unwrap_or_else(|| "a check failed".into())
-            ),
-            Tone::BadStrong,
-        )
-    }];
+    let mut lines = vec![
+        if o.header.completion == crate::pipelines::Completion::Cancelled {
+            row("cancelled: no verdict on the best path so far", Tone::Warn)
+        } else if v.feasible {
+            row(
+                format!("✓ FEASIBLE · all {} checks pass", rows.len()),
+                Tone::GoodStrong,
+            )
+        } else {
+            row(
+                format!(
+                    "✗ INFEASIBLE · {}",
+                    v.first_failure().unwrap_or_else(|| "a check failed".into())
+                ),
+                Tone::BadStrong,
+            )
+        },
+    ];
     let n = o.reconfigurations.len();
     lines.push(vec![
         Cell::plain(format!(
