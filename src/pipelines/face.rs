@@ -115,16 +115,6 @@ pub struct Request<'a> {
     pub warm: Option<&'a WarmStart>,
 }
 
-impl Request<'_> {
-    /// A cold run with default options.
-    pub fn seeded(seed: u64) -> Request<'static> {
-        Request {
-            seed,
-            ..Request::default()
-        }
-    }
-}
-
 /// A pipeline: its words, its limits and its run. One unit value per
 /// pipeline (`Kind::face`).
 pub trait Pipeline: Sync {
