@@ -191,21 +191,7 @@ fn the_margin_search_returns_a_margin_whose_check_meets_the_target() {
         seed: 2,
         threads: None,
     };
-    let mut plan = |m: &Mission| -> Result<Planned, String> {
-        let o = outcome::run(
-            Kind::ThetaPso,
-            m,
-            1,
-            PlanOptions::default(),
-            &mut Silent,
-            &CancelToken::new(),
-        )
-        .map_err(|e| e.to_string())?;
-        if !o.ok() {
-            return Err(o.headline());
-        }
-        Ok(Planned::from_outcome(m, &o))
-    };
+    let mut plan = |m: &Mission| flight::passing_plan(Kind::ThetaPso, m, 1, &CancelToken::new());
     let search = flight::find_margin(
         Kind::ThetaPso,
         &m,
@@ -365,21 +351,7 @@ fn the_margin_search_stops_at_what_the_slots_allow_and_says_so() {
         seed: 1,
         threads: None,
     };
-    let mut plan = |m: &Mission| -> Result<Planned, String> {
-        let o = outcome::run(
-            Kind::ThetaPso,
-            m,
-            1,
-            PlanOptions::default(),
-            &mut Silent,
-            &CancelToken::new(),
-        )
-        .map_err(|e| e.to_string())?;
-        if !o.ok() {
-            return Err(o.headline());
-        }
-        Ok(Planned::from_outcome(m, &o))
-    };
+    let mut plan = |m: &Mission| flight::passing_plan(Kind::ThetaPso, m, 1, &CancelToken::new());
     let search = flight::find_margin(
         Kind::ThetaPso,
         &m,

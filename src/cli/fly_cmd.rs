@@ -7,11 +7,9 @@ use std::path::PathBuf;
 
 use super::{cancel_on_ctrl_c, exit, load_reporting};
 use crate::base::atomic;
-use crate::export::Planned;
 use crate::flight::{self, FlightError, Options, Setup};
 use crate::mission::Mission;
-use crate::pipelines::{CancelToken, Kind, Silent};
-use crate::run::Run;
+use crate::pipelines::{CancelToken, Kind};
 
 /// The arguments of `skyform fly` (its help is on `Command::Fly`).
 #[derive(Debug, clap::Args)]
@@ -189,16 +187,7 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
         );
         return exit::ERROR;
     };
-    let mut plan = |m: &Mission| -> Result<Planned, String> {
-        let outcome = Run::new(pipeline, seed)
-            .carry_out(m, None, &mut Silent, cancel)
-            .result
-            .map_err(|e| e.to_string())?;
-        if !outcome.ok() {
-            return Err(outcome.headline());
-        }
-        Ok(Planned::from_outcome(m, &outcome))
-    };
+    let mut plan = |m: &Mission| flight::passing_plan(pipeline, m, seed, cancel);
     eprintln!(
         "searching the margin: {} flights per try (0, then 0.25 m doubling, then halving to {} m)",
         options.flights,

@@ -657,6 +657,30 @@ pub fn margin_field(mission: &Mission, pipeline: Kind) -> Option<(&'static str, 
     pipeline.face().margin_field(mission)
 }
 
+/// A plan to check: `pipeline` run cold on `mission` with `seed`, as the
+/// export writes it; `Err` (the run's error, or its headline when its
+/// verdict fails) when there is none that passes. What [`find_margin`]'s
+/// callers plan each margin with.
+pub fn passing_plan(
+    pipeline: Kind,
+    mission: &Mission,
+    seed: u64,
+    cancel: &CancelToken,
+) -> Result<Planned, String> {
+    let request = crate::pipelines::Request {
+        seed,
+        ..Default::default()
+    };
+    let outcome = pipeline
+        .face()
+        .run(mission, request, &mut crate::pipelines::Silent, cancel)
+        .map_err(|e| e.to_string())?;
+    if !outcome.ok() {
+        return Err(outcome.headline());
+    }
+    Ok(Planned::from_outcome(mission, &outcome))
+}
+
 /// The margin search stops refining at this width, metres.
 pub const MARGIN_RESOLUTION: f64 = 0.05;
 /// The largest extra clearance tried, metres.

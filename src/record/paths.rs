@@ -29,11 +29,6 @@ pub fn log(kind: Kind) -> String {
     format!("{}/log", root(kind))
 }
 
-/// Where a pipeline's events on `sim_time` go (reconfigurations, closest approaches).
-pub fn events(kind: Kind) -> String {
-    format!("{}/events", root(kind))
-}
-
 /// An entity path as the viewer layout names it (rooted).
 pub fn origin(path: &str) -> String {
     format!("/{path}")
@@ -78,10 +73,31 @@ mod tests {
         for kind in Kind::ALL {
             let root = format!("{}/", root(kind));
             assert!(log(kind).starts_with(&root));
-            assert!(events(kind).starts_with(&root));
             for plot in kind.face().plots().iter().flat_map(|panel| panel.iter()) {
                 assert!(plot.path.starts_with(&root), "{kind:?}: {plot:?}");
             }
+        }
+        // Each pipeline's own entities (its `recording.rs`) under its root.
+        use crate::pipelines::{flatlo, fleet, theta_pso};
+        for (kind, own_root, events) in [
+            (
+                Kind::ThetaPso,
+                theta_pso::recording::paths::ROOT,
+                theta_pso::recording::paths::EVENTS,
+            ),
+            (
+                Kind::Flatlo,
+                flatlo::recording::paths::ROOT,
+                flatlo::recording::paths::EVENTS,
+            ),
+            (
+                Kind::Fleet,
+                fleet::recording::paths::ROOT,
+                fleet::recording::paths::EVENTS,
+            ),
+        ] {
+            assert_eq!(own_root, root(kind));
+            assert_eq!(events, format!("{}/events", root(kind)));
         }
         assert_eq!(log(Kind::Flatlo), "flatlo/log");
         assert_eq!(root(Kind::ThetaPso), "theta_pso");

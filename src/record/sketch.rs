@@ -66,7 +66,11 @@ fn strips3d(strips: Vec<Vec<Point3<f64>>>, style: &Style) -> rerun::LineStrips3D
 }
 
 fn points3d(points: Vec<Point3<f64>>, style: &Style) -> rerun::Points3D {
-    let mut archetype = rerun::Points3D::new(points.iter().map(f32x3));
+    styled_points(rerun::Points3D::new(points.iter().map(f32x3)), style)
+}
+
+/// `archetype` with `style`'s colour, radius and label.
+fn styled_points(mut archetype: rerun::Points3D, style: &Style) -> rerun::Points3D {
     if let Some(c) = style.color {
         archetype = archetype.with_colors([color(c)]);
     }
@@ -117,17 +121,10 @@ impl Sketch for RerunSketch<'_> {
     /// Its style logged once, its positions as one `send_columns`.
     fn moving_point(&mut self, path: &str, at: &[f64], positions: &[Point3<f64>], style: Style) {
         self.then(|s| {
-            let mut fields = rerun::Points3D::update_fields();
-            if let Some(c) = style.color {
-                fields = fields.with_colors([color(c)]);
-            }
-            if let Some(r) = style.radius {
-                fields = fields.with_radii([r]);
-            }
-            if let Some(l) = &style.label {
-                fields = fields.with_labels([l.clone()]);
-            }
-            s.log_static(path, &fields)?;
+            s.log_static(
+                path,
+                &styled_points(rerun::Points3D::update_fields(), &style),
+            )?;
             s.send_columns(
                 path,
                 [times(at)],
