@@ -40,10 +40,11 @@ pub struct FlyArgs {
     #[arg(long)]
     pub verbose: bool,
     /// Find the smallest extra clearance m from the obstacles (θ-PSO:
-    /// formation.safety_margin + m; fleet: fleet.safety_distance + m)
-    /// whose plan breaks 2 r_Q or r_Q in at most this share of the flights
-    /// (0.001: one flight in a thousand), re-planning as needed, and report
-    /// that plan.
+    /// formation.obstacle_margin + m; fleet: fleet.safety_distance + m)
+    /// whose plan breaks r_Q in at most this share of the flights (0.001:
+    /// one flight in a thousand), then, if the pairs still break 2 r_Q more
+    /// often, the smallest widening of the slots that brings them within it,
+    /// re-planning as needed, and report that plan and the fields to set.
     #[arg(long, value_name = "SHARE")]
     pub target: Option<f64>,
     /// A Rerun recording of the check: the plan as written, the p99
@@ -187,9 +188,17 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
         );
         return exit::ERROR;
     };
-    let mut plan = |m: &Mission| flight::passing_plan(pipeline, m, seed, cancel);
+    let mut tries = 0;
+    let mut plan = |m: &Mission| {
+        tries += 1;
+        if let Some((field, value)) = flight::margin_field(m, pipeline) {
+            eprintln!("try {tries}: {field} = {value:.2}");
+        }
+        flight::passing_plan(pipeline, m, seed, cancel)
+    };
     eprintln!(
-        "searching the margin: {} flights per try (0, then 0.25 m doubling, then halving to {} m)",
+        "searching the margin from the obstacles, then the spacing if the pairs need it: {} flights \
+         per try (0, then 0.25 m doubling, then halving to {} m)",
         options.flights,
         flight::MARGIN_RESOLUTION
     );
@@ -200,20 +209,75 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
     let tried: Vec<String> = search
         .tried
         .iter()
-        .map(|t| format!("{:.2} m: {}", t.margin, t.note))
+        .map(|t| {
+            if t.spacing == 1.0 {
+                format!("{:.2} m: {}", t.margin, t.note)
+            } else {
+                format!("{:.2} m, spacing ×{:.2}: {}", t.margin, t.spacing, t.note)
+            }
+        })
         .collect();
+    let widened = |scale: f64| {
+        let mut m = mission.clone();
+        flight::with_spacing(&mut m, pipeline, scale);
+        m
+    };
+    let spacing_field = pipeline.face().spacing_field().unwrap_or("the spacing");
     let code = match (&search.margin, &search.report) {
         (Some(m), Some(report)) => {
+            let spacing = search
+                .spacing
+                .map(|s| format!(" and the spacing ×{s:.2}"))
+                .unwrap_or_default();
             println!(
-                "margin       {m:.2} m keeps {} of flights within 2 r_Q and r_Q (target {:.2} %): \
-                 plan with {field} = {:.2} m (now {now:.2} m)",
+                "margin       {m:.2} m from the obstacles{spacing} keeps {} of flights within \
+                 2 r_Q and r_Q (target {:.2} %)",
                 format_share(report.break_any.share),
                 100.0 * target,
-                now + m,
             );
+            println!("set          {field} = {:.2}   # now {now:.2}", now + m);
+            if let Some(s) = search.spacing {
+                println!(
+                    "             {spacing_field} = {}   # ×{s:.2}: at the mission's spacing the \
+                     pairs broke 2 r_Q in more than {:.2} % of flights whatever the margin",
+                    slots_text(&widened(s)),
+                    100.0 * target
+                );
+            }
             println!("tried        {}", tried.join("; "));
             print!("{}", report.text(args.verbose));
             exit::OK
+        }
+        (Some(m), None) => {
+            println!(
+                "margin       {m:.2} m from the obstacles keeps r_Q in all but {:.2} % of flights, \
+                 but the pairs break 2 r_Q more often than that",
+                100.0 * target
+            );
+            let widest = search.spacing_limit.as_ref().map_or(
+                if pipeline.face().spacing_field().is_some() {
+                    flight::MAX_SPACING
+                } else {
+                    1.0
+                },
+                |l| l.margin,
+            );
+            if widest > 1.0 {
+                println!(
+                    "spacing      none up to ×{widest:.2} ({spacing_field}) meets {:.2} %",
+                    100.0 * target
+                );
+            } else {
+                println!("spacing      {spacing_field} cannot be widened here");
+            }
+            if let Some(limit) = &search.spacing_limit {
+                println!(
+                    "limit        no spacing above ×{:.2} is valid: {}",
+                    limit.margin, limit.why
+                );
+            }
+            println!("tried        {}", tried.join("; "));
+            exit::INFEASIBLE
         }
         _ => {
             let highest = search
@@ -221,7 +285,8 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
                 .as_ref()
                 .map_or(flight::MAX_MARGIN, |l| l.margin);
             println!(
-                "margin       none up to {highest:.2} m meets {:.2} %",
+                "margin       none up to {highest:.2} m from the obstacles keeps r_Q in all but \
+                 {:.2} % of flights",
                 100.0 * target
             );
             if let Some(limit) = &search.limit {
@@ -252,6 +317,17 @@ fn said(e: &FlightError) -> u8 {
         eprintln!("error: {e}");
         exit::ERROR
     }
+}
+
+/// The θ-PSO slots as a TOML array, to the millimetre.
+fn slots_text(mission: &Mission) -> String {
+    let slots: Vec<String> = mission
+        .formation
+        .slots
+        .iter()
+        .map(|s| format!("[{:.3}, {:.3}, {:.3}]", s.x, s.y, s.z))
+        .collect();
+    format!("[{}]", slots.join(", "))
 }
 
 /// 1 − share as a percentage of flights kept ("99.9 %").

@@ -320,6 +320,12 @@ pub struct Formation {
     /// zero by construction: 0.1 m by default, room for a tracking autopilot
     /// that a zero margin never leaves.
     pub safety_margin: f64,
+    /// Room kept from every obstacle beyond r_Q and the safety margin,
+    /// metres (0 by default): what `skyform fly --target` finds when GNSS
+    /// fixes need more room from the site than the slots leave between the
+    /// UAVs, so the obstacles can be given it without moving the slots.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub obstacle_margin: f64,
     /// Length of the straight inspection pass along an inspected obstacle,
     /// metres of centroid path over which eq. 8 must hold. Not in the paper:
     /// 6 m is 2 s of video at 3 m/s past a pier of the bridge.
@@ -337,6 +343,7 @@ impl Default for Formation {
             comm_range: 20.0,
             ground_speed: 3.0,
             safety_margin: 0.1,
+            obstacle_margin: 0.0,
             surface_distance: [1.0, 5.0],
             inspection_pass: 6.0,
             slots: vec![
@@ -1136,9 +1143,9 @@ impl Formation {
     }
 
     /// The least clearance a plan keeps from every obstacle's surface:
-    /// r_Q + the safety margin.
+    /// r_Q + the safety margin + the obstacle margin.
     pub fn least_clearance(&self) -> f64 {
-        self.uav_radius + self.safety_margin
+        self.uav_radius + self.safety_margin + self.obstacle_margin
     }
 
     /// Safe radius of the whole formation around its centroid, r_F + r_Q.

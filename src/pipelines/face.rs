@@ -162,6 +162,16 @@ pub trait Pipeline: Sync {
     }
     /// `mission` asked to keep `m` more (the field of [`Pipeline::margin_field`]).
     fn add_margin(&self, _mission: &mut Mission, _m: f64) {}
+    /// The mission field that spaces its vehicles apart (θ-PSO: the
+    /// slots), when a flight check may widen it: what `skyform fly
+    /// --target` scales when the pairs break more often than the target
+    /// however far the obstacles are kept. `None`: it cannot.
+    fn spacing_field(&self) -> Option<&'static str> {
+        None
+    }
+    /// `mission` with its vehicles spaced `scale` times as far apart (the
+    /// field of [`Pipeline::spacing_field`]).
+    fn widen_spacing(&self, _mission: &mut Mission, _scale: f64) {}
     /// The plots its viewer layout puts beside the scene, a column of
     /// panels (a panel of several plots is a set of tabs).
     fn plots(&self) -> &'static [&'static [Plot]];

@@ -21,6 +21,14 @@ impl Checker {
             " m",
             "a margin is room for tracking; no site leaves so much",
         );
+        self.non_negative(path.key("obstacle_margin"), f.obstacle_margin, " m");
+        self.at_most(
+            path.key("obstacle_margin"),
+            f.obstacle_margin,
+            physical::UAV_RADIUS,
+            " m",
+            "a margin is room for tracking and fixes; no site leaves so much",
+        );
         if f.comm_range.is_finite() && f.comm_range < 2.0 * f.uav_radius {
             self.error(
                 path.key("comm_range"),

@@ -61,17 +61,32 @@ impl Pipeline for ThetaPso {
         }
     }
 
-    /// The safety margin, which verification holds as a hard limit (every
-    /// UAV r_Q + it from every obstacle, every pair 2 r_Q + it apart,
-    /// eq. 7), so a plan that passes keeps it everywhere, in a named IWP's
-    /// gap too. (`theta_pso.clearance_margin`, the room the cost asks for,
-    /// is capped site-wide by the narrowest IWP gap.)
+    /// The obstacle margin, kept beyond r_Q and the safety margin from every
+    /// obstacle; verification holds it as a hard limit (eq. 7), so a plan
+    /// that passes keeps it everywhere, in a named IWP's gap too. It leaves
+    /// the pairs to the slots ([`Pipeline::widen_spacing`]): a margin between
+    /// the UAVs could not pass the slots' own spacing.
+    /// (`theta_pso.clearance_margin`, the room the cost asks for, is capped
+    /// site-wide by the narrowest IWP gap.)
     fn margin_field(&self, mission: &Mission) -> Option<(&'static str, f64)> {
-        Some(("formation.safety_margin", mission.formation.safety_margin))
+        Some((
+            "formation.obstacle_margin",
+            mission.formation.obstacle_margin,
+        ))
     }
 
     fn add_margin(&self, mission: &mut Mission, m: f64) {
-        mission.formation.safety_margin += m;
+        mission.formation.obstacle_margin += m;
+    }
+
+    fn spacing_field(&self) -> Option<&'static str> {
+        Some("formation.slots")
+    }
+
+    fn widen_spacing(&self, mission: &mut Mission, scale: f64) {
+        for slot in &mut mission.formation.slots {
+            *slot *= scale;
+        }
     }
 
     fn plots(&self) -> &'static [&'static [Plot]] {

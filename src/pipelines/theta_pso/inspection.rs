@@ -31,6 +31,16 @@ pub struct PassGeometry {
     pub range_right: [f64; 2],
 }
 
+/// A band's end as written when it is a round figure (`1`, `2.5`), to the
+/// centimetre when the margins moved it (`1.65`).
+fn short(x: f64) -> String {
+    let rounded = format!("{x:.2}");
+    rounded
+        .trim_end_matches('0')
+        .trim_end_matches('.')
+        .to_owned()
+}
+
 /// Samples along a pass when its geometry is computed (setup only).
 const PASS_SAMPLES: usize = 64;
 
@@ -80,10 +90,13 @@ impl PassGeometry {
             let range = facing_range(slots, r, radius, length, sign);
             if range[0] < d_min || range[1] > d_max {
                 return Err(format!(
-                    "a {length} m pass cannot keep the facing UAV within [{d_min}, {d_max}] m of \
+                    "a {length} m pass cannot keep the facing UAV within [{}, {}] m of \
                      its surface: along a straight pass the distance varies from {:.2} to {:.2} m; \
                      shorten formation.inspection_pass or widen the band",
-                    range[0], range[1]
+                    short(d_min),
+                    short(d_max),
+                    range[0],
+                    range[1]
                 ));
             }
             Ok((radius, range))
@@ -122,6 +135,24 @@ impl PassGeometry {
     }
 }
 
+/// The part of the stand-off band `band` a pass aims into: eq. 8's band
+/// above the least clearance a plan keeps (r_Q + the margins, eq. 7).
+/// Reading: a pass in the middle of the band would put the facing UAV
+/// closer than verification allows once the margins pass the band's lower
+/// end (a flight check's margin of 2.5 m against the bridge's [1, 5] m), so
+/// the pass aims at the middle of what both allow; with the default margins
+/// (0.6 m under a 1 m lower end) nothing moves.
+fn flown_band([d_min, d_max]: [f64; 2], least_clearance: f64) -> Result<[f64; 2], String> {
+    if least_clearance >= d_max {
+        return Err(format!(
+            "its stand-off band ends at {d_max} m, within the {least_clearance:.2} m a plan keeps \
+             from every obstacle (r_Q + formation.safety_margin + formation.obstacle_margin): \
+             no UAV may come close enough to inspect it"
+        ));
+    }
+    Ok([d_min.max(least_clearance), d_max])
+}
+
 /// The pass geometry of every inspected obstacle, or the first reason one
 /// cannot be flown, with its obstacle index.
 pub fn pass_geometries(mission: &Mission) -> Result<Vec<(usize, PassGeometry)>, (usize, String)> {
@@ -146,14 +177,49 @@ pub fn pass_geometries(mission: &Mission) -> Result<Vec<(usize, PassGeometry)>, 
                         ),
                     ));
                 }
-                return Ok((
-                    k,
-                    PassGeometry::face(&f.slots, o.stand_off_band(f), f.inspection_pass),
-                ));
+                let band =
+                    flown_band(o.stand_off_band(f), f.least_clearance()).map_err(|e| (k, e))?;
+                return Ok((k, PassGeometry::face(&f.slots, band, f.inspection_pass)));
             }
-            PassGeometry::new(&f.slots, o.radius, o.stand_off_band(f), f.inspection_pass)
+            let written = o.stand_off_band(f);
+            let band = flown_band(written, f.least_clearance()).map_err(|e| (k, e))?;
+            PassGeometry::new(&f.slots, o.radius, band, f.inspection_pass)
                 .map(|g| (k, g))
-                .map_err(|e| (k, e))
+                .map_err(|e| {
+                    if band == written {
+                        (k, e)
+                    } else {
+                        let kept = f.least_clearance();
+                        (k, format!("{e} (the band above the {kept:.2} m kept from every obstacle: r_Q + the margins)"))
+                    }
+                })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_pass_aims_into_the_band_above_the_clearance_the_plan_keeps() {
+        // Default margins under the band's lower end: the band as written.
+        assert_eq!(flown_band([1.0, 5.0], 0.6), Ok([1.0, 5.0]));
+        // A margin past it: the pass aims above it, and the facing UAV's
+        // distance over the bridge's 6 m pass stays in [3.05, 5] m.
+        let band = flown_band([1.0, 5.0], 3.05).expect("room above 3.05 m");
+        assert_eq!(band, [3.05, 5.0]);
+        let slots = [
+            Vector3::new(0.0, 2.0, 0.0),
+            Vector3::new(-2.0, -1.0, 0.0),
+            Vector3::new(2.0, -1.0, 0.0),
+        ];
+        let pass = PassGeometry::new(&slots, 2.5, band, 6.0).expect("a pass");
+        for [lo, hi] in [pass.range_left, pass.range_right] {
+            assert!(lo >= 3.05 && hi <= 5.0, "facing UAV at {lo:.2}-{hi:.2} m");
+        }
+        // No room left: refused, naming the fields.
+        let refused = flown_band([1.0, 5.0], 5.2).expect_err("no room");
+        assert!(refused.contains("formation.obstacle_margin"), "{refused}");
+    }
 }

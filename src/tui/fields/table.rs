@@ -163,6 +163,7 @@ static FORMATION: Table = Table { base: &[], derived: &[
     Spec { name: "ground speed", unit: "m/s", keys: &["formation", "ground_speed"], get: |m, _| num(m.formation.ground_speed), set: |m, _, t| put(&mut m.formation.ground_speed, number(t)) },
     Spec { name: "comm range", unit: "m", keys: &["formation", "comm_range"], get: |m, _| num(m.formation.comm_range), set: |m, _, t| put(&mut m.formation.comm_range, number(t)) },
     Spec { name: "safety margin", unit: "m", keys: &["formation", "safety_margin"], get: |m, _| num(m.formation.safety_margin), set: |m, _, t| put(&mut m.formation.safety_margin, number(t)) },
+    Spec { name: "obstacle margin", unit: "m", keys: &["formation", "obstacle_margin"], get: |m, _| num(m.formation.obstacle_margin), set: |m, _, t| put(&mut m.formation.obstacle_margin, number(t)) },
     Spec { name: "max speed", unit: "m/s", keys: &["vehicle", "max_speed"], get: |m, _| num(m.vehicle.max_speed), set: |m, _, t| put(&mut m.vehicle.max_speed, number(t)) },
     Spec { name: "max climb", unit: "m/s", keys: &["vehicle", "max_climb_rate"], get: |m, _| num(m.vehicle.max_climb_rate), set: |m, _, t| put(&mut m.vehicle.max_climb_rate, number(t)) },
     Spec { name: "max descent", unit: "m/s", keys: &["vehicle", "max_descent_rate"], get: |m, _| num(m.vehicle.max_descent_rate), set: |m, _, t| put(&mut m.vehicle.max_descent_rate, number(t)) },
