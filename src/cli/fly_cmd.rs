@@ -248,6 +248,26 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
             print!("{}", report.text(args.verbose));
             exit::OK
         }
+        (Some(_), None) if search.spacing.is_some() => {
+            let s = search.spacing.unwrap_or(1.0);
+            let highest = search
+                .limit
+                .as_ref()
+                .map_or(flight::MAX_MARGIN, |l| l.margin);
+            println!(
+                "margin       the spacing ×{s:.2} keeps 2 r_Q in all but {:.2} % of flights, but no \
+                 margin up to {highest:.2} m from the obstacles then keeps r_Q too",
+                100.0 * target
+            );
+            if let Some(limit) = &search.limit {
+                println!(
+                    "limit        no margin above {:.2} m is valid: {}",
+                    limit.margin, limit.why
+                );
+            }
+            println!("tried        {}", tried.join("; "));
+            exit::INFEASIBLE
+        }
         (Some(m), None) => {
             println!(
                 "margin       {m:.2} m from the obstacles keeps r_Q in all but {:.2} % of flights, \

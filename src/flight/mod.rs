@@ -761,16 +761,16 @@ fn valid_up_to(
     // A step inside the boundary: a plan keeps its limits with a little
     // room (a pair exactly at 2 r_Q + the margin fails verification).
     let step = MARGIN_RESOLUTION;
-    Some((
-        base + (((low - base) / step).ceil() - 1.0).max(0.0) * step,
-        why,
-    ))
+    let inside = base + (((low - base) / step).ceil() - 1.0).max(0.0) * step;
+    Some(((100.0 * inside).round() / 100.0, why))
 }
 
 /// The smallest x in [`from`, `highest`] for which `attempt(x)` gives a
 /// report that `meets`: `from` (unless it is known to fail), then
 /// `from` + 0.25 doubling the step, then halving the interval between the
-/// last that failed and the first that met it to [`MARGIN_RESOLUTION`].
+/// last that failed and the first that met it to [`MARGIN_RESOLUTION`]
+/// (each halving on a centimetre grid: the value reported is the value
+/// planned with, as the user will write it).
 fn smallest(
     from: f64,
     from_fails: bool,
@@ -813,7 +813,8 @@ fn smallest(
         return Ok(Some((high, best)));
     };
     while high - low > MARGIN_RESOLUTION {
-        let mid = 0.5 * (low + high);
+        // On a centimetre grid, so that the value printed is the one planned.
+        let mid = (50.0 * (low + high)).round() / 100.0;
         match attempt(mid)? {
             Some(report) if meets(&report) => {
                 high = mid;
@@ -832,8 +833,10 @@ fn smallest(
 /// 2 r_Q in more than `target` of the flights with it (set by the slots'
 /// spacing against each receiver's own fix error and the take-off skew, which
 /// no margin from the site moves), the smallest spacing scale that brings
-/// every limit within `target` (1.25, doubling the step, then halving), for
-/// a pipeline that can widen its spacing. Values that make the mission
+/// the pairs within `target` (1.25, doubling the step, then halving), for
+/// a pipeline that can widen its spacing; and when the wider formation,
+/// passing closer to the site, breaks r_Q again, the margin once more at
+/// that spacing, up from the one found. Values that make the mission
 /// invalid are not tried beyond the largest valid one, and the search says
 /// so ([`MarginSearch::limit`], [`MarginSearch::spacing_limit`]). `plan`
 /// plans a mission (`Err`: no plan, and why). The share is the flights' own
@@ -908,14 +911,40 @@ pub fn find_margin(
                 with_spacing(changed, pipeline, s);
             });
             let widest = spacing_cap.as_ref().map_or(MAX_SPACING, |(s, _)| *s);
-            if widest > 1.0 {
-                let widened = smallest(1.0, true, widest, &mut |s| attempt(m, s), &keeps_all)?;
-                if let Some((s, report)) = widened {
+            search.spacing_limit = spacing_cap.map(|(s, why)| MarginLimit { margin: s, why });
+            let keeps_pairs = |r: &Report| r.break_separation.share <= target;
+            let widened = if widest > 1.0 {
+                smallest(1.0, true, widest, &mut |s| attempt(m, s), &keeps_pairs)?
+            } else {
+                None
+            };
+            match widened {
+                Some((s, report)) if keeps_all(&report) => {
                     search.spacing = Some(s);
                     search.report = Some(report);
                 }
+                // A wider formation passes closer to the site: the margin
+                // again, at that spacing, from where it was.
+                Some((s, _)) => {
+                    search.spacing = Some(s);
+                    let cap = valid_up_to(mission, pipeline, m, MAX_MARGIN, &|changed, x| {
+                        with_margin(changed, pipeline, x);
+                        with_spacing(changed, pipeline, s);
+                    });
+                    let highest = cap.as_ref().map_or(MAX_MARGIN, |(x, _)| *x);
+                    if let Some((x, why)) = cap {
+                        search.limit = Some(MarginLimit { margin: x, why });
+                    }
+                    if highest > m
+                        && let Some((x, report)) =
+                            smallest(m, true, highest, &mut |x| attempt(x, s), &keeps_all)?
+                    {
+                        search.margin = Some(x);
+                        search.report = Some(report);
+                    }
+                }
+                None => {}
             }
-            search.spacing_limit = spacing_cap.map(|(s, why)| MarginLimit { margin: s, why });
         }
         _ => {}
     }
