@@ -385,10 +385,6 @@ const KNOWS_PIPELINES_BY_NAME: &[(&str, &str)] = &[
         "src/tui/view/map/mod.rs",
         "the map draws each pipeline's result (its own painter)",
     ),
-    (
-        "src/tui/fixtures.rs",
-        "ready-made jobs of each pipeline for the tests",
-    ),
 ];
 
 /// Lines of `file` outside comments and its `#[cfg(test)]` module that name

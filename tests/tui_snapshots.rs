@@ -12,9 +12,7 @@ use ratatui::backend::TestBackend;
 use skyform::mission::default_mission;
 use skyform::tui::app::Focus;
 use skyform::tui::fields::Item;
-use skyform::tui::fixtures::{
-    app_with_flatlo_result, app_with_result, bridge_with_oaks, type_into,
-};
+use skyform::tui::fixtures::{app_with_result, app_with_run, bridge_with_oaks, type_into};
 use skyform::tui::jobs::{Job, JobMsg, Kind};
 use skyform::tui::{Action, App, Document, view};
 
@@ -164,7 +162,7 @@ fn a_flatlo_result_on_the_kilometre_map_with_its_verification_table() {
     let m = skyform::mission::load(std::path::Path::new(path))
         .unwrap()
         .mission;
-    let mut app = app_with_flatlo_result(m, 3);
+    let mut app = app_with_run(Kind::Flatlo, m, 3, "squadron.toml");
     app.update(Action::FocusOn(Focus::Jobs));
     let screen = render(&app, app.jobs()[0].started);
     assert!(screen.contains("✓ separation kept"), "{screen}");
@@ -850,7 +848,7 @@ fn a_flatlo_result_turns_stale_after_an_edit() {
     let m = skyform::mission::load(std::path::Path::new(path))
         .unwrap()
         .mission;
-    let mut app = app_with_flatlo_result(m, 3);
+    let mut app = app_with_run(Kind::Flatlo, m, 3, "squadron.toml");
     let started = app.jobs()[0].started;
     let fresh = render(&app, started);
     assert!(
@@ -888,7 +886,7 @@ fn a_fleet_result_turns_stale_after_an_edit() {
         .unwrap()
         .mission;
     m.fleet.duration = 6.0;
-    let mut app = skyform::tui::fixtures::app_with_fleet_result(m, 1);
+    let mut app = skyform::tui::fixtures::app_with_run(Kind::Fleet, m, 1, "fleet.toml");
     let started = app.jobs()[0].started;
     let fresh = map_title(&render(&app, started));
     assert!(fresh.contains("job 1 fleet seed 1: "), "{fresh}");

@@ -8,11 +8,9 @@ use nalgebra::{Point2, Point3};
 use super::action::{Action, Focus};
 use super::app::App;
 use super::document::Document;
-use super::jobs::{Job, JobError, JobMsg, Kind, Outcome};
+use super::jobs::{Job, JobError, JobMsg, Kind};
 use crate::mission::{self, Mission, Obstacle};
-use crate::pipelines::flatlo;
-use crate::pipelines::theta_pso::{PlanOptions, plan};
-use crate::pipelines::{CancelToken, Silent};
+use crate::pipelines::{CancelToken, Request, Silent};
 
 /// A 400 m × 400 m field with `n` small posts on a jittered grid, clear of
 /// the start and goal corners: a stress case for drawing.
@@ -83,60 +81,31 @@ pub fn bridge_with_oaks() -> Mission {
     m
 }
 
-/// An app on `mission` whose map shows a finished fleet run with `seed`.
-pub fn app_with_fleet_result(mission: Mission, seed: u64) -> App {
-    let outcome = crate::pipelines::fleet::plan(&mission, seed, &mut Silent, &CancelToken::new());
+/// An app on `mission`, opened from `file`, whose map shows a finished
+/// `kind` run with `seed`, planned synchronously through its face.
+pub fn app_with_run(kind: Kind, mission: Mission, seed: u64, file: &str) -> App {
+    let request = Request {
+        seed,
+        ..Default::default()
+    };
+    let outcome = kind
+        .face()
+        .run(&mission, request, &mut Silent, &CancelToken::new());
     let mut app = App::new(
-        Document::new(mission.clone(), Some(PathBuf::from("fleet.toml"))),
+        Document::new(mission.clone(), Some(PathBuf::from(file))),
         PathBuf::from("."),
     );
     let started = Instant::now();
-    app.adopt_job(Job::new(1, Kind::Fleet, seed, mission, started));
-    let result = outcome
-        .map(|o| Outcome::Fleet(Box::new(o)))
-        .map_err(JobError::from);
-    app.on_job_msg(JobMsg::Done(1, result), started);
+    app.adopt_job(Job::new(1, kind, seed, mission, started));
+    app.on_job_msg(JobMsg::Done(1, outcome.map_err(JobError::from)), started);
     app
 }
 
-/// An app on `mission` whose map shows a finished θ-PSO run (`iterations`
-/// swarm iterations, seed `seed`), planned synchronously.
+/// An app on `mission` whose map shows a finished run of the designer's
+/// default pipeline (θ-PSO: `iterations` swarm iterations, seed `seed`).
 pub fn app_with_result(mut mission: Mission, seed: u64, iterations: usize) -> App {
     mission.theta_pso.iterations = iterations;
-    let outcome = plan(
-        &mission,
-        seed,
-        PlanOptions::default(),
-        &mut Silent,
-        &CancelToken::new(),
-    );
-    let mut app = App::new(
-        Document::new(mission.clone(), Some(PathBuf::from("mission.toml"))),
-        PathBuf::from("."),
-    );
-    let started = Instant::now();
-    app.adopt_job(Job::new(1, Kind::ThetaPso, seed, mission, started));
-    let result = outcome
-        .map(|o| Outcome::ThetaPso(Box::new(o)))
-        .map_err(JobError::from);
-    app.on_job_msg(JobMsg::Done(1, result), started);
-    app
-}
-
-/// An app on `mission` whose map shows a finished FLATLO run with `seed`.
-pub fn app_with_flatlo_result(mission: Mission, seed: u64) -> App {
-    let outcome = flatlo::plan(&mission, seed, &mut Silent, &CancelToken::new());
-    let mut app = App::new(
-        Document::new(mission.clone(), Some(PathBuf::from("squadron.toml"))),
-        PathBuf::from("."),
-    );
-    let started = Instant::now();
-    app.adopt_job(Job::new(1, Kind::Flatlo, seed, mission, started));
-    let result = outcome
-        .map(|o| Outcome::Flatlo(Box::new(o)))
-        .map_err(JobError::from);
-    app.on_job_msg(JobMsg::Done(1, result), started);
-    app
+    app_with_run(Kind::default(), mission, seed, "mission.toml")
 }
 
 /// Types `text` into the selected item's field labelled `label` and applies
