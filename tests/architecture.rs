@@ -376,10 +376,6 @@ const KNOWS_PIPELINES_BY_NAME: &[(&str, &str)] = &[
         "src/distributed/coordinator.rs",
         "the fleet's transport returns the fleet's outcome",
     ),
-    (
-        "src/tui/board.rs",
-        "the designer's distributed fleet run (D)",
-    ),
     ("src/tui/keys.rs", "the key table: each pipeline's run key"),
     (
         "src/tui/view/map/mod.rs",

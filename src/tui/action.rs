@@ -108,9 +108,10 @@ pub enum Action {
     Run(Kind),
     /// Live planning on or off: the plan follows every edit.
     ToggleLive,
-    /// Run the fleet with its agents in processes of their own, over Zenoh
-    /// (lockstep: the same result as `Run(Kind::Fleet)`).
-    RunDistributed,
+    /// Run a pipeline with its agents in processes of their own, over Zenoh
+    /// (the key table binds it for the fleet; lockstep: the same result as
+    /// `Run` of the same pipeline).
+    RunDistributed(Kind),
     /// Fly the shown plan in the mission's `[flight]` air (`skyform fly`).
     FlightCheck,
     /// Move the fleet replay by this many seconds (and pause it).

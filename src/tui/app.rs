@@ -331,7 +331,7 @@ impl App {
             Find | FindInput(_) | FindBackspace | FindClear | FindStep(_) | FindKeep
             | FindCancel => self.update_find(action),
             Scrub(_) | TogglePlay => self.update_replay(action),
-            Run(_) | RunDistributed | FlightCheck | RunNewSeed | Cancel | JobUp | JobDown
+            Run(_) | RunDistributed(_) | FlightCheck | RunNewSeed | Cancel | JobUp | JobDown
             | ToggleRecording | CycleViewer => {
                 self.board
                     .update(action, self.editor.doc(), &self.cwd, &mut self.status)

@@ -237,8 +237,8 @@ impl JobBoard {
         let seed = doc.mission().seed;
         match action {
             Run(kind) => self.run(crate::run::Run::new(kind, seed), doc, cwd, status),
-            RunDistributed => {
-                let mut run = crate::run::Run::new(Kind::Fleet, seed);
+            RunDistributed(kind) => {
+                let mut run = crate::run::Run::new(kind, seed);
                 run.distributed = Some(crate::run::Distribution {
                     processes: doc.mission().fleet.agents.clamp(1, DESIGNER_PROCESSES),
                     realtime: false,

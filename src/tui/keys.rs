@@ -446,7 +446,11 @@ pub static KEYS: &[KeyRow] = &[
         group: "Run",
         keys: "Z",
         help: "run the fleet as agent processes over Zenoh (same as T)",
-        bindings: &[bind(Key::Char('Z'), When::Always, Action::RunDistributed)],
+        bindings: &[bind(
+            Key::Char('Z'),
+            When::Always,
+            Action::RunDistributed(Kind::Fleet),
+        )],
     },
     KeyRow {
         group: "Run",
