@@ -177,6 +177,24 @@ fn pole_field() -> Mission {
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// θ-PSO's plan of `m` with seed 1, as the margin search plans each try.
+fn theta_pso_plan(m: &Mission) -> Result<Planned, String> {
+    flight::passing_plan(Kind::ThetaPso, m, 1, &CancelToken::new())
+}
+
+/// The margin search over θ-PSO plans of `m`, flying `options` each try.
+fn search_margin(m: &Mission, target: f64, options: flight::Options) -> flight::MarginSearch {
+    flight::find_margin(
+        Kind::ThetaPso,
+        m,
+        target,
+        options,
+        &mut theta_pso_plan,
+        &CancelToken::new(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Issue 39, item 3: in a 5 m/s northerly with light turbulence, on fixes
 /// of σ 0.3 m, a formation passing a pole: the margin search finds an extra
 /// clearance whose plan's own check meets the target (here: no flight of
@@ -191,16 +209,7 @@ fn the_margin_search_returns_a_margin_whose_check_meets_the_target() {
         seed: 2,
         threads: None,
     };
-    let mut plan = |m: &Mission| flight::passing_plan(Kind::ThetaPso, m, 1, &CancelToken::new());
-    let search = flight::find_margin(
-        Kind::ThetaPso,
-        &m,
-        target,
-        options,
-        &mut plan,
-        &CancelToken::new(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let search = search_margin(&m, target, options);
     let (Some(margin), Some(report)) = (search.margin, &search.report) else {
         panic!("no margin: {:?}", search.tried);
     };
@@ -214,7 +223,7 @@ fn the_margin_search_returns_a_margin_whose_check_meets_the_target() {
     // And checking that plan again, as a user would, gives the same share.
     let mut again = m.clone();
     flight::with_margin(&mut again, Kind::ThetaPso, margin);
-    let planned = plan(&again).unwrap_or_else(|e| panic!("{e}"));
+    let planned = theta_pso_plan(&again).unwrap_or_else(|e| panic!("{e}"));
     let setup = Setup::new(&again, &planned).unwrap_or_else(|e| panic!("{e}"));
     let check = flight::check(&setup, options, &|_, _| {}, &CancelToken::new())
         .unwrap_or_else(|e| panic!("{e}"));
@@ -351,16 +360,7 @@ fn pairs_that_break_whatever_the_margin_are_given_wider_slots() {
         seed: 1,
         threads: None,
     };
-    let mut plan = |m: &Mission| flight::passing_plan(Kind::ThetaPso, m, 1, &CancelToken::new());
-    let search = flight::find_margin(
-        Kind::ThetaPso,
-        &m,
-        0.0,
-        options,
-        &mut plan,
-        &CancelToken::new(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let search = search_margin(&m, 0.0, options);
     let (Some(margin), Some(spacing), Some(report)) =
         (search.margin, search.spacing, &search.report)
     else {
@@ -381,7 +381,7 @@ fn pairs_that_break_whatever_the_margin_are_given_wider_slots() {
     flight::with_margin(&mut again, Kind::ThetaPso, margin);
     flight::with_spacing(&mut again, Kind::ThetaPso, spacing);
     assert!((again.formation.slots[0].y - 0.65 * spacing).abs() < 1e-12);
-    let planned = plan(&again).unwrap_or_else(|e| panic!("{e}"));
+    let planned = theta_pso_plan(&again).unwrap_or_else(|e| panic!("{e}"));
     let setup = Setup::new(&again, &planned).unwrap_or_else(|e| panic!("{e}"));
     let check = flight::check(&setup, options, &|_, _| {}, &CancelToken::new())
         .unwrap_or_else(|e| panic!("{e}"));
@@ -406,16 +406,7 @@ fn the_margin_search_stops_at_what_an_inspection_allows_and_says_so() {
         seed: 1,
         threads: None,
     };
-    let mut plan = |m: &Mission| flight::passing_plan(Kind::ThetaPso, m, 1, &CancelToken::new());
-    let search = flight::find_margin(
-        Kind::ThetaPso,
-        &m,
-        0.0,
-        options,
-        &mut plan,
-        &CancelToken::new(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let search = search_margin(&m, 0.0, options);
     assert_eq!(search.margin, None, "{:?}", search.tried);
     let limit = search
         .limit

@@ -217,58 +217,45 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
             }
         })
         .collect();
-    let widened = |scale: f64| {
-        let mut m = mission.clone();
-        flight::with_spacing(&mut m, pipeline, scale);
-        m
-    };
     let spacing_field = pipeline.face().spacing_field().unwrap_or("the spacing");
-    let code = match (&search.margin, &search.report) {
-        (Some(m), Some(report)) => {
-            let spacing = search
-                .spacing
+    let highest_margin = search
+        .limit
+        .as_ref()
+        .map_or(flight::MAX_MARGIN, |l| l.margin);
+    let code = match (search.margin, &search.report, search.spacing) {
+        (Some(m), Some(report), spacing) => {
+            let widened = spacing
                 .map(|s| format!(" and the spacing ×{s:.2}"))
                 .unwrap_or_default();
             println!(
-                "margin       {m:.2} m from the obstacles{spacing} keeps {} of flights within \
+                "margin       {m:.2} m from the obstacles{widened} keeps {} of flights within \
                  2 r_Q and r_Q (target {:.2} %)",
                 format_share(report.break_any.share),
                 100.0 * target,
             );
             println!("set          {field} = {:.2}   # now {now:.2}", now + m);
-            if let Some(s) = search.spacing {
+            if let Some(s) = spacing {
+                let mut wider = mission.clone();
+                flight::with_spacing(&mut wider, pipeline, s);
                 println!(
                     "             {spacing_field} = {}   # ×{s:.2}: at the mission's spacing the \
                      pairs broke 2 r_Q in more than {:.2} % of flights whatever the margin",
-                    slots_text(&widened(s)),
+                    slots_text(&wider),
                     100.0 * target
                 );
             }
-            println!("tried        {}", tried.join("; "));
-            print!("{}", report.text(args.verbose));
             exit::OK
         }
-        (Some(_), None) if search.spacing.is_some() => {
-            let s = search.spacing.unwrap_or(1.0);
-            let highest = search
-                .limit
-                .as_ref()
-                .map_or(flight::MAX_MARGIN, |l| l.margin);
+        (Some(_), None, Some(s)) => {
             println!(
                 "margin       the spacing ×{s:.2} keeps 2 r_Q in all but {:.2} % of flights, but no \
-                 margin up to {highest:.2} m from the obstacles then keeps r_Q too",
+                 margin up to {highest_margin:.2} m from the obstacles then keeps r_Q too",
                 100.0 * target
             );
-            if let Some(limit) = &search.limit {
-                println!(
-                    "limit        no margin above {:.2} m is valid: {}",
-                    limit.margin, limit.why
-                );
-            }
-            println!("tried        {}", tried.join("; "));
+            print_limit("margin", search.limit.as_ref(), |m| format!("{m:.2} m"));
             exit::INFEASIBLE
         }
-        (Some(m), None) => {
+        (Some(m), None, None) => {
             println!(
                 "margin       {m:.2} m from the obstacles keeps r_Q in all but {:.2} % of flights, \
                  but the pairs break 2 r_Q more often than that",
@@ -290,35 +277,25 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
             } else {
                 println!("spacing      {spacing_field} cannot be widened here");
             }
-            if let Some(limit) = &search.spacing_limit {
-                println!(
-                    "limit        no spacing above ×{:.2} is valid: {}",
-                    limit.margin, limit.why
-                );
-            }
-            println!("tried        {}", tried.join("; "));
+            print_limit("spacing", search.spacing_limit.as_ref(), |s| {
+                format!("×{s:.2}")
+            });
             exit::INFEASIBLE
         }
-        _ => {
-            let highest = search
-                .limit
-                .as_ref()
-                .map_or(flight::MAX_MARGIN, |l| l.margin);
+        (None, ..) => {
             println!(
-                "margin       none up to {highest:.2} m from the obstacles keeps r_Q in all but \
-                 {:.2} % of flights",
+                "margin       none up to {highest_margin:.2} m from the obstacles keeps r_Q in all \
+                 but {:.2} % of flights",
                 100.0 * target
             );
-            if let Some(limit) = &search.limit {
-                println!(
-                    "limit        no margin above {:.2} m is valid: {}",
-                    limit.margin, limit.why
-                );
-            }
-            println!("tried        {}", tried.join("; "));
+            print_limit("margin", search.limit.as_ref(), |m| format!("{m:.2} m"));
             exit::INFEASIBLE
         }
     };
+    println!("tried        {}", tried.join("; "));
+    if let Some(report) = &search.report {
+        print!("{}", report.text(args.verbose));
+    }
     if let (Some(path), Ok(text)) = (&args.json, serde_json::to_string_pretty(&search))
         && let Err(e) = atomic::write(path, text.as_bytes())
     {
@@ -336,6 +313,18 @@ fn said(e: &FlightError) -> u8 {
     } else {
         eprintln!("error: {e}");
         exit::ERROR
+    }
+}
+
+/// The `limit` line: the largest `what` the mission stays valid with, as
+/// `shown`, and the validator's words above it.
+fn print_limit(what: &str, limit: Option<&flight::MarginLimit>, shown: fn(f64) -> String) {
+    if let Some(limit) = limit {
+        println!(
+            "limit        no {what} above {} is valid: {}",
+            shown(limit.margin),
+            limit.why
+        );
     }
 }
 

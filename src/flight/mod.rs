@@ -780,9 +780,10 @@ fn smallest(
 ) -> Result<Option<(f64, Report)>, FlightError> {
     let mut failed = from_fails.then_some(from);
     let mut met: Option<(f64, Report)> = None;
-    let mut step = 0.25;
+    // The first step beyond `from`; each later one doubles the distance.
+    const FIRST: f64 = 0.25;
     let mut x = if from_fails {
-        (from + step).min(highest)
+        (from + FIRST).min(highest)
     } else {
         from
     };
@@ -799,12 +800,11 @@ fn smallest(
         }
         // The highest value is tried before giving up.
         x = if x == from {
-            from + step
+            from + FIRST
         } else {
             from + 2.0 * (x - from)
         }
         .min(highest);
-        step = x - from;
     }
     let Some((mut high, mut best)) = met else {
         return Ok(None);
