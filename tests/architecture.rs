@@ -377,10 +377,6 @@ const KNOWS_PIPELINES_BY_NAME: &[(&str, &str)] = &[
         "the fleet's transport returns the fleet's outcome",
     ),
     ("src/tui/keys.rs", "the key table: each pipeline's run key"),
-    (
-        "src/tui/view/map/mod.rs",
-        "the map draws each pipeline's result (its own painter)",
-    ),
 ];
 
 /// Lines of `file` outside comments and its `#[cfg(test)]` module that name

@@ -11,6 +11,7 @@
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
+use super::chart::{Chart, ChartView};
 use super::sketch::{Plot, Sketch};
 use super::table::Row;
 use super::theta_pso::{PlanOptions, WarmStart};
@@ -247,6 +248,26 @@ pub trait PipelineOutcome {
     /// Draws the outcome in a recording; `scene` is the mission when the
     /// recording has it.
     fn sketch(&self, scene: Option<&Mission>, out: &mut dyn Sketch);
+    /// Charts the outcome on the designer's map, top down.
+    fn chart(&self, view: &ChartView, out: &mut dyn Chart);
+    /// The path the designer's side view unrolls (distance along it against
+    /// altitude); `None`: the straight line from start to goal.
+    fn flown_path(&self) -> Option<&[Point3<f64>]> {
+        None
+    }
+    /// Charts the outcome in the side view, along [`PipelineOutcome::flown_path`].
+    fn chart_side(&self, _view: &ChartView, _out: &mut dyn Chart) {}
+    /// Where the formation heads from its start, when the plan says (θ-PSO:
+    /// its first waypoint); the designer turns the slots it draws there.
+    fn heading_from_start(&self) -> Option<Point3<f64>> {
+        None
+    }
+    /// Its flight spans kilometres (FLATLO's): the designer leaves the
+    /// site's labels and the formation's slots off the map under it, where
+    /// they would be letters piled on a few cells.
+    fn dwarfs_the_site(&self) -> bool {
+        false
+    }
     /// What a live plan adds to its vehicles' tracks in a recording, under
     /// `root` (θ-PSO: its centroid path).
     fn sketch_live(&self, _root: &str, _out: &mut dyn Sketch) {}

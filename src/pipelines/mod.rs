@@ -8,6 +8,7 @@
 //! [`Outcome`], and the two matches that hand them their faces. Adding a
 //! pipeline: see "Adding a pipeline" in `docs/architecture.md`.
 
+pub mod chart;
 pub mod face;
 pub mod interface;
 pub mod sketch;

@@ -2,8 +2,9 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::{FlatloOutcome, recording, summary};
+use super::{FlatloOutcome, chart, recording, summary};
 use crate::mission::{Diagnostic, Mission};
+use crate::pipelines::chart::{Chart, ChartView};
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
@@ -99,6 +100,15 @@ impl Pipeline for Flatlo {
 }
 
 impl PipelineOutcome for FlatloOutcome {
+    fn chart(&self, view: &ChartView, out: &mut dyn Chart) {
+        chart::chart(self, view, out);
+    }
+
+    /// The transition flies kilometres.
+    fn dwarfs_the_site(&self) -> bool {
+        true
+    }
+
     fn header(&self) -> &crate::pipelines::Header {
         &self.header
     }

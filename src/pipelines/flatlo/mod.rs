@@ -13,6 +13,7 @@
 
 pub mod aircraft;
 pub mod algorithm;
+pub mod chart;
 pub mod envelope;
 pub mod face;
 pub mod maneuver;

@@ -2,8 +2,9 @@
 
 use nalgebra::Point3;
 
-use super::{FleetOutcome, recording, summary};
+use super::{FleetOutcome, chart, recording, summary};
 use crate::mission::{Diagnostic, Mission};
+use crate::pipelines::chart::{Chart, ChartView};
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
@@ -83,6 +84,10 @@ impl Pipeline for Fleet {
 }
 
 impl PipelineOutcome for FleetOutcome {
+    fn chart(&self, view: &ChartView, out: &mut dyn Chart) {
+        chart::chart(self, view, out);
+    }
+
     fn header(&self) -> &crate::pipelines::Header {
         &self.header
     }

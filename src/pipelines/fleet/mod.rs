@@ -13,6 +13,7 @@
 //! and `quadrotor.rs`.
 
 pub mod agent;
+pub mod chart;
 pub mod cost;
 pub mod face;
 pub mod network;

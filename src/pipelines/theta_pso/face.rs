@@ -1,7 +1,8 @@
 //! θ-PSO's face: what every front end reads of it (`pipelines::face`).
 
-use super::{ThetaPsoOutcome, recording, summary};
+use super::{ThetaPsoOutcome, chart, recording, summary};
 use crate::mission::{Diagnostic, Mission};
+use crate::pipelines::chart::{Chart, ChartView};
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
@@ -137,6 +138,22 @@ impl Pipeline for ThetaPso {
 }
 
 impl PipelineOutcome for ThetaPsoOutcome {
+    fn chart(&self, view: &ChartView, out: &mut dyn Chart) {
+        chart::chart(self, view, out);
+    }
+
+    fn flown_path(&self) -> Option<&[nalgebra::Point3<f64>]> {
+        Some(&self.flown_path)
+    }
+
+    fn chart_side(&self, view: &ChartView, out: &mut dyn Chart) {
+        chart::chart_side(self, view, out);
+    }
+
+    fn heading_from_start(&self) -> Option<nalgebra::Point3<f64>> {
+        self.centroid_path.get(1).copied()
+    }
+
     fn header(&self) -> &crate::pipelines::Header {
         &self.header
     }

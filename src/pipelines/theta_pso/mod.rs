@@ -5,6 +5,7 @@
 //! result against the hard constraints and the inspection passes (eq. 8).
 
 pub mod benchmark;
+pub mod chart;
 pub mod cost;
 pub mod face;
 pub mod flight;

@@ -24,17 +24,17 @@ use crate::base::geometry::segment_projection;
 use crate::mission::{Mission, Preset, ShapeChoice};
 use crate::outcome::Verdict;
 use crate::pipelines::Kind;
-use crate::pipelines::flatlo::FlatloOutcome;
-use crate::pipelines::fleet::FleetOutcome;
-use crate::pipelines::theta_pso::ThetaPsoOutcome;
+use crate::pipelines::chart::ChartView;
 use crate::tui::app::{App, Focus};
 use crate::tui::fields::{Item, shape_name};
 use crate::tui::jobs::{Job, Outcome};
 use crate::tui::live::Live;
 
+mod chart;
 mod formation;
 mod side;
 
+use chart::OnCanvas;
 pub use formation::{draw_formation, formation_split};
 use side::draw_side;
 
@@ -132,9 +132,11 @@ fn result_part(app: &App, job: &Job, outcome: &Outcome) -> Part<'static> {
     let name = crate::tui::live::label(job.id);
     // θ-PSO's words are its own: a plan is feasible or not.
     let word = outcome.verdict_word().unwrap_or("cancelled");
-    let what = match job.pipeline {
-        Kind::ThetaPso => String::new(),
-        other => format!("{} ", other.name()),
+    // The designer's own pipeline goes unnamed; the others say theirs.
+    let what = if job.pipeline == Kind::default() {
+        String::new()
+    } else {
+        format!("{} ", job.pipeline.name())
     };
     let yellow = Style::default().black().on_yellow();
     let (long, short, style) = if Live::owns(job.id) {
@@ -155,9 +157,9 @@ fn result_part(app: &App, job: &Job, outcome: &Outcome) -> Part<'static> {
                 yellow,
             ),
             (false, _) => {
-                let warm = match outcome.theta_pso() {
-                    Some(o) if o.warm_start.is_some() => "warm, ",
-                    _ => "",
+                let warm = match outcome.face().warm_from() {
+                    Some(_) => "warm, ",
+                    None => "",
                 };
                 let ms = job.elapsed(std::time::Instant::now()).as_secs_f64() * 1e3;
                 match outcome.verdict() {
@@ -204,66 +206,18 @@ fn result_part(app: &App, job: &Job, outcome: &Outcome) -> Part<'static> {
     Part::shortened(2, Span::styled(long, style), Span::styled(short, style))
 }
 
-/// The shown job's outcome of one pipeline (`pick`), and whether it is stale.
-fn shown_outcome<'a, T>(
-    app: &'a App,
-    pick: impl FnOnce(&'a Outcome) -> Option<&'a T>,
-) -> Option<(&'a T, bool)> {
+/// The shown job's outcome and how the map charts it (stale, live, the
+/// replay's instant).
+fn shown_chart(app: &App) -> Option<(&Outcome, ChartView<'_>)> {
     let job = app.shown()?;
-    let outcome = pick(job.outcome.as_ref()?)?;
-    Some((outcome, app.is_stale(job)))
-}
-
-/// The shown θ-PSO result, if the shown job is one.
-fn result_of(app: &App) -> Option<(&ThetaPsoOutcome, bool)> {
-    shown_outcome(app, Outcome::theta_pso)
-}
-
-/// The fleet at the replay instant: trails so far, each agent with its
-/// detection range, and its reference.
-fn paint_fleet(ctx: &mut Context, app: &App, o: &FleetOutcome, stale: bool, dot: f64) {
-    let t = app.replay_time().unwrap_or(o.duration);
-    let detection = app.mission().fleet.detection_range;
-    for a in &o.agents {
-        let color = if stale {
-            Color::Gray
-        } else {
-            uav_color(a.index)
-        };
-        let upto = a.samples.partition_point(|s| s.t <= t);
-        let trail = decimate(
-            a.samples[..upto]
-                .iter()
-                .map(|s| (s.position.x, s.position.y)),
-            dot,
-        );
-        ctx.draw(&Polyline {
-            points: &trail,
-            color,
-        });
-        if let Some(s) = a.samples[..upto].last() {
-            ctx.draw(&Ring {
-                x: s.position.x,
-                y: s.position.y,
-                radius: detection,
-                color: Color::DarkGray,
-                dot,
-            });
-            ctx.print(
-                s.reference.x,
-                s.reference.y,
-                Span::styled("·", Style::default().fg(Color::White)),
-            );
-            ctx.print(
-                s.position.x,
-                s.position.y,
-                Span::styled(
-                    format!("●{}", a.index + 1),
-                    Style::default().fg(color).bold(),
-                ),
-            );
-        }
-    }
+    let outcome = job.outcome.as_ref()?;
+    let view = ChartView {
+        mission: app.mission(),
+        stale: app.is_stale(job),
+        live: Live::owns(job.id),
+        at: app.replay_time(),
+    };
+    Some((outcome, view))
 }
 
 /// The top-down map (or the side view when toggled).
@@ -517,76 +471,6 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
             color: Color::Blue,
         });
     }
-    if let Some((o, stale)) = result_of(app) {
-        for (k, t) in o.trajectories.iter().enumerate() {
-            let color = if stale { Color::DarkGray } else { uav_color(k) };
-            let pts = decimate(t.samples.iter().map(|s| (s.position.x, s.position.y)), dot);
-            ctx.draw(&Polyline {
-                points: &pts,
-                color,
-            });
-        }
-        let color = if stale { Color::Gray } else { Color::White };
-        let pts: Vec<(f64, f64)> = o.centroid_path.iter().map(|p| (p.x, p.y)).collect();
-        ctx.draw(&Polyline {
-            points: &pts,
-            color,
-        });
-        ctx.layer();
-        // Reconfiguration zones [t1, t4]: the centroid's stretch, highlighted.
-        if !stale {
-            for r in &o.reconfigurations {
-                let zone = centroid_between(o, r.t1, r.t4);
-                let pts = decimate(zone.into_iter(), dot);
-                ctx.draw(&Polyline {
-                    points: &pts,
-                    color: Color::LightCyan,
-                });
-            }
-            // Inspection passes (eq. 8): the centroid's stretch.
-            for pass in &o.passes {
-                let stretch = centroid_between(o, pass.time[0], pass.time[1]);
-                let pts = decimate(stretch.into_iter(), dot);
-                ctx.draw(&Polyline {
-                    points: &pts,
-                    color: Color::LightMagenta,
-                });
-            }
-        }
-        for v in o.verification.violations.iter().take(50) {
-            ctx.print(
-                v.location.position.x,
-                v.location.position.y,
-                Span::styled("✗", Style::default().red().bold()),
-            );
-        }
-        // A live plan says at once where it fails: the first violation named.
-        if let (false, Some(v), Some(job)) = (stale, o.verification.violations.first(), app.shown())
-            && crate::tui::live::Live::owns(job.id)
-        {
-            let with = v
-                .location
-                .other
-                .as_ref()
-                .map_or_else(String::new, |other| format!(" vs {other}"));
-            ctx.print(
-                v.location.position.x,
-                v.location.position.y,
-                Span::styled(
-                    format!(
-                        "✗ UAV {} {} {:.2}{with}",
-                        v.location.uav + 1,
-                        v.check,
-                        v.value
-                    ),
-                    Style::default().red().bold(),
-                ),
-            );
-        }
-    }
-    if let Some((o, stale)) = shown_outcome(app, Outcome::flatlo) {
-        paint_squadron(ctx, o, stale, dot);
-    }
     for (k, t) in m.fleet.targets.iter().enumerate() {
         let style = if *app.selected() == Item::FleetTarget(k) {
             Style::default().black().on_yellow().bold()
@@ -599,13 +483,17 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
             Span::styled(format!("◎{}", k + 1), style),
         );
     }
-    if let Some((o, stale)) = shown_outcome(app, Outcome::fleet) {
-        paint_fleet(ctx, app, o, stale, dot);
+    let shown = shown_chart(app);
+    if let Some((o, view)) = &shown {
+        let mut canvas = OnCanvas {
+            ctx,
+            step: dot,
+            dot,
+        };
+        o.face().chart(view, &mut canvas);
     }
     paint_flight_check(ctx, app, dot);
-
-    // At a FLATLO result's kilometre scale the formation is a dot.
-    if shown_outcome(app, Outcome::flatlo).is_none() {
+    if shown.is_none_or(|(o, _)| !o.face().dwarfs_the_site()) {
         draw_formation_at_start(ctx, app, m, dot);
     }
 }
@@ -687,10 +575,10 @@ impl Labels<'_> {
 
 /// The map's text: IWP marks, obstacle names where they fit, start and goal.
 fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
-    // A FLATLO result is drawn at kilometre scale: the θ-PSO route, IWPs and
-    // obstacle names would be letters piled on a few cells (the selected
-    // obstacle's name is still drawn).
-    let kilometres = shown_outcome(app, Outcome::flatlo).is_some();
+    // A result drawn at kilometre scale (FLATLO's): the θ-PSO route, IWPs
+    // and obstacle names would be letters piled on a few cells (the
+    // selected obstacle's name is still drawn).
+    let kilometres = shown_chart(app).is_some_and(|(o, _)| o.face().dwarfs_the_site());
     let scale = vp.metres_per_column();
     let mut labels = Labels {
         vp,
@@ -806,29 +694,6 @@ fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
     ctx.print(g.x, g.y, marker(Item::Goal, "G", Color::Red));
 }
 
-/// The formation centroid (mean of the UAVs) from time `t0` to `t1`, x-y.
-fn centroid_between(o: &ThetaPsoOutcome, t0: f64, t1: f64) -> Vec<(f64, f64)> {
-    let Some(first) = o.trajectories.first() else {
-        return Vec::new();
-    };
-    let n = o.trajectories.len() as f64;
-    (0..first.samples.len())
-        .filter(|&k| (t0..=t1).contains(&first.samples[k].t))
-        .map(|k| {
-            let (mut x, mut y) = (0.0, 0.0);
-            for t in &o.trajectories {
-                if let Some(s) = t.samples.get(k) {
-                    x += s.position.x;
-                    y += s.position.y;
-                }
-            }
-            (x / n, y / n)
-        })
-        .collect()
-}
-
-/// FLATLO: each aircraft's reference (grey) and flight (its colour), where it
-/// started and where it ended.
 /// The shown job's flight check (`G`): each UAV's p99 envelope as rings
 /// along its plan (a ring of that radius every second or so, in the UAV's
 /// colour), and the worst place marked.
@@ -860,51 +725,11 @@ fn paint_flight_check(ctx: &mut Context, app: &App, dot: f64) {
     }
 }
 
-fn paint_squadron(ctx: &mut Context, o: &FlatloOutcome, stale: bool, dot: f64) {
-    for a in &o.aircraft {
-        let reference = decimate(
-            a.reference.iter().map(|s| (s.position.x, s.position.y)),
-            dot,
-        );
-        ctx.draw(&Polyline {
-            points: &reference,
-            color: Color::DarkGray,
-        });
-    }
-    for a in &o.aircraft {
-        let color = if stale {
-            Color::Gray
-        } else {
-            uav_color(a.index)
-        };
-        let flown = decimate(a.flown.iter().map(|s| (s.position.x, s.position.y)), dot);
-        ctx.draw(&Polyline {
-            points: &flown,
-            color,
-        });
-    }
-    for a in &o.aircraft {
-        let style = Style::default().fg(uav_color(a.index)).bold();
-        ctx.print(
-            a.start.x,
-            a.start.y,
-            Span::styled(format!("{}", a.index + 1), style),
-        );
-        if let Some(end) = a.flown.last() {
-            ctx.print(
-                end.position.x,
-                end.position.y,
-                Span::styled(format!("✈{}", a.index + 1), style),
-            );
-        }
-    }
-}
-
 /// The slots around the start, facing the goal (or the planned path's first leg).
 fn draw_formation_at_start(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     let start = m.route.start;
-    let toward = result_of(app)
-        .and_then(|(o, _)| o.centroid_path.get(1).copied())
+    let toward = shown_chart(app)
+        .and_then(|(o, _)| o.face().heading_from_start())
         .unwrap_or(m.route.goal);
     let d = (toward - start).xy();
     let heading = if d.norm() > 1e-9 { d.y.atan2(d.x) } else { 0.0 };

@@ -9,9 +9,11 @@ use super::*;
 /// flight check's envelope, path).
 pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
     let m = app.mission();
-    let result = result_of(app);
-    let centroid: Vec<Point3<f64>> = match &result {
-        Some((o, _)) => o.flown_path.clone(),
+    // The shown result that has a path to unroll, else start to goal.
+    let result = shown_chart(app).filter(|(o, _)| o.face().flown_path().is_some());
+    let centroid: Vec<Point3<f64>> = match result.as_ref().and_then(|(o, _)| o.face().flown_path())
+    {
+        Some(path) => path.to_vec(),
         None => vec![m.route.start, m.route.goal],
     };
     let along = cumulative(&centroid);
@@ -40,7 +42,7 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
         ],
         area.width.saturating_sub(2),
     );
-    let stale = result.as_ref().is_some_and(|(_, s)| *s);
+    let stale = result.as_ref().is_some_and(|(_, view)| view.stale);
     let canvas = Canvas::default()
         .block(pane_block(title, app.focus() == Focus::Map))
         .marker(Marker::Braille)
@@ -110,22 +112,13 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
                 }
             }
             ctx.layer();
-            if let Some((o, _)) = &result {
-                for (k, t) in o.trajectories.iter().enumerate() {
-                    let color = if stale { Color::DarkGray } else { uav_color(k) };
-                    // Each sample where the centroid is along the flown path.
-                    let pts = decimate(
-                        t.samples
-                            .iter()
-                            .zip(&o.flown_arcs)
-                            .map(|(s, along)| (*along, s.position.z)),
-                        length / 400.0,
-                    );
-                    ctx.draw(&Polyline {
-                        points: &pts,
-                        color,
-                    });
-                }
+            if let Some((o, view)) = &result {
+                let mut canvas = OnCanvas {
+                    ctx,
+                    step: length / 400.0,
+                    dot: length / 400.0,
+                };
+                o.face().chart_side(view, &mut canvas);
             }
             // The flight check's p99 envelope (`G`): a bar of its radius
             // above and below each UAV's plan, one a second, and the worst place.
