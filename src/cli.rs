@@ -12,8 +12,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::mission::{self, Checked, Report};
-use crate::pipelines::theta_pso::PlanOptions;
-use crate::pipelines::{CancelToken, Completion, Event, Kind, Level, Observer};
+use crate::pipelines::{CancelToken, Completion, Event, Kind, Level, Observer, PlanOptions};
+use crate::pipelines::{flatlo, fleet, theta_pso};
 use crate::record::{self, Recorder, Sinks};
 use crate::run::Run;
 
@@ -431,29 +431,25 @@ pub fn main() -> ExitCode {
                 verbose,
                 |seed| Run {
                     options,
-                    warm,
-                    ..Run::new(Kind::ThetaPso, seed)
+                    ..Run::asking(theta_pso::Request { warm: warm.clone() }, seed)
                 },
             ))
         }
         Command::Run(RunCommand::Fleet(a)) => {
             #[cfg(feature = "zenoh")]
-            let distributed = a.distributed.map(|processes| crate::run::Distribution {
-                processes,
+            let processes = a.distributed.map(|count| crate::pipelines::Processes {
+                count,
                 realtime: a.realtime,
             });
             #[cfg(not(feature = "zenoh"))]
-            let distributed = None;
+            let processes = None;
             ExitCode::from(run_pipeline(
                 &a.mission,
                 a.seed,
                 a.json.as_deref(),
                 &a.record.sinks(),
                 false,
-                |seed| Run {
-                    distributed,
-                    ..Run::new(Kind::Fleet, seed)
-                },
+                |seed| Run::asking(fleet::Request { processes }, seed),
             ))
         }
         Command::Run(RunCommand::Flatlo {
@@ -467,7 +463,7 @@ pub fn main() -> ExitCode {
             json.as_deref(),
             &record.sinks(),
             false,
-            |seed| Run::new(Kind::Flatlo, seed),
+            |seed| Run::asking(flatlo::Request, seed),
         )),
         Command::Run(RunCommand::Other(args)) => ExitCode::from(run_other(&args)),
         Command::Record { mission, record } => {
@@ -820,7 +816,7 @@ fn run_pipeline(
         return exit::ERROR;
     };
     let run = run(seed.unwrap_or(mission.seed));
-    let kind = run.kind;
+    let kind = run.kind();
     let recorder = match start_recorder(&mission, kind, sinks) {
         Ok(r) => r,
         Err(code) => return code,

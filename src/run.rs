@@ -1,41 +1,27 @@
 //! One run, the same for every front end: the CLI's `run`, `export` and
 //! `sweep` and the designer's jobs all carry out a [`Run`] here. It logs the
 //! mission to the recorder (if any), hands the pipeline's events to the
-//! caller's observer and the recorder, plans through `outcome::run_warm`, logs
+//! caller's observer and the recorder, plans through `outcome::run_request`, logs
 //! the outcome and finishes the recording; what the caller does with the
 //! [`Ran`] (print, export, count, show) is its own.
 
 use crate::mission::Mission;
 use crate::outcome::{self, Outcome};
-use crate::pipelines::theta_pso::PlanOptions;
-use crate::pipelines::{CancelToken, Kind, Observer, PipelineError, Tee};
+use crate::pipelines::{
+    CancelToken, Kind, Observer, PipelineError, PlanOptions, Processes, Request, Tee,
+};
 
 #[cfg(feature = "rerun")]
 pub use crate::record::{Finished, Recorder};
 
-/// What to run: a pipeline, a seed, θ-PSO's options (and the plan it starts
-/// warm from) and where a fleet's agents fly.
+/// What to run: a seed, how the run may use the machine, and the
+/// pipeline's own request (which pipeline, and what only it reads: θ-PSO's
+/// warm start, the fleet's agent processes).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Run {
-    pub kind: Kind,
     pub seed: u64,
-    /// Only θ-PSO reads them.
     pub options: PlanOptions,
-    /// The fleet's agents in processes of their own, over Zenoh (`None`: in
-    /// this process). Only the fleet reads it.
-    pub distributed: Option<Distribution>,
-    /// θ-PSO: start part of the swarm from this plan (the designer's live
-    /// re-plans); `None`, a cold run. Only θ-PSO reads it.
-    pub warm: Option<std::sync::Arc<crate::pipelines::theta_pso::WarmStart>>,
-}
-
-/// A fleet flown by agent processes on this machine.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Distribution {
-    /// How many agent processes.
-    pub processes: usize,
-    /// Each on its own wall clock (not reproducible) instead of lockstep.
-    pub realtime: bool,
+    pub request: Request,
 }
 
 /// What a run left: the outcome (or why there is none) and the recording.
@@ -47,14 +33,23 @@ pub struct Ran {
 }
 
 impl Run {
+    /// A plain run of `kind`: nothing asked beyond the mission and the seed.
     pub fn new(kind: Kind, seed: u64) -> Self {
+        Run::asking(kind.request(), seed)
+    }
+
+    /// A run of the pipeline `request` is for, asking it that.
+    pub fn asking(request: impl Into<Request>, seed: u64) -> Self {
         Run {
-            kind,
             seed,
             options: PlanOptions::default(),
-            distributed: None,
-            warm: None,
+            request: request.into(),
         }
+    }
+
+    /// The pipeline it runs.
+    pub fn kind(&self) -> Kind {
+        self.request.kind()
     }
 
     /// Carries the run out on this thread; `recorder` (started by the
@@ -91,34 +86,33 @@ impl Run {
         observer: &mut dyn Observer,
         cancel: &CancelToken,
     ) -> Result<Outcome, PipelineError> {
-        if let (Kind::Fleet, Some(d)) = (self.kind, self.distributed) {
-            return distributed(mission, self.seed, d, observer, cancel);
+        if let Some(processes) = self.request.processes() {
+            return distributed(mission, self.seed, processes, observer, cancel);
         }
-        outcome::run_warm(
-            self.kind,
+        outcome::run_request(
+            &self.request,
             mission,
             self.seed,
             self.options,
-            self.warm.as_deref(),
             observer,
             cancel,
         )
     }
 }
 
-/// The fleet over agent processes (the coordinator in this process).
+/// A run whose vehicles fly as agent processes (the coordinator in this
+/// process; the fleet's, the one pipeline that does).
 #[cfg(feature = "zenoh")]
 fn distributed(
     mission: &Mission,
     seed: u64,
-    d: Distribution,
+    processes: Processes,
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<Outcome, PipelineError> {
-    let mut options = crate::distributed::Options::new(d.processes);
-    options.realtime = d.realtime;
-    crate::distributed::coordinate(mission, seed, &options, observer, cancel)
-        .map(|o| Outcome::Fleet(Box::new(o)))
+    let mut options = crate::distributed::Options::new(processes.count);
+    options.realtime = processes.realtime;
+    crate::distributed::coordinate(mission, seed, &options, observer, cancel).map(Outcome::from)
 }
 
 /// A build without Zenoh flies every fleet in process.
@@ -126,7 +120,7 @@ fn distributed(
 fn distributed(
     _: &Mission,
     _: u64,
-    _: Distribution,
+    _: Processes,
     _: &mut dyn Observer,
     _: &CancelToken,
 ) -> Result<Outcome, PipelineError> {

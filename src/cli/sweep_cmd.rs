@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use super::{exit, load_reporting};
 use crate::mission::{CostKind, Encoding, Mission};
 use crate::outcome::{self, Verdict};
-use crate::pipelines::theta_pso::PlanOptions;
+use crate::pipelines::PlanOptions;
 use crate::pipelines::{CancelToken, Kind, Silent};
 use crate::run::Run;
 
@@ -126,11 +126,8 @@ pub fn run_seed(mission: &Mission, kind: Kind, seed: u64) -> SeedRow {
         error: None,
     };
     let run = Run {
-        kind,
-        seed,
         options: PlanOptions { parallel: false },
-        distributed: None,
-        warm: None,
+        ..Run::new(kind, seed)
     };
     match run.carry_out(mission, None, &mut Silent, &cancel).result {
         Ok(o) => {

@@ -696,13 +696,15 @@ pub fn passing_plan(
     seed: u64,
     cancel: &CancelToken,
 ) -> Result<Planned, String> {
-    let request = crate::pipelines::Request {
+    let request = pipeline.request();
+    let ask = crate::pipelines::Ask {
         seed,
-        ..Default::default()
+        options: crate::pipelines::PlanOptions::default(),
+        request: &request,
     };
     let outcome = pipeline
         .face()
-        .run(mission, request, &mut crate::pipelines::Silent, cancel)
+        .run(mission, ask, &mut crate::pipelines::Silent, cancel)
         .map_err(|e| e.to_string())?;
     if !outcome.ok() {
         return Err(outcome.headline());

@@ -18,8 +18,9 @@ pub mod tracks;
 use serde::Serialize;
 
 use crate::mission::Mission;
-use crate::pipelines::theta_pso::{self, PlanOptions};
-use crate::pipelines::{CancelToken, Completion, Kind, Observer, PipelineError, Request};
+use crate::pipelines::{
+    Ask, CancelToken, Completion, Kind, Observer, PipelineError, PlanOptions, Request,
+};
 pub use crate::pipelines::{Outcome, Verdict};
 use tracks::Track;
 
@@ -48,7 +49,8 @@ pub fn budget(kind: Kind, mission: &Mission) -> Vec<crate::mission::Diagnostic> 
     kind.face().budget(mission)
 }
 
-/// Runs `kind` on `mission` with `seed`, cold. `options` only matters to θ-PSO.
+/// Runs `kind` on `mission` with `seed`, asking nothing more of it (θ-PSO
+/// cold, the fleet in this process).
 pub fn run(
     kind: Kind,
     mission: &Mission,
@@ -57,27 +59,25 @@ pub fn run(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<Outcome, PipelineError> {
-    run_warm(kind, mission, seed, options, None, observer, cancel)
+    run_request(&kind.request(), mission, seed, options, observer, cancel)
 }
 
-/// [`run`], θ-PSO started in part from `warm`'s plan (the designer's live
-/// re-plans); the other pipelines have no warm start and ignore it. The one
-/// place a run is handed to its pipeline.
-pub fn run_warm(
-    kind: Kind,
+/// [`run`], the pipeline asked `request` (its own request type: θ-PSO's
+/// warm start, say). The one place a run is handed to its pipeline.
+pub fn run_request(
+    request: &Request,
     mission: &Mission,
     seed: u64,
     options: PlanOptions,
-    warm: Option<&theta_pso::WarmStart>,
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<Outcome, PipelineError> {
-    let request = Request {
+    let ask = Ask {
         seed,
         options,
-        warm,
+        request,
     };
-    kind.face().run(mission, request, observer, cancel)
+    request.kind().face().run(mission, ask, observer, cancel)
 }
 
 /// What every front end reads of an outcome, each answer its pipeline's

@@ -14,7 +14,6 @@ use serde::Serialize;
 use super::chart::{Chart, ChartView};
 use super::sketch::{Plot, Sketch};
 use super::table::Row;
-use super::theta_pso::{PlanOptions, WarmStart};
 use super::{CancelToken, Completion, Kind, Limits, Observer, Outcome, PipelineError, TrackSample};
 use crate::mission::{Diagnostic, Mission};
 
@@ -106,14 +105,39 @@ pub struct ExportRules {
     pub loiter_radius: f64,
 }
 
-/// What a front end asks of one run beyond the mission: its seed, and what
-/// only θ-PSO reads (its plan options and the designer's warm start; the
-/// other pipelines ignore them).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Request<'a> {
+/// How a run may use the machine (not what to plan: that is the mission,
+/// nor what only its pipeline reads: that is its [`super::Request`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlanOptions {
+    /// Spread the run's work over the rayon pool (same result either way;
+    /// θ-PSO evaluates its swarm there). A sweep runs seeds side by side
+    /// instead.
+    pub parallel: bool,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        PlanOptions { parallel: true }
+    }
+}
+
+/// A pipeline's vehicles flown by agent processes on this machine, talking
+/// over Zenoh (`distributed`), instead of in the planning process.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Processes {
+    /// How many agent processes.
+    pub count: usize,
+    /// Each on its own wall clock (not reproducible) instead of lockstep.
+    pub realtime: bool,
+}
+
+/// One run as its pipeline is asked it: the seed, how it may use the
+/// machine, and the pipeline's own request (`super::Request`).
+#[derive(Debug, Clone, Copy)]
+pub struct Ask<'a> {
     pub seed: u64,
     pub options: PlanOptions,
-    pub warm: Option<&'a WarmStart>,
+    pub request: &'a super::Request,
 }
 
 /// A pipeline: its words, its limits and its run. One unit value per
@@ -192,11 +216,17 @@ pub trait Pipeline: Sync {
     /// The sizes that keep a run on `mission` from being planned live
     /// (each with its figure and the limit); none when it may be.
     fn over_live_limits(&self, mission: &Mission) -> Vec<String>;
-    /// Runs it on `mission`.
+    /// Its vehicles can fly as agent processes ([`Processes`], the fleet's):
+    /// its request may ask for them, and the run path hands such a run to
+    /// the transport (`distributed`) instead of [`Pipeline::run`].
+    fn flies_as_processes(&self) -> bool {
+        false
+    }
+    /// Runs it on `mission`, in this process.
     fn run(
         &self,
         mission: &Mission,
-        request: Request<'_>,
+        ask: Ask<'_>,
         observer: &mut dyn Observer,
         cancel: &CancelToken,
     ) -> Result<Outcome, PipelineError>;
@@ -280,9 +310,10 @@ pub trait PipelineOutcome {
     fn best_cost(&self) -> Option<f64> {
         None
     }
-    /// The plan as a warm start for the next run (θ-PSO's), `from` saying
-    /// where it came from; `None` for a pipeline without warm starts.
-    fn warm_start(&self, _from: &str) -> Option<WarmStart> {
+    /// The request that starts the next run of its pipeline from this plan
+    /// (θ-PSO's warm start), `from` saying where it came from; `None` for a
+    /// pipeline without warm starts.
+    fn warm_request(&self, _from: &str) -> Option<super::Request> {
         None
     }
     /// Its vehicles still flying at the end, of how many (the fleet's agents

@@ -20,7 +20,10 @@ pub mod theta_pso;
 
 use serde::{Deserialize, Serialize};
 
-pub use face::{Airframe, ExportRules, Header, Pipeline, PipelineOutcome, Request, Track, Verdict};
+pub use face::{
+    Airframe, Ask, ExportRules, Header, Pipeline, PipelineOutcome, PlanOptions, Processes, Track,
+    Verdict,
+};
 pub use interface::*;
 
 /// The planning pipelines: what `outcome::run` runs, what a track came
@@ -43,6 +46,18 @@ pub enum Outcome {
     Fleet(Box<fleet::FleetOutcome>),
 }
 
+/// What one run asks of its pipeline beyond the mission and the seed, in
+/// the pipeline's own request type (θ-PSO: a plan to start warm from; the
+/// fleet: agent processes to fly in). A front end builds the one it means
+/// (`theta_pso::Request { .. }.into()`) or a pipeline's plain one
+/// ([`Kind::request`]); the pipeline is the request's.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Request {
+    ThetaPso(theta_pso::Request),
+    Flatlo(flatlo::Request),
+    Fleet(fleet::Request),
+}
+
 impl Kind {
     /// Every pipeline, in the order menus and tables list them.
     pub const ALL: [Kind; 3] = [Kind::ThetaPso, Kind::Flatlo, Kind::Fleet];
@@ -54,6 +69,69 @@ impl Kind {
             Kind::Flatlo => &flatlo::face::Flatlo,
             Kind::Fleet => &fleet::face::Fleet,
         }
+    }
+}
+
+impl Kind {
+    /// Its plain request: nothing asked beyond the mission and the seed.
+    pub fn request(self) -> Request {
+        match self {
+            Kind::ThetaPso => theta_pso::Request::default().into(),
+            Kind::Flatlo => flatlo::Request.into(),
+            Kind::Fleet => fleet::Request::default().into(),
+        }
+    }
+}
+
+impl Request {
+    /// The pipeline asked.
+    pub fn kind(&self) -> Kind {
+        match self {
+            Request::ThetaPso(_) => Kind::ThetaPso,
+            Request::Flatlo(_) => Kind::Flatlo,
+            Request::Fleet(_) => Kind::Fleet,
+        }
+    }
+
+    /// The agent processes it asks its vehicles to fly in, if any (the
+    /// run path then goes through the transport).
+    pub fn processes(&self) -> Option<Processes> {
+        match self {
+            Request::Fleet(r) => r.processes,
+            Request::ThetaPso(_) | Request::Flatlo(_) => None,
+        }
+    }
+
+    /// Its vehicles asked to fly in `processes` (a pipeline whose face
+    /// [`Pipeline::flies_as_processes`]); `None` for one that cannot.
+    pub fn in_processes(self, processes: Processes) -> Option<Request> {
+        match self {
+            Request::Fleet(_) => Some(
+                fleet::Request {
+                    processes: Some(processes),
+                }
+                .into(),
+            ),
+            Request::ThetaPso(_) | Request::Flatlo(_) => None,
+        }
+    }
+}
+
+impl From<theta_pso::Request> for Request {
+    fn from(r: theta_pso::Request) -> Request {
+        Request::ThetaPso(r)
+    }
+}
+
+impl From<flatlo::Request> for Request {
+    fn from(r: flatlo::Request) -> Request {
+        Request::Flatlo(r)
+    }
+}
+
+impl From<fleet::Request> for Request {
+    fn from(r: fleet::Request) -> Request {
+        Request::Fleet(r)
     }
 }
 

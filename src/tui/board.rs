@@ -238,12 +238,18 @@ impl JobBoard {
         match action {
             Run(kind) => self.run(crate::run::Run::new(kind, seed), doc, cwd, status),
             RunDistributed(kind) => {
-                let mut run = crate::run::Run::new(kind, seed);
-                run.distributed = Some(crate::run::Distribution {
-                    processes: doc.mission().fleet.agents.clamp(1, DESIGNER_PROCESSES),
+                let processes = crate::pipelines::Processes {
+                    count: doc.mission().fleet.agents.clamp(1, DESIGNER_PROCESSES),
                     realtime: false,
-                });
-                self.run(run, doc, cwd, status);
+                };
+                match kind.request().in_processes(processes) {
+                    Some(request) => {
+                        self.run(crate::run::Run::asking(request, seed), doc, cwd, status);
+                    }
+                    None => {
+                        status.error(format!("{} does not fly as agent processes", kind.name()))
+                    }
+                }
             }
             RunNewSeed => {
                 let seed = self
@@ -255,7 +261,13 @@ impl JobBoard {
                 let last = self.jobs.last();
                 let mut run =
                     crate::run::Run::new(last.map_or_else(Kind::default, |j| j.pipeline), seed);
-                run.distributed = last.and_then(|j| j.distributed);
+                // Where the last one flew: in agent processes, again.
+                if let Some(request) = last
+                    .and_then(|j| j.distributed)
+                    .and_then(|p| run.request.clone().in_processes(p))
+                {
+                    run.request = request;
+                }
                 self.run(run, doc, cwd, status);
             }
             FlightCheck => self.flight_check(status),
@@ -343,7 +355,7 @@ impl JobBoard {
     }
 
     fn run(&mut self, run: crate::run::Run, doc: &Document, cwd: &Path, status: &mut StatusLine) {
-        let (pipeline, seed) = (run.kind, run.seed);
+        let (pipeline, seed) = (run.kind(), run.seed);
         let errors = doc.error_lines();
         if let Some(first) = errors.first() {
             status.error(format!(
@@ -354,7 +366,7 @@ impl JobBoard {
         }
         let id = self.jobs.last().map_or(1, |j| j.id + 1);
         let mut job = Job::new(id, pipeline, seed, doc.mission().clone(), Instant::now());
-        job.distributed = run.distributed;
+        job.distributed = run.request.processes();
         // A new name rather than over an earlier recording (of this session
         // or a file already there).
         let taken: Vec<&Path> = self.jobs.iter().filter_map(|j| j.rrd.as_deref()).collect();
@@ -365,8 +377,8 @@ impl JobBoard {
             rrd: job.rrd.clone(),
             viewer: self.viewer,
         };
-        let how = run.distributed.map_or_else(String::new, |d| {
-            format!(" in {} agent process(es) over Zenoh", d.processes)
+        let how = run.request.processes().map_or_else(String::new, |d| {
+            format!(" in {} agent process(es) over Zenoh", d.count)
         });
         jobs::spawn_pipeline(
             id,

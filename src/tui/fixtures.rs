@@ -10,7 +10,7 @@ use super::app::App;
 use super::document::Document;
 use super::jobs::{Job, JobError, JobMsg, Kind};
 use crate::mission::{self, Mission, Obstacle};
-use crate::pipelines::{CancelToken, Request, Silent};
+use crate::pipelines::{CancelToken, PlanOptions, Silent};
 
 /// A 400 m × 400 m field with `n` small posts on a jittered grid, clear of
 /// the start and goal corners: a stress case for drawing.
@@ -84,13 +84,15 @@ pub fn bridge_with_oaks() -> Mission {
 /// An app on `mission`, opened from `file`, whose map shows a finished
 /// `kind` run with `seed`, planned synchronously through its face.
 pub fn app_with_run(kind: Kind, mission: Mission, seed: u64, file: &str) -> App {
-    let request = Request {
+    let options = PlanOptions::default();
+    let outcome = crate::outcome::run(
+        kind,
+        &mission,
         seed,
-        ..Default::default()
-    };
-    let outcome = kind
-        .face()
-        .run(&mission, request, &mut Silent, &CancelToken::new());
+        options,
+        &mut Silent,
+        &CancelToken::new(),
+    );
     let mut app = App::new(
         Document::new(mission.clone(), Some(PathBuf::from(file))),
         PathBuf::from("."),

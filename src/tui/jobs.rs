@@ -17,8 +17,9 @@ use nalgebra::Point3;
 use crate::mission::Mission;
 pub use crate::outcome::Outcome;
 pub use crate::pipelines::Kind;
+use crate::pipelines::Processes;
 use crate::pipelines::{CancelToken, Completion, Event, Level, Observer};
-use crate::run::{Distribution, Recorder, Run};
+use crate::run::{Recorder, Run};
 
 pub type JobId = usize;
 
@@ -169,7 +170,7 @@ pub struct Job {
     /// The recording written, and its size in bytes.
     pub recorded: Option<(PathBuf, u64)>,
     /// A fleet flown by agent processes (`None`: in this process).
-    pub distributed: Option<Distribution>,
+    pub distributed: Option<Processes>,
     /// Its agents still flying, of how many (once the processes are ready).
     pub agents: Option<(usize, usize)>,
     /// Its plan's flight check (`G`), when one was asked for.
@@ -317,7 +318,7 @@ impl Observer for Forward {
 }
 
 /// Starts a run on `mission` on a worker thread (a fleet's agents flown
-/// where `run.distributed` says).
+/// where its request's `processes` say).
 pub fn spawn_pipeline(
     id: JobId,
     run: Run,
@@ -365,7 +366,7 @@ fn carry_out(
         tx: tx.clone(),
         last_cost: None,
     };
-    let recorder = start_recording(id, run.kind, mission, record, tx);
+    let recorder = start_recording(id, run.kind(), mission, record, tx);
     let ran = run.carry_out(mission, recorder, &mut forward, cancel);
     let outcome = ran.result?;
     #[cfg(feature = "rerun")]

@@ -13,7 +13,6 @@
 //! Nothing runs and nothing wakes the loop while nothing changes: the loop
 //! sleeps until [`Live::due`].
 
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use crossbeam_channel::Sender;
@@ -21,7 +20,6 @@ use crossbeam_channel::Sender;
 use super::document::Document;
 use super::jobs::{self, Job, JobId, JobMsg, JobState, Kind, RecordSettings};
 use crate::mission::Mission;
-use crate::pipelines::theta_pso::WarmStart;
 use crate::run::Run;
 
 /// Live runs' ids start here, far above the listed runs'.
@@ -221,12 +219,15 @@ impl Live {
         self.next_id += 1;
         let mut run = Run::new(self.pipeline, mission.seed);
         // A pipeline with warm starts (θ-PSO) starts from the last plan.
-        run.warm = self
+        if let Some(request) = self
             .latest
             .as_ref()
             .or(warm_from)
-            .and_then(warm_start)
-            .map(Arc::new);
+            .and_then(warm_request)
+            .filter(|r| r.kind() == self.pipeline)
+        {
+            run.request = request;
+        }
         let job = Job::new(id, self.pipeline, mission.seed, mission.clone(), now);
         jobs::spawn_pipeline(id, run, mission, job.cancel.clone(), record, tx.clone());
         self.running.push(job);
@@ -264,9 +265,10 @@ impl Live {
     }
 }
 
-/// A job's plan as a warm start, where its pipeline has them (θ-PSO's).
-fn warm_start(job: &Job) -> Option<WarmStart> {
-    job.outcome.as_ref()?.face().warm_start(&label(job.id))
+/// The request that starts a run warm from a job's plan, where its
+/// pipeline has warm starts (θ-PSO's).
+fn warm_request(job: &Job) -> Option<crate::pipelines::Request> {
+    job.outcome.as_ref()?.face().warm_request(&label(job.id))
 }
 
 /// A run as people read its id: `job 3`, or `live 12` for a live run.

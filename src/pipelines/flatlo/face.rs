@@ -8,7 +8,7 @@ use crate::pipelines::chart::{Chart, ChartView};
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
-    CancelToken, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome, Request, Track,
+    Ask, CancelToken, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome, Track,
     TrackSample, Verdict,
 };
 
@@ -91,11 +91,11 @@ impl Pipeline for Flatlo {
     fn run(
         &self,
         mission: &Mission,
-        request: Request<'_>,
+        ask: Ask<'_>,
         observer: &mut dyn Observer,
         cancel: &CancelToken,
     ) -> Result<Outcome, PipelineError> {
-        super::plan(mission, request.seed, observer, cancel).map(Outcome::from)
+        super::plan(mission, ask.seed, observer, cancel).map(Outcome::from)
     }
 }
 

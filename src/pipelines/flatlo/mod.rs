@@ -524,6 +524,11 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
     out
 }
 
+/// What a FLATLO run asks beyond the mission and the seed: nothing (its
+/// section says it all).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Request;
+
 /// Plans and simulates the mission's squadron with `seed` (the noise). Fails
 /// only on an invalid mission; a squadron that comes too close is a failed
 /// verification, not an error.

@@ -8,7 +8,7 @@ use crate::pipelines::chart::{Chart, ChartView};
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
-    CancelToken, Completion, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome, Request,
+    Ask, CancelToken, Completion, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome,
     Track, Verdict,
 };
 
@@ -72,14 +72,23 @@ impl Pipeline for Fleet {
         vec!["the fleet simulates for seconds: never live".to_owned()]
     }
 
+    fn flies_as_processes(&self) -> bool {
+        true
+    }
+
     fn run(
         &self,
         mission: &Mission,
-        request: Request<'_>,
+        ask: Ask<'_>,
         observer: &mut dyn Observer,
         cancel: &CancelToken,
     ) -> Result<Outcome, PipelineError> {
-        super::plan(mission, request.seed, observer, cancel).map(Outcome::from)
+        if ask.request.processes().is_some() {
+            return Err(PipelineError::Unsupported(
+                "agent processes are flown by the run path (`run::Run`), not in process".into(),
+            ));
+        }
+        super::plan(mission, ask.seed, observer, cancel).map(Outcome::from)
     }
 }
 

@@ -179,6 +179,14 @@ pub struct FleetOutcome {
     pub distributed: Option<Distributed>,
 }
 
+/// What a fleet run asks beyond the mission and the seed: agent processes
+/// to fly in (`skyform run fleet --distributed`, the designer's `Z`);
+/// `None`, in this process.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Request {
+    pub processes: Option<crate::pipelines::Processes>,
+}
+
 /// A fleet flown by agents in processes of their own (`skyform run fleet
 /// --distributed`): how, and what the transport cost.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -6,8 +6,7 @@ use crate::pipelines::chart::{Chart, ChartView};
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
-    CancelToken, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome, Request, Track,
-    Verdict,
+    Ask, CancelToken, Observer, Outcome, Pipeline, PipelineError, PipelineOutcome, Track, Verdict,
 };
 
 /// θ-PSO (`Kind::ThetaPso`).
@@ -121,19 +120,15 @@ impl Pipeline for ThetaPso {
     fn run(
         &self,
         mission: &Mission,
-        request: Request<'_>,
+        ask: Ask<'_>,
         observer: &mut dyn Observer,
         cancel: &CancelToken,
     ) -> Result<Outcome, PipelineError> {
-        super::plan_warm(
-            mission,
-            request.seed,
-            request.options,
-            request.warm,
-            observer,
-            cancel,
-        )
-        .map(Outcome::from)
+        let warm = match ask.request {
+            crate::pipelines::Request::ThetaPso(own) => own.warm.as_deref(),
+            _ => None,
+        };
+        super::plan_warm(mission, ask.seed, ask.options, warm, observer, cancel).map(Outcome::from)
     }
 }
 
@@ -247,13 +242,15 @@ impl PipelineOutcome for ThetaPsoOutcome {
         Some(self.cost.total)
     }
 
-    fn warm_start(&self, from: &str) -> Option<crate::pipelines::theta_pso::WarmStart> {
-        (!self.waypoints.is_empty()).then(|| crate::pipelines::theta_pso::WarmStart {
+    fn warm_request(&self, from: &str) -> Option<crate::pipelines::Request> {
+        let warm = super::WarmStart {
             from: format!("the plan of run {from} (J {:.2})", self.cost.total),
             waypoints: self.waypoints.clone(),
             pass_angles: self.pass_angles.clone(),
             corridor: Some(self.corridor.clone()),
-        })
+        };
+        let warm = Some(std::sync::Arc::new(warm));
+        (!self.waypoints.is_empty()).then(|| super::Request { warm }.into())
     }
 
     fn warm_from(&self) -> Option<String> {

@@ -42,17 +42,14 @@ pub use plan::{PlanSource, passed_by_altitude, plan, plan_warm};
 pub use trajectory::{Reconfiguration, Sample, Trajectory};
 pub use verify::{Check, InspectionResult, Verification};
 
-/// How to run (not what to plan: that is the mission).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PlanOptions {
-    /// Evaluate the swarm's costs on the rayon pool (same result either way).
-    pub parallel: bool,
-}
+pub use crate::pipelines::PlanOptions;
 
-impl Default for PlanOptions {
-    fn default() -> Self {
-        PlanOptions { parallel: true }
-    }
+/// What a θ-PSO run asks beyond the mission and the seed: a plan to start
+/// part of its swarm from (the designer's live re-plans, `--warm-from`);
+/// `None`, a cold run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Request {
+    pub warm: Option<std::sync::Arc<WarmStart>>,
 }
 
 /// Where a warm-started run's swarm starts besides the corridor: a plan of

@@ -263,7 +263,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         );
         facts.push(Line::raw(format!(
             "{} agent process(es) over Zenoh: {alive}",
-            d.processes
+            d.count
         )));
     }
     // The verdict and the table first, from the top: the chart takes what
