@@ -368,7 +368,6 @@ const KNOWS_PIPELINES_BY_NAME: &[(&str, &str)] = &[
         "src/distributed/coordinator.rs",
         "the fleet's transport (fleet code that does process and network I/O, so on a floor of its own above the pipelines) builds the fleet's outcome; it matches over no kind",
     ),
-    ("src/tui/keys.rs", "the key table: each pipeline's run key"),
 ];
 
 /// Lines of `file` outside comments and its `#[cfg(test)]` module that name
@@ -441,4 +440,55 @@ fn outside_the_pipelines_only_the_listed_places_name_a_pipeline() {
         gone.is_empty(),
         "these files no longer name a pipeline: take them off the list: {gone:?}"
     );
+}
+
+/// The files "Adding a pipeline" lists: the numbered items' first path.
+fn files_a_pipeline_touches() -> Vec<String> {
+    let doc = std::fs::read_to_string("docs/architecture.md")
+        .unwrap_or_else(|e| panic!("docs/architecture.md: {e}"));
+    let section = doc
+        .split("## Adding a pipeline")
+        .nth(1)
+        .and_then(|rest| rest.split("\n## ").next())
+        .unwrap_or_else(|| panic!("no \"Adding a pipeline\" section"));
+    section
+        .lines()
+        .filter_map(|line| {
+            let (number, rest) = line.split_once(". `")?;
+            number.parse::<usize>().ok()?;
+            Some(rest.split_once('`')?.0.to_owned())
+        })
+        .collect()
+}
+
+/// Issue 38: "Adding a pipeline" lists the files a new pipeline touches
+/// outside its folder, at most four; each exists, and each source file
+/// among them is where every pipeline is registered (it names each
+/// pipeline's module or section), so the list names no file a pipeline
+/// does not need.
+#[test]
+fn adding_a_pipeline_lists_the_files_every_pipeline_registers_in() {
+    let files = files_a_pipeline_touches();
+    assert!(
+        (1..=4).contains(&files.len()),
+        "\"Adding a pipeline\" lists {} files: {files:?}",
+        files.len()
+    );
+    assert!(files.contains(&"src/pipelines/mod.rs".to_owned()), "{files:?}");
+    assert!(files.contains(&"docs/architecture.md".to_owned()), "{files:?}");
+    let pipelines = children(Path::new("src/pipelines"))
+        .into_iter()
+        .filter(|c| Path::new("src/pipelines").join(c).is_dir())
+        .collect::<Vec<_>>();
+    assert!(pipelines.len() >= 3, "{pipelines:?}");
+    for file in files.iter().filter(|f| f.ends_with(".rs")) {
+        let text =
+            std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{file} (listed): {e}"));
+        for p in &pipelines {
+            assert!(
+                text.contains(&format!("{p}:")) || text.contains(&format!("mod {p};")),
+                "{file} is listed as a place every pipeline registers in, but does not register `{p}`"
+            );
+        }
+    }
 }

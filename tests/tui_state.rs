@@ -581,7 +581,7 @@ mod mouse {
 fn the_readme_lists_every_key_the_help_overlay_shows() {
     let readme =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
-    for key in skyform::tui::keys::KEYS {
+    for key in skyform::tui::keys::KEYS.iter() {
         let row = format!("| `{}` | {} |", key.keys, key.help);
         assert!(readme.contains(&row), "README.md lacks the key row {row}");
     }
@@ -1263,8 +1263,8 @@ fn every_binding_dispatches_and_every_key_that_acts_is_in_the_table() {
         );
     };
     let mut bindings = 0;
-    for row in KEYS {
-        for b in row.bindings {
+    for row in KEYS.iter() {
+        for b in &row.bindings {
             let Some(&state) = states
                 .iter()
                 .find(|at| b.when.holds(**at) && lookup(b.key, **at) == Some(b))
@@ -1313,7 +1313,7 @@ fn every_binding_dispatches_and_every_key_that_acts_is_in_the_table() {
     }
     let in_table = |action: &Action| {
         KEYS.iter()
-            .flat_map(|row| row.bindings)
+            .flat_map(|row| &row.bindings)
             .any(|b| &b.action == action)
     };
     for &state in &states {

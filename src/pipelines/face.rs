@@ -164,6 +164,14 @@ pub trait Pipeline: Sync {
     fn passed_phrase(&self) -> &'static str;
     /// The designer may re-plan it after every edit.
     fn live(&self) -> bool;
+    /// Its run key in the designer and what the key table (the help, the
+    /// README) says it does.
+    fn run_key(&self) -> (char, &'static str);
+    /// The designer's key that runs it as agent processes, and its words,
+    /// for one that [`Pipeline::flies_as_processes`].
+    fn processes_key(&self) -> Option<(char, &'static str)> {
+        None
+    }
     /// The mission field that limits its vehicles' speed, when that is not
     /// the `[vehicle]` section's.
     fn speed_field(&self) -> Option<&'static str> {

@@ -50,6 +50,13 @@ impl Pipeline for Flatlo {
     }
 
     /// The paper's case takes about 30 ms.
+    fn run_key(&self) -> (char, &'static str) {
+        (
+            'F',
+            "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
+        )
+    }
+
     fn live(&self) -> bool {
         true
     }

@@ -46,6 +46,20 @@ impl Pipeline for Fleet {
     }
 
     /// Its run is a flight of seconds, re-run by hand.
+    fn run_key(&self) -> (char, &'static str) {
+        (
+            'T',
+            "run the distributed fleet (select Fleet and its targets with n/p to edit them; d adds a target)",
+        )
+    }
+
+    fn processes_key(&self) -> Option<(char, &'static str)> {
+        Some((
+            'Z',
+            "run the fleet as agent processes over Zenoh (same as T)",
+        ))
+    }
+
     fn live(&self) -> bool {
         false
     }

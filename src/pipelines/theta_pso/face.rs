@@ -44,6 +44,10 @@ impl Pipeline for ThetaPso {
     }
 
     /// A live run is short and deterministic.
+    fn run_key(&self) -> (char, &'static str) {
+        ('r', "run θ-PSO with the mission's seed")
+    }
+
     fn live(&self) -> bool {
         true
     }

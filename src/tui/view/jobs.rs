@@ -151,7 +151,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
         }) {
             let help = row.help.split(" (").next().unwrap_or(row.help);
             text.push(Line::from(vec![
-                Span::styled(row.keys.to_owned(), Style::default().yellow().bold()),
+                Span::styled(row.keys.to_string(), Style::default().yellow().bold()),
                 Span::raw(format!(" {help}")),
             ]));
         }

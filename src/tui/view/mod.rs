@@ -480,7 +480,7 @@ fn draw_help(frame: &mut Frame, app: &App, area: Rect) {
                 Style::default().bold().underlined(),
             ));
             for row in KEYS.iter().filter(|row| row.group == *name) {
-                lines.extend(key_lines(row.keys, row.help, width));
+                lines.extend(key_lines(&row.keys, row.help, width));
             }
         }
         lines
