@@ -363,12 +363,10 @@ fn the_floors_stand_in_order() {
 /// (a `Kind` or `Outcome` variant, an outcome type, `.theta_pso()` /
 /// `.flatlo()` / `.fleet()`), each with why. Issue 38: a pipeline is read
 /// through its face; this list only shrinks.
-const KNOWS_PIPELINES_BY_NAME: &[(&str, &str)] = &[
-    (
-        "src/distributed/coordinator.rs",
-        "the fleet's transport (fleet code that does process and network I/O, so on a floor of its own above the pipelines) builds the fleet's outcome; it matches over no kind",
-    ),
-];
+const KNOWS_PIPELINES_BY_NAME: &[(&str, &str)] = &[(
+    "src/distributed/coordinator.rs",
+    "the fleet's transport (fleet code that does process and network I/O, so on a floor of its own above the pipelines) builds the fleet's outcome; it matches over no kind",
+)];
 
 /// Lines of `file` outside comments and its `#[cfg(test)]` module that name
 /// a pipeline.
@@ -474,16 +472,21 @@ fn adding_a_pipeline_lists_the_files_every_pipeline_registers_in() {
         "\"Adding a pipeline\" lists {} files: {files:?}",
         files.len()
     );
-    assert!(files.contains(&"src/pipelines/mod.rs".to_owned()), "{files:?}");
-    assert!(files.contains(&"docs/architecture.md".to_owned()), "{files:?}");
+    assert!(
+        files.contains(&"src/pipelines/mod.rs".to_owned()),
+        "{files:?}"
+    );
+    assert!(
+        files.contains(&"docs/architecture.md".to_owned()),
+        "{files:?}"
+    );
     let pipelines = children(Path::new("src/pipelines"))
         .into_iter()
         .filter(|c| Path::new("src/pipelines").join(c).is_dir())
         .collect::<Vec<_>>();
     assert!(pipelines.len() >= 3, "{pipelines:?}");
     for file in files.iter().filter(|f| f.ends_with(".rs")) {
-        let text =
-            std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{file} (listed): {e}"));
+        let text = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{file} (listed): {e}"));
         for p in &pipelines {
             assert!(
                 text.contains(&format!("{p}:")) || text.contains(&format!("mod {p};")),

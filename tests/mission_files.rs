@@ -150,6 +150,22 @@ fn a_missing_file_is_a_clear_error() {
     );
 }
 
+/// A mission whose every section is at its defaults: the fields a TOML file
+/// may leave out, left out.
+fn with_default_sections() -> Mission {
+    let text = r#"
+        name = "defaults"
+        [bounds]
+        x = [0.0, 10.0]
+        y = [0.0, 10.0]
+        z = [0.0, 10.0]
+        [route]
+        start = [1.0, 1.0, 1.0]
+        goal = [9.0, 9.0, 1.0]
+    "#;
+    toml::from_str(text).unwrap_or_else(|e| panic!("the defaults mission: {e}"))
+}
+
 /// Random missions that pass validation: a box, a route inside it, obstacles
 /// away from the route, the default triangle.
 fn valid_mission() -> impl Strategy<Value = Mission> {
@@ -211,14 +227,10 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                 bounds,
                 route,
                 formation: Formation::default(),
-                vehicle: Default::default(),
-                reconfiguration: Default::default(),
-                theta_pso: Default::default(),
-                flatlo: Default::default(),
-                fleet: Default::default(),
-                flight: Default::default(),
                 obstacles,
                 terrain: None,
+                // Every section at its defaults (a new section too).
+                ..with_default_sections()
             };
             m.reconfiguration.default_shape = shape;
             m.formation.slots[0] = Vector3::new(0.0, 2.0, 0.0);
