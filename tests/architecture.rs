@@ -495,3 +495,110 @@ fn adding_a_pipeline_lists_the_files_every_pipeline_registers_in() {
         }
     }
 }
+
+/// Every `.rs` file under `dir`.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+/// The `N` of the first "Long (~N lines)" in `text`.
+fn stated_length(text: &str) -> Option<usize> {
+    let (_, rest) = text.split_once("Long (~")?;
+    rest.split_once(" lines)")?.0.parse().ok()
+}
+
+/// Whether a stated length is current: within 10 % (files) or 15 %
+/// (functions) of the real one, or a few lines.
+fn current(stated: usize, real: usize, share: f64, slack: usize) -> bool {
+    stated.abs_diff(real) as f64 <= (share * real as f64).max(slack as f64)
+}
+
+/// Issue 38: a file over 700 lines or a function over 120 says why in one
+/// line that starts "Long (~N lines) because", and N is current (the
+/// module's `//!` doc for a file, the function's `///` doc).
+#[test]
+fn long_files_and_functions_say_why_and_how_long() {
+    let mut wrong = Vec::new();
+    for file in rust_files(Path::new("src")) {
+        let text =
+            std::fs::read_to_string(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        let lines: Vec<&str> = text.lines().collect();
+        if lines.len() > 700 {
+            let module_doc: String = lines
+                .iter()
+                .take_while(|l| l.starts_with("//!") || l.trim().is_empty())
+                .copied()
+                .collect::<Vec<_>>()
+                .join(" ");
+            match stated_length(&module_doc) {
+                None => wrong.push(format!(
+                    "{}: {} lines, no reason",
+                    file.display(),
+                    lines.len()
+                )),
+                Some(n) if !current(n, lines.len(), 0.10, 25) => wrong.push(format!(
+                    "{}: {} lines, says ~{n}",
+                    file.display(),
+                    lines.len()
+                )),
+                Some(_) => {}
+            }
+        }
+        for (start, line) in lines.iter().enumerate() {
+            let code = line.trim_start();
+            let indent = &line[..line.len() - code.len()];
+            let signature = code
+                .trim_start_matches("pub(crate) ")
+                .trim_start_matches("pub(super) ")
+                .trim_start_matches("pub ")
+                .trim_start_matches("const ")
+                .trim_start_matches("unsafe ");
+            if !signature.starts_with("fn ") || line.trim_end().ends_with(';') {
+                continue;
+            }
+            let close = format!("{indent}}}");
+            let Some(end) = lines[start..].iter().position(|l| *l == close) else {
+                continue;
+            };
+            let length = end + 1;
+            if length <= 120 {
+                continue;
+            }
+            let doc: Vec<&str> = lines[..start]
+                .iter()
+                .rev()
+                .take_while(|l| {
+                    l.trim_start().starts_with("///") || l.trim_start().starts_with("#[")
+                })
+                .copied()
+                .collect();
+            let name = signature[3..].split(['(', '<']).next().unwrap_or("?");
+            let at = format!("{}:{} fn {name}", file.display(), start + 1);
+            match stated_length(&doc.join(" ")) {
+                None => wrong.push(format!("{at}: {length} lines, no reason")),
+                Some(n) if !current(n, length, 0.15, 15) => {
+                    wrong.push(format!("{at}: {length} lines, says ~{n}"))
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "say why in one line, \"Long (~N lines) because …\", or split where a concept ends:\n  {}",
+        wrong.join("\n  ")
+    );
+}

@@ -170,6 +170,10 @@ fn record(
 }
 
 /// `--target`: the margin search, then the report of the plan it found.
+///
+/// Long (~135 lines) because it is the search's whole output in reading order: the
+/// progress, then one verdict per outcome (met, met with wider slots, not met, no plan), the
+/// fields to set, the tries, the report and the JSON.
 fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &CancelToken) -> u8 {
     if !(target.is_finite() && (0.0..1.0).contains(&target)) {
         eprintln!("error: --target {target}: a share of flights in [0, 1)");

@@ -109,6 +109,9 @@ pub static KEYS: LazyLock<Vec<KeyRow>> = LazyLock::new(table);
 /// The table: the designer's own keys, and each pipeline's run keys where
 /// the Run group lists them (from its face: `Pipeline::run_key`,
 /// `Pipeline::processes_key`).
+///
+/// Long (~380 lines) because it is the key table itself, as data: one row of
+/// four short fields per key, in the order the help shows them.
 fn table() -> Vec<KeyRow> {
     let mut rows = vec![
         KeyRow {

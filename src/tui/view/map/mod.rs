@@ -6,10 +6,8 @@
 //! The side view (`side`) and the formation editor's drawing (`formation`)
 //! share this module's viewport and painters.
 //!
-//! Long (~950 lines) because it holds the viewport and every painter of the
-//! top-down map, each pipeline's result among them (θ-PSO's plan and
-//! reconfigurations, FLATLO's squadron, the fleet's replay), which the side
-//! view and the formation editor reuse.
+//! Each pipeline's result is charted by the pipeline (`pipelines::chart`)
+//! and drawn here (`chart`); the map's text is placed by `labels`.
 
 use nalgebra::{Point2, Point3};
 use ratatui::Frame;
@@ -32,10 +30,12 @@ use crate::tui::live::Live;
 
 mod chart;
 mod formation;
+mod labels;
 mod side;
 
 use chart::OnCanvas;
 pub use formation::{draw_formation, formation_split};
+use labels::paint_labels;
 use side::draw_side;
 
 use super::title::{Part, fit};
@@ -358,7 +358,7 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport, folded:
     }
 }
 
-/// Long (~200 lines): the map's layers in drawing order (terrain, bounds,
+/// Long (~140 lines): the map's layers in drawing order (terrain, bounds,
 /// obstacles, IWPs, plans, vehicles), each a short block.
 fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     let b = &m.bounds;
@@ -496,202 +496,6 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     if shown.is_none_or(|(o, _)| !o.face().dwarfs_the_site()) {
         draw_formation_at_start(ctx, app, m, dot);
     }
-}
-
-/// Cells taken by the map's text, so a label is drawn only where it does
-/// not cover another (at 80×24 the bridge's piers are a few cells apart).
-struct Labels<'a> {
-    vp: &'a Viewport,
-    taken: Vec<Rect>,
-}
-
-impl Labels<'_> {
-    /// The cell the canvas prints a label at `(x, y)` in (its own rounding,
-    /// which is not [`Viewport::to_cell`]'s), or None outside the view.
-    fn cell(&self, x: f64, y: f64) -> Option<(u16, u16)> {
-        let (r, vp) = (self.vp.inner, self.vp);
-        let inside = (vp.x[0]..=vp.x[1]).contains(&x) && (vp.y[0]..=vp.y[1]).contains(&y);
-        if !inside || r.width == 0 || r.height == 0 {
-            return None;
-        }
-        let fx = (x - vp.x[0]) * f64::from(r.width - 1) / (vp.x[1] - vp.x[0]);
-        let fy = (vp.y[1] - y) * f64::from(r.height - 1) / (vp.y[1] - vp.y[0]);
-        Some((r.x + fx as u16, r.y + fy as u16))
-    }
-
-    /// The cells text of `width` printed at `(x, y)` covers, when all of it
-    /// is in view.
-    fn rect(&self, x: f64, y: f64, width: usize) -> Option<Rect> {
-        let (column, row) = self.cell(x, y)?;
-        let width = u16::try_from(width).ok()?;
-        let r = Rect::new(column, row, width, 1);
-        (r.right() <= self.vp.inner.right()).then_some(r)
-    }
-
-    fn free(&self, r: Rect) -> bool {
-        // One blank column between two labels, so they do not read as one.
-        let padded = Rect::new(r.x.saturating_sub(1), r.y, r.width + 2, 1);
-        !self.taken.iter().any(|t| t.intersects(padded))
-    }
-
-    /// Marks text printed regardless (markers) as taken.
-    fn reserve(&mut self, x: f64, y: f64, width: usize) {
-        if let Some((column, row)) = self.cell(x, y) {
-            let width = u16::try_from(width).unwrap_or(u16::MAX);
-            self.taken.push(Rect::new(column, row, width, 1));
-        }
-    }
-
-    /// Prints `label` at the first of `spots` where it is in view and free;
-    /// `force` prints it even when none is (the selection's): at the first
-    /// spot where it is whole in view, else the first.
-    fn place(
-        &mut self,
-        ctx: &mut Context,
-        spots: &[(f64, f64)],
-        label: Span<'static>,
-        force: bool,
-    ) {
-        let width = label.width();
-        let spot = spots
-            .iter()
-            .find(|(x, y)| self.rect(*x, *y, width).is_some_and(|r| self.free(r)))
-            .or_else(|| {
-                // Forced: where it is whole in view if it can be, not cut at
-                // the map's edge.
-                let whole = spots
-                    .iter()
-                    .find(|(x, y)| self.rect(*x, *y, width).is_some());
-                whole.or(spots.first()).filter(|_| force)
-            });
-        if let Some(&(x, y)) = spot {
-            if let Some(r) = self.rect(x, y, width) {
-                self.taken.push(r);
-            }
-            ctx.print(x, y, label);
-        }
-    }
-}
-
-/// The map's text: IWP marks, obstacle names where they fit, start and goal.
-fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
-    // A result drawn at kilometre scale (FLATLO's): the θ-PSO route, IWPs
-    // and obstacle names would be letters piled on a few cells (the
-    // selected obstacle's name is still drawn).
-    let kilometres = shown_chart(app).is_some_and(|(o, _)| o.face().dwarfs_the_site());
-    let scale = vp.metres_per_column();
-    let mut labels = Labels {
-        vp,
-        taken: Vec::new(),
-    };
-    let (s, g) = (&m.route.start, &m.route.goal);
-    if !kilometres {
-        labels.reserve(s.x, s.y, 1);
-        labels.reserve(g.x, g.y, 1);
-        for t in &m.fleet.targets {
-            labels.reserve(t.position.x, t.position.y, 2);
-        }
-        // IWPs (eq. 9): enabled ones bright, disabled ones dim, the
-        // selected one highlighted and named.
-        for w in app.iwps() {
-            let selected = *app.selected() == Item::Waypoint(w.between.clone());
-            let (glyph, style) = match (selected, w.enabled) {
-                (true, true) => ("◆", Style::default().black().on_yellow()),
-                (true, false) => ("◇", Style::default().black().on_yellow()),
-                (false, true) => ("◆", Style::default().fg(Color::LightCyan)),
-                (false, false) => ("◇", Style::default().fg(Color::DarkGray)),
-            };
-            labels.reserve(w.position.x, w.position.y, 1);
-            ctx.print(w.position.x, w.position.y, Span::styled(glyph, style));
-        }
-        if let Some(w) = app
-            .iwps()
-            .iter()
-            .find(|w| *app.selected() == Item::Waypoint(w.between.clone()))
-        {
-            let label = format!("{} ↔ {}", w.between[0], w.between[1]);
-            let width = Span::raw(label.as_str()).width() as f64;
-            let spots = [
-                (w.position.x + 2.0 * scale, w.position.y),
-                (w.position.x - scale * (width + 1.0), w.position.y),
-            ];
-            let style = Style::default().black().on_yellow().bold();
-            labels.place(ctx, &spots, Span::styled(label, style), true);
-        }
-    }
-    // Obstacle names, right of the obstacle or else left of it, where they
-    // cover no other text: the selected one's always, first; then a find's
-    // matches; then, on a site of at most 40 obstacles, the others.
-    let selected = match *app.selected() {
-        Item::Obstacle(i) => Some(i),
-        _ => None,
-    };
-    let found: Vec<usize> = app
-        .finder()
-        .matches()
-        .iter()
-        .filter_map(|item| match item {
-            Item::Obstacle(i) if Some(*i) != selected => Some(*i),
-            _ => None,
-        })
-        .collect();
-    let rest = (!kilometres && m.obstacles.len() <= 40)
-        .then(|| (0..m.obstacles.len()).filter(|i| Some(*i) != selected && !found.contains(i)))
-        .into_iter()
-        .flatten();
-    let order = selected
-        .into_iter()
-        .chain(found.iter().copied())
-        .chain(rest);
-    for i in order {
-        let Some(o) = m.obstacles.get(i) else {
-            continue;
-        };
-        let style = if selected == Some(i) {
-            Style::default().black().on_yellow().bold()
-        } else if found.contains(&i) {
-            Style::default().yellow()
-        } else if o.inspect {
-            Style::default().fg(Color::LightMagenta)
-        } else {
-            Style::default().fg(Color::Gray)
-        };
-        let label = if o.inspect {
-            format!("{} ◉", o.name)
-        } else {
-            o.name.clone()
-        };
-        let width = Span::raw(label.as_str()).width() as f64;
-        // Beside the outline at its centre's height: a footprint's own
-        // extent across, not its bounding circle's (a long beam's is wide).
-        let (west, east) = if o.footprint.is_empty() {
-            (o.center.x - o.radius, o.center.x + o.radius)
-        } else {
-            o.footprint
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                    (lo.min(p.x), hi.max(p.x))
-                })
-        };
-        let spots = [
-            (east + scale, o.center.y),
-            (west - scale * (width + 1.0), o.center.y),
-        ];
-        labels.place(ctx, &spots, Span::styled(label, style), selected == Some(i));
-    }
-    if kilometres {
-        return;
-    }
-    let marker = |item: Item, glyph: &'static str, color: Color| {
-        let style = if *app.selected() == item {
-            Style::default().black().bg(color).bold()
-        } else {
-            Style::default().fg(color).bold()
-        };
-        Span::styled(glyph, style)
-    };
-    ctx.print(s.x, s.y, marker(Item::Start, "S", Color::Green));
-    ctx.print(g.x, g.y, marker(Item::Goal, "G", Color::Red));
 }
 
 /// The shown job's flight check (`G`): each UAV's p99 envelope as rings

@@ -1,0 +1,374 @@
+//! The margin a plan needs (`skyform fly --target P`): the smallest
+//! obstacle margin, and where the pairs need it the smallest spacing, whose
+//! plan breaks a limit in at most P of its flights; each try planned and
+//! flown again through [`super::check`]. The steps and the limits it stops
+//! at: docs/flight-check.md, "Margins".
+
+use serde::Serialize;
+
+use super::{FlightError, Options, Report, Setup, check};
+use crate::export::Planned;
+use crate::mission::Mission;
+use crate::pipelines::{CancelToken, Kind};
+
+/// One margin tried by [`find_margin`]: the extra clearance, the spacing
+/// scale, and the share of flights that broke a limit (`None`: no plan
+/// with them).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Tried {
+    pub margin: f64,
+    /// The vehicles' spacing as a multiple of the mission's (1: as drawn).
+    pub spacing: f64,
+    pub share: Option<f64>,
+    pub note: String,
+}
+
+/// What [`find_margin`] found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MarginSearch {
+    /// The target share of flights that may break 2 r_Q or r_Q.
+    pub target: f64,
+    /// The smallest extra clearance from the obstacles found that keeps
+    /// r_Q in all but the target share (to [`MARGIN_RESOLUTION`]), metres;
+    /// `None`: none up to [`MAX_MARGIN`] or the mission's limit.
+    pub margin: Option<f64>,
+    /// The spacing scale (> 1) the pairs needed beyond that margin, when
+    /// they broke 2 r_Q too often at the mission's own spacing; `None`:
+    /// not widened.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spacing: Option<f64>,
+    /// The check of the plan made with them, when it meets the target.
+    pub report: Option<Report>,
+    pub tried: Vec<Tried>,
+    /// The largest margin the mission stays valid with, when that is
+    /// below [`MAX_MARGIN`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit: Option<MarginLimit>,
+    /// The largest spacing scale the mission stays valid with, when that
+    /// is below [`MAX_SPACING`] (its `margin` is the scale).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spacing_limit: Option<MarginLimit>,
+}
+
+impl MarginSearch {
+    /// Whether the search found a plan whose check meets the target.
+    pub fn met(&self) -> bool {
+        self.report.is_some()
+    }
+}
+
+/// What stops the margin search short of [`MAX_MARGIN`] (or the spacing
+/// short of [`MAX_SPACING`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MarginLimit {
+    /// The largest valid margin, metres (or spacing scale).
+    pub margin: f64,
+    /// The validator's message just above it.
+    pub why: String,
+}
+
+/// `mission` asked to keep `m` more from the obstacles ([`find_margin`]):
+/// the pipeline's margin field (`Pipeline::margin_field`: θ-PSO's
+/// `formation.obstacle_margin`, which verification holds as a hard limit,
+/// so a plan that passes keeps it everywhere, in a named IWP's gap too;
+/// the fleet's `fleet.safety_distance`).
+pub fn with_margin(mission: &mut Mission, pipeline: Kind, m: f64) {
+    pipeline.face().add_margin(mission, m);
+}
+
+/// `mission` with its vehicles `scale` times as far apart
+/// (`Pipeline::widen_spacing`: θ-PSO's slots).
+pub fn with_spacing(mission: &mut Mission, pipeline: Kind, scale: f64) {
+    if scale != 1.0 {
+        pipeline.face().widen_spacing(mission, scale);
+    }
+}
+
+/// The field [`with_margin`] adds to, and its value in `mission`; `None`
+/// for a pipeline the check does not fly.
+pub fn margin_field(mission: &Mission, pipeline: Kind) -> Option<(&'static str, f64)> {
+    pipeline.face().margin_field(mission)
+}
+
+/// A plan to check: `pipeline` run cold on `mission` with `seed`, as the
+/// export writes it; `Err` (the run's error, or its headline when its
+/// verdict fails) when there is none that passes. What [`find_margin`]'s
+/// callers plan each margin with.
+pub fn passing_plan(
+    pipeline: Kind,
+    mission: &Mission,
+    seed: u64,
+    cancel: &CancelToken,
+) -> Result<Planned, String> {
+    let request = pipeline.request();
+    let ask = crate::pipelines::Ask {
+        seed,
+        options: crate::pipelines::PlanOptions::default(),
+        request: &request,
+    };
+    let outcome = pipeline
+        .face()
+        .run(mission, ask, &mut crate::pipelines::Silent, cancel)
+        .map_err(|e| e.to_string())?;
+    if !outcome.ok() {
+        return Err(outcome.headline());
+    }
+    Ok(Planned::from_outcome(mission, &outcome))
+}
+
+/// The margin search stops refining at this width, metres (and the
+/// spacing search at this step of its scale).
+pub const MARGIN_RESOLUTION: f64 = 0.05;
+/// The largest extra clearance tried, metres.
+pub const MAX_MARGIN: f64 = 8.0;
+/// The largest spacing scale tried: the slots three times as far apart.
+pub const MAX_SPACING: f64 = 3.0;
+
+/// Why `change` makes the mission one `pipeline` refuses, in the
+/// validator's words (its rules, then what the pipeline finds before a run:
+/// θ-PSO's inspections that the margin leaves no room for); `None` when the
+/// mission stays valid with it.
+fn invalid_with(
+    mission: &Mission,
+    pipeline: Kind,
+    change: &dyn Fn(&mut Mission),
+) -> Option<String> {
+    let mut changed = mission.clone();
+    change(&mut changed);
+    let rules = crate::pipelines::validate(&changed);
+    let is_error = |d: &crate::mission::Diagnostic| d.severity == crate::mission::Severity::Error;
+    let findings = || pipeline.face().findings(&changed);
+    rules
+        .into_iter()
+        .find(is_error)
+        .or_else(|| findings().into_iter().find(is_error))
+        .map(|d| format!("{}: {}", d.path, d.message))
+}
+
+/// The largest x in [`low`, `high`] the mission stays valid with under
+/// `change(x)`, a [`MARGIN_RESOLUTION`] step inside the boundary, and why
+/// not more; `None` when `high` is valid.
+fn valid_up_to(
+    mission: &Mission,
+    pipeline: Kind,
+    low: f64,
+    high: f64,
+    change: &dyn Fn(&mut Mission, f64),
+) -> Option<(f64, String)> {
+    let mut why = invalid_with(mission, pipeline, &|m| change(m, high))?;
+    let (base, mut low, mut high) = (low, low, high);
+    while high - low > MARGIN_RESOLUTION / 4.0 {
+        let mid = 0.5 * (low + high);
+        match invalid_with(mission, pipeline, &|m| change(m, mid)) {
+            Some(message) => (high, why) = (mid, message),
+            None => low = mid,
+        }
+    }
+    // A step inside the boundary: a plan keeps its limits with a little
+    // room (a pair exactly at 2 r_Q + the margin fails verification).
+    let step = MARGIN_RESOLUTION;
+    let inside = base + (((low - base) / step).ceil() - 1.0).max(0.0) * step;
+    Some(((100.0 * inside).round() / 100.0, why))
+}
+
+/// The smallest x in [`from`, `highest`] for which `attempt(x)` gives a
+/// report that `meets`: `from` (unless it is known to fail), then
+/// `from` + 0.25 doubling the step, then halving the interval between the
+/// last that failed and the first that met it to [`MARGIN_RESOLUTION`]
+/// (each halving on a centimetre grid: the value reported is the value
+/// planned with, as the user will write it).
+fn smallest(
+    from: f64,
+    from_fails: bool,
+    highest: f64,
+    attempt: &mut dyn FnMut(f64) -> Result<Option<Report>, FlightError>,
+    meets: &dyn Fn(&Report) -> bool,
+) -> Result<Option<(f64, Report)>, FlightError> {
+    let mut failed = from_fails.then_some(from);
+    let mut met: Option<(f64, Report)> = None;
+    // The first step beyond `from`; each later one doubles the distance.
+    const FIRST: f64 = 0.25;
+    let mut x = if from_fails {
+        (from + FIRST).min(highest)
+    } else {
+        from
+    };
+    loop {
+        match attempt(x)? {
+            Some(report) if meets(&report) => {
+                met = Some((x, report));
+                break;
+            }
+            _ => failed = Some(x),
+        }
+        if x >= highest {
+            break;
+        }
+        // The highest value is tried before giving up.
+        x = if x == from {
+            from + FIRST
+        } else {
+            from + 2.0 * (x - from)
+        }
+        .min(highest);
+    }
+    let Some((mut high, mut best)) = met else {
+        return Ok(None);
+    };
+    let Some(mut low) = failed else {
+        return Ok(Some((high, best)));
+    };
+    while high - low > MARGIN_RESOLUTION {
+        // On a centimetre grid, so that the value printed is the one planned.
+        let mid = (50.0 * (low + high)).round() / 100.0;
+        match attempt(mid)? {
+            Some(report) if meets(&report) => {
+                high = mid;
+                best = report;
+            }
+            _ => low = mid,
+        }
+    }
+    Ok(Some((high, best)))
+}
+
+/// The smallest extra clearance m from the obstacles whose plan, flown
+/// `options.flights` times, breaks r_Q in at most `target` of the flights
+/// (0, then doubling from 0.25 m, then halving to [`MARGIN_RESOLUTION`]; see
+/// [`with_margin`] for what m is added to). When the pairs still break
+/// 2 r_Q in more than `target` of the flights with it (set by the slots'
+/// spacing against each receiver's own fix error and the take-off skew, which
+/// no margin from the site moves), the smallest spacing scale that brings
+/// the pairs within `target` (1.25, doubling the step, then halving), for
+/// a pipeline that can widen its spacing; and when the wider formation,
+/// passing closer to the site, breaks r_Q again, the margin once more at
+/// that spacing, up from the one found. Values that make the mission
+/// invalid are not tried beyond the largest valid one, and the search says
+/// so ([`MarginSearch::limit`], [`MarginSearch::spacing_limit`]). `plan`
+/// plans a mission (`Err`: no plan, and why). The share is the flights' own
+/// (its 95 % interval is in the report).
+pub fn find_margin(
+    pipeline: Kind,
+    mission: &Mission,
+    target: f64,
+    options: Options,
+    plan: &mut dyn FnMut(&Mission) -> Result<Planned, String>,
+    cancel: &CancelToken,
+) -> Result<MarginSearch, FlightError> {
+    let cap = valid_up_to(mission, pipeline, 0.0, MAX_MARGIN, &|m, x| {
+        with_margin(m, pipeline, x)
+    });
+    let mut tried = Vec::new();
+    let mut attempt = |m: f64, spacing: f64| -> Result<Option<Report>, FlightError> {
+        if cancel.is_cancelled() {
+            return Err(FlightError::Cancelled);
+        }
+        let mut changed = mission.clone();
+        with_margin(&mut changed, pipeline, m);
+        with_spacing(&mut changed, pipeline, spacing);
+        let planned = match plan(&changed) {
+            Ok(p) => p,
+            Err(why) => {
+                tried.push(Tried {
+                    margin: m,
+                    spacing,
+                    share: None,
+                    note: why,
+                });
+                return Ok(None);
+            }
+        };
+        let setup = Setup::new(&changed, &planned)?;
+        let report = check(&setup, options, &|_, _| {}, cancel)?;
+        tried.push(Tried {
+            margin: m,
+            spacing,
+            share: Some(report.break_any.share),
+            note: tried_note(&report),
+        });
+        Ok(Some(report))
+    };
+    let highest = cap.as_ref().map_or(MAX_MARGIN, |(m, _)| *m);
+    // First the obstacles: r_Q.
+    let keeps_clearance = |r: &Report| r.break_clearance.share <= target;
+    let found = smallest(
+        0.0,
+        false,
+        highest,
+        &mut |m| attempt(m, 1.0),
+        &keeps_clearance,
+    )?;
+    let mut search = MarginSearch {
+        target,
+        margin: found.as_ref().map(|(m, _)| *m),
+        spacing: None,
+        report: None,
+        tried: Vec::new(),
+        limit: cap.map(|(m, why)| MarginLimit { margin: m, why }),
+        spacing_limit: None,
+    };
+    let keeps_all = |r: &Report| r.break_any.share <= target;
+    match found {
+        Some((_, report)) if keeps_all(&report) => search.report = Some(report),
+        // Then the pairs: 2 r_Q, at that margin.
+        Some((m, _)) if pipeline.face().spacing_field().is_some() => {
+            let spacing_cap = valid_up_to(mission, pipeline, 1.0, MAX_SPACING, &|changed, s| {
+                with_margin(changed, pipeline, m);
+                with_spacing(changed, pipeline, s);
+            });
+            let widest = spacing_cap.as_ref().map_or(MAX_SPACING, |(s, _)| *s);
+            search.spacing_limit = spacing_cap.map(|(s, why)| MarginLimit { margin: s, why });
+            let keeps_pairs = |r: &Report| r.break_separation.share <= target;
+            let widened = if widest > 1.0 {
+                smallest(1.0, true, widest, &mut |s| attempt(m, s), &keeps_pairs)?
+            } else {
+                None
+            };
+            match widened {
+                Some((s, report)) if keeps_all(&report) => {
+                    search.spacing = Some(s);
+                    search.report = Some(report);
+                }
+                // A wider formation passes closer to the site: the margin
+                // again, at that spacing, from where it was.
+                Some((s, _)) => {
+                    search.spacing = Some(s);
+                    let cap = valid_up_to(mission, pipeline, m, MAX_MARGIN, &|changed, x| {
+                        with_margin(changed, pipeline, x);
+                        with_spacing(changed, pipeline, s);
+                    });
+                    let highest = cap.as_ref().map_or(MAX_MARGIN, |(x, _)| *x);
+                    if let Some((x, why)) = cap {
+                        search.limit = Some(MarginLimit { margin: x, why });
+                    }
+                    if highest > m
+                        && let Some((x, report)) =
+                            smallest(m, true, highest, &mut |x| attempt(x, s), &keeps_all)?
+                    {
+                        search.margin = Some(x);
+                        search.report = Some(report);
+                    }
+                }
+                None => {}
+            }
+        }
+        _ => {}
+    }
+    search.tried = tried;
+    Ok(search)
+}
+
+/// A try's counts, and its worst place when a flight broke a limit.
+fn tried_note(report: &Report) -> String {
+    let counts = format!(
+        "{} of {} flights break a limit ({} 2 r_Q, {} r_Q",
+        report.break_any.count,
+        report.break_any.of,
+        report.break_separation.count,
+        report.break_clearance.count
+    );
+    match &report.worst {
+        Some(w) if report.break_any.count > 0 => format!("{counts}; worst: {})", w.what),
+        _ => format!("{counts})"),
+    }
+}
