@@ -1,11 +1,12 @@
 //! Drawing: a pure function of the app state (and the clock, for elapsed
 //! times), so every screen can be snapshot-tested on a `TestBackend`.
 //!
-//! Long (~760 lines) because it is the screen's frame: the layout, the status and find
-//! lines, and every overlay (help, quit, save as, open, import, overwrite, recovery,
-//! discard) with the popup helpers they share; the map, inspector and jobs panes are
-//! submodules.
+//! This file is the screen's frame: the layout, the status and find lines,
+//! and the overlays (quit, save as, open, import, overwrite, recovery,
+//! discard) with the popup helpers they share; the help overlay, the map,
+//! the inspector and the jobs panes are submodules.
 
+mod help;
 pub mod inspector;
 pub mod jobs;
 pub mod map;
@@ -22,7 +23,6 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, BorderType, Borders, Clear, Paragraph, Wrap};
 
 use super::app::{App, Focus, Overlay, Pane};
-use super::keys::KEYS;
 use title::Part;
 
 /// Below this the layout cannot show a usable map and inspector.
@@ -357,60 +357,6 @@ fn key(k: &str) -> Span<'static> {
     Span::styled(k.to_owned(), Style::default().yellow().bold())
 }
 
-/// The keys column of the help overlay, in cells: descriptions start here.
-const KEYS_COLUMN: usize = 18;
-
-/// One key of the help overlay in a column `width` cells wide: the keys,
-/// then what they do, wrapped so that every continuation line starts under
-/// the description (a hanging indent), not at the left edge.
-fn key_lines(keys: &str, what: &str, width: u16) -> Vec<Line<'static>> {
-    let indent = KEYS_COLUMN.max(Line::raw(keys).width() + 4);
-    // A blank cell at the end keeps it apart from the next column.
-    let room = usize::from(width).saturating_sub(indent + 1).max(12);
-    let mut lines = Vec::new();
-    for (k, chunk) in wrap_words(what, room).into_iter().enumerate() {
-        let lead = if k == 0 {
-            key(&format!("  {keys:<w$}", w = indent - 2))
-        } else {
-            Span::raw(" ".repeat(indent))
-        };
-        lines.push(Line::from(vec![lead, Span::raw(chunk)]));
-    }
-    lines
-}
-
-/// `text` in lines of at most `room` cells, broken between words (a word
-/// longer than a line is cut).
-fn wrap_words(text: &str, room: usize) -> Vec<String> {
-    let width = |s: &str| Line::raw(s).width();
-    let mut lines: Vec<String> = Vec::new();
-    let mut current = String::new();
-    for word in text.split_whitespace() {
-        let needed = width(&current) + usize::from(!current.is_empty()) + width(word);
-        if needed <= room {
-            if !current.is_empty() {
-                current.push(' ');
-            }
-            current.push_str(word);
-            continue;
-        }
-        if !current.is_empty() {
-            lines.push(std::mem::take(&mut current));
-        }
-        // A word wider than a whole line: cut it where the line ends.
-        for c in word.chars() {
-            if width(&current) + width(c.encode_utf8(&mut [0; 4])) > room && !current.is_empty() {
-                lines.push(std::mem::take(&mut current));
-            }
-            current.push(c);
-        }
-    }
-    if !current.is_empty() || lines.is_empty() {
-        lines.push(current);
-    }
-    lines
-}
-
 /// "1 job is running (θ-PSO s7): quitting cancels it." when one is.
 fn running_line(app: &App) -> Vec<Line<'static>> {
     let running: Vec<String> = app
@@ -434,7 +380,7 @@ fn running_line(app: &App) -> Vec<Line<'static>> {
 
 fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
     match overlay {
-        Overlay::Help => draw_help(frame, app, area),
+        Overlay::Help => help::draw_help(frame, app, area),
         Overlay::Quit => draw_quit(frame, app, area),
         Overlay::QuitRunning => draw_quit_running(frame, app, area),
         Overlay::SaveAs { input, .. } => draw_save_as(frame, app, area, input),
@@ -449,90 +395,6 @@ fn draw_overlay(frame: &mut Frame, app: &App, overlay: &Overlay, area: Rect) {
         Overlay::Overwrite { path, .. } => draw_overwrite(frame, area, path),
         Overlay::Recover(copy) => draw_recover(frame, area, copy),
         Overlay::Discard(entry) => draw_discard(frame, area, entry),
-    }
-}
-
-/// The key table, in two columns when there is room; it scrolls when taller than the screen.
-fn draw_help(frame: &mut Frame, app: &App, area: Rect) {
-    // Two columns when there is room, else one (the README lists every key too).
-    let groups = ["General", "Select & move", "Edit", "Formation", "Run"];
-    let wide = area.width >= 120;
-    let width = if wide {
-        area.width.min(150)
-    } else {
-        96.min(area.width)
-    };
-    let inner_width = width.saturating_sub(2);
-    let (left_width, right_width) = if wide {
-        let l = inner_width * 45 / 100;
-        (l, inner_width - l)
-    } else {
-        (inner_width, inner_width)
-    };
-    let column = |names: &[&str], width: u16| {
-        let mut lines = Vec::new();
-        for name in names {
-            if !lines.is_empty() {
-                lines.push(Line::raw(""));
-            }
-            lines.push(Line::styled(
-                name.to_string(),
-                Style::default().bold().underlined(),
-            ));
-            for row in KEYS.iter().filter(|row| row.group == *name) {
-                lines.extend(key_lines(&row.keys, row.help, width));
-            }
-        }
-        lines
-    };
-    let (left, right) = if wide {
-        (
-            column(&groups[..2], left_width),
-            column(&groups[2..], right_width),
-        )
-    } else {
-        (column(&groups, left_width), Vec::new())
-    };
-    let content = rows(&left, left_width).max(rows(&right, right_width));
-    let height = content + 2;
-    let r = centred(area, width, height);
-    frame.render_widget(Clear, r);
-    // Taller than the screen: it scrolls (↑ ↓ PgUp PgDn), and says so.
-    let fits = height <= r.height;
-    let max_scroll = content.saturating_sub(r.height.saturating_sub(2));
-    let scroll = app.help_scroll().min(max_scroll);
-    let title = if fits {
-        "Keys · any key closes".to_owned()
-    } else {
-        format!(
-            "Keys · ↑↓ PgUp PgDn scroll ({}/{}) · other keys close",
-            scroll, max_scroll
-        )
-    };
-    let block = boxed(&title, Color::Cyan);
-    let inner = block.inner(r);
-    frame.render_widget(block, r);
-    let text = |lines: Vec<Line<'static>>| {
-        Paragraph::new(lines)
-            .wrap(Wrap { trim: false })
-            .scroll((scroll, 0))
-    };
-    if wide {
-        // The widths the lines were wrapped to (a layout of the
-        // real rectangle may round its split a cell differently).
-        let a = Rect {
-            width: left_width.min(inner.width),
-            ..inner
-        };
-        let b = Rect {
-            x: a.right(),
-            width: inner.width - a.width,
-            ..inner
-        };
-        frame.render_widget(text(left), a);
-        frame.render_widget(text(right), b);
-    } else {
-        frame.render_widget(text(left), inner);
     }
 }
 
@@ -739,25 +601,4 @@ fn draw_discard(frame: &mut Frame, area: Rect, entry: &super::overlay::Entry) {
     let size = (width, rows(&lines, width.saturating_sub(2)) + 2);
     let body = Paragraph::new(lines).wrap(Wrap { trim: false });
     popup(frame, area, size, ("Unsaved changes", Color::Yellow), body);
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn words_wrap_within_the_room_and_long_ones_are_cut() {
-        assert_eq!(wrap_words("one two three", 7), ["one two", "three"]);
-        assert_eq!(wrap_words("abcdefghij", 4), ["abcd", "efgh", "ij"]);
-        assert_eq!(wrap_words("", 4), [""]);
-    }
-
-    #[test]
-    fn a_wrapped_key_line_hangs_under_its_description() {
-        let lines = key_lines("n  p", "next / previous item of the map", 37);
-        let text: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
-        assert_eq!(text[0], "  n  p            next / previous");
-        assert_eq!(text[1], "                  item of the map");
-        assert!(lines.iter().all(|l| l.width() < 37), "{text:?}");
-    }
 }
