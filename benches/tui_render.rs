@@ -1,13 +1,16 @@
 //! TUI drawing speed: one full frame of a 200-obstacle mission with a
 //! planned result, at 200×60 cells. Target (issue 5): ≤ 2 ms per frame.
+//! And the help overlay at 140×40, whose two columns are balanced on
+//! every frame (issue 38).
 
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
+use skyform::mission::default_mission;
 use skyform::tui::fixtures::{app_with_result, crowded_mission};
-use skyform::tui::view;
+use skyform::tui::{Action, App, Document, view};
 
 fn full_frame(c: &mut Criterion) {
     let app = app_with_result(crowded_mission(200), 3, 20);
@@ -28,5 +31,24 @@ fn full_frame(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, full_frame);
+fn help_overlay(c: &mut Criterion) {
+    let mut app = App::new(
+        Document::new(default_mission().mission, None),
+        std::path::PathBuf::from("/missions"),
+    );
+    app.update(Action::ToggleHelp);
+    let mut terminal = Terminal::new(TestBackend::new(140, 40)).expect("test backend");
+    let now = Instant::now();
+    c.bench_function("tui/help_overlay_140x40", |b| {
+        b.iter(|| {
+            terminal
+                .draw(|frame| {
+                    view::draw(frame, &app, now);
+                })
+                .map(|_| ())
+        })
+    });
+}
+
+criterion_group!(benches, full_frame, help_overlay);
 criterion_main!(benches);

@@ -132,19 +132,46 @@ fn balanced_columns(
                 && row_of(k.checked_sub(1), group)
                 && row_of(Some(k + 1), group))
     };
+    let (left, right) = column_heights(blocks, (left_width, right_width));
     let split = (1..blocks.len())
         .filter(|&k| allowed(k))
-        .min_by_key(|&k| {
-            let left = rows(&help_column(&blocks[..k], left_width), left_width);
-            let right = rows(&help_column(&blocks[k..], right_width), right_width);
-            // A split at a heading before one inside a group.
-            (left.max(right), blocks[k].1.is_some())
-        })
+        // A split at a heading before one inside a group.
+        .min_by_key(|&k| (left[k].max(right[k]), blocks[k].1.is_some()))
         .unwrap_or(blocks.len());
     (
         help_column(&blocks[..split], left_width),
         help_column(&blocks[split..], right_width),
     )
+}
+
+/// For each split `k`, the rows `help_column` gives `blocks[..k]` at
+/// `left_width` and `blocks[k..]` at `right_width`, counted once per block
+/// (a heading is a line and a blank before it, but at a column's top; a
+/// column that starts on a key row adds its "continued" heading) rather
+/// than by building both columns for every split.
+fn column_heights(
+    blocks: &[(&str, Option<&KeyRow>)],
+    (left_width, right_width): (u16, u16),
+) -> (Vec<u16>, Vec<u16>) {
+    let height = |row: Option<&KeyRow>, width: u16| {
+        row.map_or(2, |r| rows(&key_lines(&r.keys, r.help, width), width))
+    };
+    let n = blocks.len();
+    let mut left = vec![0; n + 1];
+    for (k, (_, row)) in blocks.iter().enumerate() {
+        let top = if k == 0 && row.is_none() { 1 } else { 0 };
+        left[k + 1] = left[k] + height(*row, left_width) - top;
+    }
+    let mut right = vec![0; n + 1];
+    let mut below = 0;
+    for k in (0..n).rev() {
+        let row = blocks[k].1;
+        below += height(row, right_width);
+        // At the column's top a heading has no blank line before it, and a
+        // key row gets the "continued" heading.
+        right[k] = below - u16::from(row.is_none()) + u16::from(row.is_some());
+    }
+    (left, right)
 }
 
 /// The keys column of the help overlay, in cells: descriptions start here.
@@ -261,6 +288,35 @@ mod tests {
         assert_eq!(right[0], "C (continued)");
         // At least two of the split group's rows on each side.
         assert_eq!(left.len() - 9, 2);
+    }
+
+    /// The heights counted once per block are those of the columns built.
+    #[test]
+    fn column_heights_are_the_built_columns_rows() {
+        let blocks: Vec<(&str, Option<&KeyRow>)> = KEYS
+            .iter()
+            .enumerate()
+            .flat_map(|(k, row)| {
+                let heading =
+                    (k == 0 || KEYS[k - 1].group != row.group).then_some((row.group, None));
+                heading.into_iter().chain([(row.group, Some(row))])
+            })
+            .collect();
+        for widths in [(40, 60), (61, 77), (30, 30)] {
+            let (left, right) = column_heights(&blocks, widths);
+            for k in 0..=blocks.len() {
+                assert_eq!(
+                    left[k],
+                    rows(&help_column(&blocks[..k], widths.0), widths.0),
+                    "left of {k} at {widths:?}"
+                );
+                assert_eq!(
+                    right[k],
+                    rows(&help_column(&blocks[k..], widths.1), widths.1),
+                    "right of {k} at {widths:?}"
+                );
+            }
+        }
     }
 
     #[test]
