@@ -18,17 +18,7 @@ fn full_frame(c: &mut Criterion) {
         app.shown().and_then(|j| j.outcome.as_ref()).is_some(),
         "the frame must show a result"
     );
-    let mut terminal = Terminal::new(TestBackend::new(200, 60)).expect("test backend");
-    let now = Instant::now();
-    c.bench_function("tui/frame_200_obstacles_200x60", |b| {
-        b.iter(|| {
-            terminal
-                .draw(|frame| {
-                    view::draw(frame, &app, now);
-                })
-                .map(|_| ())
-        })
-    });
+    bench_frame(c, "tui/frame_200_obstacles_200x60", &app, (200, 60));
 }
 
 fn help_overlay(c: &mut Criterion) {
@@ -37,13 +27,18 @@ fn help_overlay(c: &mut Criterion) {
         std::path::PathBuf::from("/missions"),
     );
     app.update(Action::ToggleHelp);
-    let mut terminal = Terminal::new(TestBackend::new(140, 40)).expect("test backend");
+    bench_frame(c, "tui/help_overlay_140x40", &app, (140, 40));
+}
+
+/// One whole frame of `app` drawn on a `width` × `height` test terminal.
+fn bench_frame(c: &mut Criterion, name: &str, app: &App, (width, height): (u16, u16)) {
+    let mut terminal = Terminal::new(TestBackend::new(width, height)).expect("test backend");
     let now = Instant::now();
-    c.bench_function("tui/help_overlay_140x40", |b| {
+    c.bench_function(name, |b| {
         b.iter(|| {
             terminal
                 .draw(|frame| {
-                    view::draw(frame, &app, now);
+                    view::draw(frame, app, now);
                 })
                 .map(|_| ())
         })

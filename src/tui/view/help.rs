@@ -159,7 +159,8 @@ fn column_heights(
     let n = blocks.len();
     let mut left = vec![0; n + 1];
     for (k, (_, row)) in blocks.iter().enumerate() {
-        let top = if k == 0 && row.is_none() { 1 } else { 0 };
+        // At the column's top a heading has no blank line before it.
+        let top = u16::from(k == 0 && row.is_none());
         left[k + 1] = left[k] + height(*row, left_width) - top;
     }
     let mut right = vec![0; n + 1];
@@ -293,15 +294,7 @@ mod tests {
     /// The heights counted once per block are those of the columns built.
     #[test]
     fn column_heights_are_the_built_columns_rows() {
-        let blocks: Vec<(&str, Option<&KeyRow>)> = KEYS
-            .iter()
-            .enumerate()
-            .flat_map(|(k, row)| {
-                let heading =
-                    (k == 0 || KEYS[k - 1].group != row.group).then_some((row.group, None));
-                heading.into_iter().chain([(row.group, Some(row))])
-            })
-            .collect();
+        let blocks = blocks(&KEYS);
         for widths in [(40, 60), (61, 77), (30, 30)] {
             let (left, right) = column_heights(&blocks, widths);
             for k in 0..=blocks.len() {
