@@ -129,21 +129,30 @@ pub enum Command {
     /// error, 2 some flight did, 130 cancelled. See docs/flight-check.md.
     Fly(fly_cmd::FlyArgs),
     /// Bring a site survey's obstacles into a mission: GeoJSON (RFC 7946),
-    /// KML or KMZ.
+    /// KML or KMZ, as Google Earth, QGIS or OpenStreetMap draw them.
     ///
-    /// Points become cylinders, lines a row of cylinders, polygons a cover
-    /// of cylinders whose union contains them (the area it adds is said per
-    /// polygon); lines and polygons are clipped to the bounds. Radius and
-    /// height come from each feature's `radius` and `height` properties
-    /// (KML: ExtendedData), metres, else 1 m and 1 m above the altitude
-    /// band (a warning lists them); names from `name`, kinds from `kind` (KML:
-    /// the folder). Features outside the bounds or without a usable geometry
-    /// are listed. Obstacles are matched by name: importing the same file
-    /// again changes nothing. The mission is edited in place (comments and
-    /// layout kept) and saved atomically; nothing is written on an error.
-    /// Needs the mission's [origin]. Exit status: 0 imported (or nothing to
-    /// change), 1 error, 2 refused: the mission would then have validation
-    /// errors it does not have now (--force writes it anyway).
+    /// Heights: a feature's `height` (or `top`) and `base` (or `min_height`)
+    /// properties, metres above the ground (KML: ExtendedData), else the
+    /// altitudes it is drawn with: KML's altitudeMode (relativeToGround;
+    /// absolute, less [origin] altitude; clampToGround has none) and
+    /// extrude; GeoJSON's third coordinate (above the WGS-84 ellipsoid, less
+    /// [origin] altitude). A point is a post up to its altitude; an extruded
+    /// polygon a footprint standing on the ground, one not extruded a deck
+    /// at its altitude (resting on what the survey stands under it); a line
+    /// not extruded, or marked as a power line or cable, a wire at its
+    /// height (flown under or over, kept `radius`, 0.5 m, round it); another
+    /// line a row of posts. Without any height, 1 m above the altitude band
+    /// (a warning lists them); without a radius, 1 m. Everything is clipped
+    /// to the bounds and written to the millimetre; the report says how
+    /// each feature was read. Names from `name`, kinds from `kind` (KML: the
+    /// folder). Obstacles are matched by name: importing the same file again
+    /// changes nothing, a default never replaces a known height or radius.
+    /// The mission is edited in place (comments and layout kept) and saved
+    /// atomically; nothing is written on an error. Needs the mission's
+    /// [origin]. Exit status: 0 imported (or nothing to change), 1 error, 2
+    /// refused: the survey would lower, thin or remove an obstacle the
+    /// mission has, or the mission would have validation errors it does not
+    /// have now (--force writes it anyway).
     Import(import_cmd::ImportArgs),
     /// Print the cost of given paths under the mission's cost, one per line
     /// with 17 significant digits (`inf` where infinite): the parity hook

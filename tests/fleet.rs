@@ -20,12 +20,9 @@ fn one_agent(start: Point2<f64>, targets: &[(f64, [f64; 2])], duration: f64) -> 
     f.initial_positions = vec![start];
     f.targets = targets
         .iter()
-        .map(|&(time, p)| FleetTarget {
-            time,
-            position: Point2::new(p[0], p[1]),
-        })
+        .map(|&(time, p)| FleetTarget::around(time, Point2::new(p[0], p[1])))
         .collect();
-    f.duration = duration;
+    f.duration = Some(duration);
     m
 }
 
@@ -150,7 +147,7 @@ fn three_agents_form_the_triangle_and_keep_apart_for_ten_seeds() {
 #[test]
 fn results_do_not_depend_on_the_number_of_threads() {
     let mut m = triangle_mission();
-    m.fleet.duration = 10.0;
+    m.fleet.duration = Some(10.0);
     let on = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -169,7 +166,7 @@ fn thirty_agents_run_with_their_neighbourhoods() {
     m.obstacles.clear();
     m.fleet.agents = 30;
     m.fleet.target_distance = 9.0;
-    m.fleet.duration = 3.0;
+    m.fleet.duration = Some(3.0);
     m.fleet.targets.truncate(1);
     let o = run(&m, 5);
     assert_eq!(o.agents.len(), 30);

@@ -22,7 +22,7 @@ fn triangle(seconds: f64) -> Mission {
         Ok(l) => l.mission,
         Err(e) => panic!("{e}"),
     };
-    m.fleet.duration = seconds;
+    m.fleet.duration = Some(seconds);
     m.fleet.targets.retain(|t| t.time < seconds);
     m
 }
@@ -142,7 +142,7 @@ fn lockstep_over_zenoh_is_the_in_process_run_bit_for_bit() {
             .take()
             .unwrap_or_else(|| panic!("no transport figures"));
         assert_eq!((d.processes, d.clock.as_str()), (3, "lockstep"));
-        let steps = (m.fleet.duration / m.fleet.sim_step).round() + 1.0;
+        let steps = (m.fleet.duration.unwrap_or(0.0) / m.fleet.sim_step).round() + 1.0;
         assert!(d.messages as f64 >= 3.0 * steps, "{} messages", d.messages);
         assert!(there.lost.is_empty());
         assert!(

@@ -106,7 +106,7 @@ fn survivors_keep_clear_of_a_lost_agents_last_position() {
 fn a_lost_agents_region_grows_at_its_last_speed_up_to_its_reach() {
     let mut m = triangle();
     // Lost at the run's last step, 2 s in: still on its way to the target.
-    m.fleet.duration = 2.0;
+    m.fleet.duration = Some(2.0);
     let step = (2.0 / m.fleet.sim_step).round() as usize;
     let mut link = Loopback::new(3).losing(0, step, "gone");
     let mut simulation = Simulation::new(&m, 1);
@@ -146,11 +146,8 @@ fn hexagon(seconds: f64) -> Mission {
     let f = &mut m.fleet;
     f.agents = 6;
     f.target_distance = 3.0;
-    f.targets = vec![FleetTarget {
-        time: 0.0,
-        position: Point2::new(0.0, 0.0),
-    }];
-    f.duration = seconds;
+    f.targets = vec![FleetTarget::around(0.0, Point2::new(0.0, 0.0))];
+    f.duration = Some(seconds);
     m
 }
 

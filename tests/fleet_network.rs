@@ -64,7 +64,7 @@ fn the_ideal_network_flies_the_fleet_of_the_perfect_snapshot_bit_for_bit() {
 #[test]
 fn a_late_lossy_network_is_reproducible_and_counted() {
     let mut m = triangle_mission();
-    m.fleet.duration = 20.0;
+    m.fleet.duration = Some(20.0);
     let latency = (0.1 / m.fleet.sim_step).round() as usize;
     m.fleet.network = FleetNetwork {
         range: None,
@@ -128,7 +128,7 @@ fn a_link_with_a_latency_of_its_own_is_read_checked_and_flown() {
         .unwrap_or_else(|e| panic!("{e}"))
         .mission;
     assert_eq!(m.fleet.network.links[0].between, [1, 3]);
-    m.fleet.duration = 20.0;
+    m.fleet.duration = Some(20.0);
     let linked = run(&m, 2);
     m.fleet.network.links.clear();
     let plain = run(&m, 2);
@@ -181,10 +181,10 @@ fn agents_on_their_own_clocks_decide_on_them_and_repeat() {
             phase: 7
         }]
     );
-    m.fleet.duration = 20.0;
+    m.fleet.duration = Some(20.0);
     let own = run(&m, 4);
     assert_eq!(own, run(&m, 4), "the same mission and seed fly the same");
-    let steps = (m.fleet.duration / m.fleet.sim_step).round() as usize;
+    let steps = (m.fleet.duration.unwrap_or(0.0) / m.fleet.sim_step).round() as usize;
     // Its own steps 7, 67, …: each one a decision (the first target is out
     // from t = 0); a neighbour closer than c may add some.
     let ticks = (steps - 7) / 60 + 1;

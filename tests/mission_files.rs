@@ -201,6 +201,7 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                 // 3 m in from the corners: the whole formation fits there.
                 start: Point3::new(-w / 2.0 + 3.0, 3.0, z),
                 goal: Point3::new(w / 2.0 - 3.0, d - 3.0, z),
+                via: Vec::new(),
             };
             let obstacles = obstacles
                 .into_iter()
@@ -217,6 +218,9 @@ fn valid_mission() -> impl Strategy<Value = Mission> {
                     kind: (!kind.is_empty()).then_some(kind),
                     inspect: false,
                     stand_off: None,
+                    description: None,
+                    wire: None,
+                    inspect_side: None,
                 })
                 .collect();
             let mut m = Mission {

@@ -382,7 +382,8 @@ fn a_fleet_recording_holds_agents_references_and_the_distance_series() {
         );
         let expected: Vec<f64> = outcome["distances"]
             .as_array()
-            .and_then(|all| all.iter().find(|d| d["a"] == a && d["b"] == b))
+            // The JSON numbers agents from 1, as the entity paths do.
+            .and_then(|all| all.iter().find(|d| d["a"] == a + 1 && d["b"] == b + 1))
             .and_then(|d| d["values"].as_array())
             .map(|v| v.iter().filter_map(|x| x.as_f64()).collect())
             .unwrap_or_default();
@@ -433,7 +434,7 @@ fn a_fleet_recording_shows_the_links_and_the_lost_agents() {
     let mut m = skyform::mission::load(Path::new("missions/fleet-triangle.toml"))
         .unwrap_or_else(|e| panic!("{e}"))
         .mission;
-    m.fleet.duration = 4.0;
+    m.fleet.duration = Some(4.0);
     let mut o =
         fleet::plan(&m, 3, &mut Silent, &CancelToken::new()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(o.links.len(), o.times.len(), "a set of links per sample");

@@ -237,6 +237,7 @@ fn j3_sees_the_height_of_a_rotated_shape_eq5() {
         hold: 5.0,
         straight: 8.0,
         window: [f64::NEG_INFINITY, f64::INFINITY],
+        gate: None,
     };
     let path = |z: f64| CentroidPath {
         points: vec![Point3::new(20.0, 50.0, z), Point3::new(80.0, 50.0, z)],
@@ -312,6 +313,7 @@ fn jr_is_the_mean_horizontal_distance_to_enabled_iwps_eq11() {
         hold: 1.0,
         straight: 4.0,
         window: [f64::NEG_INFINITY, f64::INFINITY],
+        gate: None,
     };
     let iwps = [iwp(0.0, 4.0, true), iwp(100.0, 100.0, false)];
     let model = CostModel::new(&m, &iwps);

@@ -133,6 +133,9 @@ pub fn generated(index: u64) -> Mission {
             kind: Some("wall".into()),
             inspect: false,
             stand_off: None,
+            description: None,
+            wire: None,
+            inspect_side: None,
         });
     }
 

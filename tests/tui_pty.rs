@@ -514,7 +514,7 @@ fn z_runs_the_fleet_over_agent_processes() {
     )))
     .unwrap()
     .mission;
-    m.fleet.duration = 14.0;
+    m.fleet.duration = Some(14.0);
     m.fleet.targets.truncate(1);
     std::fs::write(&file, mission::to_toml_string(&m).unwrap()).unwrap();
     let mut s = launch(&file, &state);

@@ -591,7 +591,7 @@ fn the_readme_lists_every_key_the_help_overlay_shows() {
 fn a_fleet_run_replays_on_the_map() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/missions/fleet-triangle.toml");
     let mut m = mission::load(std::path::Path::new(path)).unwrap().mission;
-    m.fleet.duration = 6.0;
+    m.fleet.duration = Some(6.0);
     let mut app = App::new(Document::new(m, None), std::env::temp_dir());
     app.update(Action::Run(skyform::pipelines::Kind::Fleet));
     assert!(app.wait_for_jobs(Duration::from_secs(60)));

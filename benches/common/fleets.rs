@@ -23,7 +23,7 @@ pub fn fleet_of(n: usize, duration: f64) -> Mission {
     m.obstacles.clear();
     m.fleet.agents = n;
     m.fleet.target_distance = radius;
-    m.fleet.duration = duration;
+    m.fleet.duration = Some(duration);
     m.fleet.targets.truncate(1);
     m.fleet.targets[0].position = Point2::origin();
     m

@@ -52,6 +52,31 @@ impl Prism {
         }
     }
 
+    /// Distance in the plane from the segment `a` → `b` to the footprint:
+    /// 0 where it crosses the outline, negative (as deep as its deeper
+    /// end) when an end is inside. Between two polylines the least distance
+    /// is at a vertex of one of them, so this is exact.
+    pub fn segment_distance(&self, a: &Point2<f64>, b: &Point2<f64>) -> f64 {
+        let ends = self.outward(a).min(self.outward(b));
+        if ends <= 0.0 || self.polygon.is_empty() {
+            return if self.polygon.is_empty() {
+                segment_point_distance(a, b, &self.center) - self.radius
+            } else {
+                ends
+            };
+        }
+        let n = self.polygon.len();
+        let mut best = ends;
+        for i in 0..n {
+            let (p, q) = (self.polygon[i], self.polygon[(i + 1) % n]);
+            if segments_cross(a, b, &p, &q) {
+                return 0.0;
+            }
+            best = best.min(segment_point_distance(a, b, &p));
+        }
+        best
+    }
+
     /// The point of the footprint's outline nearest `q`.
     pub fn nearest_on_outline(&self, q: &Point2<f64>) -> Point2<f64> {
         if self.polygon.is_empty() {

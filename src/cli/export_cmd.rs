@@ -165,6 +165,9 @@ pub fn summary(done: &Exported) -> String {
         done.tolerance,
         done.tolerance_source
     );
+    if let Some(note) = &done.limits_note {
+        out.push_str(&format!("  limits: {note}\n"));
+    }
     let waypoint_files = done.files.iter().any(|f| f.format.waypoints());
     if waypoint_files {
         for p in &done.plans {

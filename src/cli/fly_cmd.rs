@@ -12,14 +12,28 @@ use crate::mission::Mission;
 use crate::pipelines::{CancelToken, Kind};
 
 /// The arguments of `skyform fly` (its help is on `Command::Fly`).
+/// The pipelines `--pipeline` offers: those whose vehicles the check flies
+/// (multicopters; a fixed-wing squadron flies on its own model).
+fn flown_pipelines() -> impl clap::builder::TypedValueParser<Value = Kind> {
+    use clap::ValueEnum;
+    use clap::builder::TypedValueParser;
+    let names: Vec<clap::builder::PossibleValue> = Kind::value_variants()
+        .iter()
+        .filter(|k| !k.fixed_wing())
+        .filter_map(|k| k.to_possible_value())
+        .collect();
+    clap::builder::PossibleValuesParser::new(names)
+        .map(|name: String| Kind::from_str(&name, true).unwrap_or_default())
+}
+
 #[derive(Debug, clap::Args)]
 pub struct FlyArgs {
     /// Mission TOML file (its `[flight]` section sets the air; defaults:
     /// calm, GNSS σ 1 m / 1.5 m, take-off skew σ 0.3 s).
     pub mission: PathBuf,
-    /// The pipeline that plans the mission (θ-PSO or the fleet: their
-    /// multicopters; FLATLO's fixed wings are not flown here).
-    #[arg(long, value_enum, default_value = "theta-pso")]
+    /// The pipeline that plans the mission: one whose vehicles are
+    /// multicopters, which the check flies.
+    #[arg(long, value_parser = flown_pipelines(), default_value = "theta-pso")]
     pub pipeline: Kind,
     /// Flights (default: flight.flights, 1000).
     #[arg(long)]

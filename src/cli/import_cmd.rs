@@ -20,7 +20,8 @@ pub struct ImportArgs {
     #[arg(long)]
     pub dry_run: bool,
     /// Write even when the mission then has validation errors it does not
-    /// have now.
+    /// have now, or when the survey lowers, thins or removes an obstacle
+    /// the mission already has.
     #[arg(long)]
     pub force: bool,
 }
@@ -70,6 +71,21 @@ pub fn import_command(args: &ImportArgs) -> u8 {
             }
         },
     };
+    let losses = &imported.changes.losses;
+    if !losses.is_empty() && !args.force {
+        eprintln!(
+            "error: the survey would lower, thin or remove {} obstacle(s) {name} already has \
+             (listed above as `loss:`); nothing written (--force writes it)",
+            losses.len()
+        );
+        return exit::INFEASIBLE;
+    }
+    if !losses.is_empty() {
+        eprintln!(
+            "warning: --force: {} obstacle(s) lowered, thinned or removed as the survey has them",
+            losses.len()
+        );
+    }
     let new_errors = errors_added(&checked.report.diagnostics, &new_text, &name);
     if !new_errors.is_empty() {
         let label = if args.force { "warning" } else { "error" };

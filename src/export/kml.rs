@@ -281,6 +281,35 @@ fn mission_folder(mission: &Mission, placement: &Placement, placemarks: &mut usi
 /// with room under it (a deck) as a closed solid from its base to its top.
 fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> {
     let ground = mission.ground(o.center.x, o.center.y);
+    if let Some(w) = &o.wire {
+        // A wire as the conductor it is: a line at its height.
+        let end = |p: &Point3<f64>| {
+            absolute(
+                placement,
+                &Point3::new(p.x, p.y, mission.ground(p.x, p.y) + p.z),
+            )
+        };
+        let mut text = format!(
+            "wire from {} to {} m above the ground, kept {} m round",
+            w.from.z, w.to.z, w.radius
+        );
+        if let Some(kind) = &o.kind {
+            text = format!("{kind}: {text}");
+        }
+        if let Some(d) = &o.description {
+            text = format!("{text}\n{d}");
+        }
+        return placemark(
+            &o.name,
+            text,
+            Geometry::LineString(kml::types::LineString {
+                coords: vec![end(&w.from), end(&w.to)],
+                altitude_mode: AltitudeMode::Absolute,
+                ..kml::types::LineString::default()
+            }),
+            "obstacle",
+        );
+    }
     let ring_at = |z: f64| {
         let at = |p: &Point2<f64>| absolute(placement, &Point3::new(p.x, p.y, ground + z));
         if o.footprint.is_empty() {
@@ -335,6 +364,13 @@ fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> 
     }
     if o.inspect {
         text.push_str("; inspected (eq. 8)");
+        if let Some(side) = &o.inspect_side {
+            text.push_str(&format!(", its {} face", side.words()));
+        }
+    }
+    // The survey's own words, kept.
+    if let Some(d) = &o.description {
+        text = format!("{text}\n{d}");
     }
     placemark(
         &o.name,
@@ -352,13 +388,21 @@ fn signed_area(v: &[Point2<f64>]) -> f64 {
 }
 
 /// An inspected obstacle's stand-off band [d_min, d_max] from its surface,
-/// as a ring on the ground.
+/// as a ring on the ground: about a cylinder two circles, about a
+/// footprint its outline offset by each (`geo`'s buffer, round corners).
 fn band(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> {
     let [d_min, d_max] = o.stand_off_band(&mission.formation);
-    let outer = circle(&o.center, o.radius + d_max, |p| on_ground(placement, p));
-    let inner = circle(&o.center, o.radius + d_min.max(1e-3), |p| {
-        on_ground(placement, p)
-    });
+    let (outer, inner) = if o.footprint.len() >= 3 {
+        let offset = |d: f64| footprint_offset(&o.footprint, d, |p| on_ground(placement, p));
+        (offset(d_max), offset(d_min.max(1e-3)))
+    } else {
+        (
+            circle(&o.center, o.radius + d_max, |p| on_ground(placement, p)),
+            circle(&o.center, o.radius + d_min.max(1e-3), |p| {
+                on_ground(placement, p)
+            }),
+        )
+    };
     placemark(
         &format!("{} band", o.name),
         format!(
@@ -369,6 +413,37 @@ fn band(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> {
         polygon(outer, vec![inner], AltitudeMode::ClampToGround, false),
         "band",
     )
+}
+
+/// The outline of a footprint grown by `d` metres (round corners), as a
+/// closed ring counter-clockwise, through `at`.
+fn footprint_offset(
+    footprint: &[Point2<f64>],
+    d: f64,
+    at: impl Fn(&Point2<f64>) -> Coord<f64>,
+) -> Vec<Coord<f64>> {
+    use geo::Buffer;
+    let mut ring: Vec<geo::Coord<f64>> = footprint
+        .iter()
+        .map(|p| geo::coord! { x: p.x, y: p.y })
+        .collect();
+    ring.push(ring[0]);
+    let grown = geo::Polygon::new(geo::LineString::new(ring), Vec::new()).buffer(d);
+    let outline: Vec<Point2<f64>> = grown
+        .0
+        .first()
+        .map(|p| {
+            p.exterior()
+                .coords()
+                .map(|c| Point2::new(c.x, c.y))
+                .collect()
+        })
+        .unwrap_or_default();
+    let mut out: Vec<Coord<f64>> = outline.iter().map(&at).collect();
+    if signed_area(&outline) < 0.0 {
+        out.reverse();
+    }
+    out
 }
 
 fn placemark(name: &str, description: String, geometry: Geometry<f64>, style: &str) -> Kml<f64> {

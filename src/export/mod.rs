@@ -120,6 +120,8 @@ pub struct Planned {
     pub loiter_radius: f64,
     /// The run's verdict in one line (`Outcome::headline`), for the KML.
     pub verdict: String,
+    /// Why the files' limits are not the run's (`ExportRules::limits_note`).
+    pub limits_note: Option<String>,
 }
 
 impl Planned {
@@ -146,6 +148,7 @@ impl Planned {
             margin_source: rules.margin_source.into(),
             loiter_radius: rules.loiter_radius,
             verdict: outcome.headline(),
+            limits_note: rules.limits_note,
         }
     }
 
@@ -344,6 +347,9 @@ pub struct Exported {
     pub pipeline: Kind,
     pub tolerance: f64,
     pub tolerance_source: String,
+    /// Why the files' limits are not the run's, when they are not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limits_note: Option<String>,
     pub plans: Vec<VehiclePlan>,
     pub reverification: Reverification,
     /// Written although the flown plans break a constraint (`--force`).
@@ -525,6 +531,7 @@ pub fn export(
         pipeline: planned.pipeline,
         tolerance,
         tolerance_source,
+        limits_note: planned.limits_note.clone(),
         plans,
         reverification,
         forced,

@@ -3,11 +3,14 @@
 //! on its own, so one that does not parse is named by its number and name
 //! rather than failing the file at a byte offset. A `crs` member (the 2008
 //! draft's, which QGIS and GDAL still write) must name WGS-84
-//! longitude/latitude.
+//! longitude/latitude. A position's third coordinate is its altitude above
+//! the WGS-84 ellipsoid (RFC 7946 §3.1.1), unless the feature's
+//! `altitudeMode` property (as GDAL writes a KML's) says otherwise; an
+//! `extrude` property (GDAL's, again) says whether it stands on the ground.
 
 use serde_json::{Map, Value};
 
-use super::{Feature, Shape, Survey};
+use super::{AltitudeMode, Drawn, Feature, Position, Shape, Survey, Vertical};
 
 /// Why a GeoJSON file was not read.
 pub enum Problem {
@@ -72,9 +75,25 @@ pub fn read(text: &str) -> Result<Survey, Problem> {
         match serde_json::from_value::<geojson::Feature>(value) {
             Ok(f) => {
                 feature.properties = f.properties.unwrap_or_default();
-                match &f.geometry {
-                    Some(g) => shapes(&g.value, &mut feature.shapes),
-                    None => feature.unusable = Some("it has no geometry (null)".into()),
+                feature.description = feature
+                    .property("description")
+                    .and_then(Value::as_str)
+                    .map(str::trim)
+                    .filter(|d| !d.is_empty())
+                    .map(str::to_owned);
+                match vertical(&feature) {
+                    Ok(v) => match &f.geometry {
+                        Some(g) => {
+                            let mut found = Vec::new();
+                            shapes(&g.value, &mut found);
+                            feature.shapes = found
+                                .into_iter()
+                                .map(|shape| Drawn { shape, vertical: v })
+                                .collect();
+                        }
+                        None => feature.unusable = Some("it has no geometry (null)".into()),
+                    },
+                    Err(why) => problems.push(format!("{}: {why}", feature.label())),
                 }
                 if feature.shapes.is_empty() && feature.unusable.is_none() {
                     feature.unusable = Some("its geometry is empty".into());
@@ -142,10 +161,11 @@ fn shapes(value: &geojson::GeometryValue, out: &mut Vec<Shape>) {
     use geojson::GeometryValue as G;
     let position = |p: &geojson::Position| {
         let s = p.as_slice();
-        [
-            s.first().copied().unwrap_or(f64::NAN),
-            s.get(1).copied().unwrap_or(f64::NAN),
-        ]
+        Position {
+            lon: s.first().copied().unwrap_or(f64::NAN),
+            lat: s.get(1).copied().unwrap_or(f64::NAN),
+            alt: s.get(2).copied(),
+        }
     };
     let line = |points: &[geojson::Position]| points.iter().map(position).collect::<Vec<_>>();
     let polygon =
@@ -167,4 +187,42 @@ fn shapes(value: &geojson::GeometryValue, out: &mut Vec<Shape>) {
             }
         }
     }
+}
+
+/// How the feature's altitudes are meant: RFC 7946's ellipsoidal height,
+/// or the `altitudeMode` property a KML converted by GDAL carries; its
+/// `extrude` property, when it has one.
+fn vertical(f: &Feature) -> Result<Vertical, String> {
+    let mode = match f
+        .property("altitudeMode")
+        .or_else(|| f.property("altitude_mode"))
+    {
+        None | Some(Value::Null) => AltitudeMode::AboveEllipsoid,
+        Some(Value::String(s)) => match s.trim() {
+            "" => AltitudeMode::AboveEllipsoid,
+            "clampToGround" | "clampToSeaFloor" => AltitudeMode::ClampToGround,
+            "relativeToGround" | "relativeToSeaFloor" => AltitudeMode::RelativeToGround,
+            "absolute" => AltitudeMode::AboveSeaLevel,
+            other => {
+                return Err(format!(
+                    "its `altitudeMode` is \"{other}\": clampToGround, relativeToGround or \
+                     absolute (KML's words)"
+                ));
+            }
+        },
+        Some(other) => return Err(format!("its `altitudeMode` must be text, got {other}")),
+    };
+    let extrude = match f.property("extrude") {
+        None | Some(Value::Null) => None,
+        Some(Value::Bool(b)) => Some(*b),
+        Some(Value::Number(n)) if n.as_f64() == Some(1.0) => Some(true),
+        Some(Value::Number(n)) if n.as_f64() == Some(0.0) => Some(false),
+        Some(Value::String(s)) => match s.trim().to_ascii_lowercase().as_str() {
+            "1" | "true" | "yes" => Some(true),
+            "0" | "false" | "no" => Some(false),
+            _ => return Err(format!("its `extrude` must be true or false, got \"{s}\"")),
+        },
+        Some(other) => return Err(format!("its `extrude` must be true or false, got {other}")),
+    };
+    Ok(Vertical { mode, extrude })
 }

@@ -2,8 +2,12 @@
 //! document order, however deep its Documents and Folders nest (Google
 //! Earth's "My Places" export), the folder it is in as its kind, its
 //! ExtendedData (`Data`/`value` and `SchemaData`/`SimpleData`) as its
-//! properties. A KMZ is a zip: its KML is `doc.kml`, else the first `.kml`
-//! in it (what Google Earth reads).
+//! properties, its description. Each geometry keeps the altitude of every
+//! coordinate (`lon,lat,alt`), its `altitudeMode` and its `extrude`; Google
+//! Earth's `gx:altitudeMode` (`clampToSeaFloor`, `relativeToSeaFloor`) is
+//! read as the ground's (skyform's ground is the ground, sea or not). A KMZ
+//! is a zip: its KML is `doc.kml`, else the first `.kml` in it (what Google
+//! Earth reads).
 
 use std::io::Read;
 
@@ -11,7 +15,7 @@ use kml::types::{Element, Geometry, Placemark};
 use kml::{Kml, KmlReader};
 use serde_json::{Map, Value};
 
-use super::{Feature, Shape, Survey};
+use super::{AltitudeMode, Drawn, Feature, Position, Shape, Survey, Vertical};
 
 pub fn read_kmz(bytes: &[u8]) -> Result<Survey, String> {
     let mut archive = zip::ZipArchive::new(std::io::Cursor::new(bytes))
@@ -41,7 +45,8 @@ pub fn read_kmz(bytes: &[u8]) -> Result<Survey, String> {
 }
 
 pub fn read_kml(text: &str, format: &'static str) -> Result<Survey, String> {
-    let root: Kml<f64> = KmlReader::<_, f64>::from_string(text)
+    let text = normalize_flags(text);
+    let root: Kml<f64> = KmlReader::<_, f64>::from_string(&text)
         .read()
         .map_err(|e| format!("not KML: {e}"))?;
     let mut features = Vec::new();
@@ -75,6 +80,12 @@ fn feature(p: &Placemark<f64>, number: usize, folder: Option<&str>) -> Feature {
             .filter(|n| !n.is_empty())
             .map(str::to_owned),
         folder: folder.map(str::to_owned),
+        description: p
+            .description
+            .as_deref()
+            .map(str::trim)
+            .filter(|d| !d.is_empty())
+            .map(str::to_owned),
         properties: extended_data(&p.children),
         ..Feature::default()
     };
@@ -89,17 +100,49 @@ fn feature(p: &Placemark<f64>, number: usize, folder: Option<&str>) -> Feature {
 }
 
 fn geometry(g: &Geometry<f64>, f: &mut Feature) {
-    let ring = |coords: &[kml::types::Coord<f64>]| -> Vec<[f64; 2]> {
-        coords.iter().map(|c| [c.x, c.y]).collect()
+    let ring = |coords: &[kml::types::Coord<f64>]| -> Vec<Position> {
+        coords
+            .iter()
+            .map(|c| Position {
+                lon: c.x,
+                lat: c.y,
+                alt: c.z,
+            })
+            .collect()
     };
+    let vertical = |mode: kml::types::AltitudeMode, extrude: bool| Vertical {
+        mode: match mode {
+            kml::types::AltitudeMode::ClampToGround => AltitudeMode::ClampToGround,
+            kml::types::AltitudeMode::RelativeToGround => AltitudeMode::RelativeToGround,
+            kml::types::AltitudeMode::Absolute => AltitudeMode::AboveSeaLevel,
+        },
+        extrude: Some(extrude),
+    };
+    let drawn = |shape: Shape, vertical: Vertical| Drawn { shape, vertical };
     match g {
-        Geometry::Point(p) => f.shapes.push(Shape::Point([p.coord.x, p.coord.y])),
-        Geometry::LineString(l) => f.shapes.push(Shape::Line(ring(&l.coords))),
-        Geometry::LinearRing(r) => f.shapes.push(Shape::Polygon(vec![ring(&r.coords)])),
+        Geometry::Point(p) => f.shapes.push(drawn(
+            Shape::Point(Position {
+                lon: p.coord.x,
+                lat: p.coord.y,
+                alt: p.coord.z,
+            }),
+            vertical(p.altitude_mode, p.extrude),
+        )),
+        Geometry::LineString(l) => f.shapes.push(drawn(
+            Shape::Line(ring(&l.coords)),
+            vertical(l.altitude_mode, l.extrude),
+        )),
+        Geometry::LinearRing(r) => f.shapes.push(drawn(
+            Shape::Polygon(vec![ring(&r.coords)]),
+            vertical(r.altitude_mode, r.extrude),
+        )),
         Geometry::Polygon(p) => {
             let mut rings = vec![ring(&p.outer.coords)];
             rings.extend(p.inner.iter().map(|r| ring(&r.coords)));
-            f.shapes.push(Shape::Polygon(rings));
+            f.shapes.push(drawn(
+                Shape::Polygon(rings),
+                vertical(p.altitude_mode, p.extrude),
+            ));
         }
         Geometry::MultiGeometry(m) => m.geometries.iter().for_each(|g| geometry(g, f)),
         Geometry::Element(e) => {
@@ -115,6 +158,43 @@ fn geometry(g: &Geometry<f64>, f: &mut Feature) {
                 .get_or_insert_with(|| "its geometry is of a kind skyform does not read".into());
         }
     }
+}
+
+/// The text with every `altitudeMode` (KML's, `gx:`'s) and `extrude` as
+/// the `kml` crate reads them: trimmed, Google Earth's sea-floor modes as
+/// the ground's, `true`/`false` as `1`/`0`. Nothing else changes.
+fn normalize_flags(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = ["altitudeMode>", "extrude>"]
+        .iter()
+        .filter_map(|tag| rest.find(tag).map(|i| (i, tag.len())))
+        .min()
+    {
+        let (i, len) = at;
+        let open = i + len;
+        // An opening tag (`<altitudeMode>`, `<gx:altitudeMode>`), not a closing one.
+        let is_open = rest[..i]
+            .rfind('<')
+            .is_some_and(|lt| !rest[lt..i].starts_with("</"));
+        out.push_str(&rest[..open]);
+        rest = &rest[open..];
+        if !is_open {
+            continue;
+        }
+        let end = rest.find('<').unwrap_or(rest.len());
+        let value = rest[..end].trim();
+        out.push_str(match value {
+            "clampToSeaFloor" => "clampToGround",
+            "relativeToSeaFloor" => "relativeToGround",
+            "true" => "1",
+            "false" => "0",
+            other => other,
+        });
+        rest = &rest[end..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// `<ExtendedData>`: `<Data name="k"><value>v</value></Data>` and

@@ -1,22 +1,31 @@
 //! A site survey into a mission: obstacles from GeoJSON (RFC 7946) and
-//! KML/KMZ files.
+//! KML/KMZ files, with the heights the tools draw them with.
 //!
 //! A file is read into a [`Survey`] of features in WGS-84 (`geojson.rs`,
 //! `kml.rs`: the georust readers, then the checks a survey must pass:
 //! closed rings, coordinates in range, near the mission's origin). Each
-//! feature becomes obstacles in the mission's ENU frame (`obstacles.rs`):
-//! a point one cylinder, a line a row of them (`cover.rs`), a polygon a
-//! footprint as surveyed, clipped to the bounds; its top, base and whether
-//! it may be flown over read from its properties. The report names the
-//! narrowest aisle between the footprints imported. They join the mission by name (`merge.rs`): importing the same
-//! file again changes nothing, an updated survey updates its obstacles.
+//! position keeps its altitude and each shape the way its altitudes are
+//! meant ([`Vertical`]: KML's `altitudeMode` / `gx:altitudeMode` and
+//! `extrude`; GeoJSON's third coordinate, RFC 7946 §3.1.1). Each feature
+//! becomes obstacles in the mission's ENU frame (`obstacles.rs`, its
+//! heights read in `heights.rs`): a point a post, a polygon a footprint as
+//! surveyed (a block standing on the ground, or a deck or a slab at its
+//! height), a line not extruded (or marked as a power line) a wire at its
+//! height, another line a row of posts (`cover.rs`); all clipped to the
+//! bounds. The report says which reading each feature got and names the
+//! narrowest aisle between the footprints imported. They join the mission by
+//! name (`merge.rs`): importing the same file again changes nothing, an
+//! updated survey updates its obstacles, and one that would lower or thin a
+//! known obstacle says so (the CLI then asks for `--force`).
 //! Reading the file is the only I/O; the CLI and the designer write.
 
 pub mod cover;
 mod geojson;
+mod heights;
 mod kml;
 mod merge;
 mod obstacles;
+mod pieces;
 
 use std::path::Path;
 
@@ -24,17 +33,112 @@ use serde_json::{Map, Value};
 
 use crate::mission::Mission;
 
+pub use heights::{DEFAULT_DECK_THICKNESS, DEFAULT_WIRE_RADIUS, Reading};
 pub use merge::{Change, Changes};
 pub use obstacles::{DEFAULT_LINE_RADIUS, DEFAULT_POINT_RADIUS, HEIGHT_ABOVE_BAND, Note};
 
-/// A shape of a feature, in degrees `[longitude, latitude]` (the order both
-/// GeoJSON and KML write).
+/// One position of a feature: degrees of longitude and latitude (the order
+/// both GeoJSON and KML write) and the altitude written with it, metres,
+/// when there is one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Position {
+    pub lon: f64,
+    pub lat: f64,
+    pub alt: Option<f64>,
+}
+
+impl Position {
+    /// A position without an altitude.
+    pub fn flat(lon: f64, lat: f64) -> Self {
+        Position {
+            lon,
+            lat,
+            alt: None,
+        }
+    }
+}
+
+/// A shape of a feature.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Shape {
-    Point([f64; 2]),
-    Line(Vec<[f64; 2]>),
+    Point(Position),
+    Line(Vec<Position>),
     /// The outer ring, then the holes; each ring closed as written.
-    Polygon(Vec<Vec<[f64; 2]>>),
+    Polygon(Vec<Vec<Position>>),
+}
+
+impl Shape {
+    /// Every position of the shape.
+    pub fn positions(&self) -> Vec<Position> {
+        match self {
+            Shape::Point(p) => vec![*p],
+            Shape::Line(l) => l.clone(),
+            Shape::Polygon(rings) => rings.iter().flatten().copied().collect(),
+        }
+    }
+}
+
+/// What the altitudes written with a shape measure from (KML's
+/// `altitudeMode` and `gx:altitudeMode`; GeoJSON's third coordinate).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AltitudeMode {
+    /// KML's default: the shape lies on the ground, its altitudes unused
+    /// (also `gx:altitudeMode` `clampToSeaFloor`).
+    #[default]
+    ClampToGround,
+    /// Metres above the ground under each position (also
+    /// `relativeToSeaFloor`: skyform's ground is the ground).
+    RelativeToGround,
+    /// KML's `absolute`: metres above mean sea level.
+    AboveSeaLevel,
+    /// GeoJSON's third coordinate: metres above the WGS-84 ellipsoid
+    /// (RFC 7946 §3.1.1).
+    AboveEllipsoid,
+}
+
+impl AltitudeMode {
+    /// As the tool that wrote it names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            AltitudeMode::ClampToGround => "clampToGround",
+            AltitudeMode::RelativeToGround => "relativeToGround",
+            AltitudeMode::AboveSeaLevel => "absolute",
+            AltitudeMode::AboveEllipsoid => "above the WGS-84 ellipsoid, RFC 7946",
+        }
+    }
+}
+
+/// How a shape's altitudes are meant: from what they measure, and whether
+/// the shape is extruded down to the ground (KML's `extrude`; `None` where
+/// the format has no such flag, GeoJSON without an `extrude` property).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Vertical {
+    pub mode: AltitudeMode,
+    pub extrude: Option<bool>,
+}
+
+/// A shape as drawn: its positions and how their altitudes are meant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Drawn {
+    pub shape: Shape,
+    pub vertical: Vertical,
+}
+
+impl Drawn {
+    /// A shape with no altitudes (clamped to the ground).
+    pub fn flat(shape: Shape) -> Self {
+        Drawn {
+            shape,
+            vertical: Vertical::default(),
+        }
+    }
+
+    /// Whether the shape's altitudes mean anything: a mode other than
+    /// clamped to the ground, and at least one position with an altitude.
+    pub fn has_altitudes(&self) -> bool {
+        self.vertical.mode != AltitudeMode::ClampToGround
+            && self.shape.positions().iter().any(|p| p.alt.is_some())
+    }
 }
 
 /// One feature of a survey: a GeoJSON Feature, a KML Placemark.
@@ -47,7 +151,9 @@ pub struct Feature {
     pub properties: Map<String, Value>,
     /// The KML folder it is in, the kind when it gives none.
     pub folder: Option<String>,
-    pub shapes: Vec<Shape>,
+    /// Its free text (KML's `description`, a `description` property).
+    pub description: Option<String>,
+    pub shapes: Vec<Drawn>,
     /// Why it has no usable geometry, when it has none.
     pub unusable: Option<String>,
 }
@@ -107,6 +213,8 @@ pub struct Imported {
     pub changes: Changes,
     /// Per polygon and line: the cylinders made and what they add.
     pub notes: Vec<Note>,
+    /// How each feature's heights were read.
+    pub readings: Vec<Reading>,
     /// Features listed, not imported: outside the bounds, no usable geometry.
     pub skipped: Vec<String>,
     /// Defaults assumed (no radius, no height), grouped.
@@ -172,8 +280,14 @@ fn looks_like_xml(bytes: &[u8]) -> bool {
 /// range, rings closed and long enough (RFC 7946 3.1.6; KML's LinearRing).
 fn check_feature(f: &Feature) -> Vec<String> {
     let mut problems = Vec::new();
-    let check_position = |p: &[f64; 2], problems: &mut Vec<String>| {
-        let [lon, lat] = *p;
+    let check_position = |p: &Position, problems: &mut Vec<String>| {
+        let (lon, lat) = (p.lon, p.lat);
+        if p.alt.is_some_and(|a| !a.is_finite()) {
+            problems.push(format!(
+                "{}: the altitude at ({lon}, {lat}) is not a number",
+                f.label()
+            ));
+        }
         if !(lon.is_finite() && lat.is_finite()) {
             problems.push(format!(
                 "{}: coordinate ({lon}, {lat}) is not a number",
@@ -192,8 +306,8 @@ fn check_feature(f: &Feature) -> Vec<String> {
             ));
         }
     };
-    for shape in &f.shapes {
-        match shape {
+    for drawn in &f.shapes {
+        match &drawn.shape {
             Shape::Point(p) => check_position(p, &mut problems),
             Shape::Line(points) => points.iter().for_each(|p| check_position(p, &mut problems)),
             Shape::Polygon(rings) => {
@@ -211,15 +325,17 @@ fn check_feature(f: &Feature) -> Vec<String> {
                             f.label(),
                             ring.len()
                         )),
-                        (Some(a), Some(b)) if a != b => problems.push(format!(
-                            "{}: {which} does not close: it starts at ({}, {}) and ends at \
+                        (Some(a), Some(b)) if (a.lon, a.lat) != (b.lon, b.lat) => {
+                            problems.push(format!(
+                                "{}: {which} does not close: it starts at ({}, {}) and ends at \
                              ({}, {}); the last position must repeat the first",
-                            f.label(),
-                            a[0],
-                            a[1],
-                            b[0],
-                            b[1]
-                        )),
+                                f.label(),
+                                a.lon,
+                                a.lat,
+                                b.lon,
+                                b.lat
+                            ))
+                        }
                         _ => {}
                     }
                 }
@@ -250,6 +366,7 @@ pub fn import(mission: &Mission, survey: &Survey, stem: &str) -> Result<Imported
         features: survey.features.len(),
         changes,
         notes: made.notes,
+        readings: made.readings,
         skipped: made.skipped,
         warnings: made.warnings,
         aisle,
@@ -327,6 +444,12 @@ impl Imported {
         }
         for note in &self.notes {
             out.push_str(&format!("  {note}\n"));
+        }
+        for reading in &self.readings {
+            out.push_str(&format!("  read {reading}\n"));
+        }
+        for loss in &c.losses {
+            out.push_str(&format!("  loss: {loss}\n"));
         }
         for s in &self.skipped {
             out.push_str(&format!("  skipped {s}\n"));

@@ -8,6 +8,7 @@ mod file;
 pub mod geodesy;
 pub mod geodetic;
 mod model;
+mod obstacle;
 mod presets;
 mod read;
 mod source;
@@ -22,6 +23,7 @@ pub use file::{
     to_toml_string,
 };
 pub use model::*;
+pub use obstacle::*;
 pub use presets::{
     Preset, max_pair_distance, min_pair_distance, rescale, reshape, resize_custom, round_mm,
     smallest_scale, spacing_of,

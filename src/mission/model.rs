@@ -13,6 +13,8 @@
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
+use super::obstacle::Obstacle;
+
 /// A complete mission: the operating space, what is in it, the formation that
 /// flies it, and the parameters of the three planning pipelines.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -246,59 +248,59 @@ impl Bounds {
     }
 }
 
-/// A vertical prism from `base` (the ground unless set) up to `height`: a
-/// cylinder (`center`, `radius`), or a polygon `footprint` (a building, a
-/// transformer bay), whose bounding circle `center` and `radius` then are.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Obstacle {
-    pub name: String,
-    /// Axis position, metres ENU; derived from the footprint when there is
-    /// one (then the file may leave it out).
-    #[serde(default = "unset_point")]
-    pub center: Point2<f64>,
-    /// Metres; derived from the footprint when there is one.
-    #[serde(default = "unset")]
-    pub radius: f64,
-    /// A simple polygon's vertices, metres ENU, either winding, not closed;
-    /// empty for a cylinder.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub footprint: Vec<Point2<f64>>,
-    /// Its top, metres above ground.
-    pub height: f64,
-    /// Its underside, metres above ground: 0 for what stands on the ground,
-    /// the clear height under a deck or a gantry beam otherwise.
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub base: f64,
-    /// May the formation fly over its top? `false` for live equipment or
-    /// people: the planner then treats it as reaching the sky.
-    #[serde(default = "yes", skip_serializing_if = "is_yes")]
-    pub overfly: bool,
-    /// Metres the formation keeps above its top when it flies over, beyond
-    /// r_Q and the margins (a roof's aerials, a crane's swing): the planner
-    /// treats it as that much taller.
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub clearance_above: f64,
-    /// Free label ("pier", "pole", "tree", …), for display only.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kind: Option<String>,
-    /// Inspect this obstacle's surface (θ-PSO eq. 8): the plan flies the
-    /// formation past it so that the UAV facing it stays within the stand-off
-    /// band over a pass of `formation.inspection_pass` metres.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub inspect: bool,
-    /// [d_min^s, d_max^s] for this obstacle, metres from its surface (eq. 8);
-    /// `formation.surface_distance` when absent.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stand_off: Option<[f64; 2]>,
-}
-
-/// Where the formation centroid starts and ends. Metres ENU.
+/// Where the formation centroid starts and ends, and what it must pass on
+/// the way, in order. Metres ENU.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Route {
     pub start: Point3<f64>,
     pub goal: Point3<f64>,
+    /// The passages and points the route must take, in this order
+    /// (`[[route.via]]`): a plan keeps every one or is refused naming it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub via: Vec<Via>,
+}
+
+/// One place the route must take: between two named obstacles (a gate),
+/// or by a point within a radius.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Via {
+    /// The two obstacles the route passes between (`between = ["pier 3",
+    /// "pier 4"]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub between: Option<[String; 2]>,
+    /// A point the centroid passes, metres ENU (z above the ground).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<Point3<f64>>,
+    /// How near the centroid passes `point`, metres (1 m by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+}
+
+/// A via point's radius when the file gives none, metres.
+pub const DEFAULT_VIA_RADIUS: f64 = 1.0;
+
+impl Via {
+    /// How near the centroid must pass a via point, metres.
+    pub fn radius(&self) -> f64 {
+        self.radius.unwrap_or(DEFAULT_VIA_RADIUS)
+    }
+
+    /// As people read it: `between 'pier 3' and 'pier 4'`, `by (40, 10, 12)`.
+    pub fn label(&self) -> String {
+        match (&self.between, &self.point) {
+            (Some([a, b]), _) => format!("between '{a}' and '{b}'"),
+            (None, Some(p)) => format!(
+                "by ({}, {}, {}) within {} m",
+                crate::mission::compact(p.x),
+                crate::mission::compact(p.y),
+                crate::mission::compact(p.z),
+                crate::mission::compact(self.radius())
+            ),
+            (None, None) => "(nothing)".to_owned(),
+        }
+    }
 }
 
 /// The formation flown by the θ-PSO pipeline (θ-PSO paper, Section III).
@@ -639,23 +641,23 @@ pub struct WaypointChoice {
 
 /// A centre or a radius the file left out: NaN, which validation names
 /// unless a footprint sets them.
-fn unset() -> f64 {
+pub(super) fn unset() -> f64 {
     f64::NAN
 }
 
-fn unset_point() -> Point2<f64> {
+pub(super) fn unset_point() -> Point2<f64> {
     Point2::new(f64::NAN, f64::NAN)
 }
 
-fn is_yes(b: &bool) -> bool {
+pub(super) fn is_yes(b: &bool) -> bool {
     *b
 }
 
-fn is_zero(x: &f64) -> bool {
+pub(super) fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
-fn yes() -> bool {
+pub(super) fn yes() -> bool {
     true
 }
 
@@ -839,14 +841,59 @@ impl Default for FlatloParams {
     }
 }
 
-/// One target of the fleet's timed sequence.
+/// One target of the fleet's timed sequence: a point the formation forms
+/// around (`position`), or one point per agent (`positions`), which agent
+/// to which the planner assigns.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FleetTarget {
     /// When the target becomes active, s.
     pub time: f64,
-    /// Target point P_d in the flight plane, metres ENU.
+    /// Target point P_d in the flight plane, metres ENU: the fleet forms
+    /// around it (d_ip^d from it, d_ij^d apart).
+    #[serde(default = "unset_point", skip_serializing_if = "is_unset_point")]
     pub position: Point2<f64>,
+    /// One target point per agent, metres ENU: each agent flies to the one
+    /// the planner assigns it (the least total distance), the formation
+    /// being their arrangement.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub positions: Vec<Point2<f64>>,
+}
+
+impl FleetTarget {
+    /// A target the formation forms around.
+    pub fn around(time: f64, position: Point2<f64>) -> Self {
+        FleetTarget {
+            time,
+            position,
+            positions: Vec::new(),
+        }
+    }
+
+    /// Where it is on the map: its point, or the middle of its points.
+    pub fn centre(&self) -> Point2<f64> {
+        if self.positions.is_empty() {
+            self.position
+        } else {
+            let sum: Vector2<f64> = self.positions.iter().map(|p| p.coords).sum();
+            Point2::from(sum / self.positions.len() as f64)
+        }
+    }
+
+    /// Moves it (every point of it) so its centre is at `p`.
+    pub fn move_to(&mut self, p: Point2<f64>) {
+        let by = p - self.centre();
+        for q in &mut self.positions {
+            *q += by;
+        }
+        if self.positions.is_empty() {
+            self.position = p;
+        }
+    }
+}
+
+fn is_unset_point(p: &Point2<f64>) -> bool {
+    p.x.is_nan() && p.y.is_nan()
 }
 
 /// A push on one agent, as in the disturbance experiment (fleet paper, 4.2).
@@ -901,8 +948,10 @@ pub struct FleetParams {
     pub social: f64,
     /// Simulation step of the quadrotor dynamics, s.
     pub sim_step: f64,
-    /// Simulated duration, s.
-    pub duration: f64,
+    /// Simulated duration, s; absent: as long as the fleet needs at its
+    /// cruise speed to reach its last target ([`FleetParams::run_duration`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub duration: Option<f64>,
     /// Quadrotor mass, kg (Parrot AR.Drone 2).
     pub mass: f64,
     /// Diagonal of the inertia matrix J, kg·m².
@@ -1016,7 +1065,7 @@ impl Default for FleetParams {
             cognitive: 1.49618,
             social: 1.49618,
             sim_step: 0.005,
-            duration: 40.0,
+            duration: None,
             mass: 0.42,
             inertia_diag: Vector3::new(0.0022, 0.0029, 0.0048),
             position_gains: [4.0, 3.0],
@@ -1032,100 +1081,36 @@ impl Default for FleetParams {
     }
 }
 
-impl Obstacle {
-    /// The eq. 8 band for this obstacle: its own, or the formation's.
-    pub fn stand_off_band(&self, formation: &Formation) -> [f64; 2] {
-        self.stand_off.unwrap_or(formation.surface_distance)
-    }
+/// The longest a fleet run lasts when `fleet.duration` is left out, s:
+/// ten minutes of flight, well within the run's budget for the fleets the
+/// limits allow (a longer one is written, and `check` says when it is needed).
+pub const AUTO_DURATION_MAX: f64 = 600.0;
 
-    /// The top the planner keeps under the formation: the sky when it may
-    /// not be flown over.
-    pub fn top(&self) -> f64 {
-        if self.overfly {
-            self.height + self.clearance_above.max(0.0)
+impl FleetParams {
+    /// The speed an agent cruises at on its way, m/s: its reference is at
+    /// most h_max ahead on each axis, and the position law (eq. 11) flies
+    /// it at K_p / K_d of the distance to it in the steady state.
+    pub fn cruise_speed(&self) -> f64 {
+        let [kp, kd] = self.position_gains;
+        if kd > 0.0 {
+            kp / kd * self.step_max
         } else {
-            f64::INFINITY
+            self.step_max / self.replan_period.max(1e-9)
         }
     }
 
-    /// Does it stand in the way of a UAV at altitude `z` (between its base
-    /// and its top)?
-    pub fn spans(&self, z: f64) -> bool {
-        self.base < z && z < self.top()
-    }
-
-    /// Does any of it lie within the altitudes `band`?
-    pub fn within(&self, band: [f64; 2]) -> bool {
-        self.top() > band[0] && self.base < band[1]
-    }
-
-    /// Does it close the altitudes `band` to a UAV that keeps `clearance`
-    /// from it: no room over its top, nor under its base?
-    pub fn closes(&self, band: [f64; 2], clearance: f64) -> bool {
-        self.top() + clearance > band[1] && self.base - clearance < band[0]
-    }
-
-    /// The solid the planner keeps clear of: up to the sky when it may not
-    /// be flown over.
-    pub fn prism(&self) -> crate::base::geometry::Prism {
-        crate::base::geometry::Prism {
-            center: self.center,
-            radius: self.radius,
-            polygon: self.footprint.as_slice().into(),
-            base: self.base,
-            height: self.top(),
-        }
-    }
-
-    /// A polygon's `center` and `radius` are its bounding circle's: set
-    /// them from the footprint (after reading a file, after an edit of a
-    /// vertex).
-    pub fn settle(&mut self) {
-        if self.footprint.len() >= 3 {
-            (self.center, self.radius) = crate::base::geometry::bounding_circle(&self.footprint);
-        }
-    }
-
-    /// Moves the obstacle, its footprint with it, so its centre is at `p`.
-    pub fn move_to(&mut self, p: Point2<f64>) {
-        let by = p - self.center;
-        for v in &mut self.footprint {
-            *v += by;
-        }
-        self.center = p;
-    }
-
-    /// Sets the radius; a footprint is scaled about the centre to match.
-    pub fn set_radius(&mut self, radius: f64) {
-        if !self.footprint.is_empty() && self.radius > 0.0 && radius.is_finite() && radius > 0.0 {
-            let k = radius / self.radius;
-            for v in &mut self.footprint {
-                *v = self.center + (*v - self.center) * k;
+    /// The simulated duration: `duration` when written, else the last
+    /// target's time plus twice the time the farthest agent needs to reach
+    /// it at the cruise speed (`farthest`, metres) and 20 s to settle,
+    /// rounded up to a whole 10 s, at most [`AUTO_DURATION_MAX`].
+    pub fn run_duration(&self, last_target: f64, farthest: f64) -> f64 {
+        match self.duration {
+            Some(d) => d,
+            None => {
+                let travel = 2.0 * farthest / self.cruise_speed().max(1e-6);
+                (((last_target.max(0.0) + travel + 20.0) / 10.0).ceil() * 10.0)
+                    .min(AUTO_DURATION_MAX)
             }
-        }
-        self.radius = radius;
-    }
-
-    /// A cylinder standing on the ground, to be overflown: the fields every
-    /// obstacle has, with the rest at their defaults.
-    pub fn standing(
-        name: impl Into<String>,
-        center: Point2<f64>,
-        radius: f64,
-        height: f64,
-    ) -> Self {
-        Obstacle {
-            name: name.into(),
-            center,
-            radius,
-            height,
-            footprint: Vec::new(),
-            base: 0.0,
-            overfly: true,
-            clearance_above: 0.0,
-            kind: None,
-            inspect: false,
-            stand_off: None,
         }
     }
 }

@@ -103,6 +103,9 @@ pub struct ExportRules {
     pub margin_source: &'static str,
     /// Fixed-wing loiter radius at the end, metres.
     pub loiter_radius: f64,
+    /// Why the files are held to other limits than the run's verification
+    /// (said in the export's summary), when they are.
+    pub limits_note: Option<String>,
 }
 
 /// How a run may use the machine (not what to plan: that is the mission,

@@ -10,6 +10,19 @@ pub const OBSTACLES: &str = "world/obstacles";
 /// Obstacles with a polygon footprint, one mesh each (`world/footprints/<k>`,
 /// k the obstacle's index in the mission).
 pub const FOOTPRINTS: &str = "world/footprints";
+/// Wires (power lines, cables) as lines at their height, labelled.
+pub const WIRES: &str = "world/wires";
+
+/// A footprint's entity, named after its obstacle (`world/footprints/pier 3`,
+/// the name escaped as Rerun needs it).
+pub fn footprint(name: &str) -> rerun::EntityPath {
+    let mut parts: Vec<rerun::EntityPathPart> = FOOTPRINTS
+        .split('/')
+        .map(rerun::EntityPathPart::from)
+        .collect();
+    parts.push(rerun::EntityPathPart::from(name));
+    rerun::EntityPath::from(parts)
+}
 pub const INSPECTION: &str = "world/inspection";
 pub const ROUTE: &str = "world/route";
 pub const TERRAIN: &str = "world/terrain";

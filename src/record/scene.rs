@@ -72,13 +72,32 @@ pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStrea
         )
         .with_labels(["altitude band"]),
     )?;
-    for (k, o) in m.obstacles.iter().enumerate() {
+    for o in m.obstacles.iter().filter(|o| !o.is_wire()) {
         if let Some(mesh) = footprint_mesh(o) {
             stream.log_static(
-                format!("{}/{k}", paths::FOOTPRINTS),
+                paths::footprint(&o.name),
                 &mesh.with_albedo_factor(obstacle_color(o).0),
             )?;
         }
+    }
+    let wires: Vec<_> = m
+        .obstacles
+        .iter()
+        .filter_map(|o| Some((o, o.wire.as_ref()?)))
+        .collect();
+    if !wires.is_empty() {
+        stream.log_static(
+            paths::WIRES,
+            &rerun::LineStrips3D::new(wires.iter().map(|(_, w)| {
+                [
+                    [w.from.x as f32, w.from.y as f32, w.from.z as f32],
+                    [w.to.x as f32, w.to.y as f32, w.to.z as f32],
+                ]
+            }))
+            .with_radii(wires.iter().map(|(_, w)| w.radius as f32))
+            .with_labels(wires.iter().map(|(o, _)| o.name.clone()))
+            .with_colors(wires.iter().map(|_| rerun::Color::from_rgb(230, 160, 40))),
+        )?;
     }
     let o: Vec<_> = m
         .obstacles

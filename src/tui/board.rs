@@ -288,10 +288,46 @@ impl JobBoard {
     }
 
     /// `G`: flies the shown job's plan (θ-PSO or the fleet) in the
-    /// mission's `[flight]` air on a worker thread.
+    /// mission's `[flight]` air on a worker thread. A live plan on the map
+    /// is kept as a job of its own first (the next edit replaces the live
+    /// one), and that job is flown.
     fn flight_check(&mut self, status: &mut StatusLine) {
+        if let Some(live) = self.shown.filter(|id| Live::owns(*id)) {
+            match self
+                .live
+                .latest()
+                .filter(|j| j.id == live && j.outcome.is_some())
+            {
+                Some(plan) => {
+                    let id = self.jobs.last().map_or(1, |j| j.id + 1);
+                    let mut kept = Job::new(
+                        id,
+                        plan.pipeline,
+                        plan.seed,
+                        plan.mission.clone(),
+                        plan.started,
+                    );
+                    kept.state = plan.state.clone();
+                    kept.stage = plan.stage.clone();
+                    kept.progress = plan.progress;
+                    kept.convergence = plan.convergence.clone();
+                    kept.outcome = plan.outcome.clone();
+                    kept.ended = plan.ended;
+                    self.jobs.push(kept);
+                    self.cursor = self.jobs.len() - 1;
+                    self.shown = Some(id);
+                    status.say(format!("{} kept as job {id}", super::live::label(live)));
+                }
+                None => {
+                    status.error("flight check: the live plan is still coming; G again once it is on the map");
+                    return;
+                }
+            }
+        }
         let Some(id) = self.shown.filter(|id| !Live::owns(*id)) else {
-            status.error("flight check: run a plan first (r), then G flies it");
+            status.error(
+                "flight check: no plan on the map: run one first (r), or turn live planning on (L)",
+            );
             return;
         };
         let Some(job) = self.jobs.iter_mut().find(|j| j.id == id) else {

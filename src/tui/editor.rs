@@ -350,14 +350,16 @@ impl Editor {
             Item::Fleet | Item::FleetTarget(_) => {
                 // A new target 10 s after the last, 1 m east of it.
                 let next = match self.mission().fleet.targets.last() {
-                    Some(t) => FleetTarget {
-                        time: t.time + 10.0,
-                        position: t.position + Vector2::new(1.0, 0.0),
-                    },
-                    None => FleetTarget {
-                        time: 0.0,
-                        position: crate::pipelines::fleet::default_target(self.mission()),
-                    },
+                    Some(t) => {
+                        let mut next = t.clone();
+                        next.time = t.time + 10.0;
+                        next.move_to(t.centre() + Vector2::new(1.0, 0.0));
+                        next
+                    }
+                    None => FleetTarget::around(
+                        0.0,
+                        crate::pipelines::fleet::default_target(self.mission()),
+                    ),
                 };
                 self.edit(status, |m| m.fleet.targets.push(next));
                 self.select(Item::FleetTarget(self.mission().fleet.targets.len() - 1));
@@ -656,7 +658,7 @@ impl Editor {
             Item::Start => Some(m.route.start.xy()),
             Item::Goal => Some(m.route.goal.xy()),
             Item::Slot(i) => m.formation.slots.get(*i).map(|s| Point2::new(s.x, s.y)),
-            Item::FleetTarget(i) => m.fleet.targets.get(*i).map(|t| t.position),
+            Item::FleetTarget(i) => m.fleet.targets.get(*i).map(|t| t.centre()),
             _ => None,
         }
     }
@@ -869,7 +871,7 @@ fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
         }
         Item::FleetTarget(i) => {
             if let Some(t) = m.fleet.targets.get_mut(*i) {
-                t.position = p;
+                t.move_to(p);
             }
         }
         _ => {}

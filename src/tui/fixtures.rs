@@ -43,6 +43,9 @@ pub fn crowded_mission(n: usize) -> Mission {
                 kind: Some("post".into()),
                 inspect: false,
                 stand_off: None,
+                description: None,
+                wire: None,
+                inspect_side: None,
             }
         })
         .collect();
@@ -67,6 +70,9 @@ pub fn bridge_with_oaks() -> Mission {
         kind: Some(kind.into()),
         inspect: false,
         stand_off: None,
+        description: None,
+        wire: None,
+        inspect_side: None,
     };
     for k in 0..114 {
         let (column, row) = (k % 19, k / 19);

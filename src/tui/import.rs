@@ -55,7 +55,16 @@ pub fn import(editor: &mut Editor, cwd: &Path, input: &str, status: &mut StatusL
         text.push_str(" (defaults assumed: see `skyform import`)");
     }
     let errors = editor.doc().error_count();
-    if errors > errors_before {
+    if let Some(first) = c.losses.first() {
+        // Undoable here, but never quiet: the first loss named, the count.
+        let more = c.losses.len() - 1;
+        let more = if more > 0 {
+            format!(" and {more} more")
+        } else {
+            String::new()
+        };
+        status.error(format!("{text}; {first}{more}: u undoes"));
+    } else if errors > errors_before {
         status.error(format!(
             "{text}; {} new error(s), see the inspector; u undoes",
             errors - errors_before

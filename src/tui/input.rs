@@ -270,7 +270,7 @@ fn hit(
                 }
             }
             for (i, t) in m.fleet.targets.iter().enumerate() {
-                let d = (t.position - p).norm();
+                let d = (t.centre() - p).norm();
                 if d <= tolerance * 1.5 {
                     consider(d - tolerance * 2.0, Item::FleetTarget(i));
                 }

@@ -327,6 +327,9 @@ fn generate(index: u64, wide: bool) -> Site {
             kind: Some("wall".into()),
             inspect: false,
             stand_off: None,
+            description: None,
+            wire: None,
+            inspect_side: None,
         });
     }
 
@@ -425,6 +428,9 @@ fn generate(index: u64, wide: bool) -> Site {
             kind: None,
             inspect,
             stand_off: None,
+            description: None,
+            wire: None,
+            inspect_side: None,
         });
     }
     let mut towers = inspect_placed;

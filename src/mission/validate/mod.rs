@@ -16,6 +16,7 @@ use crate::mission::model::{
 
 use crate::mission::model::GRAVITY as G;
 
+mod fleet;
 mod flight;
 mod formation;
 mod pipelines;

@@ -38,11 +38,84 @@ impl Checker {
     }
 
     pub(super) fn route(&mut self, path: &FieldPath, mission: &Mission) {
-        let Route { start, goal } = &mission.route;
+        let Route { start, goal, via } = &mission.route;
         self.route_point(path.key("start"), "start", start, mission);
         self.route_point(path.key("goal"), "goal", goal, mission);
         if (goal - start).norm() < 1e-9 {
             self.error(path.key("goal"), "is the same point as the start");
+        }
+        for (i, v) in via.iter().enumerate() {
+            self.via(path.key("via").index(i), v, mission);
+        }
+    }
+
+    /// One `[[route.via]]`: a gate between two obstacles that exist (and
+    /// are two), or a point in the bounds with a positive radius.
+    fn via(&mut self, path: FieldPath, v: &crate::mission::Via, mission: &Mission) {
+        match (&v.between, &v.point) {
+            (Some(_), Some(_)) => self.error(
+                path.key("point"),
+                "a via is `between` two obstacles or a `point`, not both: write two [[route.via]]",
+            ),
+            (None, None) => self.error(
+                path,
+                "says nowhere to pass: give `between = [\"a\", \"b\"]` (two obstacles' names) \
+                 or `point = [x, y, z]`",
+            ),
+            (Some(pair), None) => {
+                for (k, name) in pair.iter().enumerate() {
+                    if !mission.obstacles.iter().any(|o| &o.name == name) {
+                        let near = crate::mission::nearest_name(
+                            name,
+                            mission.obstacles.iter().map(|o| o.name.as_str()),
+                        );
+                        self.error(
+                            path.key("between").index(k),
+                            format!(
+                                "no obstacle is named '{name}'{}",
+                                near.map(|n| format!(" (did you mean '{n}'?)"))
+                                    .unwrap_or_default()
+                            ),
+                        );
+                    }
+                }
+                if pair[0] == pair[1] {
+                    self.error(
+                        path.key("between").index(1),
+                        "names the same obstacle twice: a gate is between two",
+                    );
+                }
+                if v.radius.is_some() {
+                    self.warning(
+                        path.key("radius"),
+                        "a gate's width is the gap between its obstacles: the radius is not used",
+                    );
+                }
+            }
+            (None, Some(p)) => {
+                if p.iter().all(|c| c.is_finite()) {
+                    let b = &mission.bounds;
+                    if !b.contains(p) {
+                        self.error(
+                            path.key("point"),
+                            format!(
+                                "({}, {}, {}) is outside the bounds x {:?}, y {:?}, z {:?}",
+                                compact(p.x),
+                                compact(p.y),
+                                compact(p.z),
+                                b.x,
+                                b.y,
+                                b.z
+                            ),
+                        );
+                    }
+                } else {
+                    self.error(path.key("point"), "must be three finite numbers");
+                }
+                if let Some(r) = v.radius {
+                    self.positive(path.key("radius"), r, " m");
+                }
+            }
         }
     }
 
@@ -164,7 +237,7 @@ impl Checker {
 
     /// The `[[obstacles]]` rows: their count, then each row's keys.
     ///
-    /// Long (~150 lines) because it is one pass over the rows with one rule per key of an
+    /// Long (~195 lines) because it is one pass over the rows with one rule per key of an
     /// obstacle (stand-off, inspect, name, center and radius or footprint, heights, the
     /// bounds), each naming its field; the footprint's own rules are already `footprint`.
     pub(super) fn obstacles(&mut self, path: &FieldPath, mission: &Mission) {
@@ -235,6 +308,20 @@ impl Checker {
                     ),
                 );
             }
+            if let Some(w) = &o.wire {
+                self.wire(at.key("wire"), w, bounds);
+                if o.inspect {
+                    self.error(
+                        at.key("inspect"),
+                        format!(
+                            "'{}' is a wire: eq. 8's stand-off is measured from a surface, \
+                             inspect its towers instead",
+                            o.name
+                        ),
+                    );
+                }
+                continue;
+            }
             if o.footprint.is_empty() {
                 for (key, unset) in [
                     ("center", !o.center.iter().all(|v| v.is_finite())),
@@ -244,12 +331,44 @@ impl Checker {
                         self.error(
                             at.key(key),
                             "missing or not a finite number: a cylinder needs `center` and `radius` (a \
-                             building or a bay may give `footprint = [[x, y], …]` instead)",
+                             building or a bay may give `footprint = [[x, y], …]` instead, a power \
+                             line `wire = { from = [x, y, z], to = [x, y, z] }`)",
                         );
                     }
                 }
             } else {
                 self.footprint(at.key("footprint"), o, bounds);
+            }
+            if o.height.is_nan() {
+                self.error(
+                    at.key("height"),
+                    "missing: every obstacle but a wire needs its top, metres above the ground",
+                );
+            }
+            if let Some(side) = &o.inspect_side {
+                match side.bearing() {
+                    None => self.error(
+                        at.key("inspect_side"),
+                        format!(
+                            "'{}' is no side: a bearing in degrees clockwise from north (90 is \
+                             east) or a compass point ({})",
+                            side.label(),
+                            crate::mission::Side::NAMES
+                                .iter()
+                                .map(|(n, _, _)| format!("\"{n}\""))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
+                    ),
+                    Some(_) if !o.inspect => self.warning(
+                        at.key("inspect_side"),
+                        format!(
+                            "'{}' is not inspected (`inspect = true`): the side is not used",
+                            o.name
+                        ),
+                    ),
+                    Some(_) => {}
+                }
             }
             self.positive(at.key("radius"), o.radius, " m");
             self.positive(at.key("height"), o.height, " m");
@@ -313,6 +432,57 @@ impl Checker {
                     self.warning(at.key("radius"), "the cylinder reaches outside the bounds");
                 }
             }
+        }
+    }
+
+    /// A wire: finite ends at or above the ground, a positive radius, some
+    /// of it over the bounds (a span may run beyond them: a power line
+    /// crosses the whole site).
+    fn wire(&mut self, path: FieldPath, w: &crate::mission::Wire, bounds: &Bounds) {
+        let mut finite = true;
+        for (key, end) in [("from", &w.from), ("to", &w.to)] {
+            for (k, v) in end.iter().enumerate() {
+                if !v.is_finite() {
+                    self.error(path.key(key).index(k), "must be a finite number");
+                    finite = false;
+                }
+            }
+            if end.z.is_finite() && end.z < 0.0 {
+                self.error(
+                    path.key(key).index(2),
+                    format!(
+                        "{} m is below the ground: a wire's z is its height above it",
+                        end.z
+                    ),
+                );
+            }
+        }
+        if !(w.radius.is_finite() && w.radius > 0.0) {
+            self.error(
+                path.key("radius"),
+                format!("must be a positive number of metres, is {}", w.radius),
+            );
+        }
+        if finite && (w.from - w.to).norm() < 1e-6 {
+            self.error(
+                path.key("to"),
+                "is the same point as `from`: a span needs two ends",
+            );
+        }
+        if !finite {
+            return;
+        }
+        // Any point of the span over the box (its ends, or a crossing of a side).
+        let (a, b) = (w.from.xy(), w.to.xy());
+        let over = (0..=64).any(|k| bounds.contains_xy(&(a + (b - a) * (k as f64 / 64.0))));
+        if !over {
+            self.error(
+                path,
+                format!(
+                    "runs outside the bounds x {:?}, y {:?}: no part of it is over them",
+                    bounds.x, bounds.y
+                ),
+            );
         }
     }
 

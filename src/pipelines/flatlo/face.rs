@@ -249,6 +249,7 @@ impl PipelineOutcome for FlatloOutcome {
                 .map(|a| a.tracking_max)
                 .fold(0.0, f64::max),
             margin_source: "the simulated squadron's largest tracking error",
+            limits_note: None,
             loiter_radius: p.turn_radius,
         }
     }

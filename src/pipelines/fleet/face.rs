@@ -82,6 +82,12 @@ impl Pipeline for Fleet {
         super::budget(mission)
     }
 
+    /// A written `fleet.duration` shorter than the fleet needs to reach its
+    /// last target at its cruise speed.
+    fn findings(&self, mission: &Mission) -> Vec<Diagnostic> {
+        super::duration_finding(mission).into_iter().collect()
+    }
+
     fn over_live_limits(&self, _: &Mission) -> Vec<String> {
         vec!["the fleet simulates for seconds: never live".to_owned()]
     }
@@ -116,10 +122,11 @@ impl PipelineOutcome for FleetOutcome {
     }
 
     /// Every pair (a lost agent where it was last heard) and every obstacle
-    /// kept at c, no agent lost, every target's formation reached. Fails on
-    /// the first broken one, in words; when agents were lost and that is
-    /// not the first, they are named after it. A cancelled run has flown
-    /// only part of the way: no verdict.
+    /// kept at c, no agent lost, every target's formation reached (by the
+    /// agents still flying: a lost one is left out of it). Fails on the
+    /// first broken one, in words; an agent lost is named with how its
+    /// survivors did. A cancelled run has flown only part of the way: no
+    /// verdict.
     fn verdict(&self) -> Verdict {
         if self.header.completion == Completion::Cancelled {
             return Verdict::Cancelled;
@@ -140,8 +147,14 @@ impl PipelineOutcome for FleetOutcome {
                 c.time,
                 self.safety_distance
             )
-        } else if let Some(lost) = &lost {
-            return Verdict::Failed(lost.clone());
+        } else if let Some(lost) = &lost
+            && self.targets.iter().all(|t| t.converged_after.is_some())
+        {
+            // A contingency the run must report, with how the survivors did.
+            return Verdict::Failed(format!(
+                "{lost}; the {} survivors (it left out) reached every formation and kept c",
+                self.agents.len() - self.lost.len()
+            ));
         } else if let Some((k, t)) = self
             .targets
             .iter()
@@ -233,6 +246,7 @@ impl PipelineOutcome for FleetOutcome {
             airframe: Airframe::Multicopter,
             margin: p.tolerance * p.safety_distance / 2.0,
             margin_source: "fleet.tolerance × fleet.safety_distance / 2",
+            limits_note: None,
             loiter_radius: 0.0,
         }
     }

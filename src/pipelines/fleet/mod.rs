@@ -16,22 +16,26 @@ pub mod agent;
 pub mod chart;
 pub mod cost;
 pub mod face;
+pub mod judge;
 pub mod network;
+pub mod numbering;
 pub mod quadrotor;
 pub mod recording;
+pub mod scenario;
 pub mod simulation;
 pub mod summary;
 
 use std::collections::HashMap;
 
 use nalgebra::{Point2, Point3};
-use rand::rngs::ChaCha8Rng;
-use rand::{RngExt, SeedableRng};
 use serde::Serialize;
 
 use crate::mission::{Diagnostic, FieldPath, Mission};
 use crate::pipelines::{CancelToken, Event, Observer, PipelineError};
 
+pub use scenario::{
+    Goal, Scenario, assign, default_target, duration_finding, polygon_distances, scenario,
+};
 use simulation::Simulation;
 
 /// Samples kept per simulated second (positions, distances).
@@ -48,6 +52,9 @@ pub struct AgentSample {
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AgentOutcome {
+    /// 0-based here; numbered from 1 in the JSON (`agent`), as everywhere a
+    /// person reads it.
+    #[serde(rename = "agent", serialize_with = "numbering::one")]
     pub index: usize,
     pub start: Point2<f64>,
     pub samples: Vec<AgentSample>,
@@ -62,7 +69,18 @@ pub struct AgentOutcome {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TargetOutcome {
     pub time: f64,
+    /// The target, or the middle of its points (one per agent).
     pub position: Point2<f64>,
+    /// For a target of one point per agent: the point each agent was given
+    /// (by agent), and which of the file's points that is (numbered from
+    /// 1, as the file lists them).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub assigned: Vec<Point2<f64>>,
+    #[serde(
+        skip_serializing_if = "Vec::is_empty",
+        serialize_with = "numbering::ones"
+    )]
+    pub assignment: Vec<usize>,
     /// Seconds after the target appeared when every distance (to the target
     /// and between every two agents, lost ones where they were last heard)
     /// entered its tolerance for good; None if never.
@@ -87,8 +105,11 @@ pub struct FormationError {
 /// One distance of the formation against its desired value.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Deviation {
-    /// 0-based agents; `b` is None for the distance from `a` to the target.
+    /// 0-based agents (numbered from 1 in the JSON); `b` is None for the
+    /// distance from `a` to the target.
+    #[serde(serialize_with = "numbering::one")]
     pub a: usize,
+    #[serde(serialize_with = "numbering::maybe")]
     pub b: Option<usize>,
     pub distance: f64,
     pub desired: f64,
@@ -107,9 +128,11 @@ impl Deviation {
     }
 }
 
-/// A closest approach of agent `a` (0-based) to another agent or an obstacle.
+/// A closest approach of agent `a` (0-based; from 1 in the JSON) to
+/// another agent or an obstacle.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Closest {
+    #[serde(serialize_with = "numbering::one")]
     pub a: usize,
     pub b: Other,
     pub distance: f64,
@@ -120,8 +143,8 @@ pub struct Closest {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Other {
-    /// Another agent, 0-based.
-    Agent(usize),
+    /// Another agent, 0-based (from 1 in the JSON).
+    Agent(#[serde(serialize_with = "numbering::one")] usize),
     /// An obstacle, by name.
     Obstacle(String),
 }
@@ -140,7 +163,10 @@ impl std::fmt::Display for Other {
 /// small enough to list every pair.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DistanceSeries {
+    /// 0-based agents (from 1 in the JSON).
+    #[serde(serialize_with = "numbering::one")]
     pub a: usize,
+    #[serde(serialize_with = "numbering::one")]
     pub b: usize,
     pub desired: f64,
     pub values: Vec<f64>,
@@ -168,8 +194,11 @@ pub struct FleetOutcome {
     pub closest_obstacle: Option<Closest>,
     /// Per sample (fleets up to `MAX_SERIES_AGENTS`), the pairs of agents
     /// (i < j) that each heard the other within l: the links the network
-    /// kept up.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    /// kept up (agents from 1 in the JSON).
+    #[serde(
+        skip_serializing_if = "Vec::is_empty",
+        serialize_with = "numbering::links"
+    )]
     pub links: Vec<Vec<(usize, usize)>>,
     /// Agents whose process went away during the run (distributed runs).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -177,6 +206,26 @@ pub struct FleetOutcome {
     /// How the run was carried out over processes, when it was.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub distributed: Option<Distributed>,
+    /// For each target not reached: what held each agent back that stood
+    /// short of its place at the end of the target's time.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub short: Vec<Shortfall>,
+}
+
+/// An agent that stood short of its place in a formation not reached, and
+/// why: the obstacle it is stalled behind, or the time it still needed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Shortfall {
+    /// The target, numbered from 1.
+    pub target: usize,
+    /// 0-based (from 1 in the JSON).
+    #[serde(serialize_with = "numbering::one")]
+    pub agent: usize,
+    /// Metres from its place (its target point, or d_ip from the target).
+    pub short_by: f64,
+    /// In words: `stalled behind 'pier 2'`, `on its way at 0.52 m/s: about
+    /// 80 s more`.
+    pub why: String,
 }
 
 /// What a fleet run asks beyond the mission and the seed: agent processes
@@ -227,124 +276,6 @@ impl FleetOutcome {
     }
 }
 
-/// The scenario a fleet mission describes, resolved: starts, targets, d^d.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Scenario {
-    pub starts: Vec<Point2<f64>>,
-    pub targets: Vec<(f64, Point2<f64>)>,
-    /// d_ij^d.
-    pub desired: Vec<Vec<f64>>,
-}
-
-/// Default d_ij^d: a regular polygon of radius d_ip^d around the target, the
-/// agents in index order (three agents 1 m out: 1.732 m apart).
-pub fn polygon_distances(n: usize, radius: f64) -> Vec<Vec<f64>> {
-    (0..n)
-        .map(|i| {
-            (0..n)
-                .map(|j| {
-                    let k = i.abs_diff(j) as f64;
-                    2.0 * radius * (std::f64::consts::PI * k / n as f64).sin()
-                })
-                .collect()
-        })
-        .collect()
-}
-
-/// Resolves the mission's fleet section. Random starts are drawn (seeded)
-/// inside the bounds, at least c from each other and from obstacles.
-pub fn scenario(m: &Mission, seed: u64) -> Scenario {
-    let p = &m.fleet;
-    let n = p.agents;
-    let starts = if p.initial_positions.len() == n {
-        p.initial_positions.clone()
-    } else {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        rng.set_stream(u64::MAX);
-        let b = &m.bounds;
-        let mut starts: Vec<Point2<f64>> = Vec::with_capacity(n);
-        let mut attempts = 0;
-        while starts.len() < n {
-            let q = Point2::new(
-                rng.random_range(b.x[0]..=b.x[1]),
-                rng.random_range(b.y[0]..=b.y[1]),
-            );
-            attempts += 1;
-            let clear = starts
-                .iter()
-                .all(|s| (s - q).norm() >= 2.0 * p.safety_distance)
-                && m.obstacles
-                    .iter()
-                    .all(|o| o.prism().outward(&q) >= 2.0 * p.safety_distance);
-            // A crowded box still gets its agents (the check is a courtesy).
-            if clear || attempts > 1000 * n {
-                starts.push(q);
-            }
-        }
-        starts
-    };
-    let targets = if p.targets.is_empty() {
-        vec![(0.0, default_target(m))]
-    } else {
-        p.targets.iter().map(|t| (t.time, t.position)).collect()
-    };
-    let desired = if p.distances.len() == n {
-        p.distances.clone()
-    } else {
-        polygon_distances(n, p.target_distance)
-    };
-    Scenario {
-        starts,
-        targets,
-        desired,
-    }
-}
-
-/// Where the fleet forms when the mission names no target: the free spot
-/// nearest the bounds' centre, where the formation (agents d_ip round it,
-/// each keeping c) stays inside the bounds and keeps c from every obstacle
-/// taller than the flight altitude. A grid of at most 200 × 200 candidates;
-/// the centre itself when nothing is free.
-pub fn default_target(m: &Mission) -> Point2<f64> {
-    let p = &m.fleet;
-    let b = &m.bounds;
-    let centre = b.center_xy();
-    let reach = p.target_distance + p.safety_distance;
-    let free = |q: &Point2<f64>| {
-        q.x - reach >= b.x[0]
-            && q.x + reach <= b.x[1]
-            && q.y - reach >= b.y[0]
-            && q.y + reach <= b.y[1]
-            && m.obstacles
-                .iter()
-                .filter(|o| o.spans(p.altitude))
-                .all(|o| o.prism().outward(q) >= reach + p.safety_distance)
-    };
-    if free(&centre) {
-        return centre;
-    }
-    let span = (b.x[1] - b.x[0]).max(b.y[1] - b.y[0]);
-    let step = (reach / 2.0).max(span / 200.0).max(1e-3);
-    let (nx, ny) = (
-        ((b.x[1] - b.x[0]) / step).ceil().min(200.0) as usize,
-        ((b.y[1] - b.y[0]) / step).ceil().min(200.0) as usize,
-    );
-    let mut best: Option<(f64, Point2<f64>)> = None;
-    for i in 0..=nx {
-        for j in 0..=ny {
-            let q = Point2::new(
-                b.x[0] + (b.x[1] - b.x[0]) * i as f64 / nx.max(1) as f64,
-                b.y[0] + (b.y[1] - b.y[0]) * j as f64 / ny.max(1) as f64,
-            );
-            let d = (q - centre).norm();
-            if best.is_none_or(|(bd, _)| d < bd) && free(&q) {
-                best = Some((d, q));
-            }
-        }
-    }
-    best.map_or(centre, |(_, q)| q)
-}
-
 /// Agents within `radius` of each agent (eq. 2), by a uniform grid of that
 /// cell size: O(n) for a spread-out fleet, not all pairs.
 pub fn neighbourhoods(positions: &[Point2<f64>], radius: f64) -> Vec<Vec<usize>> {
@@ -383,6 +314,8 @@ pub fn neighbourhoods(positions: &[Point2<f64>], radius: f64) -> Vec<Vec<usize>>
 pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
     use crate::pipelines::{figure, limits};
     let p = &mission.fleet;
+    // Left out, a run lasts at most the automatic cap: the budget holds that.
+    let duration = p.duration.unwrap_or(crate::mission::AUTO_DURATION_MAX);
     let at = |key: &str| FieldPath::root().key("fleet").key(key);
     let mut out = Vec::new();
     let n = p.agents as f64;
@@ -397,7 +330,7 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
         ));
         return out;
     }
-    let replans = (p.duration / p.replan_period).ceil();
+    let replans = (duration / p.replan_period).ceil();
     let evaluations = n * replans * p.swarm_size as f64 * p.iterations as f64;
     if crate::pipelines::exceeds(evaluations, limits::FLEET_EVALUATIONS) {
         let key = if p.replan_period < 1e-3 {
@@ -422,7 +355,7 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
             ),
         ));
     }
-    let steps = n * (p.duration / p.sim_step).ceil();
+    let steps = n * (duration / p.sim_step).ceil();
     if crate::pipelines::exceeds(steps, limits::FLEET_STEPS) {
         let key = if p.sim_step < 1e-4 {
             "sim_step"
@@ -434,21 +367,21 @@ pub fn budget(mission: &Mission) -> Vec<Diagnostic> {
             format!(
                 "{} agents over {} s in steps of {} s: {} dynamics steps (limit {})",
                 p.agents,
-                figure(p.duration),
+                figure(duration),
                 figure(p.sim_step),
                 figure(steps),
                 figure(limits::FLEET_STEPS)
             ),
         ));
     }
-    let samples = n * p.duration * SAMPLE_RATE;
+    let samples = n * duration * SAMPLE_RATE;
     if crate::pipelines::exceeds(samples, limits::FLEET_SAMPLES) {
         out.push(Diagnostic::error(
             at("duration"),
             format!(
                 "{} agents over {} s at {SAMPLE_RATE} Hz: {} samples kept (limit {})",
                 p.agents,
-                figure(p.duration),
+                figure(duration),
                 figure(samples),
                 figure(limits::FLEET_SAMPLES)
             ),
@@ -480,6 +413,8 @@ pub fn plan(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::rngs::ChaCha8Rng;
+    use rand::{RngExt, SeedableRng};
 
     #[test]
     fn three_agents_one_metre_out_are_1_732_apart() {

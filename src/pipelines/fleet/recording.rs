@@ -101,10 +101,19 @@ pub fn sketch(o: &FleetOutcome, out: &mut dyn Sketch) {
         .and_then(|a| a.samples.first())
         .map_or(0.0, |s| s.position.z);
     for (k, t) in o.targets.iter().enumerate() {
+        // A target of one point per agent: its points; else the target.
+        let points = if t.assigned.is_empty() {
+            vec![Point3::new(t.position.x, t.position.y, z)]
+        } else {
+            t.assigned
+                .iter()
+                .map(|q| Point3::new(q.x, q.y, z))
+                .collect()
+        };
         out.points_at(
             paths::TARGET,
             t.time,
-            vec![Point3::new(t.position.x, t.position.y, z)],
+            points,
             Style::rgb([255, 215, 0])
                 .radius(0.1)
                 .label(format!("target {}", k + 1)),

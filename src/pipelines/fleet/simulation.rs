@@ -22,11 +22,13 @@ use serde::Serialize;
 
 use super::agent::Planner;
 use super::cost::{Detected, Neighbour, Observation};
+use super::judge::{formation_error, tolerance_of};
 use super::network::{Message, Network};
 use super::quadrotor::{self, Body, State};
 use super::{
-    AgentOutcome, AgentSample, Closest, Deviation, DistanceSeries, FleetOutcome, FormationError,
-    MAX_SERIES_AGENTS, Other, SAMPLE_RATE, Scenario, TargetOutcome, neighbourhoods, scenario,
+    AgentOutcome, AgentSample, Closest, DistanceSeries, FleetOutcome, FormationError,
+    MAX_SERIES_AGENTS, Other, SAMPLE_RATE, Scenario, Shortfall, TargetOutcome, neighbourhoods,
+    scenario,
 };
 use crate::base::ode::rk4_step;
 use crate::mission::{FleetParams, FleetPush, Mission};
@@ -109,7 +111,8 @@ impl Link for Loopback {
 /// An agent whose process went away, and when.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LostAgent {
-    /// 0-based.
+    /// 0-based (numbered from 1 in the JSON, as in the log).
+    #[serde(serialize_with = "super::numbering::one")]
     pub agent: usize,
     pub step: usize,
     /// Seconds of flight.
@@ -145,11 +148,12 @@ pub struct Clock {
 }
 
 impl Clock {
-    pub fn of(p: &FleetParams) -> Self {
+    /// The clock of a run of `duration` seconds.
+    pub fn of(p: &FleetParams, duration: f64) -> Self {
         let dt = p.sim_step;
         Clock {
             dt,
-            steps: (p.duration / dt).round() as usize,
+            steps: (duration / dt).round() as usize,
             replan_every: ((p.replan_period / dt).round() as usize).max(1),
             record_every: ((1.0 / (SAMPLE_RATE * dt)).round() as usize).max(1),
             report_every: ((1.0 / dt).round() as usize).max(1),
@@ -161,9 +165,8 @@ impl Clock {
 pub struct Snapshot {
     step: usize,
     t: f64,
-    /// The target in force (index into the scenario's targets) and where it is.
+    /// The target in force (index into the scenario's targets).
     active: usize,
-    target: Point2<f64>,
     positions: Vec<Point2<f64>>,
     /// A scheduled round (every τ): everyone decides, neighbour lists rebuilt.
     scheduled: bool,
@@ -181,8 +184,10 @@ struct Log {
     /// Per target: the last sampled time the formation was outside tolerance.
     outside: Vec<Option<f64>>,
     inside_at_end: Vec<bool>,
-    /// Per target: how far the formation was at its last sample.
+    /// Per target: how far the formation was at its last sample, and
+    /// where every agent was then.
     ends: Vec<Option<FormationError>>,
+    last_positions: Vec<Option<(f64, Vec<Point2<f64>>)>>,
     /// Per sample, the pairs (i < j) where each heard the other within l at
     /// that step (fleets up to `MAX_SERIES_AGENTS`): the links of the recording.
     links: Vec<Vec<(usize, usize)>>,
@@ -289,7 +294,7 @@ impl<'m> Simulation<'m> {
                 reference: *s,
             })
             .collect();
-        let clock = Clock::of(p);
+        let clock = Clock::of(p, sc.duration);
         let kept = if recording {
             clock.steps / clock.record_every + 1
         } else {
@@ -302,7 +307,7 @@ impl<'m> Simulation<'m> {
                     distances.push(DistanceSeries {
                         a,
                         b,
-                        desired: sc.desired[a][b],
+                        desired: sc.targets[0].desired[a][b],
                         values: Vec::new(),
                     });
                 }
@@ -317,6 +322,7 @@ impl<'m> Simulation<'m> {
             outside: vec![None; sc.targets.len()],
             inside_at_end: vec![false; sc.targets.len()],
             ends: vec![None; sc.targets.len()],
+            last_positions: vec![None; sc.targets.len()],
             links: Vec::new(),
         };
         let mut pushes: Vec<&FleetPush> = p.pushes.iter().collect();
@@ -378,7 +384,7 @@ impl<'m> Simulation<'m> {
             self.network.exchange(k, fresh, &self.near);
             let due = self.due(&now);
             // Before the first target appears the agents hold their starts.
-            let started = now.t >= self.scenario.targets[0].0;
+            let started = now.t >= self.scenario.targets[0].time;
             if started && due.iter().any(|&d| d) {
                 for (count, _) in self.decided.iter_mut().zip(&due).filter(|(_, d)| **d) {
                     *count += 1;
@@ -397,7 +403,7 @@ impl<'m> Simulation<'m> {
                 if cancel.is_cancelled() {
                     let text = format!(
                         "cancelled at t = {:.1} s of {:.1} s",
-                        now.t, self.p.duration
+                        now.t, self.scenario.duration
                     );
                     observer.on_event(Event::Log(Level::Warn, &text));
                     return Ok(Completion::Cancelled);
@@ -456,10 +462,7 @@ impl<'m> Simulation<'m> {
     fn snapshot(&mut self, k: usize) -> Snapshot {
         let t = k as f64 * self.clock.dt;
         let targets = &self.scenario.targets;
-        let active = targets
-            .iter()
-            .rposition(|(time, _)| *time <= t)
-            .unwrap_or(0);
+        let active = targets.iter().rposition(|g| g.time <= t).unwrap_or(0);
         let positions: Vec<Point2<f64>> = self.current.iter().map(|m| m.position).collect();
         let scheduled = k.is_multiple_of(self.clock.replan_every);
         if scheduled {
@@ -484,7 +487,6 @@ impl<'m> Simulation<'m> {
             step: k,
             t,
             active,
-            target: targets[active].1,
             positions,
             scheduled,
             lost,
@@ -577,17 +579,20 @@ impl<'m> Simulation<'m> {
             );
         }
         // Eq. 4: every distance, to the target and between every two agents
-        // (a lost one where it was last heard), within its tolerance.
-        let tolerance = |want: f64| p.tolerance * want.max(p.safety_distance);
+        // still flying, within its tolerance: a lost agent is left out of
+        // the formation its survivors hold (its slot stays empty).
+        let goal = &self.scenario.targets[now.active];
+        let tolerance = tolerance_of(p, goal);
         let within = |d: f64, want: f64| (d - want).abs() <= tolerance(want);
-        let desired = &self.scenario.desired;
+        let alive = &self.alive;
         let n = positions.len();
-        let formed = positions
-            .iter()
-            .all(|q| within((q - now.target).norm(), p.target_distance))
-            && (0..n).all(|i| {
-                (i + 1..n).all(|j| within((positions[j] - positions[i]).norm(), desired[i][j]))
-            });
+        let formed = (0..n).filter(|&i| alive[i]).all(|i| {
+            let (point, want) = goal.of(i, p.target_distance);
+            within((positions[i] - point).norm(), want)
+                && (i + 1..n)
+                    .filter(|&j| alive[j])
+                    .all(|j| within((positions[j] - positions[i]).norm(), goal.desired[i][j]))
+        });
         log.inside_at_end[now.active] = formed;
         if !formed {
             log.outside[now.active] = Some(t);
@@ -595,12 +600,13 @@ impl<'m> Simulation<'m> {
         if ends {
             log.ends[now.active] = Some(formation_error(
                 positions,
-                now.target,
+                alive,
+                goal,
                 p.target_distance,
-                desired,
                 &tolerance,
                 t,
             ));
+            log.last_positions[now.active] = Some((t, positions.clone()));
         }
     }
 
@@ -613,7 +619,7 @@ impl<'m> Simulation<'m> {
                 .scenario
                 .targets
                 .get(now.active + 1)
-                .is_some_and(|(time, _)| *time <= t)
+                .is_some_and(|g| g.time <= t)
     }
 
     /// Disturbances (4.2): an impulse due by `t` changes the velocity at once
@@ -716,10 +722,12 @@ impl<'m> Simulation<'m> {
     fn observation(&self, i: usize, now: &Snapshot) -> Observation {
         let (p, positions) = (self.p, &now.positions);
         let me = positions[i];
+        let goal = &self.scenario.targets[now.active];
+        let (target, target_distance) = goal.of(i, p.target_distance);
         Observation {
             position: me,
-            target: now.target,
-            target_distance: p.target_distance,
+            target,
+            target_distance,
             // Eq. 2: Ξ_i, the agents within l (the round's lists reach a little
             // further, for the safety check).
             // What it heard of them, not where they are.
@@ -727,7 +735,7 @@ impl<'m> Simulation<'m> {
                 .in_reach(i, me)
                 .map(|m| Neighbour {
                     position: m.position,
-                    desired: self.scenario.desired[i][m.sender],
+                    desired: goal.desired[i][m.sender],
                 })
                 .collect(),
             // The obstacles within d_obs, and each lost agent's region as one
@@ -822,6 +830,7 @@ impl<'m> Simulation<'m> {
                 *slot = e;
             }
         }
+        let short = self.shortfalls();
         let Simulation {
             mission,
             p,
@@ -837,15 +846,19 @@ impl<'m> Simulation<'m> {
             .targets
             .iter()
             .enumerate()
-            .map(|(k, &(time, position))| {
+            .map(|(k, goal)| {
+                let time = goal.time;
                 let converged_after = (log.inside_at_end[k] && time <= end).then(|| {
                     let since = log.outside[k]
                         .map_or(time, |last| last + clock.record_every as f64 * clock.dt);
                     (since - time).max(0.0)
                 });
+                let (assigned, assignment) = goal.assigned.clone().unwrap_or_default();
                 TargetOutcome {
                     time,
-                    position,
+                    position: goal.centre,
+                    assigned,
+                    assignment,
                     converged_after,
                     end: log.ends[k].clone(),
                 }
@@ -860,8 +873,8 @@ impl<'m> Simulation<'m> {
             let text = format!(
                 "target {} at ({:.2}, {:.2}): {reached}",
                 k + 1,
-                t.1.x,
-                t.1.y
+                t.centre.x,
+                t.centre.y
             );
             observer.on_event(Event::Log(Level::Info, &text));
         }
@@ -900,54 +913,76 @@ impl<'m> Simulation<'m> {
             links: log.links,
             lost,
             distributed: None,
+            short,
         }
     }
-}
 
-/// How far the fleet at `positions` is from its formation around `target`
-/// at `t`: the pair distance and the distance to the target furthest from
-/// their desired values (in tolerances), and the centre's offset.
-fn formation_error(
-    positions: &[Point2<f64>],
-    target: Point2<f64>,
-    target_distance: f64,
-    desired: &[Vec<f64>],
-    tolerance: &dyn Fn(f64) -> f64,
-    t: f64,
-) -> FormationError {
-    let deviation = |a: usize, b: Option<usize>, distance: f64, want: f64| Deviation {
-        a,
-        b,
-        distance,
-        desired: want,
-        tolerance: tolerance(want),
-    };
-    let worse = |best: Option<Deviation>, d: Deviation| match best {
-        Some(b) if b.tolerances() >= d.tolerances() => Some(b),
-        _ => Some(d),
-    };
-    let n = positions.len();
-    let mut pair = None;
-    for i in 0..n {
-        for j in i + 1..n {
-            let d = (positions[j] - positions[i]).norm();
-            pair = worse(pair, deviation(i, Some(j), d, desired[i][j]));
+    /// For each target not reached, each surviving agent that stood short
+    /// of its place at its last sample: by how much, and what held it
+    /// back. An obstacle in the flight plane between it and its place,
+    /// within d_obs of it, is what it is stalled behind; else it was on its
+    /// way, and the time it still needed at the cruise speed is said.
+    fn shortfalls(&self) -> Vec<Shortfall> {
+        let p = self.p;
+        let mut out = Vec::new();
+        for (k, goal) in self.scenario.targets.iter().enumerate() {
+            if self.log.inside_at_end[k] {
+                continue;
+            }
+            let Some((t, positions)) = &self.log.last_positions[k] else {
+                continue;
+            };
+            let tolerance = tolerance_of(p, goal);
+            for (i, q) in positions.iter().enumerate().filter(|(i, _)| self.alive[*i]) {
+                let (point, want) = goal.of(i, p.target_distance);
+                let to = point - q;
+                let distance = to.norm();
+                let short_by = (distance - want).abs();
+                if short_by <= tolerance(want) {
+                    continue;
+                }
+                // Where it should be: its point, or d_ip short of the target.
+                let place = if distance > 1e-9 {
+                    q + to * ((distance - want).max(0.0) / distance)
+                } else {
+                    *q
+                };
+                let blocking = self
+                    .mission
+                    .obstacles
+                    .iter()
+                    .filter(|o| o.spans(p.altitude))
+                    .map(|o| (o, o.prism()))
+                    .filter(|(_, prism)| {
+                        prism.outward(q) <= p.detection_range
+                            && prism.segment_distance(q, &place) < p.safety_distance
+                    })
+                    .min_by(|a, b| a.1.outward(q).total_cmp(&b.1.outward(q)));
+                let why = match blocking {
+                    Some((o, prism)) => format!(
+                        "stalled behind '{}' ({:.1} m from it at t = {t:.1} s): the way to its \
+                         place passes within c of it",
+                        o.name,
+                        prism.outward(q).max(0.0)
+                    ),
+                    None => {
+                        let speed = p.cruise_speed();
+                        format!(
+                            "still on its way at t = {t:.1} s: at about {speed:.2} m/s it needs \
+                             about {:.0} s more (fleet.duration)",
+                            short_by / speed.max(1e-6)
+                        )
+                    }
+                };
+                out.push(Shortfall {
+                    target: k + 1,
+                    agent: i,
+                    short_by,
+                    why,
+                });
+            }
         }
-    }
-    let mut to_target = None;
-    for (i, q) in positions.iter().enumerate() {
-        let d = (q - target).norm();
-        to_target = worse(to_target, deviation(i, None, d, target_distance));
-    }
-    let centre = positions
-        .iter()
-        .fold(nalgebra::Vector2::zeros(), |s, q| s + q.coords)
-        / n.max(1) as f64;
-    FormationError {
-        time: t,
-        pair,
-        to_target,
-        centre_offset: (Point2::from(centre) - target).norm(),
+        out
     }
 }
 
@@ -962,7 +997,7 @@ mod tests {
     #[test]
     fn the_rounds_count_each_agents_decisions_as_it_makes_them() {
         let mut m = crate::mission::default_mission().mission;
-        m.fleet.duration = 8.0;
+        m.fleet.duration = Some(8.0);
         m.fleet.network.updates = vec![crate::mission::FleetUpdate {
             agent: 2,
             period: 30,

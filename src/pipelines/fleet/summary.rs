@@ -1,7 +1,6 @@
 //! The human summary of a fleet outcome (`skyform run fleet`) and the
 //! words its verdict and the designer's tables share. Agents are numbered
-//! from 1 here as everywhere a person reads them; the JSON keeps the
-//! 0-based indices.
+//! from 1 here as everywhere a person reads them, the JSON too.
 
 use super::{Closest, Deviation, FleetOutcome, FormationError, Other};
 use crate::pipelines::Verdict;
@@ -9,7 +8,8 @@ use crate::pipelines::table::{Cell, Row, Tone, row};
 
 /// The human summary of a fleet outcome.
 ///
-/// Long (~150 lines) because it writes the summary's lines top to bottom (run, targets,
+/// Long (~185 lines) because it writes the summary's lines top to bottom (run, targets and
+/// their assignments and shortfalls, the survivors judged,
 /// pairs, closest, network, distributed, per-agent traffic, lost agents, effort, result),
 /// each a few lines of formatting in the order printed.
 pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
@@ -41,16 +41,56 @@ pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
             t.position.y,
             t.time
         );
+        if !t.assignment.is_empty() {
+            let each: Vec<String> = t
+                .assignment
+                .iter()
+                .zip(&t.assigned)
+                .enumerate()
+                .map(|(i, (j, p))| format!("{} → point {} ({:.1}, {:.1})", i + 1, j + 1, p.x, p.y))
+                .collect();
+            let _ = writeln!(s, "    assigned   agent {}", each.join(", "));
+        }
+        for short in o.short.iter().filter(|f| f.target == k + 1) {
+            let _ = writeln!(
+                s,
+                "    agent {:<4} {:.2} m short: {}",
+                short.agent + 1,
+                short.short_by,
+                short.why
+            );
+        }
     }
-    for d in &o.distances {
-        let last = d.values.last().copied().unwrap_or(f64::NAN);
-        let min = d.values.iter().copied().fold(f64::INFINITY, f64::min);
+    if !o.lost.is_empty() {
+        let names: Vec<String> = o.lost.iter().map(|l| (l.agent + 1).to_string()).collect();
         let _ = writeln!(
             s,
-            "  pair {:>2}-{:<3}   final {last:.3} m (desired {:.3}), min {min:.3} m",
+            "  judged       the {} surviving agent(s): agent {} lost, left out of the formation",
+            o.agents.len() - o.lost.len(),
+            names.join(", ")
+        );
+    }
+    let lost_one = |i: usize| o.lost.iter().find(|l| l.agent == i);
+    for d in &o.distances {
+        let min = d.values.iter().copied().fold(f64::INFINITY, f64::min);
+        // A pair with a lost agent has no final distance: it is no longer there.
+        let end = match lost_one(d.a).or_else(|| lost_one(d.b)) {
+            Some(l) => format!(
+                "agent {} lost at t = {:.1} s (no final distance)",
+                l.agent + 1,
+                l.time
+            ),
+            None => format!(
+                "final {:.3} m (desired {:.3})",
+                d.values.last().copied().unwrap_or(f64::NAN),
+                d.desired
+            ),
+        };
+        let _ = writeln!(
+            s,
+            "  pair {:>2}-{:<3}   {end}, min {min:.3} m",
             d.a + 1,
-            d.b + 1,
-            d.desired
+            d.b + 1
         );
     }
     let agents = o.closest_agents.as_ref().map_or("-".to_owned(), |c| {
@@ -159,9 +199,9 @@ pub fn fleet(o: &FleetOutcome, verdict: &Verdict) -> String {
     );
     // The pass rule is `Outcome::verdict`'s, written once.
     let verdict = match verdict {
-        Verdict::Passed => "PASS",
-        Verdict::Failed(_) => "FAIL",
-        Verdict::Cancelled => "CANCELLED",
+        Verdict::Passed => "PASS".to_owned(),
+        Verdict::Failed(why) => format!("FAIL: {why}"),
+        Verdict::Cancelled => "CANCELLED".to_owned(),
     };
     let _ = writeln!(s, "  result       {verdict}");
     s

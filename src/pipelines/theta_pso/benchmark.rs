@@ -153,6 +153,7 @@ pub fn plan(
         flown_arcs: flight.progress,
         reconfigurations: flight.reconfigurations,
         bypassed: Vec::new(),
+        unused_choices: Vec::new(),
         source: super::PlanSource::Swarm,
         route_length: length,
         corridor: super::route::Corridor {

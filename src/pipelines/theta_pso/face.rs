@@ -231,6 +231,15 @@ impl PipelineOutcome for ThetaPsoOutcome {
             margin: mission.theta_pso.clearance_margin,
             margin_source: "theta_pso.clearance_margin",
             loiter_radius: 0.0,
+            limits_note: Some(format!(
+                "the files are held to r_Q = {} m from the obstacles and 2 r_Q = {} m apart; \
+                 the plan was verified at r_Q + the safety margin ({} m and {} m), and that \
+                 margin is the room the files may stray from it",
+                crate::mission::compact(f.uav_radius),
+                crate::mission::compact(2.0 * f.uav_radius),
+                crate::mission::compact(f.least_clearance()),
+                crate::mission::compact(f.closest_pair())
+            )),
         }
     }
 

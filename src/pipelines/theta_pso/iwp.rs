@@ -26,6 +26,17 @@
 //!   narrows it, so `auto` never offers it for a gap;
 //! - a shape that does not fit (the operator's choice) makes the IWP unusable,
 //!   with the reason, instead of a plan that fails later.
+//!
+//! A gate the user names (`[[route.via]] between = [p, q]`) is an IWP
+//! whatever its width: one wider than the formation is flown straight
+//! through in the nominal shape. It is a via the path must take (the route
+//! stage and the path builder place it in order); one that cannot be taken
+//! (narrower than one UAV, blocked, never in the way at a common altitude)
+//! is unusable with the reason, which refuses the plan (`NO PLAN`).
+//!
+//! Long (~860 lines) because it is eq. 9 and Fig. 2 together: the shapes, the widths they
+//! need, the crossing's hold against each obstacle as the crossing sees it (a disc, a
+//! footprint's edges), each pair's IWP (or gate) with why none, read as one reading.
 
 use nalgebra::{Point2, Vector2, Vector3};
 use serde::Serialize;
@@ -70,6 +81,10 @@ pub struct Iwp {
     /// the formation passes over or under one of them, and the gap is none.
     #[serde(skip)]
     pub window: [f64; 2],
+    /// The `[[route.via]]` entry (0-based) that names this gap: the route
+    /// must pass through it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gate: Option<usize>,
 }
 
 impl Iwp {
@@ -356,6 +371,107 @@ fn conflict(o: &Vector3<f64>, x_k: f64, y_k: f64, reach: f64) -> Option<(f64, f6
     })
 }
 
+/// An obstacle as the crossing sees it: in the crossing's frame (x
+/// forward along the crossing, y to its left, from the gap's midpoint), a
+/// disc (a cylinder) or its footprint's outline (its own edges, not its
+/// bounding circle: a bay's circle reaches across the aisle beside it).
+enum Seen {
+    Disc { x: f64, y: f64, radius: f64 },
+    Outline(Vec<Vector2<f64>>),
+}
+
+impl Seen {
+    fn of(o: &crate::mission::Obstacle, center: Point2<f64>, forward: Vector2<f64>) -> Self {
+        let left = Vector2::new(-forward.y, forward.x);
+        let frame = |p: &Point2<f64>| {
+            let d = p - center;
+            Vector2::new(d.dot(&forward), d.dot(&left))
+        };
+        if o.footprint.len() >= 3 {
+            Seen::Outline(o.footprint.iter().map(frame).collect())
+        } else {
+            let c = frame(&o.center);
+            Seen::Disc {
+                x: c.x,
+                y: c.y,
+                radius: o.radius,
+            }
+        }
+    }
+
+    /// How deep it reaches along the crossing either side of the gap line
+    /// (a disc of the gap's pair stands on the line through the gap, so its
+    /// radius; taken so, a hair's breadth off the line changes nothing).
+    fn depth(&self) -> f64 {
+        match self {
+            Seen::Disc { radius, .. } => *radius,
+            Seen::Outline(v) => v.iter().map(|p| p.x.abs()).fold(0.0, f64::max),
+        }
+    }
+
+    /// Where a UAV at offset `o` would come within `clearance` of it: the
+    /// interval of the centroid's forward position (a footprint's: the
+    /// hull of its edges' intervals, exact for a convex one).
+    fn conflict(&self, o: &Vector3<f64>, clearance: f64) -> Option<(f64, f64)> {
+        match self {
+            Seen::Disc { x, y, radius } => conflict(o, *x, *y, radius + clearance),
+            Seen::Outline(v) => {
+                let n = v.len();
+                let mut hull: Option<(f64, f64)> = None;
+                for i in 0..n {
+                    if let Some((lo, hi)) = capsule_on_line(v[i], v[(i + 1) % n], o.y, clearance) {
+                        hull = Some(hull.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
+                    }
+                }
+                hull.map(|(lo, hi)| (lo - o.x, hi - o.x))
+            }
+        }
+    }
+}
+
+/// The x interval where the line y = `y0` comes closer than `r` to the
+/// segment a-b (their capsule cut by the line), if it does: the distance
+/// to a segment is convex along a line, so its least is found by ternary
+/// search and each end by bisection.
+fn capsule_on_line(a: Vector2<f64>, b: Vector2<f64>, y0: f64, r: f64) -> Option<(f64, f64)> {
+    let distance = |x: f64| {
+        let p = Vector2::new(x, y0);
+        let ab = b - a;
+        let t = if ab.norm_squared() > 0.0 {
+            ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (a + ab * t - p).norm()
+    };
+    let (mut lo, mut hi) = (a.x.min(b.x) - r, a.x.max(b.x) + r);
+    let (span_lo, span_hi) = (lo, hi);
+    for _ in 0..100 {
+        let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+        if distance(m1) < distance(m2) {
+            hi = m2;
+        } else {
+            lo = m1;
+        }
+    }
+    let best = (lo + hi) / 2.0;
+    if distance(best) >= r - 1e-9 {
+        return None;
+    }
+    let root = |mut inside: f64, mut outside: f64| {
+        for _ in 0..100 {
+            let mid = (inside + outside) / 2.0;
+            if distance(mid) < r {
+                inside = mid;
+            } else {
+                outside = mid;
+            }
+        }
+        (inside + outside) / 2.0
+    };
+    Some((root(best, span_lo), root(best, span_hi)))
+}
+
 /// The hold of the crossing of a gap, or why its shape cannot cross.
 ///
 /// Crossing straight along the gap's normal, the formation must be in its
@@ -377,7 +493,12 @@ fn crossing_hold(
     let r_q = f.least_clearance();
     let margin = mission.theta_pso.clearance_margin.max(0.0);
     let obstacles = &mission.obstacles;
-    let deepest = obstacles[pair[0]].radius.max(obstacles[pair[1]].radius);
+    // How deep the wall the gap pierces is along the crossing: its two
+    // obstacles' reach either side of the gap line.
+    let deepest = pair
+        .iter()
+        .map(|&k| Seen::of(&obstacles[k], center, normal).depth())
+        .fold(0.0, f64::max);
     let wall_zone = deepest + f.safe_radius() + margin;
     let mut approaching = vec![f.slots.clone()];
     if let Some(shape) = shape {
@@ -390,13 +511,10 @@ fn crossing_hold(
     let mut depth: f64 = 0.0;
     for sign in [1.0, -1.0] {
         let forward = normal * sign;
-        let left = Vector2::new(-forward.y, forward.x);
         for k in (0..obstacles.len()).filter(in_band) {
-            let d = obstacles[k].center - center;
-            let (x_k, y_k) = (d.dot(&forward), d.dot(&left));
-            let reach = obstacles[k].radius + r_q + margin;
+            let seen = Seen::of(&obstacles[k], center, forward);
             for o in approaching.iter().flatten() {
-                if let Some((lo, hi)) = conflict(o, x_k, y_k, reach) {
+                if let Some((lo, hi)) = seen.conflict(o, r_q + margin) {
                     // Only conflicts at the wall: the path may turn before
                     // an obstacle farther along the crossing line.
                     if lo < wall_zone && hi > -wall_zone {
@@ -407,9 +525,6 @@ fn crossing_hold(
         }
     }
     let hold = mission.reconfiguration.hold_distance + depth;
-    // A column flies along the path: the straight through the gap is the
-    // hold above, the shape is held until its last UAV is that far past the
-    // gap line (and from when its first is that far before it).
     // A column flies along the path: it is held from before its first UAV
     // reaches the wall until its last has left it (and at least as long as a
     // rigid shape would be), but the path need only be straight through the
@@ -428,11 +543,8 @@ fn crossing_hold(
     };
     for sign in [1.0, -1.0] {
         let forward = normal * sign;
-        let left = Vector2::new(-forward.y, forward.x);
         for k in (0..obstacles.len()).filter(in_band) {
-            let d = obstacles[k].center - center;
-            let (x_k, y_k) = (d.dot(&forward), d.dot(&left));
-            let reach = obstacles[k].radius + r_q;
+            let seen = Seen::of(&obstacles[k], center, forward);
             // Only where the UAV is on the straight: a column's UAVs beyond
             // it are on the path's other legs, which the cost judges.
             let on_line = |o: &Vector3<f64>, (lo, hi): (f64, f64)| {
@@ -444,7 +556,7 @@ fn crossing_hold(
             let along = hold.max(line);
             if held
                 .iter()
-                .filter_map(|o| conflict(o, x_k, y_k, reach).and_then(|c| on_line(o, c)))
+                .filter_map(|o| seen.conflict(o, r_q).and_then(|c| on_line(o, c)))
                 .any(|(lo, hi)| lo < along && hi > -along)
             {
                 return Err(format!(
@@ -480,116 +592,208 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
     for p in 0..obstacles.len() {
         for q in (p + 1)..obstacles.len() {
             let (a, b) = (&obstacles[p], &obstacles[q]);
-            if !a.within(mission.bounds.z) || !b.within(mission.bounds.z) {
-                continue;
+            let gate = gate_of(mission, &a.name, &b.name);
+            if let Some(iwp) = pair_iwp(mission, p, q, gate, too_narrow, fits_formation) {
+                found.push(iwp);
             }
-            // The altitudes at which both stand in the way, within those the
-            // centroid may take (the band less the shape's half height).
-            let ([over_a, under_a], [over_b, under_b]) =
-                (mission.passing_altitudes(a), mission.passing_altitudes(b));
-            let window = [under_a.max(under_b), over_a.min(over_b)];
-            let half = vertical_half_height(&f.slots);
-            let z = mission.bounds.z;
-            if window[0] >= window[1] || window[0] >= z[1] - half || window[1] <= z[0] + half {
-                continue;
-            }
-            let (p_p, p_q, gap, u) = if a.footprint.is_empty() && b.footprint.is_empty() {
-                let axis = b.center - a.center;
-                let distance = axis.norm();
-                if distance == 0.0 {
-                    continue;
-                }
-                let u = axis / distance;
-                let gap = distance - a.radius - b.radius;
-                (a.center + u * a.radius, b.center - u * b.radius, gap, u)
-            } else {
-                // Footprints: the IWP is at the middle of their nearest
-                // points (eq. 9's P_p, P_q on the outlines).
-                if (a.center - b.center).norm() - a.radius - b.radius >= fits_formation {
-                    continue;
-                }
-                let (pa, pb) = (a.prism(), b.prism());
-                let (p_p, p_q) = nearest_points(&pa, &pb);
-                let apart = pa.outward(&p_q) > 0.0 && pb.outward(&p_p) > 0.0;
-                let gap = if apart { (p_q - p_p).norm() } else { -1.0 };
-                (p_p, p_q, gap, (p_q - p_p) / gap.abs().max(1e-12))
-            };
-            if !(too_narrow <= gap && gap < fits_formation) {
-                continue;
-            }
-            let blocked = obstacles.iter().enumerate().any(|(k, o)| {
-                k != p
-                    && k != q
-                    && stands_in(mission, o, window)
-                    && segment_point_distance(&p_p, &p_q, &o.center) < o.radius + r_q
-            });
-            if blocked {
-                continue;
-            }
-            let choice = mission.reconfiguration.choice(&a.name, &b.name);
-            let (enabled, shape_choice, scale) = match choice {
-                Some(w) => (
-                    w.enabled,
-                    w.shape,
-                    w.scale.unwrap_or(mission.reconfiguration.shrink_scale),
-                ),
-                None => (
-                    true,
-                    mission.reconfiguration.default_shape,
-                    mission.reconfiguration.shrink_scale,
-                ),
-            };
-            let position = Point2::from((p_p.coords + p_q.coords) / 2.0);
-            let normal = Vector2::new(-u.y, u.x);
-            let margin = mission.theta_pso.clearance_margin.max(0.0);
-            let hold_for = |shape: Option<Shape>| {
-                crossing_hold(mission, [p, q], position, normal, shape, window)
-            };
-            let resolved = if shape_choice == ShapeChoice::Auto {
-                // The least change whose crossing the site leaves room for
-                // (a shrink's straight may run into the next wall where a
-                // column's, through the posts only, does not).
-                auto_shapes(gap, f, margin).and_then(|shapes| {
-                    if shapes.is_empty() {
-                        return hold_for(None).map(|hold| (None, hold));
-                    }
-                    let mut first_reason = None;
-                    for shape in &shapes {
-                        match hold_for(Some(*shape)) {
-                            Ok(hold) => return Ok((Some(*shape), hold)),
-                            Err(reason) => {
-                                first_reason.get_or_insert(reason);
-                            }
-                        }
-                    }
-                    Err(first_reason.unwrap_or_default())
-                })
-            } else {
-                resolve_shape(shape_choice, gap, f, scale, margin)
-                    .and_then(|shape| hold_for(shape).map(|hold| (shape, hold)))
-            };
-            let (shape, (hold, straight), unusable) = match resolved {
-                Ok((shape, hold)) => (shape, hold, None),
-                Err(reason) => (None, (0.0, 0.0), Some(reason)),
-            };
-            found.push(Iwp {
-                between: [a.name.clone(), b.name.clone()],
-                obstacles: [p, q],
-                position,
-                gap,
-                normal,
-                enabled,
-                choice: shape_choice,
-                shape,
-                unusable,
-                hold,
-                straight,
-                window,
-            });
         }
     }
     prefer_columns_in_sequence(mission, &mut found);
     found
+}
+
+/// Why eq. 9 places no IWP between obstacles `p` and `q` (`p < q`), in
+/// words, with what would make the route pass between them.
+pub fn why_no_iwp(mission: &Mission, p: usize, q: usize) -> String {
+    let f = &mission.formation;
+    let r_q = f.least_clearance();
+    let (too_narrow, fits_formation) = (2.0 * r_q, 2.0 * (f.radius() + r_q));
+    let (a, b) = (&mission.obstacles[p].name, &mission.obstacles[q].name);
+    let route = format!(
+        "to make the route pass between them, add [[route.via]] between = [\"{a}\", \"{b}\"]"
+    );
+    match pair_iwp(mission, p, q, Some(usize::MAX), too_narrow, fits_formation) {
+        Some(iwp) => match iwp.unusable {
+            Some(reason) => reason,
+            None if iwp.gap >= fits_formation => format!(
+                "their gap, {:.2} m, is wider than the formation ({:.2} m with r_Q and the \
+                 margins): it passes without reconfiguring, so no reconfiguration is chosen \
+                 there; {route}",
+                iwp.gap, fits_formation
+            ),
+            None => format!("eq. 9 does not place one there; {route}"),
+        },
+        None => format!("they are no gap the formation could pass; {route}"),
+    }
+}
+
+/// The `[[route.via]]` entry that names the pair `a`, `b` as a gate.
+fn gate_of(mission: &Mission, a: &str, b: &str) -> Option<usize> {
+    mission.route.via.iter().position(|v| {
+        v.point.is_none()
+            && v.between
+                .as_ref()
+                .is_some_and(|pair| crate::mission::same_pair(pair, a, b))
+    })
+}
+
+/// Eq. 9 on the pair `p`, `q`: its IWP, or `None` when it has none. A gate
+/// (`gate`: the user's `[[route.via]]`) always has one: unusable, with the
+/// reason, when no formation can pass it.
+///
+/// Long (~150 lines) because it is eq. 9 on one pair in order (the altitudes both block,
+/// the gap and its ends, what else stands in it, the operator's choice, the shape and its
+/// hold), each test reading the figures of the one before, and each saying why a gate
+/// the user named cannot be kept.
+fn pair_iwp(
+    mission: &Mission,
+    p: usize,
+    q: usize,
+    gate: Option<usize>,
+    too_narrow: f64,
+    fits_formation: f64,
+) -> Option<Iwp> {
+    let f = &mission.formation;
+    let r_q = f.least_clearance();
+    let obstacles = &mission.obstacles;
+    let (a, b) = (&obstacles[p], &obstacles[q]);
+    let mut refusal: Option<String> = None;
+    if !a.within(mission.bounds.z) || !b.within(mission.bounds.z) {
+        gate?;
+        let low = if a.within(mission.bounds.z) { b } else { a };
+        refusal = Some(format!(
+            "'{}' stands outside the altitude band z {:?} m: the formation passes over or \
+             under it, not between",
+            low.name, mission.bounds.z
+        ));
+    }
+    // The altitudes at which both stand in the way, within those the
+    // centroid may take (the band less the shape's half height).
+    let ([over_a, under_a], [over_b, under_b]) =
+        (mission.passing_altitudes(a), mission.passing_altitudes(b));
+    let window = [under_a.max(under_b), over_a.min(over_b)];
+    let half = vertical_half_height(&f.slots);
+    let z = mission.bounds.z;
+    if window[0] >= window[1] || window[0] >= z[1] - half || window[1] <= z[0] + half {
+        gate?;
+        refusal.get_or_insert_with(|| {
+            format!(
+                "'{}' and '{}' do not stand in the formation's way at a common altitude of \
+                 the band: it passes over or under one of them",
+                a.name, b.name
+            )
+        });
+    }
+    let (p_p, p_q, gap, u) = if a.footprint.is_empty() && b.footprint.is_empty() {
+        let axis = b.center - a.center;
+        let distance = axis.norm();
+        if distance == 0.0 {
+            gate?;
+            return None;
+        }
+        let u = axis / distance;
+        let gap = distance - a.radius - b.radius;
+        (a.center + u * a.radius, b.center - u * b.radius, gap, u)
+    } else {
+        // Footprints: the IWP is at the middle of their nearest
+        // points (eq. 9's P_p, P_q on the outlines).
+        if gate.is_none() && (a.center - b.center).norm() - a.radius - b.radius >= fits_formation {
+            return None;
+        }
+        let (pa, pb) = (a.prism(), b.prism());
+        let (p_p, p_q) = nearest_points(&pa, &pb);
+        let apart = pa.outward(&p_q) > 0.0 && pb.outward(&p_p) > 0.0;
+        let gap = if apart { (p_q - p_p).norm() } else { -1.0 };
+        (p_p, p_q, gap, (p_q - p_p) / gap.abs().max(1e-12))
+    };
+    if gap < too_narrow {
+        gate?;
+        refusal.get_or_insert_with(|| {
+            if gap < 0.0 {
+                format!("'{}' and '{}' touch: there is no gap", a.name, b.name)
+            } else {
+                format!(
+                    "the gap is {gap:.2} m, narrower than one UAV (2 × (r_Q + the margins) = \
+                     {too_narrow:.2} m)"
+                )
+            }
+        });
+    } else if gap >= fits_formation {
+        gate?;
+    }
+    let blocker = obstacles.iter().enumerate().find(|(k, o)| {
+        *k != p
+            && *k != q
+            && stands_in(mission, o, window)
+            && segment_point_distance(&p_p, &p_q, &o.center) < o.radius + r_q
+            && (o.footprint.is_empty() || o.prism().segment_distance(&p_p, &p_q) < r_q)
+    });
+    if let Some((_, o)) = blocker {
+        gate?;
+        refusal.get_or_insert_with(|| format!("'{}' stands in the gap", o.name));
+    }
+    let choice = mission.reconfiguration.choice(&a.name, &b.name);
+    let (enabled, shape_choice, scale) = match choice {
+        Some(w) => (
+            w.enabled || gate.is_some(),
+            w.shape,
+            w.scale.unwrap_or(mission.reconfiguration.shrink_scale),
+        ),
+        None => (
+            true,
+            mission.reconfiguration.default_shape,
+            mission.reconfiguration.shrink_scale,
+        ),
+    };
+    let position = Point2::from((p_p.coords + p_q.coords) / 2.0);
+    let normal = Vector2::new(-u.y, u.x);
+    let margin = mission.theta_pso.clearance_margin.max(0.0);
+    let hold_for =
+        |shape: Option<Shape>| crossing_hold(mission, [p, q], position, normal, shape, window);
+    let resolved = if let Some(reason) = refusal {
+        Err(reason)
+    } else if shape_choice == ShapeChoice::Auto {
+        // The least change whose crossing the site leaves room for
+        // (a shrink's straight may run into the next wall where a
+        // column's, through the posts only, does not).
+        auto_shapes(gap, f, margin).and_then(|shapes| {
+            if shapes.is_empty() {
+                return hold_for(None).map(|hold| (None, hold));
+            }
+            let mut first_reason = None;
+            for shape in &shapes {
+                match hold_for(Some(*shape)) {
+                    Ok(hold) => return Ok((Some(*shape), hold)),
+                    Err(reason) => {
+                        first_reason.get_or_insert(reason);
+                    }
+                }
+            }
+            Err(first_reason.unwrap_or_default())
+        })
+    } else {
+        resolve_shape(shape_choice, gap, f, scale, margin)
+            .and_then(|shape| hold_for(shape).map(|hold| (shape, hold)))
+    };
+    let (shape, (hold, straight), unusable) = match resolved {
+        Ok((shape, hold)) => (shape, hold, None),
+        Err(reason) => (None, (0.0, 0.0), Some(reason)),
+    };
+    Some(Iwp {
+        between: [a.name.clone(), b.name.clone()],
+        obstacles: [p, q],
+        position,
+        gap: gap.max(0.0),
+        normal,
+        enabled,
+        choice: shape_choice,
+        shape,
+        unusable,
+        hold,
+        straight,
+        window,
+        gate,
+    })
 }
 
 /// Two crossings in sequence whose straights overlap along the way (walls

@@ -25,6 +25,7 @@ pub mod timing;
 pub mod trajectory;
 pub mod unusable;
 pub mod verify;
+pub mod vias;
 
 use std::f64::consts::FRAC_PI_2;
 
@@ -134,6 +135,10 @@ pub struct ThetaPsoOutcome {
     /// Usable, enabled IWPs the plan does not cross (it goes round them),
     /// as indices into `iwps`.
     pub bypassed: Vec<usize>,
+    /// The `[[reconfiguration.waypoints]]` entries that name no IWP, each
+    /// with why (`unused_choices`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unused_choices: Vec<String>,
     /// The obstacles some UAV flies over (above the top, inside the
     /// footprint) and under (below the base), by name, in mission order:
     /// what the summary states, the site being the user's to allow.
@@ -278,9 +283,25 @@ pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
             .position(&iwp.between[0], &iwp.between[1])
             .is_some()
     };
+    for iwp in iwps.iter().filter(|i| i.gate.is_some()) {
+        if let (Some(g), Some(reason)) = (iwp.gate, &iwp.unusable) {
+            out.push(Diagnostic::error(
+                FieldPath::root()
+                    .key("route")
+                    .key("via")
+                    .index(g)
+                    .key("between"),
+                format!(
+                    "the route cannot pass between '{}' and '{}': {reason}",
+                    iwp.between[0], iwp.between[1]
+                ),
+            ));
+        }
+    }
+    out.extend(unused_choices(mission, &iwps));
     let defaulted: Vec<Iwp> = iwps
         .iter()
-        .filter(|i| i.enabled && i.unusable.is_some() && !chosen(i))
+        .filter(|i| i.enabled && i.unusable.is_some() && !chosen(i) && i.gate.is_none())
         .cloned()
         .collect();
     let grouped = defaulted.len() > UNUSABLE_WARNED;
@@ -306,7 +327,7 @@ pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
             ));
         }
     }
-    for iwp in iwps {
+    for iwp in iwps.into_iter().filter(|i| i.gate.is_none()) {
         if grouped && !chosen(&iwp) {
             continue;
         }
@@ -345,6 +366,36 @@ pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
                 "'{}' cannot be inspected: {reason}",
                 mission.obstacles[k].name
             ),
+        ));
+    }
+    out
+}
+
+/// The `[[reconfiguration.waypoints]]` entries that name no IWP, each a
+/// warning saying why (the pair is no gap eq. 9 places an IWP in) and what
+/// would make the route pass there: a choice is never silently ignored.
+pub fn unused_choices(mission: &Mission, iwps: &[Iwp]) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    let index = |name: &str| mission.obstacles.iter().position(|o| o.name == name);
+    for (i, w) in mission.reconfiguration.waypoints.iter().enumerate() {
+        let [a, b] = &w.between;
+        if iwps
+            .iter()
+            .any(|iwp| w.is_between(&iwp.between[0], &iwp.between[1]))
+        {
+            continue;
+        }
+        let (Some(p), Some(q)) = (index(a), index(b)) else {
+            continue; // a name that is no obstacle: validation says so
+        };
+        let why = iwp::why_no_iwp(mission, p.min(q), p.max(q));
+        out.push(Diagnostic::warning(
+            FieldPath::root()
+                .key("reconfiguration")
+                .key("waypoints")
+                .index(i)
+                .key("between"),
+            format!("not used: no IWP between '{a}' and '{b}': {why}"),
         ));
     }
     out

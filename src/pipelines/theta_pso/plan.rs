@@ -5,6 +5,9 @@
 //! verification, the repair step and restarts; [`Search::fly_the_corridor`]
 //! when every run fails), [`report_broken`], and the [`outcome`] with its
 //! trajectories (eqs. 12-15).
+//!
+//! Long (~710 lines) because it is Fig. 3 whole: each stage a short function, the search's
+//! attempts and restarts, the repair and the corridor, in the order they run.
 
 use std::ops::ControlFlow;
 
@@ -76,6 +79,21 @@ pub fn plan_warm(
 fn admit(mission: &Mission) -> Result<(), PipelineError> {
     crate::pipelines::require_valid(mission)?;
     crate::pipelines::require_within_budget(budget(mission))?;
+    // A gate the user asked for that no formation can take: no plan keeps
+    // the route as written.
+    if mission.route.via.iter().any(|v| v.between.is_some())
+        && let Some((g, iwp)) = super::find_iwps(mission)
+            .into_iter()
+            .find_map(|i| Some((i.gate?, i)).filter(|(_, i)| i.unusable.is_some()))
+    {
+        return Err(PipelineError::NoRoute(format!(
+            "route.via {} (between '{}' and '{}') cannot be kept: {}",
+            g + 1,
+            iwp.between[0],
+            iwp.between[1],
+            iwp.unusable.unwrap_or_default()
+        )));
+    }
     let errors: Vec<String> = diagnostics(mission)
         .into_iter()
         .filter(|d| d.is_error())
@@ -448,6 +466,10 @@ fn outcome(
         .collect();
     let reference_length = reference.map(|r| r.length);
     let [passed_over, passed_under] = passed_by_altitude(mission, &best.flight.trajectories);
+    let unused_choices = super::unused_choices(mission, &problem.iwps)
+        .into_iter()
+        .map(|d| d.message)
+        .collect();
     ThetaPsoOutcome {
         header: crate::pipelines::Header {
             pipeline: crate::pipelines::Kind::ThetaPso,
@@ -476,6 +498,7 @@ fn outcome(
         flown_arcs: best.flight.progress,
         reconfigurations: best.flight.reconfigurations,
         bypassed,
+        unused_choices,
         passed_over,
         passed_under,
         source: best.source,

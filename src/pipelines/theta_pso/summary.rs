@@ -72,6 +72,9 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
         o.route_length
     );
     iwps(&mut s, o, verbose);
+    for why in &o.unused_choices {
+        let _ = writeln!(s, "  IWP choice   {why}");
+    }
     for (word, names) in [("over", &o.passed_over), ("under", &o.passed_under)] {
         if !names.is_empty() {
             let _ = writeln!(s, "  flies {word:<6} {}", few_names(names));
@@ -158,10 +161,17 @@ pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
             || "never within the band".to_owned(),
             |[lo, hi]| format!("facing UAV at {lo:.2}-{hi:.2} m"),
         );
+        // The face looked at: the side asked for, and the bearing flown.
+        let face = match (&i.side, i.face) {
+            (Some(side), Some(b)) => format!(", its {side} face ({b:.0}°)"),
+            (Some(side), None) => format!(", its {side} face"),
+            (None, Some(b)) => format!(", the face toward {}", compass(b)),
+            (None, None) => String::new(),
+        };
         rows.push(VerificationRow {
             ok: i.ok,
             text: format!(
-                "inspection of {:<19} {:>5.1} m ≥ {} m within [{}, {}] m, {band}",
+                "inspection of {:<19} {:>5.1} m ≥ {} m within [{}, {}] m, {band}{face}",
                 format!("'{}'", i.obstacle),
                 i.achieved,
                 i.required,
@@ -170,7 +180,27 @@ pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
             ),
         });
     }
+    for v in &o.verification.vias {
+        let when = match (v.time, v.distance) {
+            (Some(t), Some(d)) => format!("at t = {t:.1} s, {d:.2} m from it"),
+            (Some(t), None) => format!("at t = {t:.1} s"),
+            _ => String::new(),
+        };
+        let text = match &v.why {
+            Some(why) => format!("route.via {} {}: {why}", v.via, v.label),
+            None => format!("route.via {} {} kept {when}", v.via, v.label),
+        };
+        rows.push(VerificationRow { ok: v.ok, text });
+    }
     rows
+}
+
+/// A bearing (degrees clockwise from north) as the nearest of the eight
+/// compass points, with the figure: `east (87°)`.
+pub fn compass(bearing: f64) -> String {
+    let names = crate::mission::Side::NAMES;
+    let k = ((bearing.rem_euclid(360.0) + 22.5) / 45.0).floor() as usize % 8;
+    format!("{} ({bearing:.0}°)", names[k].0)
 }
 
 /// Bypassed IWPs the summary names one per line; more are one line.

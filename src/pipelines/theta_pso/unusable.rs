@@ -225,6 +225,7 @@ mod tests {
             hold: 0.0,
             straight: 0.0,
             window: [f64::NEG_INFINITY, f64::INFINITY],
+            gate: None,
         }
     }
 

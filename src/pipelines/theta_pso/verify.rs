@@ -87,6 +87,9 @@ pub struct Verification {
     /// Eq. 8, one row per inspected obstacle.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub inspections: Vec<InspectionResult>,
+    /// The route's vias (`[[route.via]]`), one row each, in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub vias: Vec<super::vias::ViaResult>,
 }
 
 impl Verification {
@@ -111,10 +114,23 @@ impl Verification {
                 limit_figure(c.limit)
             ));
         }
-        self.inspections.iter().find(|i| !i.ok).map(|i| {
-            format!(
-                "inspection of '{}': {:.1} m within [{}, {}] m of its surface, {} m required (eq. 8)",
+        if let Some(i) = self.inspections.iter().find(|i| !i.ok) {
+            let side = i
+                .side
+                .as_ref()
+                .map_or_else(String::new, |s| format!(" on its {s} face"));
+            return Some(format!(
+                "inspection of '{}': {:.1} m within [{}, {}] m of its surface{side}, {} m required \
+                 (eq. 8)",
                 i.obstacle, i.achieved, i.band[0], i.band[1], i.required
+            ));
+        }
+        self.vias.iter().find(|v| !v.ok).map(|v| {
+            format!(
+                "route.via {} ({}): {}",
+                v.via,
+                v.label,
+                v.why.as_deref().unwrap_or("not kept")
             )
         })
     }
@@ -283,17 +299,23 @@ pub fn verify_within(
         }
         checks.extend(dynamics.checks);
     }
-    let inspections = if limits.inspections {
-        verify_inspections(mission, trajectories)
+    let (inspections, vias) = if limits.inspections {
+        (
+            verify_inspections(mission, trajectories),
+            super::vias::verify_vias(mission, trajectories),
+        )
     } else {
-        Vec::new()
+        (Vec::new(), Vec::new())
     };
     Verification {
-        feasible: checks.iter().all(|c| c.ok) && inspections.iter().all(|i| i.ok),
+        feasible: checks.iter().all(|c| c.ok)
+            && inspections.iter().all(|i| i.ok)
+            && vias.iter().all(|v| v.ok),
         checks,
         violations,
         violation_count: count,
         inspections,
+        vias,
     }
 }
 
@@ -466,7 +488,58 @@ pub struct InspectionResult {
     /// 0-based UAV facing the surface in the middle of the stretch.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub uav: Option<usize>,
+    /// The side the mission asks for (`inspect_side`), as it names it; the
+    /// stretch counts only where the facing UAV's nearest point of the
+    /// obstacle lies on that face.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub side: Option<String>,
+    /// The face inspected: the bearing of its outward normal at the facing
+    /// UAV's nearest point in the middle of the stretch, degrees clockwise
+    /// from north.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub face: Option<f64>,
     pub ok: bool,
+}
+
+/// The bearing (degrees clockwise from north, [0, 360)) of the outward
+/// normal of `o`'s side nearest `p`: a footprint's nearest edge's, a
+/// cylinder's radius through `p`.
+pub fn face_bearing(o: &crate::base::geometry::Prism, p: &Point3<f64>) -> f64 {
+    let q = o.nearest_on_outline(&p.xy());
+    let normal = if o.polygon.is_empty() {
+        q - o.center
+    } else {
+        let outline = &o.polygon;
+        let n = outline.len();
+        let edge = (0..n)
+            .min_by(|&a, &b| {
+                let d = |i: usize| {
+                    crate::base::geometry::segment_point_distance(
+                        &outline[i],
+                        &outline[(i + 1) % n],
+                        &q,
+                    )
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap_or(0);
+        let d = outline[(edge + 1) % n] - outline[edge];
+        let out = nalgebra::Vector2::new(d.y, -d.x);
+        // Either winding: the normal pointing away from the footprint.
+        if o.outward(&(q + out.normalize() * 1e-3)) > o.outward(&(q - out.normalize() * 1e-3)) {
+            out
+        } else {
+            -out
+        }
+    };
+    normal.x.atan2(normal.y).to_degrees().rem_euclid(360.0)
+}
+
+/// Whether a face of bearing `face` is the side of bearing `side`: within
+/// 45° (a footprint's face is one edge; a cylinder's the quarter facing it).
+pub fn on_side(face: f64, side: f64) -> bool {
+    let d = (face - side).rem_euclid(360.0);
+    d.min(360.0 - d) <= 45.0 + 1e-9
 }
 
 /// Checks eq. 8 on the flown trajectories for every inspected obstacle:
@@ -506,6 +579,9 @@ pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec
         .map(|o| {
             let band = o.stand_off_band(f);
             let cylinder = o.prism();
+            let side = o.inspect_side.as_ref().and_then(|s| s.bearing());
+            let on_face =
+                |p: &Point3<f64>| side.is_none_or(|b| on_side(face_bearing(&cylinder, p), b));
             // (start, end) sample indices of the current and the best run.
             let mut run: Option<usize> = None;
             let mut best: Option<(usize, usize)> = None;
@@ -517,8 +593,12 @@ pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec
                     .min_by(|a, b| a.1.total_cmp(&b.1))
             };
             for k in 0..=samples {
-                let inside =
-                    k < samples && facing(k).is_some_and(|(_, d)| band[0] <= d && d <= band[1]);
+                let inside = k < samples
+                    && facing(k).is_some_and(|(n, d)| {
+                        band[0] <= d
+                            && d <= band[1]
+                            && on_face(&trajectories[n].samples[k].position)
+                    });
                 match (inside, run) {
                     (true, None) => run = Some(k),
                     (false, Some(first)) => {
@@ -558,6 +638,12 @@ pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec
                 distance,
                 time: best.map(|(a, b)| [time(a), time(b)]),
                 uav: best.and_then(|(a, b)| facing((a + b) / 2).map(|(n, _)| n)),
+                side: o.inspect_side.as_ref().map(|s| s.words()),
+                face: best.and_then(|(a, b)| {
+                    let k = (a + b) / 2;
+                    facing(k)
+                        .map(|(n, _)| face_bearing(&cylinder, &trajectories[n].samples[k].position))
+                }),
                 ok: achieved + resolution + 1e-9 >= f.inspection_pass,
             }
         })

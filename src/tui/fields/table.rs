@@ -131,16 +131,24 @@ static TERRAIN: Table = Table { base: &[Key("terrain")], derived: &[], fields: &
 static OBSTACLE: Table = Table { base: &[Key("obstacles"), Index], derived: &[], fields: &[
     Spec { name: "name", unit: "", keys: &["name"], get: |m, i| text(&obstacle_at(m, i)?.name), set: rename_obstacle },
     Spec { name: "kind", unit: "", keys: &["kind"], get: |m, i| text(obstacle_at(m, i)?.kind.as_deref().unwrap_or("")), set: |m, i, t| put(&mut obstacle(m, i)?.kind, Ok((!t.is_empty()).then(|| t.to_owned()))) },
-    Spec { name: "centre x", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.x), set: |m, i, t| { let o = obstacle(m, i)?; let x = number(t)?; o.move_to(Point2::new(x, o.center.y)); Ok(()) } },
-    Spec { name: "centre y", unit: "m", keys: &["center"], get: |m, i| num(obstacle_at(m, i)?.center.y), set: |m, i, t| { let o = obstacle(m, i)?; let y = number(t)?; o.move_to(Point2::new(o.center.x, y)); Ok(()) } },
-    Spec { name: "centre lat", unit: "°", keys: &["center", "latitude"], get: |m, i| geo(m, i, LAT), set: |m, i, t| set_geo(m, i, t, LAT) },
-    Spec { name: "centre lon", unit: "°", keys: &["center", "longitude"], get: |m, i| geo(m, i, LON), set: |m, i, t| set_geo(m, i, t, LON) },
-    Spec { name: "radius", unit: "m", keys: &["radius"], get: |m, i| num(obstacle_at(m, i)?.radius), set: |m, i, t| { let r = number(t)?; obstacle(m, i)?.set_radius(r); Ok(()) } },
-    Spec { name: "height", unit: "m", keys: &["height"], get: |m, i| num(obstacle_at(m, i)?.height), set: |m, i, t| put(&mut obstacle(m, i)?.height, number(t)) },
+    Spec { name: "centre x", unit: "m", keys: &["center"], get: |m, i| num(solid_at(m, i)?.center.x), set: |m, i, t| { let o = obstacle(m, i)?; let x = number(t)?; o.move_to(Point2::new(x, o.center.y)); Ok(()) } },
+    Spec { name: "centre y", unit: "m", keys: &["center"], get: |m, i| num(solid_at(m, i)?.center.y), set: |m, i, t| { let o = obstacle(m, i)?; let y = number(t)?; o.move_to(Point2::new(o.center.x, y)); Ok(()) } },
+    Spec { name: "centre lat", unit: "°", keys: &["center", "latitude"], get: |m, i| { solid_at(m, i)?; geo(m, i, LAT) }, set: |m, i, t| set_geo(m, i, t, LAT) },
+    Spec { name: "centre lon", unit: "°", keys: &["center", "longitude"], get: |m, i| { solid_at(m, i)?; geo(m, i, LON) }, set: |m, i, t| set_geo(m, i, t, LON) },
+    Spec { name: "radius", unit: "m", keys: &["radius"], get: |m, i| num(solid_at(m, i)?.radius), set: |m, i, t| { let r = number(t)?; obstacle(m, i)?.set_radius(r); Ok(()) } },
+    Spec { name: "height", unit: "m", keys: &["height"], get: |m, i| num(solid_at(m, i)?.height), set: |m, i, t| put(&mut obstacle(m, i)?.height, number(t)) },
+    Spec { name: "wire from x", unit: "m", keys: &["wire", "from"], get: |m, i| num(wire_at(m, i)?.from.x), set: |m, i, t| set_wire(m, i, 0, 0, t) },
+    Spec { name: "wire from y", unit: "m", keys: &["wire", "from"], get: |m, i| num(wire_at(m, i)?.from.y), set: |m, i, t| set_wire(m, i, 0, 1, t) },
+    Spec { name: "wire from z", unit: "m", keys: &["wire", "from"], get: |m, i| num(wire_at(m, i)?.from.z), set: |m, i, t| set_wire(m, i, 0, 2, t) },
+    Spec { name: "wire to x", unit: "m", keys: &["wire", "to"], get: |m, i| num(wire_at(m, i)?.to.x), set: |m, i, t| set_wire(m, i, 1, 0, t) },
+    Spec { name: "wire to y", unit: "m", keys: &["wire", "to"], get: |m, i| num(wire_at(m, i)?.to.y), set: |m, i, t| set_wire(m, i, 1, 1, t) },
+    Spec { name: "wire to z", unit: "m", keys: &["wire", "to"], get: |m, i| num(wire_at(m, i)?.to.z), set: |m, i, t| set_wire(m, i, 1, 2, t) },
+    Spec { name: "wire radius", unit: "m", keys: &["wire", "radius"], get: |m, i| num(wire_at(m, i)?.radius), set: |m, i, t| { let r = number(t)?; obstacle(m, i)?.set_radius(r); Ok(()) } },
     Spec { name: "inspect (eq. 8)", unit: "", keys: &["inspect"], get: |m, i| yes(obstacle_at(m, i)?.inspect), set: |m, i, t| put(&mut obstacle(m, i)?.inspect, yes_no(t)) },
     Spec { name: "stand-off min", unit: "m", keys: &["stand_off"], get: |m, i| num(obstacle_at(m, i)?.stand_off_band(&m.formation)[0]), set: |m, i, t| set_stand_off(m, i, 0, t) },
     Spec { name: "stand-off max", unit: "m", keys: &["stand_off"], get: |m, i| num(obstacle_at(m, i)?.stand_off_band(&m.formation)[1]), set: |m, i, t| set_stand_off(m, i, 1, t) },
-    Spec { name: "base", unit: "m", keys: &["base"], get: |m, i| num(obstacle_at(m, i)?.base), set: |m, i, t| put(&mut obstacle(m, i)?.base, number(t)) },
+    Spec { name: "inspect side", unit: "", keys: &["inspect_side"], get: |m, i| text(obstacle_at(m, i)?.inspect_side.as_ref().map_or_else(|| "any".to_owned(), |s| s.label())), set: |m, i, t| put(&mut obstacle(m, i)?.inspect_side, side(t)) },
+    Spec { name: "base", unit: "m", keys: &["base"], get: |m, i| num(solid_at(m, i)?.base), set: |m, i, t| put(&mut obstacle(m, i)?.base, number(t)) },
     Spec { name: "overfly", unit: "", keys: &["overfly"], get: |m, i| yes(obstacle_at(m, i)?.overfly), set: |m, i, t| put(&mut obstacle(m, i)?.overfly, yes_no(t)) },
     Spec { name: "clearance above", unit: "m", keys: &["clearance_above"], get: |m, i| num(obstacle_at(m, i)?.clearance_above), set: |m, i, t| put(&mut obstacle(m, i)?.clearance_above, number(t)) },
 ]};
@@ -266,7 +274,7 @@ static FLEET: Table = Table { base: &[Key("fleet")], derived: &[], fields: &[
     Spec { name: "τ replan", unit: "s", keys: &["replan_period"], get: |m, _| num(m.fleet.replan_period), set: |m, _, t| put(&mut m.fleet.replan_period, number(t)) },
     Spec { name: "d_ip to target", unit: "m", keys: &["target_distance"], get: |m, _| num(m.fleet.target_distance), set: |m, _, t| put(&mut m.fleet.target_distance, number(t)) },
     Spec { name: "altitude", unit: "m", keys: &["altitude"], get: |m, _| num(m.fleet.altitude), set: |m, _, t| put(&mut m.fleet.altitude, number(t)) },
-    Spec { name: "duration", unit: "s", keys: &["duration"], get: |m, _| num(m.fleet.duration), set: |m, _, t| put(&mut m.fleet.duration, number(t)) },
+    Spec { name: "duration", unit: "s", keys: &["duration"], get: |m, _| text(m.fleet.duration.map_or_else(|| "auto".to_owned(), fmt_num)), set: |m, _, t| put(&mut m.fleet.duration, auto_or_number(t)) },
     Spec { name: "tolerance", unit: "", keys: &["tolerance"], get: |m, _| num(m.fleet.tolerance), set: |m, _, t| put(&mut m.fleet.tolerance, number(t)) },
     Spec { name: "PSO particles", unit: "", keys: &["swarm_size"], get: |m, _| text(m.fleet.swarm_size), set: |m, _, t| put(&mut m.fleet.swarm_size, count(t)) },
     Spec { name: "PSO iterations", unit: "", keys: &["iterations"], get: |m, _| text(m.fleet.iterations), set: |m, _, t| put(&mut m.fleet.iterations, count(t)) },
@@ -292,10 +300,13 @@ static FLEET: Table = Table { base: &[Key("fleet")], derived: &[], fields: &[
 #[rustfmt::skip]
 static FLEET_TARGET: Table = Table { base: &[Key("fleet"), Key("targets"), Index], derived: &[], fields: &[
     Spec { name: "time", unit: "s", keys: &["time"], get: |m, i| num(target_at(m, i)?.time), set: |m, i, t| put(&mut target(m, i)?.time, number(t)) },
-    Spec { name: "x", unit: "m", keys: &["position"], get: |m, i| num(target_at(m, i)?.position.x), set: |m, i, t| put(&mut target(m, i)?.position.x, number(t)) },
-    Spec { name: "y", unit: "m", keys: &["position"], get: |m, i| num(target_at(m, i)?.position.y), set: |m, i, t| put(&mut target(m, i)?.position.y, number(t)) },
-    Spec { name: "lat", unit: "°", keys: &["position", "latitude"], get: |m, i| geo(m, i, LAT), set: |m, i, t| set_geo(m, i, t, LAT) },
-    Spec { name: "lon", unit: "°", keys: &["position", "longitude"], get: |m, i| geo(m, i, LON), set: |m, i, t| set_geo(m, i, t, LON) },
+    Spec { name: "x", unit: "m", keys: &["position"], get: |m, i| num(around_at(m, i)?.position.x), set: |m, i, t| put(&mut target(m, i)?.position.x, number(t)) },
+    Spec { name: "y", unit: "m", keys: &["position"], get: |m, i| num(around_at(m, i)?.position.y), set: |m, i, t| put(&mut target(m, i)?.position.y, number(t)) },
+    Spec { name: "lat", unit: "°", keys: &["position", "latitude"], get: |m, i| { around_at(m, i)?; geo(m, i, LAT) }, set: |m, i, t| set_geo(m, i, t, LAT) },
+    Spec { name: "lon", unit: "°", keys: &["position", "longitude"], get: |m, i| { around_at(m, i)?; geo(m, i, LON) }, set: |m, i, t| set_geo(m, i, t, LON) },
+    Spec { name: "centre x", unit: "m", keys: &["positions"], get: |m, i| num(each_at(m, i)?.centre().x), set: |m, i, t| { let x = number(t)?; let tg = target(m, i)?; let c = tg.centre(); tg.move_to(nalgebra::Point2::new(x, c.y)); Ok(()) } },
+    Spec { name: "centre y", unit: "m", keys: &["positions"], get: |m, i| num(each_at(m, i)?.centre().y), set: |m, i, t| { let y = number(t)?; let tg = target(m, i)?; let c = tg.centre(); tg.move_to(nalgebra::Point2::new(c.x, y)); Ok(()) } },
+    Spec { name: "points", unit: "", keys: &["positions"], get: |m, i| text(each_at(m, i)?.positions.len()), set: |_, _, _| Err("one point per agent: edit `positions` in the file (the planner assigns them)".into()) },
 ]};
 
 // Reading and writing the values as text.
@@ -560,6 +571,79 @@ fn set_spacing(m: &mut Mission, t: &str) -> Result<(), String> {
 }
 
 // The selected item in the mission, to read (`…_at`) and to write.
+
+/// A fleet target the formation forms around.
+fn around_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m FleetTarget> {
+    target_at(m, item).filter(|t| t.positions.is_empty())
+}
+
+/// A fleet target of one point per agent.
+fn each_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m FleetTarget> {
+    target_at(m, item).filter(|t| !t.positions.is_empty())
+}
+
+/// An obstacle that is not a wire (whose box the wire's own fields set).
+fn solid_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m Obstacle> {
+    obstacle_at(m, item).filter(|o| !o.is_wire())
+}
+
+/// A wire obstacle's span.
+fn wire_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m crate::mission::Wire> {
+    obstacle_at(m, item)?.wire.as_ref()
+}
+
+/// One coordinate (`axis` 0-2) of one end (`end` 0: from, 1: to) of a
+/// wire; its box follows.
+fn set_wire(
+    m: &mut Mission,
+    item: &Item,
+    end: usize,
+    axis: usize,
+    text: &str,
+) -> Result<(), String> {
+    let v = number(text)?;
+    let o = obstacle(m, item)?;
+    let w = o.wire.as_mut().ok_or("not a wire")?;
+    let p = if end == 0 { &mut w.from } else { &mut w.to };
+    p[axis] = v;
+    o.settle();
+    Ok(())
+}
+
+/// `auto` (or nothing) for a value the planner works out, else a number.
+fn auto_or_number(text: &str) -> Result<Option<f64>, String> {
+    let t = text.trim();
+    if t.is_empty() || t.eq_ignore_ascii_case("auto") {
+        Ok(None)
+    } else {
+        number(t).map(Some).map_err(|e| format!("{e}, or auto"))
+    }
+}
+
+/// An inspected side: `any` (or nothing) for none, a bearing in degrees,
+/// or a compass point.
+fn side(text: &str) -> Result<Option<crate::mission::Side>, String> {
+    use crate::mission::Side;
+    let t = text.trim();
+    if t.is_empty() || t.eq_ignore_ascii_case("any") {
+        return Ok(None);
+    }
+    let side = match t.trim_end_matches('°').trim().parse::<f64>() {
+        Ok(d) => Side::Degrees(d),
+        Err(_) => Side::Named(t.to_owned()),
+    };
+    match side.bearing() {
+        Some(_) => Ok(Some(side)),
+        None => Err(format!(
+            "a bearing in degrees clockwise from north (90: east), a compass point ({}), or any",
+            Side::NAMES
+                .iter()
+                .map(|(n, _, _)| *n)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
+}
 
 fn obstacle_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m Obstacle> {
     match item {

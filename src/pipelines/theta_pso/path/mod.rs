@@ -15,11 +15,15 @@
 //!   choice.
 //!
 //! Each via is inserted into the leg where it lengthens the path least, so the
-//! swarm still decides the route between them.
+//! swarm still decides the route between them. The user's own vias
+//! (`[[route.via]]`: a gate between two obstacles, crossed straight as an
+//! IWP is; a point) come first, in their order: each goes into the leg
+//! after the one before where it adds the least length, so every path
+//! keeps them all, in order.
 //!
-//! Long (~760 lines) because it is the one `PathBuilder`: the decoding of a particle
-//! (eq. 1), the crossings and inspections it prepares once, and their insertion as
-//! via-points into the legs they lengthen least; the rounding, the squeeze, the walker and
+//! Long (~950 lines) because it is the one `PathBuilder`: the decoding of a particle
+//! (eq. 1), the crossings, inspections and the user's vias it prepares once, and their
+//! insertion as via-points into the legs they lengthen least (in order for the user's); the rounding, the squeeze, the walker and
 //! the zones are already submodules.
 
 use nalgebra::{Point2, Point3, Vector2, Vector3};
@@ -104,6 +108,17 @@ pub struct PathBuilder {
     transition: f64,
     /// Where the route stage found the site narrower than the formation.
     squeeze: Option<std::sync::Arc<SqueezeMap>>,
+    /// The user's vias, in their order.
+    vias: Vec<UserVia>,
+}
+
+/// One of the user's `[[route.via]]`, as the builder places it.
+#[derive(Debug, Clone, Copy)]
+enum UserVia {
+    /// Crossing `c` (a gate the user named).
+    Gate(usize),
+    /// A point the centroid passes.
+    Point(Point3<f64>),
 }
 
 /// A usable IWP as a via: its straight crossing.
@@ -123,6 +138,8 @@ struct Crossing {
     /// Left to `auto` (no choice of the user's for it): a squeeze may carry
     /// the formation through instead.
     auto: bool,
+    /// A gate the user named (`[[route.via]]`, its index): always placed.
+    user_gate: Option<usize>,
     hold: f64,
     transition: f64,
     /// Altitudes the centroid may take at the IWP so every UAV of the shape
@@ -145,6 +162,9 @@ struct Inspection {
     z_range: [f64; 2],
     /// A footprint's outline, anticlockwise: its pass runs along a face.
     face: Option<std::sync::Arc<[Point2<f64>]>>,
+    /// The side to inspect (`inspect_side`): the outward normal of the face
+    /// the pass must look at; any side when `None`.
+    side: Option<Vector2<f64>>,
 }
 
 /// Number of angles a particle has for a mission: three per free waypoint,
@@ -200,11 +220,25 @@ impl PathBuilder {
                             .reconfiguration
                             .choice(&iwp.between[0], &iwp.between[1])
                             .is_none(),
+                    user_gate: iwp.gate,
                     hold,
                     transition: mission.reconfiguration.transition_distance,
                     z_range: band_for(half_height),
                     window: iwp.window,
                 }
+            })
+            .collect::<Vec<Crossing>>();
+        let vias = mission
+            .route
+            .via
+            .iter()
+            .enumerate()
+            .filter_map(|(i, v)| match v.point {
+                Some(p) => Some(UserVia::Point(p)),
+                None => crossings
+                    .iter()
+                    .position(|c| c.user_gate == Some(i))
+                    .map(UserVia::Gate),
             })
             .collect();
         let inspections = passes
@@ -220,6 +254,10 @@ impl PathBuilder {
                     .inspection_altitudes(&mission.obstacles[k])
                     .unwrap_or_else(|| band_for(vertical_half_height(nominal))),
                 face: anticlockwise(&mission.obstacles[k].footprint),
+                side: mission.obstacles[k]
+                    .inspect_side
+                    .as_ref()
+                    .and_then(|s| s.normal()),
             })
             .collect();
         // The centroid searches a box shrunk by r_F so every UAV stays inside
@@ -246,7 +284,34 @@ impl PathBuilder {
             hold_distance: mission.reconfiguration.hold_distance,
             transition: mission.reconfiguration.transition_distance,
             squeeze: None,
+            vias,
         }
+    }
+
+    /// The user's via points, in their order among the vias: (index among
+    /// the vias, the point).
+    pub fn via_points(&self) -> Vec<(usize, Point3<f64>)> {
+        self.vias
+            .iter()
+            .enumerate()
+            .filter_map(|(k, v)| match v {
+                UserVia::Point(p) => Some((k, *p)),
+                UserVia::Gate(_) => None,
+            })
+            .collect()
+    }
+
+    /// The crossing of each gate among the user's vias, in their order:
+    /// (index among the vias, crossing index).
+    pub fn via_gates(&self) -> Vec<(usize, usize)> {
+        self.vias
+            .iter()
+            .enumerate()
+            .filter_map(|(k, v)| match v {
+                UserVia::Gate(c) => Some((k, *c)),
+                UserVia::Point(_) => None,
+            })
+            .collect()
     }
 
     /// Paths of this builder fly squeezed through `map`'s regions.
@@ -337,15 +402,31 @@ impl PathBuilder {
             ins.geometry.radius_right
         };
         if let Some(outline) = &ins.face {
+            let (edge, at) = match ins.side {
+                // On the chosen face, `phi` places the pass along it.
+                Some(normal) => {
+                    let i = facing_edge(outline, normal);
+                    let n = outline.len();
+                    let length = (outline[(i + 1) % n] - outline[i]).norm();
+                    (
+                        i,
+                        (phi + std::f64::consts::PI) / std::f64::consts::TAU * length,
+                    )
+                }
+                None => perimeter_place(outline, phi),
+            };
             return face_pass(
                 outline,
-                phi,
+                edge,
+                at,
                 radius,
                 ins.geometry.pass_length,
                 ins.half,
                 on_left,
             );
         }
+        // A cylinder's chosen side fixes the pass's angle round the axis.
+        let phi = ins.side.map_or(phi, |n| n.y.atan2(n.x));
         let (sin, cos) = phi.sin_cos();
         let radial = Vector2::new(cos, sin);
         // Anticlockwise round the axis: the obstacle is on the left.
@@ -435,7 +516,7 @@ impl PathBuilder {
     /// work out, so the swarm first checks these terms against its bound.
     pub fn place(&self, angles: &[f64]) -> Placed {
         let waypoints = self.decode(angles);
-        let extra = 3 * self.crossings.len() + 2 * self.inspections.len();
+        let extra = 3 * self.crossings.len() + 2 * self.inspections.len() + self.vias.len();
         let mut points = Vec::with_capacity(waypoints.len() + 2 + extra);
         points.push(self.start);
         points.extend_from_slice(&waypoints);
@@ -447,7 +528,36 @@ impl PathBuilder {
         // Vias placed: (crossing or inspection index, index of its first point).
         let mut crossings: Vec<(usize, usize)> = Vec::with_capacity(self.crossings.len());
         let mut passes: Vec<(usize, usize, bool)> = Vec::with_capacity(self.inspections.len());
+        // The user's vias first, in order: each into a leg after the last.
+        let mut floor = 0;
+        for via in &self.vias {
+            match *via {
+                UserVia::Gate(i) => {
+                    let c = &self.crossings[i];
+                    let Some((leg, triple)) = self.gate_leg(&points, &locked, c, floor) else {
+                        continue;
+                    };
+                    insert(&mut points, &mut locked, leg, &triple);
+                    shift(&mut crossings, &mut passes, leg, 3);
+                    crossings.push((i, leg + 1));
+                    floor = leg + 3;
+                }
+                UserVia::Point(p) => {
+                    let Some(leg) = cheapest_leg(&points, &locked, floor, |a, b| {
+                        (p - a).norm() + (b - p).norm() - (b - a).norm()
+                    }) else {
+                        continue;
+                    };
+                    insert(&mut points, &mut locked, leg, &[p]);
+                    shift(&mut crossings, &mut passes, leg, 1);
+                    floor = leg + 1;
+                }
+            }
+        }
         for (i, c) in self.crossings.iter().enumerate() {
+            if c.user_gate.is_some() {
+                continue;
+            }
             // A gap whose crossing would overlap one already placed (the
             // next post pair along a lane, the gap beside it in the same
             // wall) is passed within that one's straight: flying both in
@@ -632,6 +742,48 @@ impl PathBuilder {
         })
     }
 
+    /// Where a gate's crossing goes: the first free leg from `floor` on
+    /// that crosses it (as `crossing_leg` takes an IWP), else the free leg
+    /// from `floor` on where its straight adds the least length, flown in
+    /// that leg's direction.
+    fn gate_leg(
+        &self,
+        points: &[Point3<f64>],
+        locked: &[bool],
+        via: &Crossing,
+        floor: usize,
+    ) -> Option<(usize, [Point3<f64>; 3])> {
+        let mut free = locked.to_vec();
+        for l in free.iter_mut().take(floor.min(locked.len())) {
+            *l = true;
+        }
+        if let Some((leg, triple, _)) = self.crossing_leg(points, &free, via) {
+            return Some((leg, triple));
+        }
+        let triple_for = |a: Point3<f64>, b: Point3<f64>| {
+            let sign = if (b.xy() - a.xy()).dot(&via.reach) >= 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            let reach = via.reach * sign;
+            let height =
+                |p: Point2<f64>| altitude_along(a, b, p).clamp(via.z_range[0], via.z_range[1]);
+            let (enter, leave) = (via.center - reach, via.center + reach);
+            let (z0, z1) = (height(enter), height(leave));
+            [
+                Point3::new(enter.x, enter.y, z0),
+                Point3::new(via.center.x, via.center.y, (z0 + z1) / 2.0),
+                Point3::new(leave.x, leave.y, z1),
+            ]
+        };
+        let leg = cheapest_leg(points, locked, floor, |a, b| {
+            let [t0, _, t2] = triple_for(a, b);
+            (t0 - a).norm() + (t2 - t0).norm() + (b - t2).norm() - (b - a).norm()
+        })?;
+        Some((leg, triple_for(points[leg], points[leg + 1])))
+    }
+
     /// The leg, the pass's two ends and its side (obstacle on the left) that
     /// add the least length for inspection `i`'s pass at angle `phi`.
     fn best_pass(
@@ -667,6 +819,24 @@ impl PathBuilder {
     }
 }
 
+/// The free leg from `floor` on for which `added` (of its two ends) is
+/// least; `None` when every such leg is locked.
+fn cheapest_leg(
+    points: &[Point3<f64>],
+    locked: &[bool],
+    floor: usize,
+    added: impl Fn(Point3<f64>, Point3<f64>) -> f64,
+) -> Option<usize> {
+    points
+        .windows(2)
+        .enumerate()
+        .skip(floor)
+        .filter(|(i, _)| !locked[*i])
+        .map(|(i, w)| (i, added(w[0], w[1])))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
+}
+
 /// How far (metres) a leg may start past a crossing's entry (or end short
 /// of its exit) and still be flown through it.
 const DOUBLING_BACK: f64 = 1.0;
@@ -693,30 +863,21 @@ fn anticlockwise(outline: &[Point2<f64>]) -> Option<std::sync::Arc<[Point2<f64>]
     Some(v.into())
 }
 
-/// The ends of a pass along a face of the anticlockwise `outline`: `phi`
-/// (radians in [-π, π]) picks the place along its perimeter, the face
-/// there is the one passed, the pass centred on that place (kept on the
-/// face as far as the pass's length allows), its line `radius` out from
-/// the face, `half` either way, the footprint on the formation's left or
-/// right.
+/// The ends of a pass along edge `i` of the anticlockwise `outline`,
+/// centred `at` metres along it (kept on the face as far as the pass's
+/// length allows), its line `radius` out from the face, `half` either way,
+/// the footprint on the formation's left or right.
 fn face_pass(
     outline: &[Point2<f64>],
-    phi: f64,
+    i: usize,
+    at: f64,
     radius: f64,
     pass: f64,
     half: f64,
     on_left: bool,
 ) -> [Point2<f64>; 2] {
     let n = outline.len();
-    let edge = |i: usize| (outline[i], outline[(i + 1) % n]);
-    let perimeter: f64 = (0..n).map(|i| (edge(i).1 - edge(i).0).norm()).sum();
-    let mut at = ((phi + std::f64::consts::PI) / std::f64::consts::TAU).clamp(0.0, 1.0) * perimeter;
-    let mut i = 0;
-    while i + 1 < n && at > (edge(i).1 - edge(i).0).norm() {
-        at -= (edge(i).1 - edge(i).0).norm();
-        i += 1;
-    }
-    let (a, b) = edge(i);
+    let (a, b) = (outline[i], outline[(i + 1) % n]);
     let length = (b - a).norm().max(1e-12);
     let along = (b - a) / length;
     // Anticlockwise: the outside is on the edge's right.
@@ -726,6 +887,40 @@ fn face_pass(
     // Along the edge the footprint is on the left.
     let direction = if on_left { along } else { -along };
     [centre - direction * half, centre + direction * half]
+}
+
+/// Where `phi` (radians in [-π, π]) falls on the anticlockwise `outline`'s
+/// perimeter: the edge and the distance along it.
+fn perimeter_place(outline: &[Point2<f64>], phi: f64) -> (usize, f64) {
+    let n = outline.len();
+    let edge = |i: usize| (outline[i], outline[(i + 1) % n]);
+    let perimeter: f64 = (0..n).map(|i| (edge(i).1 - edge(i).0).norm()).sum();
+    let mut at = ((phi + std::f64::consts::PI) / std::f64::consts::TAU).clamp(0.0, 1.0) * perimeter;
+    let mut i = 0;
+    while i + 1 < n && at > (edge(i).1 - edge(i).0).norm() {
+        at -= (edge(i).1 - edge(i).0).norm();
+        i += 1;
+    }
+    (i, at)
+}
+
+/// The edge of the anticlockwise `outline` whose outward normal is nearest
+/// `normal` (the face an `inspect_side` names); the longer of two as near.
+pub fn facing_edge(outline: &[Point2<f64>], normal: Vector2<f64>) -> usize {
+    let n = outline.len();
+    (0..n)
+        .map(|i| {
+            let d = outline[(i + 1) % n] - outline[i];
+            let length = d.norm().max(1e-12);
+            let outward = Vector2::new(d.y, -d.x) / length;
+            (i, outward.dot(&normal), length)
+        })
+        .max_by(|a, b| {
+            (a.1, a.2)
+                .partial_cmp(&(b.1, b.2))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })
+        .map_or(0, |(i, _, _)| i)
 }
 
 /// Puts `via` into leg `leg` (after its first point), locking the via's own legs.

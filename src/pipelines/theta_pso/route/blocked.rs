@@ -45,9 +45,31 @@ pub fn explain(
         }
         Some(Stop::Crossing(c)) => {
             let iwp = &iwps[builder.crossing_iwps()[*c]];
+            match iwp.gate {
+                Some(g) => format!(
+                    " through route.via {} (between '{}' and '{}')",
+                    g + 1,
+                    iwp.between[0],
+                    iwp.between[1]
+                ),
+                None => format!(
+                    " through the IWP asked for between '{}' and '{}'",
+                    iwp.between[0], iwp.between[1]
+                ),
+            }
+        }
+        Some(Stop::Via(k)) => {
+            let points = builder.via_points();
+            let at = points.get(*k).map(|(_, p)| *p).unwrap_or_default();
+            let number = mission
+                .route
+                .via
+                .iter()
+                .position(|v| v.point.is_some_and(|q| (q - at).norm() < 1e-9))
+                .map_or(0, |i| i + 1);
             format!(
-                " through the IWP asked for between '{}' and '{}'",
-                iwp.between[0], iwp.between[1]
+                " by route.via {number} ({:.1}, {:.1}, {:.1})",
+                at.x, at.y, at.z
             )
         }
         None => String::new(),

@@ -512,7 +512,7 @@ fn with_altitudes(mission: &Mission, blocked: Blocked, z_box: [f64; 2]) -> Block
 
 /// The route search at `levels` (see [`find`]).
 ///
-/// Long (~120 lines): the stage in order (stops, the site, crossing and pass jumps, the guided
+/// Long (~150 lines): the stage in order (stops, the site, crossing, pass and via jumps, the guided
 /// search, the corridor and its squeeze map), each step reading the one before.
 fn find_at(
     mission: &Mission,
@@ -552,6 +552,30 @@ fn find_at(
             }
         }
     }
+    // The user's via points: a stop of no length at the point's cell, at
+    // the level of its altitude (any, flat), in whatever layer it is reached.
+    let via_points = builder.via_points();
+    let mut via_jumps = Vec::new();
+    for (stage, stop) in order.iter().enumerate() {
+        let Stop::Via(k) = *stop else { continue };
+        let p = via_points[k].1;
+        let at: Vec<usize> = (0..levels.len())
+            .filter(|&l| {
+                levels.is_flat() || {
+                    let [lo, hi] = levels.span(l);
+                    lo - 1e-9 <= p.z && p.z <= hi + 1e-9
+                }
+            })
+            .collect();
+        let at = if at.is_empty() {
+            (0..levels.len()).collect()
+        } else {
+            at
+        };
+        for level in at {
+            via_jumps.push((stage, level, p.xy(), k));
+        }
+    }
     let pass_altitudes = builder.pass_altitudes();
     let mut candidates: Vec<(usize, f64, bool, [Point2<f64>; 2])> = Vec::new();
     for (stage, stop) in order.iter().enumerate() {
@@ -582,6 +606,19 @@ fn find_at(
         }
     }
 
+    let via_tag = 2 * crossings.len() + candidates.len();
+    for &(stage, level, p, k) in &via_jumps {
+        let cell = field.index_of(p);
+        jumps.push(Jump {
+            from: cell,
+            to: cell,
+            length: 0.0,
+            pass_at: Some(stage),
+            crossing: true,
+            tag: via_tag + k,
+            level,
+        });
+    }
     let climb_cost = site.climb_costs();
     let graph = Graph {
         field,
@@ -618,13 +655,14 @@ fn find_at(
         Err(reached) => return Err(explain(mission, iwps, builder, &site, &reached, &order)),
     };
 
+    let points: Vec<Point2<f64>> = via_points.iter().map(|(_, p)| p.xy()).collect();
     let mut corridor = assemble(
         &site,
         &steps,
-        start,
-        goal,
+        [start, goal],
         &crossings,
         &candidates,
+        &points,
         builder.inspections().len(),
     );
     through_crossings(&site, builder, &mut corridor);
@@ -692,14 +730,19 @@ fn dx_dy(builder: &PathBuilder) -> [[f64; 2]; 2] {
 }
 
 /// Per crossing of the path builder: whether the user asked for it by name
-/// (a `[[reconfiguration.waypoints]]` entry), which makes it a stop.
-fn requested_crossings(mission: &Mission, builder: &PathBuilder, iwps: &[Iwp]) -> Vec<bool> {
+/// (a `[[reconfiguration.waypoints]]` entry, or a gate of `[[route.via]]`),
+/// which makes it a stop.
+pub(super) fn requested_crossings(
+    mission: &Mission,
+    builder: &PathBuilder,
+    iwps: &[Iwp],
+) -> Vec<bool> {
     builder
         .crossing_iwps()
         .iter()
         .map(|&i| {
             let [a, b] = &iwps[i].between;
-            mission.reconfiguration.choice(a, b).is_some()
+            iwps[i].gate.is_some() || mission.reconfiguration.choice(a, b).is_some()
         })
         .collect()
 }
@@ -709,12 +752,16 @@ fn requested_crossings(mission: &Mission, builder: &PathBuilder, iwps: &[Iwp]) -
 pub enum Stop {
     /// Inspection `i` of the path builder.
     Pass(usize),
-    /// Crossing `c` of the path builder (a requested IWP).
+    /// Crossing `c` of the path builder (a requested IWP, or a gate).
     Crossing(usize),
+    /// The user's via point `k` (`PathBuilder::via_points`).
+    Via(usize),
 }
 
-/// The inspections and the requested crossings (builder indices) in the
-/// order they lie along start → goal.
+/// The inspections, the requested crossings (builder indices) and the via
+/// points in the order they lie along start → goal, except that the user's
+/// own vias (gates and points) keep the order of `[[route.via]]` among the
+/// places they take.
 fn stop_order(
     builder: &PathBuilder,
     crossings: &[[Point2<f64>; 2]],
@@ -736,9 +783,36 @@ fn stop_order(
                 .filter(|(c, _)| requested[*c])
                 .map(|(c, [a, z])| (Stop::Crossing(c), along(nalgebra::center(a, z)))),
         )
+        .chain(
+            builder
+                .via_points()
+                .iter()
+                .enumerate()
+                .map(|(k, (_, p))| (Stop::Via(k), along(p.xy()))),
+        )
         .collect();
     order.sort_by(|a, b| a.1.total_cmp(&b.1));
-    order.into_iter().map(|(s, _)| s).collect()
+    let mut order: Vec<Stop> = order.into_iter().map(|(s, _)| s).collect();
+    // The user's vias in the file's order, in the places they took.
+    let mut user: Vec<(usize, Stop)> = builder
+        .via_gates()
+        .into_iter()
+        .map(|(k, c)| (k, Stop::Crossing(c)))
+        .chain(
+            builder
+                .via_points()
+                .iter()
+                .enumerate()
+                .map(|(j, (k, _))| (*k, Stop::Via(j))),
+        )
+        .collect();
+    user.sort_by_key(|(k, _)| *k);
+    let is_user = |s: &Stop| user.iter().any(|(_, u)| u == s);
+    let places: Vec<usize> = (0..order.len()).filter(|&i| is_user(&order[i])).collect();
+    for (place, (_, stop)) in places.into_iter().zip(user) {
+        order[place] = stop;
+    }
+    order
 }
 
 fn shrink([lo, hi]: [f64; 2], by: f64) -> [f64; 2] {
@@ -760,10 +834,10 @@ fn shrink([lo, hi]: [f64; 2], by: f64) -> [f64; 2] {
 fn assemble(
     site: &Site,
     steps: &[Step],
-    start: Point2<f64>,
-    goal: Point2<f64>,
+    [start, goal]: [Point2<f64>; 2],
     crossings: &[[Point2<f64>; 2]],
     candidates: &[(usize, f64, bool, [Point2<f64>; 2])],
+    via_points: &[Point2<f64>],
     inspections: usize,
 ) -> Corridor {
     let field = site.field();
@@ -876,11 +950,15 @@ fn assemble(
                 let (ends, leg) = if tag < 2 * crossings.len() {
                     let [a, z] = crossings[tag / 2];
                     let ends = if tag % 2 == 0 { [a, z] } else { [z, a] };
-                    (ends, Leg::Crossing(tag / 2))
-                } else {
+                    (ends, Some(Leg::Crossing(tag / 2)))
+                } else if tag < 2 * crossings.len() + candidates.len() {
                     let (i, phi, on_left, ends) = candidates[tag - 2 * crossings.len()];
                     passes[i] = (phi, on_left);
-                    (ends, Leg::Pass(i))
+                    (ends, Some(Leg::Pass(i)))
+                } else {
+                    // A via point: a corner of the route, no leg of its own.
+                    let p = via_points[tag - 2 * crossings.len() - candidates.len()];
+                    ([p, p], None)
                 };
                 flush(
                     &mut run,
@@ -890,9 +968,16 @@ fn assemble(
                     &mut legs,
                     ends[0],
                 );
-                points.push(ends[1]);
-                heights.push(height(v));
-                legs.push(leg);
+                if let Some(leg) = leg {
+                    points.push(ends[1]);
+                    heights.push(height(v));
+                    legs.push(leg);
+                } else if points.last() != Some(&ends[0]) {
+                    // The run was already at the point (pulled tight onto it).
+                    points.push(ends[0]);
+                    heights.push(height(v));
+                    legs.push(Leg::Free { layer });
+                }
                 run.push(ends[1]);
                 (layer, level) = (l, v);
                 if last {

@@ -36,14 +36,18 @@ pub fn reuse(
         || !same(*points.last()?, goal)
         || previous.passes.len() != builder.inspections().len()
         || !previous.heights.is_empty()
+        || !mission.route.via.is_empty()
     {
+        // A route with the user's vias is searched again: their order is
+        // the search's to keep.
         return None;
     }
     let stops = builder.inspections().len()
         + super::requested_crossings(mission, builder, iwps)
             .iter()
             .filter(|r| **r)
-            .count();
+            .count()
+        + builder.via_points().len();
     let site = Site::new(mission, builder, margin, Levels::flat(mission), stops);
     let field = site.field();
     let crossings = builder.crossings();
@@ -75,10 +79,8 @@ pub fn reuse(
             return None;
         }
     }
-    let requested_missing = builder.crossing_iwps().iter().enumerate().any(|(c, &i)| {
-        let [a, b] = &iwps[i].between;
-        mission.reconfiguration.choice(a, b).is_some() && !crossed[c]
-    });
+    let requested = super::requested_crossings(mission, builder, iwps);
+    let requested_missing = (0..crossed.len()).any(|c| requested[c] && !crossed[c]);
     if passed.iter().any(|&n| n != 1) || requested_missing {
         return None;
     }

@@ -79,6 +79,18 @@ impl Labels<'_> {
 }
 
 /// The map's text: IWP marks, obstacle names where they fit, start and goal.
+/// Sites of at most this many obstacles have every name drawn (where it
+/// fits); on larger ones, the selected, the found, the inspected and
+/// `NEAREST_NAMED` nearest the path.
+const ALL_NAMED: usize = 40;
+const NEAREST_NAMED: usize = 12;
+
+/// The map's text in the order it claims its cells: start, goal and the
+/// fleet's targets, the IWPs and the selected one's name, then the
+/// obstacles' names.
+///
+/// Long (~140 lines) because it places each kind of label in turn (marks, the selected IWP,
+/// the obstacles in order: selected, found, nearest), each where no other text is.
 pub(super) fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewport) {
     // A result drawn at kilometre scale (FLATLO's): the θ-PSO route, IWPs
     // and obstacle names would be letters piled on a few cells (the
@@ -94,7 +106,8 @@ pub(super) fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewp
         labels.reserve(s.x, s.y, 1);
         labels.reserve(g.x, g.y, 1);
         for t in &m.fleet.targets {
-            labels.reserve(t.position.x, t.position.y, 2);
+            let c = t.centre();
+            labels.reserve(c.x, c.y, 2);
         }
         // IWPs (eq. 9): enabled ones bright, disabled ones dim, the
         // selected one highlighted and named.
@@ -126,7 +139,8 @@ pub(super) fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewp
     }
     // Obstacle names, right of the obstacle or else left of it, where they
     // cover no other text: the selected one's always, first; then a find's
-    // matches; then, on a site of at most 40 obstacles, the others.
+    // matches; then, on a site of at most 40 obstacles, the others, and on
+    // a larger one the inspected ones and the 12 nearest the path.
     let selected = match *app.selected() {
         Item::Obstacle(i) => Some(i),
         _ => None,
@@ -140,10 +154,45 @@ pub(super) fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewp
             _ => None,
         })
         .collect();
-    let rest = (!kilometres && m.obstacles.len() <= 40)
-        .then(|| (0..m.obstacles.len()).filter(|i| Some(*i) != selected && !found.contains(i)))
-        .into_iter()
-        .flatten();
+    // On a larger site, the inspected ones and those nearest the path on
+    // the map (the shown plan's, else start to goal), nearest first.
+    let others = (0..m.obstacles.len()).filter(|i| Some(*i) != selected && !found.contains(i));
+    let rest: Vec<usize> = if kilometres {
+        Vec::new()
+    } else if m.obstacles.len() <= ALL_NAMED {
+        others.collect()
+    } else {
+        let path: Vec<Point2<f64>> = shown_chart(app)
+            .and_then(|(o, _)| {
+                o.face()
+                    .flown_path()
+                    .map(|p| p.iter().map(|q| q.xy()).collect())
+            })
+            .unwrap_or_else(|| vec![s.xy(), g.xy()]);
+        let distance = |i: usize| {
+            let prism = m.obstacles[i].prism();
+            path.windows(2)
+                .map(|w| prism.segment_distance(&w[0], &w[1]))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut near: Vec<(usize, f64)> = others
+            .map(|i| {
+                (
+                    i,
+                    if m.obstacles[i].inspect {
+                        f64::NEG_INFINITY
+                    } else {
+                        distance(i)
+                    },
+                )
+            })
+            .collect();
+        near.sort_by(|a, b| a.1.total_cmp(&b.1));
+        near.into_iter()
+            .take(NEAREST_NAMED)
+            .map(|(i, _)| i)
+            .collect()
+    };
     let order = selected
         .into_iter()
         .chain(found.iter().copied())

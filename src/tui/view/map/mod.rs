@@ -477,11 +477,13 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
         } else {
             Style::default().fg(Color::Yellow).bold()
         };
-        ctx.print(
-            t.position.x,
-            t.position.y,
-            Span::styled(format!("◎{}", k + 1), style),
-        );
+        // A target of one point per agent: each point a dot, the target's
+        // number at their middle.
+        for q in &t.positions {
+            ctx.print(q.x, q.y, Span::styled("·", style));
+        }
+        let c = t.centre();
+        ctx.print(c.x, c.y, Span::styled(format!("◎{}", k + 1), style));
     }
     let shown = shown_chart(app);
     if let Some((o, view)) = &shown {

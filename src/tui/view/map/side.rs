@@ -21,10 +21,11 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
     // With terrain: the ground under the path, and the band above it.
     let ground = super::super::terrain::ground_profile(m, &centroid, &along, 400);
     let highest = ground.iter().map(|g| g.1).fold(0.0, f64::max);
+    // The obstacles' tops on the ground under them (drawn so below).
     let top = m
         .obstacles
         .iter()
-        .map(|o| o.height)
+        .map(|o| o.height + m.ground(o.center.x, o.center.y))
         .fold(m.bounds.z[1] + highest, f64::max)
         .max(1.0)
         * 1.15;
@@ -82,33 +83,51 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
                     ),
                 );
             }
-            // Obstacles the formation passes within its safe radius, and
-            // every inspected one (the mission's subject, however far the
-            // path stays from it), at its closest point along the path.
+            // Each obstacle over the stretch of the path that passes under,
+            // over or beside it (within the formation's reach of its
+            // footprint), at its own heights; one near the path but not
+            // that near (within `NEAR` of the reach), and every inspected
+            // one, as a bar at its closest point, named.
             let reach = m.formation.safe_radius();
             for o in &m.obstacles {
-                if let Some((s, d)) = closest_along(&centroid, &along, &o.center)
-                    && (o.inspect || d < o.radius + reach)
-                {
-                    let color = if o.inspect {
-                        Color::LightMagenta
-                    } else {
-                        Color::LightRed
-                    };
+                let prism = m.prism(o);
+                let (stretches, closest) = stretches_by(&centroid, &along, &prism, reach, length);
+                let near = closest.is_some_and(|(_, d)| d <= reach + NEAR);
+                if stretches.is_empty() && !near && !o.inspect {
+                    continue;
+                }
+                let color = if o.inspect {
+                    Color::LightMagenta
+                } else {
+                    Color::LightRed
+                };
+                let base = prism.base;
+                // Its physical top (not the sky a no-overfly one is kept as),
+                // on the ground under it.
+                let height = o.height + (prism.base - o.base);
+                let bars: Vec<[f64; 2]> = if stretches.is_empty() {
+                    let s = closest.map_or(0.0, |(s, _)| s);
+                    let half = (length / 300.0).max(0.3);
+                    vec![[s - half, s + half]]
+                } else {
+                    stretches
+                };
+                for [a, b] in &bars {
                     ctx.draw(&Rectangle {
-                        x: s - o.radius,
-                        y: o.base,
-                        width: 2.0 * o.radius,
-                        height: o.height - o.base,
+                        x: *a,
+                        y: base,
+                        width: (b - a).max(length / 400.0),
+                        height: (height - base).max(0.0),
                         color,
                     });
-                    if o.inspect {
-                        ctx.print(
-                            s,
-                            o.height,
-                            Span::styled(o.name.clone(), Style::default().fg(color)),
-                        );
-                    }
+                }
+                if o.inspect || stretches_named(o, &bars) {
+                    let [a, _] = bars[0];
+                    ctx.print(
+                        a,
+                        height,
+                        Span::styled(o.name.clone(), Style::default().fg(color)),
+                    );
                 }
             }
             ctx.layer();
@@ -185,4 +204,56 @@ fn closest_along(points: &[Point3<f64>], along: &[f64], c: &Point2<f64>) -> Opti
         }
     }
     best
+}
+
+/// Beyond the formation's reach, how near the path an obstacle may stand
+/// and still be drawn (as a bar at its closest point), metres.
+const NEAR: f64 = 5.0;
+
+/// The stretches of the path (along-path distances [from, to]) whose
+/// centroid comes within `reach` of `prism`'s footprint, sampled every
+/// `length / 400` m, and the closest approach (along, distance to the
+/// footprint) over the whole path.
+fn stretches_by(
+    points: &[Point3<f64>],
+    along: &[f64],
+    prism: &crate::base::geometry::Prism,
+    reach: f64,
+    length: f64,
+) -> (Vec<[f64; 2]>, Option<(f64, f64)>) {
+    let step = (length / 400.0).max(0.05);
+    let mut stretches: Vec<[f64; 2]> = Vec::new();
+    let mut closest: Option<(f64, f64)> = None;
+    let mut open: Option<f64> = None;
+    for i in 1..points.len() {
+        let (a, b) = (points[i - 1].xy(), points[i].xy());
+        let leg = (b - a).norm();
+        let n = (leg / step).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            let t = k as f64 / n as f64;
+            let s = along[i - 1] + t * leg;
+            let d = prism.outward(&(a + (b - a) * t));
+            if closest.is_none_or(|(_, cd)| d < cd) {
+                closest = Some((s, d));
+            }
+            match (d <= reach, open) {
+                (true, None) => open = Some(s),
+                (false, Some(from)) => {
+                    stretches.push([from, s]);
+                    open = None;
+                }
+                _ => {}
+            }
+        }
+    }
+    if let Some(from) = open {
+        stretches.push([from, along.last().copied().unwrap_or(from)]);
+    }
+    (stretches, closest)
+}
+
+/// Whether to name an obstacle drawn over `bars`: one the path passes
+/// beside for long enough to print its name over.
+fn stretches_named(o: &crate::mission::Obstacle, bars: &[[f64; 2]]) -> bool {
+    !o.name.is_empty() && bars.iter().any(|[a, b]| b - a > 0.0)
 }
