@@ -330,3 +330,136 @@ fn formed_only_when_every_distance_is_within_tolerance() {
         "some seed leaves the far pairs out of tolerance"
     );
 }
+
+/// The shipped viaduct's fleet (issue 50): five agents, one to each of
+/// five targets on the east bank.
+fn viaduct() -> Mission {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/missions/viaduct-inspection.toml"
+    );
+    match mission::load(std::path::Path::new(path)) {
+        Ok(l) => l.mission,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// Issue 50: five agents to five targets, one each, from the shipped
+/// defaults (the run as long as the fleet needs): the planner assigns each
+/// agent a point (a permutation, stated in the report), and every agent
+/// ends within tolerance of its own.
+#[test]
+fn five_agents_reach_five_targets_one_each_from_the_defaults() {
+    let m = viaduct();
+    assert_eq!(m.fleet.duration, None, "the shipped default");
+    let o = flown_losing(&m, m.seed, &[], 0.0);
+    let t = &o.targets[0];
+    assert!(t.converged_after.is_some(), "{:?}", t.end);
+    let mut taken = t.assignment.clone();
+    taken.sort_unstable();
+    assert_eq!(taken, vec![0, 1, 2, 3, 4], "one point each");
+    let points = &m.fleet.targets[0].positions;
+    for (i, a) in o.agents.iter().enumerate() {
+        let last = a.samples.last().unwrap_or_else(|| panic!("no samples"));
+        let place = points[t.assignment[i]];
+        let off = (last.position.xy() - place).norm();
+        assert!(off < 0.3, "agent {} ends {off:.3} m from its point", i + 1);
+        assert_eq!(t.assigned[i], place);
+    }
+    let summary = Outcome::Fleet(Box::new(o.clone())).summary();
+    assert!(summary.contains("assigned   agent 1 → point"), "{summary}");
+    assert!(summary.contains("result       PASS"), "{summary}");
+}
+
+/// Issue 50: an agent lost mid-run leaves the formation to its survivors:
+/// the targets are judged on the four (reached), the verdict says the lost
+/// one was left out and how the survivors did, the pair table gives no
+/// final distance to it, and the JSON numbers it 3 as the text does.
+#[test]
+fn a_killed_agents_run_judges_the_four_survivors() {
+    let m = viaduct();
+    let o = flown_losing(&m, m.seed, &[2], 60.0);
+    assert!(
+        o.targets[0].converged_after.is_some(),
+        "{:?}",
+        o.targets[0].end
+    );
+    let e = o.targets[0]
+        .end
+        .as_ref()
+        .unwrap_or_else(|| panic!("no end"));
+    for d in [e.pair, e.to_target].iter().flatten() {
+        assert!(d.a != 2 && d.b != Some(2), "the lost agent judged: {d:?}");
+    }
+    let outcome = Outcome::Fleet(Box::new(o.clone()));
+    let verdict = format!("{:?}", outcome.verdict());
+    assert!(
+        verdict.contains("agent 3 was lost at t = 60.00 s")
+            && verdict.contains("the 4 survivors (it left out) reached every formation"),
+        "{verdict}"
+    );
+    let summary = outcome.summary();
+    assert!(
+        summary.contains("agent 3 lost at t = 60.0 s (no final distance)"),
+        "{summary}"
+    );
+    assert!(
+        summary.contains("judged       the 4 surviving agent(s): agent 3 lost"),
+        "{summary}"
+    );
+    assert!(
+        summary.contains("result       FAIL: agent 3 was lost"),
+        "{summary}"
+    );
+    let json: serde_json::Value = match outcome.to_json().map(|t| serde_json::from_str(&t)) {
+        Ok(Ok(v)) => v,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(json["lost"][0]["agent"], 3, "as the text numbers it");
+    assert_eq!(json["agents"][2]["agent"], 3);
+}
+
+/// Issue 50: a run that ends short names what holds each agent back: here
+/// agent 3, whose straight way to its point runs by pier 4, stalls behind
+/// it (the fleet paper's local planner has no way round a wall of its own);
+/// and a written duration shorter than the fleet needs is a `check` warning
+/// with the time it needs.
+#[test]
+fn a_run_that_ends_short_names_the_obstacle_an_agent_is_stalled_behind() {
+    let mut m = viaduct();
+    m.fleet.initial_positions = [-20.0, -14.0, -8.0, -2.0, 4.0]
+        .iter()
+        .map(|&y| Point2::new(-70.0, y))
+        .collect();
+    m.fleet.targets[0].positions = [-20.0, -10.0, 0.0, 10.0, 20.0]
+        .iter()
+        .map(|&y| Point2::new(60.0, y))
+        .collect();
+    let o = flown_losing(&m, m.seed, &[], 0.0);
+    assert!(o.targets[0].converged_after.is_none());
+    let short: Vec<String> = o
+        .short
+        .iter()
+        .map(|s| format!("agent {}: {}", s.agent + 1, s.why))
+        .collect();
+    assert!(
+        short
+            .iter()
+            .any(|s| s.starts_with("agent 3: stalled behind 'pier 4'")),
+        "{short:?}"
+    );
+    let summary = Outcome::Fleet(Box::new(o)).summary();
+    assert!(
+        summary.contains("short: stalled behind 'pier 4'"),
+        "{summary}"
+    );
+
+    m.fleet.duration = Some(60.0);
+    let findings = skyform::pipelines::fleet::duration_finding(&m)
+        .map(|d| d.to_string())
+        .unwrap_or_default();
+    assert!(
+        findings.contains("fleet.duration: 60 s is too short: the agents cruise at about 0.53 m/s"),
+        "{findings}"
+    );
+}

@@ -597,3 +597,200 @@ fn footprints_come_in_with_their_heights_and_the_narrowest_aisle_is_named() {
         "{report}"
     );
 }
+
+/// The viaduct mission of `tests/fixtures/import/viaduct.py`, before its
+/// survey.
+fn viaduct_base() -> Mission {
+    mission::load(&fixture("viaduct-base.toml"))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission
+}
+
+/// Every obstacle's underside and top as imported, metres, checked against
+/// the survey's as drawn (`viaduct.py`): piers 0-22, the deck 22-25 (its
+/// surface at 25 m, resting on the piers), the mast 0-30, poplars 0-18, the
+/// 11 kV line a wire at 12 m, never a fence.
+fn assert_viaduct_heights(m: &Mission, what: &str) {
+    for k in 1..=7 {
+        let pier = named(m, &format!("pier {k}"));
+        assert_eq!((pier.base, pier.height), (0.0, 22.0), "{what}: {pier:?}");
+        assert_eq!(pier.footprint.len(), 4, "{what}");
+    }
+    let deck = named(m, "deck");
+    assert_eq!((deck.base, deck.height), (22.0, 25.0), "{what}: {deck:?}");
+    let mast = named(m, "signal mast");
+    assert_eq!((mast.base, mast.height), (0.0, 30.0), "{what}");
+    for k in 1..=5 {
+        let poplar = named(m, &format!("poplar {k}"));
+        assert_eq!((poplar.base, poplar.height), (0.0, 18.0), "{what}");
+    }
+    let wire: Vec<&Obstacle> = m.obstacles.iter().filter(|o| o.is_wire()).collect();
+    assert!(
+        (1..=3).contains(&wire.len()),
+        "{what}: the line is {} spans",
+        wire.len()
+    );
+    for w in &wire {
+        let span = w.wire.as_ref().unwrap_or_else(|| panic!("a wire"));
+        assert!(
+            (span.from.z - 12.0).abs() < 1e-3 && (span.to.z - 12.0).abs() < 1e-3,
+            "{what}: {span:?}"
+        );
+        // Its box: the wire's radius either side of 12 m, not from the ground.
+        assert!(w.base > 11.0 && w.height < 13.0, "{what}: {w:?}");
+    }
+    // Over the bounds' width (160 m) the line runs 160.1 m, all of it kept.
+    let length: f64 = wire
+        .iter()
+        .filter_map(|w| w.wire.as_ref().map(|s| s.span()))
+        .sum();
+    assert!((length - 160.06).abs() < 0.1, "{what}: {length} m of wire");
+    assert_eq!(
+        m.obstacles.len(),
+        15 + wire.len() - 1,
+        "{what}: {:?}",
+        names(m)
+    );
+}
+
+/// Issue 50: a site drawn as Google Earth draws it (heights only in the
+/// coordinates, `relativeToGround`, piers, mast and trees extruded, the deck
+/// and the line not) imports with every height as drawn; the same survey
+/// with `absolute` altitudes (less the origin's 480 m) and as QGIS writes it
+/// in GeoJSON (the third coordinate above the ellipsoid) comes in the same.
+#[test]
+fn a_survey_as_google_earth_and_qgis_draw_it_imports_with_every_height() {
+    let base = viaduct_base();
+    for file in [
+        "viaduct-google-earth.kml",
+        "viaduct-absolute.kml",
+        "viaduct-qgis.geojson",
+    ] {
+        let imported = import_into(&base, &fixture(file));
+        assert_viaduct_heights(&imported.mission, file);
+        let report = imported.report();
+        assert!(
+            report.contains("'deck': a deck from 22 m to 25 m, resting on what stands under it"),
+            "{file}: {report}"
+        );
+        assert!(report.contains("'11 kV line': a wire at 12 m"), "{report}");
+        // The survey's description is kept.
+        if file.ends_with(".kml") {
+            assert_eq!(
+                named(&imported.mission, "signal mast")
+                    .description
+                    .as_deref(),
+                Some("Lattice mast, 30 m")
+            );
+        }
+    }
+}
+
+/// Issue 50: what `import` writes passes `check --strict`, its numbers to
+/// the millimetre (no `0.0002999999999993008`), the wire written as a wire.
+#[test]
+fn an_imported_survey_passes_check_strict_and_is_written_to_the_millimetre() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let path = dir.path().join("viaduct.toml");
+    std::fs::copy(fixture("viaduct-base.toml"), &path).unwrap_or_else(|e| panic!("{e}"));
+    let mission = path.display().to_string();
+    let survey = fixture("viaduct-google-earth.kml").display().to_string();
+    let out = skyform(&["import", &survey, "--into", &mission]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let check = skyform(&["check", "--strict", &mission]);
+    assert_eq!(
+        check.status.code(),
+        Some(0),
+        "{}{}",
+        text(&check.stdout),
+        text(&check.stderr)
+    );
+    let written = read(&path);
+    assert!(written.contains("[obstacles.wire]"), "{written}");
+    let imported = &written[written.find("[[obstacles]]").unwrap_or(0)..];
+    for line in imported.lines() {
+        for number in line
+            .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+            .filter(|t| t.contains('.'))
+        {
+            let decimals = number.split('.').nth(1).map_or(0, str::len);
+            assert!(decimals <= 3, "{number} in `{line}`");
+        }
+    }
+}
+
+/// Issue 50: a survey that would lower a known obstacle is refused without
+/// `--force`, naming it, and nothing is written; a survey without any
+/// height never replaces a known one.
+#[test]
+fn a_reimport_that_lowers_a_known_obstacle_is_refused_unless_forced() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let path = dir.path().join("viaduct.toml");
+    std::fs::copy(fixture("viaduct-base.toml"), &path).unwrap_or_else(|e| panic!("{e}"));
+    let mission = path.display().to_string();
+    let survey = fixture("viaduct-google-earth.kml").display().to_string();
+    assert_eq!(
+        skyform(&["import", &survey, "--into", &mission])
+            .status
+            .code(),
+        Some(0)
+    );
+    let before = read(&path);
+    // The mast surveyed again at 21 m, and with no height at all.
+    let lower = dir.path().join("mast.kml");
+    let mast = |coordinates: &str, mode: &str| {
+        format!(
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\">\
+             <Document><Folder><name>Masts</name><Placemark><name>signal mast</name><Point>\
+             <extrude>1</extrude>{mode}<coordinates>{coordinates}</coordinates></Point>\
+             </Placemark></Folder></Document></kml>"
+        )
+    };
+    let frame = skyform::mission::geodesy::Frame::new(
+        viaduct_base()
+            .origin
+            .as_ref()
+            .unwrap_or_else(|| panic!("origin")),
+    );
+    let g = frame.ground_to_geodetic(&Point2::new(30.0, 45.0));
+    let at = |alt: f64| format!("{},{},{alt}", g.longitude, g.latitude);
+    std::fs::write(
+        &lower,
+        mast(&at(21.0), "<altitudeMode>relativeToGround</altitudeMode>"),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let refused = skyform(&["import", &lower.display().to_string(), "--into", &mission]);
+    assert_eq!(refused.status.code(), Some(2), "{}", text(&refused.stdout));
+    assert!(
+        text(&refused.stdout).contains("loss: 'signal mast' lowered: its top 30 → 21 m"),
+        "{}",
+        text(&refused.stdout)
+    );
+    assert!(text(&refused.stderr).contains("--force"));
+    assert_eq!(read(&path), before, "nothing written");
+    let forced = skyform(&[
+        "import",
+        &lower.display().to_string(),
+        "--into",
+        &mission,
+        "--force",
+    ]);
+    assert_eq!(forced.status.code(), Some(0), "{}", text(&forced.stderr));
+    let m = mission::load(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    assert_eq!(named(&m, "signal mast").height, 21.0);
+
+    // Clamped to the ground, with no height: the known 21 m stays.
+    std::fs::write(&lower, mast(&at(0.0), "")).unwrap_or_else(|e| panic!("{e}"));
+    let kept = skyform(&["import", &lower.display().to_string(), "--into", &mission]);
+    assert_eq!(kept.status.code(), Some(0), "{}", text(&kept.stderr));
+    let m = mission::load(&path)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    assert_eq!(
+        named(&m, "signal mast").height,
+        21.0,
+        "a default never lowers it"
+    );
+}

@@ -1873,3 +1873,175 @@ fn a_vehicle_too_slow_to_sample_is_refused_naming_the_limit() {
         "{errors:?}"
     );
 }
+
+/// The shipped viaduct (issue 50): its survey as drawn, the gate between
+/// piers 3 and 4, pier 5's east face inspected.
+fn viaduct() -> Mission {
+    mission::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/missions/viaduct-inspection.toml"
+    )))
+    .unwrap_or_else(|e| panic!("{e}"))
+    .mission
+}
+
+fn obstacle<'m>(m: &'m Mission, name: &str) -> &'m Obstacle {
+    m.obstacles
+        .iter()
+        .find(|o| o.name == name)
+        .unwrap_or_else(|| panic!("no '{name}'"))
+}
+
+/// Where a track crosses the vertical plane x = `x` (between two samples,
+/// the straight line's crossing): (y, z) of each crossing.
+fn crossings_of_x(track: &skyform::pipelines::theta_pso::Trajectory, x: f64) -> Vec<(f64, f64)> {
+    track
+        .samples
+        .windows(2)
+        .filter_map(|w| {
+            let (a, b) = (w[0].position, w[1].position);
+            if (a.x - x) * (b.x - x) > 0.0 || a.x == b.x {
+                return None;
+            }
+            let t = (x - a.x) / (b.x - a.x);
+            Some((a.y + (b.y - a.y) * t, a.z + (b.z - a.z) * t))
+        })
+        .collect()
+}
+
+/// Issue 50: the user's gate between two named obstacles is kept on every
+/// seed 0-19: every UAV's track crosses the viaduct's line (x = 0) once,
+/// between pier 3 and pier 4 (y between their faces, -16.5 and -1.5 m) and
+/// under their tops; and pier 5 is inspected on the face the mission names
+/// (`inspect_side = "east"`): over the pass, the UAV nearest pier 5 has its
+/// nearest point of the pier on the east face (x = 3 m).
+#[test]
+fn the_users_gate_and_face_are_kept_on_every_seed() {
+    let m = viaduct();
+    let (p3, p4, p5) = (
+        obstacle(&m, "pier 3"),
+        obstacle(&m, "pier 4"),
+        obstacle(&m, "pier 5"),
+    );
+    let south = p3.footprint.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+    let north = p4.footprint.iter().map(|p| p.y).fold(f64::MAX, f64::min);
+    let east = p5.footprint.iter().map(|p| p.x).fold(f64::MIN, f64::max);
+    assert_eq!((south, north, east), (-16.5, -1.5, 3.0));
+    let prism = p5.prism();
+    let outcomes: Vec<(u64, ThetaPsoOutcome)> = (0..20u64)
+        .into_par_iter()
+        .map(|seed| (seed, run(&m, seed)))
+        .collect();
+    for (seed, o) in outcomes {
+        assert!(
+            o.feasible(),
+            "seed {seed}: {:?}",
+            o.verification.first_failure()
+        );
+        for (n, track) in o.trajectories.iter().enumerate() {
+            let crossings = crossings_of_x(track, 0.0);
+            assert_eq!(
+                crossings.len(),
+                1,
+                "seed {seed} UAV {}: {crossings:?}",
+                n + 1
+            );
+            let (y, z) = crossings[0];
+            assert!(
+                south < y && y < north && z < 22.0,
+                "seed {seed} UAV {}: crosses x = 0 at y = {y:.2}, z = {z:.2}",
+                n + 1
+            );
+        }
+        let pass = o
+            .passes
+            .iter()
+            .find(|p| p.obstacle == "pier 5")
+            .unwrap_or_else(|| panic!("seed {seed}: no pass of pier 5"));
+        let times = &o.trajectories[0].samples;
+        let mut looked = 0;
+        for (k, s) in times.iter().enumerate() {
+            if s.t < pass.time[0] || s.t > pass.time[1] {
+                continue;
+            }
+            let (nearest, _) = o
+                .trajectories
+                .iter()
+                .map(|t| {
+                    let p = t.samples[k].position;
+                    (prism.nearest_on_outline(&p.xy()), prism.clearance(&p))
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap_or_else(|| panic!("no UAV"));
+            assert!(
+                (nearest.x - east).abs() < 1e-6,
+                "seed {seed} t = {:.1}: nearest point {nearest} not on the east face",
+                s.t
+            );
+            looked += 1;
+        }
+        assert!(looked > 10, "seed {seed}: {looked} samples over the pass");
+    }
+}
+
+/// Issue 50: a gate no formation can take is `NO PLAN` naming it and why;
+/// a `[[reconfiguration.waypoints]]` entry that names no IWP says why in
+/// the summary (and `check` warns of it), never silently ignored.
+#[test]
+fn an_impossible_gate_is_no_plan_and_an_unused_iwp_choice_says_why() {
+    let mut m = viaduct();
+    m.route.via[0].between = Some(["pier 3".into(), "pier 5".into()]);
+    match plan(
+        &m,
+        0,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    ) {
+        Err(PipelineError::NoRoute(reason)) => assert_eq!(
+            reason,
+            "route.via 1 (between 'pier 3' and 'pier 5') cannot be kept: 'pier 4' stands in the gap"
+        ),
+        other => panic!("{:?}", other.map(|o| o.feasible())),
+    }
+    let mut m = viaduct();
+    m.route.via.clear();
+    m.reconfiguration.waypoints.push(mission::WaypointChoice {
+        between: ["pier 3".into(), "pier 4".into()],
+        enabled: true,
+        shape: ShapeChoice::Alignment,
+        scale: None,
+    });
+    let o = run(&m, 0);
+    let summary = skyform::pipelines::Outcome::ThetaPso(Box::new(o)).summary();
+    assert!(
+        summary.contains(
+            "IWP choice   not used: no IWP between 'pier 3' and 'pier 4': their gap, 15.00 m, is \
+             wider than the formation"
+        ),
+        "{summary}"
+    );
+    assert!(summary.contains("add [[route.via]] between = [\"pier 3\", \"pier 4\"]"));
+}
+
+/// Issue 50: a via point is passed within its radius, in the order of the
+/// file with the gate: north of the viaduct first, then through the gate.
+#[test]
+fn a_via_point_is_passed_within_its_radius_in_the_files_order() {
+    let mut m = viaduct();
+    m.route.via.insert(
+        0,
+        mission::Via {
+            between: None,
+            point: Some(Point3::new(-30.0, 40.0, 12.0)),
+            radius: Some(1.0),
+        },
+    );
+    let o = run(&m, 2);
+    assert!(o.feasible(), "{:?}", o.verification.first_failure());
+    let vias = &o.verification.vias;
+    assert_eq!(vias.len(), 2);
+    assert!(vias.iter().all(|v| v.ok), "{vias:?}");
+    assert!(vias[0].distance.is_some_and(|d| d <= 1.0), "{vias:?}");
+    assert!(vias[0].time < vias[1].time, "in order: {vias:?}");
+}

@@ -1125,3 +1125,32 @@ fn the_flight_check_shows_its_verdict_the_worst_place_and_the_envelope() {
         "{side}"
     );
 }
+
+/// Issue 50: the side view of a plan under the viaduct's deck draws the
+/// deck over the few metres the path passes under it (not over 126 m of
+/// it), with the piers the path passes between and the wire it flies
+/// under, each named.
+#[test]
+fn the_side_view_under_a_deck_draws_it_where_the_path_passes_under() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/missions/viaduct-inspection.toml"
+    );
+    let m = skyform::mission::load(std::path::Path::new(path))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    let mut app = app_with_run(Kind::ThetaPso, m, 0, "viaduct-inspection.toml");
+    app.update(Action::ToggleSideView);
+    let screen = render_at(&app, Instant::now(), (WIDTH, HEIGHT));
+    for name in ["deck", "pier 3", "pier 4", "11 kV line"] {
+        assert!(screen.contains(name), "'{name}' not drawn:\n{screen}");
+    }
+    // The deck's bar: the row it is named on holds its name once, and the
+    // bar under it spans a few columns of the 80 the path fills.
+    let row = screen
+        .lines()
+        .find(|l| l.contains("deck"))
+        .unwrap_or_else(|| panic!("{screen}"));
+    assert_eq!(row.matches("deck").count(), 1, "{row}");
+    insta::assert_snapshot!(screen);
+}

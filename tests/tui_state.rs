@@ -1726,3 +1726,49 @@ fn a_footprints_vertices_are_moved_added_and_deleted_with_undo() {
         "five undos give the footprint back"
     );
 }
+
+/// Issue 50: `G` flies the plan on the map, live or not: with a live plan
+/// shown (no job run), it keeps that plan as a job of its own, shows it and
+/// starts its flight check; the check comes back with its report.
+#[test]
+fn g_flies_the_live_plan_on_the_map() {
+    let wait = Duration::from_secs(120);
+    let mut m = default_mission().mission;
+    m.flight.flights = 20;
+    let mut app = App::new(Document::new(m, None), std::env::temp_dir());
+    assert!(app.start_live(skyform::pipelines::Kind::ThetaPso).is_ok());
+    assert!(app.settle_live(wait));
+    assert!(app.jobs().is_empty());
+    let live = app
+        .shown()
+        .map(|j| (j.id, j.outcome.clone()))
+        .expect("a live plan");
+    app.update(Action::FlightCheck);
+    assert_eq!(app.jobs().len(), 1, "the live plan kept as job 1");
+    let job = &app.jobs()[0];
+    assert_eq!(job.id, 1);
+    assert_eq!(job.outcome, live.1, "the plan that was on the map");
+    assert_eq!(app.shown().map(|j| j.id), Some(1));
+    assert!(
+        matches!(
+            job.flight,
+            Some(skyform::tui::jobs::FlightCheck::Running { .. })
+        ),
+        "{:?}",
+        app.status()
+    );
+    let deadline = std::time::Instant::now() + wait;
+    while !matches!(
+        app.jobs()[0].flight,
+        Some(skyform::tui::jobs::FlightCheck::Done(_))
+    ) {
+        assert!(std::time::Instant::now() < deadline, "no report");
+        if let Ok(msg) = app
+            .board()
+            .messages()
+            .recv_timeout(Duration::from_millis(200))
+        {
+            app.on_job_msg(msg, std::time::Instant::now());
+        }
+    }
+}

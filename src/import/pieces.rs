@@ -491,8 +491,10 @@ fn polygon(
 /// GeoJSON polygon with a height: a building), else `DEFAULT_DECK_THICKNESS`
 /// below its top, with a warning. Finishes their readings.
 pub(super) fn rest_surfaces(pending: &mut [Pending]) -> Vec<String> {
-    // What stands: every post and block with a known top.
-    let standing: Vec<(Vec<Point2<f64>>, f64)> = pending
+    // What stands: every post and block with a known top; the surfaces
+    // join it as they are rested, lowest first (a GeoJSON survey's piers
+    // are surfaces too, resolved onto the ground before the deck on them).
+    let mut standing: Vec<(Vec<Point2<f64>>, f64)> = pending
         .iter()
         .flat_map(|p| &p.pieces)
         .filter_map(|piece| match piece {
@@ -510,62 +512,74 @@ pub(super) fn rest_surfaces(pending: &mut [Pending]) -> Vec<String> {
             _ => None,
         })
         .collect();
-    let mut thin = Vec::new();
-    for p in pending.iter_mut() {
-        let mut rests = Vec::new();
-        for piece in &mut p.pieces {
-            let Piece::Surface {
-                footprint,
-                top,
-                on_ground,
-            } = piece
-            else {
-                continue;
-            };
-            let area = as_polygon(footprint);
-            let under = standing
-                .iter()
-                .filter(|(v, t)| *t < *top - 1e-6 && as_polygon(v).intersects(&area))
-                .map(|(_, t)| *t)
-                .fold(f64::NEG_INFINITY, f64::max);
-            let (base, words) = if under.is_finite() {
-                (
-                    under,
-                    format!(
-                        "a deck from {} to {}, resting on what stands under it",
-                        metres(under),
-                        metres(*top)
-                    ),
-                )
-            } else if *on_ground {
-                (
-                    0.0,
-                    format!(
-                        "a block from the ground to {} (a polygon with a height and nothing \
-                         under it: a building)",
-                        metres(*top)
-                    ),
-                )
-            } else {
-                let base = (*top - DEFAULT_DECK_THICKNESS).max(0.0);
-                thin.push(p.label.clone());
-                (
-                    base,
-                    format!(
-                        "a deck from {} to {}, {} deep assumed",
-                        metres(base),
-                        metres(*top),
-                        metres(DEFAULT_DECK_THICKNESS)
-                    ),
-                )
-            };
-            rests.push(words);
-            *piece = Piece::Block {
-                footprint: std::mem::take(footprint),
-                top: Some(*top),
-                base,
-            };
+    let mut surfaces: Vec<(usize, usize, f64)> = Vec::new();
+    for (i, p) in pending.iter().enumerate() {
+        for (k, piece) in p.pieces.iter().enumerate() {
+            if let Piece::Surface { top, .. } = piece {
+                surfaces.push((i, k, *top));
+            }
         }
+    }
+    surfaces.sort_by(|a, b| a.2.total_cmp(&b.2));
+    let mut thin = Vec::new();
+    let mut rests: Vec<Vec<String>> = vec![Vec::new(); pending.len()];
+    for (i, k, top) in surfaces {
+        let p = &mut pending[i];
+        let Piece::Surface {
+            footprint,
+            on_ground,
+            ..
+        } = &mut p.pieces[k]
+        else {
+            continue;
+        };
+        let area = as_polygon(footprint);
+        let under = standing
+            .iter()
+            .filter(|(v, t)| *t < top - 1e-6 && as_polygon(v).intersects(&area))
+            .map(|(_, t)| *t)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let (base, words) = if under.is_finite() {
+            (
+                under,
+                format!(
+                    "a deck from {} to {}, resting on what stands under it",
+                    metres(under),
+                    metres(top)
+                ),
+            )
+        } else if *on_ground {
+            (
+                0.0,
+                format!(
+                    "a block from the ground to {} (a polygon with a height and nothing \
+                     under it: a building)",
+                    metres(top)
+                ),
+            )
+        } else {
+            let base = (top - DEFAULT_DECK_THICKNESS).max(0.0);
+            thin.push(p.label.clone());
+            (
+                base,
+                format!(
+                    "a deck from {} to {}, {} deep assumed",
+                    metres(base),
+                    metres(top),
+                    metres(DEFAULT_DECK_THICKNESS)
+                ),
+            )
+        };
+        let footprint = std::mem::take(footprint);
+        standing.push((footprint.clone(), top));
+        p.pieces[k] = Piece::Block {
+            footprint,
+            top: Some(top),
+            base,
+        };
+        rests[i].push(words);
+    }
+    for (p, rests) in pending.iter_mut().zip(rests) {
         // The surface's reading is its top's words; what it rests on comes first.
         for (reading, rest) in p
             .readings

@@ -234,10 +234,22 @@ pub struct ObstacleFile {
 impl From<Obstacle> for ObstacleFile {
     fn from(o: Obstacle) -> Self {
         let wire = o.wire.is_some();
+        // A footprint's bounding circle is derived (read back, it is worked
+        // out again): written to the millimetre, the radius rounded up.
+        let derived = o.footprint.len() >= 3;
+        let (center, radius) = if derived {
+            let mm = |v: f64| (v * 1000.0).round() / 1000.0;
+            (
+                Point2::new(mm(o.center.x), mm(o.center.y)),
+                (o.radius * 1000.0).ceil() / 1000.0,
+            )
+        } else {
+            (o.center, o.radius)
+        };
         ObstacleFile {
             name: o.name,
-            center: (!wire).then_some(o.center),
-            radius: (!wire).then_some(o.radius),
+            center: (!wire).then_some(center),
+            radius: (!wire).then_some(radius),
             footprint: if wire { Vec::new() } else { o.footprint },
             height: (!wire).then_some(o.height),
             base: if wire { 0.0 } else { o.base },

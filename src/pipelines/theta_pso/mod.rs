@@ -285,14 +285,16 @@ pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
     };
     for iwp in iwps.iter().filter(|i| i.gate.is_some()) {
         if let (Some(g), Some(reason)) = (iwp.gate, &iwp.unusable) {
-            out.push(Diagnostic::error(
+            // A warning: the file is right, the plan it asks for does not
+            // exist (`run` says NO PLAN, naming it).
+            out.push(Diagnostic::warning(
                 FieldPath::root()
                     .key("route")
                     .key("via")
                     .index(g)
                     .key("between"),
                 format!(
-                    "the route cannot pass between '{}' and '{}': {reason}",
+                    "no plan can keep it: the route cannot pass between '{}' and '{}': {reason}",
                     iwp.between[0], iwp.between[1]
                 ),
             ));

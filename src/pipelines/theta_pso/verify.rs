@@ -535,11 +535,30 @@ pub fn face_bearing(o: &crate::base::geometry::Prism, p: &Point3<f64>) -> f64 {
     normal.x.atan2(normal.y).to_degrees().rem_euclid(360.0)
 }
 
-/// Whether a face of bearing `face` is the side of bearing `side`: within
-/// 45° (a footprint's face is one edge; a cylinder's the quarter facing it).
-pub fn on_side(face: f64, side: f64) -> bool {
-    let d = (face - side).rem_euclid(360.0);
-    d.min(360.0 - d) <= 45.0 + 1e-9
+/// Whether the point of `o` nearest `p` lies on the face `side` (the
+/// compass bearing of its outward normal) names: a footprint's face is the
+/// edge whose outward normal is nearest that bearing (its corners are on
+/// it), a cylinder's the quarter of its surface facing that way (within
+/// 45°).
+pub fn on_side(o: &crate::base::geometry::Prism, p: &Point3<f64>, side: f64) -> bool {
+    let q = o.nearest_on_outline(&p.xy());
+    let b = side.to_radians();
+    let normal = nalgebra::Vector2::new(b.sin(), b.cos());
+    if o.polygon.len() < 3 {
+        let face = face_bearing(o, p);
+        let d = (face - side).rem_euclid(360.0);
+        return d.min(360.0 - d) <= 45.0 + 1e-9;
+    }
+    let mut outline: Vec<nalgebra::Point2<f64>> = o.polygon.to_vec();
+    let n = outline.len();
+    let area: f64 = (0..n)
+        .map(|i| outline[i].coords.perp(&outline[(i + 1) % n].coords))
+        .sum();
+    if area < 0.0 {
+        outline.reverse();
+    }
+    let i = super::path::facing_edge(&outline, normal);
+    crate::base::geometry::segment_point_distance(&outline[i], &outline[(i + 1) % n], &q) < 1e-6
 }
 
 /// Checks eq. 8 on the flown trajectories for every inspected obstacle:
@@ -580,8 +599,7 @@ pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec
             let band = o.stand_off_band(f);
             let cylinder = o.prism();
             let side = o.inspect_side.as_ref().and_then(|s| s.bearing());
-            let on_face =
-                |p: &Point3<f64>| side.is_none_or(|b| on_side(face_bearing(&cylinder, p), b));
+            let on_face = |p: &Point3<f64>| side.is_none_or(|b| on_side(&cylinder, p, b));
             // (start, end) sample indices of the current and the best run.
             let mut run: Option<usize> = None;
             let mut best: Option<(usize, usize)> = None;
@@ -639,10 +657,15 @@ pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec
                 time: best.map(|(a, b)| [time(a), time(b)]),
                 uav: best.and_then(|(a, b)| facing((a + b) / 2).map(|(n, _)| n)),
                 side: o.inspect_side.as_ref().map(|s| s.words()),
-                face: best.and_then(|(a, b)| {
-                    let k = (a + b) / 2;
-                    facing(k)
-                        .map(|(n, _)| face_bearing(&cylinder, &trajectories[n].samples[k].position))
+                // The side asked for, every sample counted being on it;
+                // else the face the facing UAV looks at mid-stretch.
+                face: side.filter(|_| best.is_some()).or_else(|| {
+                    best.and_then(|(a, b)| {
+                        let k = (a + b) / 2;
+                        facing(k).map(|(n, _)| {
+                            face_bearing(&cylinder, &trajectories[n].samples[k].position)
+                        })
+                    })
                 }),
                 ok: achieved + resolution + 1e-9 >= f.inspection_pass,
             }

@@ -3,7 +3,7 @@
 //! values as text. The tables keep one field a line (`rustfmt::skip`) so
 //! they read as tables: name, unit, keys, read, write.
 //!
-//! Long (~735 lines) because it is the field tables of every item kind (some 300 lines, one
+//! Long (~825 lines) because it is the field tables of every item kind (some 300 lines, one
 //! field a line) with the parsers, names and setters their cells call, read together.
 
 use nalgebra::{Point2, Vector3};

@@ -83,53 +83,14 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
                     ),
                 );
             }
-            // Each obstacle over the stretch of the path that passes under,
-            // over or beside it (within the formation's reach of its
-            // footprint), at its own heights; one near the path but not
-            // that near (within `NEAR` of the reach), and every inspected
-            // one, as a bar at its closest point, named.
-            let reach = m.formation.safe_radius();
-            for o in &m.obstacles {
-                let prism = m.prism(o);
-                let (stretches, closest) = stretches_by(&centroid, &along, &prism, reach, length);
-                let near = closest.is_some_and(|(_, d)| d <= reach + NEAR);
-                if stretches.is_empty() && !near && !o.inspect {
-                    continue;
-                }
-                let color = if o.inspect {
-                    Color::LightMagenta
-                } else {
-                    Color::LightRed
-                };
-                let base = prism.base;
-                // Its physical top (not the sky a no-overfly one is kept as),
-                // on the ground under it.
-                let height = o.height + (prism.base - o.base);
-                let bars: Vec<[f64; 2]> = if stretches.is_empty() {
-                    let s = closest.map_or(0.0, |(s, _)| s);
-                    let half = (length / 300.0).max(0.3);
-                    vec![[s - half, s + half]]
-                } else {
-                    stretches
-                };
-                for [a, b] in &bars {
-                    ctx.draw(&Rectangle {
-                        x: *a,
-                        y: base,
-                        width: (b - a).max(length / 400.0),
-                        height: (height - base).max(0.0),
-                        color,
-                    });
-                }
-                if o.inspect || stretches_named(o, &bars) {
-                    let [a, _] = bars[0];
-                    ctx.print(
-                        a,
-                        height,
-                        Span::styled(o.name.clone(), Style::default().fg(color)),
-                    );
-                }
-            }
+            draw_obstacles(
+                ctx,
+                m,
+                (&centroid, &along),
+                [length, top],
+                area,
+                result.is_none(),
+            );
             ctx.layer();
             if let Some((o, view)) = &result {
                 let mut canvas = OnCanvas {
@@ -181,6 +142,80 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
     frame.render_widget(canvas, area);
 }
 
+/// The obstacles near the path, each over the stretch of it that passes
+/// under, over or beside it, and their names where they fit (`Names`).
+fn draw_obstacles(
+    ctx: &mut ratatui::widgets::canvas::Context,
+    m: &crate::mission::Mission,
+    (centroid, along): (&[Point3<f64>], &[f64]),
+    [length, top]: [f64; 2],
+    area: Rect,
+    no_plan: bool,
+) {
+    // Each obstacle over the stretch of the path that passes under,
+    // over or beside it (within the formation's reach of its
+    // footprint), at its own heights; one near the path but not
+    // that near (within `NEAR` of the reach), and every inspected
+    // one, as a bar at its closest point, named.
+    let reach = m.formation.safe_radius();
+    // Names raised a row where they would cover one already printed.
+    let mut names = Names {
+        column: 1.04 * length / f64::from(area.width.saturating_sub(2).max(1)),
+        row: top / f64::from(area.height.saturating_sub(2).max(1)),
+        taken: Vec::new(),
+    };
+    if no_plan {
+        // The line printed there below (no plan yet).
+        let x = 0.05 * length;
+        names.taken.push((x, x + 60.0 * names.column, top * 0.9));
+    }
+    let mut labels: Vec<(bool, f64, f64, String, Color)> = Vec::new();
+    for o in &m.obstacles {
+        let prism = m.prism(o);
+        let (stretches, closest) = stretches_by(centroid, along, &prism, reach, length);
+        let near = closest.is_some_and(|(_, d)| d <= reach + NEAR);
+        if stretches.is_empty() && !near && !o.inspect {
+            continue;
+        }
+        let color = if o.inspect {
+            Color::LightMagenta
+        } else {
+            Color::LightRed
+        };
+        let base = prism.base;
+        // Its physical top (not the sky a no-overfly one is kept as),
+        // on the ground under it.
+        let height = o.height + (prism.base - o.base);
+        let bars: Vec<[f64; 2]> = if stretches.is_empty() {
+            let s = closest.map_or(0.0, |(s, _)| s);
+            let half = (length / 300.0).max(0.3);
+            vec![[s - half, s + half]]
+        } else {
+            stretches
+        };
+        for [a, b] in &bars {
+            ctx.draw(&Rectangle {
+                x: *a,
+                y: base,
+                width: (b - a).max(length / 400.0),
+                height: (height - base).max(0.0),
+                color,
+            });
+        }
+        if o.inspect || stretches_named(o, &bars) {
+            labels.push((o.inspect, bars[0][0], height, o.name.clone(), color));
+        }
+    }
+    // The inspected ones' names first (the mission's subject), then
+    // the others', each where it covers no other.
+    labels.sort_by_key(|l| !l.0);
+    for (_, x, z, name, color) in labels {
+        if let Some(at) = names.place(x, z, name.chars().count(), top) {
+            ctx.print(x, at, Span::styled(name, Style::default().fg(color)));
+        }
+    }
+}
+
 fn cumulative(points: &[Point3<f64>]) -> Vec<f64> {
     let mut s = 0.0;
     let mut out = Vec::with_capacity(points.len());
@@ -204,6 +239,39 @@ fn closest_along(points: &[Point3<f64>], along: &[f64], c: &Point2<f64>) -> Opti
         }
     }
     best
+}
+
+/// The side view's obstacle names so far, in data units (metres along,
+/// metres up), and the size of a cell in them.
+struct Names {
+    column: f64,
+    row: f64,
+    taken: Vec<(f64, f64, f64)>,
+}
+
+impl Names {
+    /// The altitude to print a name of `chars` at `x`: `z`, else a row at
+    /// a time up to `top`, else down to the ground, where it covers no name
+    /// already placed; taken from then on. `None` where none is free.
+    fn place(&mut self, x: f64, z: f64, chars: usize, top: f64) -> Option<f64> {
+        let width = (chars as f64 + 1.0) * self.column;
+        let free = |at: f64| {
+            !self
+                .taken
+                .iter()
+                .any(|&(x0, x1, z0)| (at - z0).abs() < self.row && x < x1 && x0 < x + width)
+        };
+        let row = self.row.max(1e-9);
+        let up = (0..)
+            .map(|k| z + k as f64 * row)
+            .take_while(|at| *at < top - row);
+        let down = (1..)
+            .map(|k| z - k as f64 * row)
+            .take_while(|at| *at >= 0.0);
+        let at = up.chain(down).find(|at| free(*at))?;
+        self.taken.push((x, x + width, at));
+        Some(at)
+    }
 }
 
 /// Beyond the formation's reach, how near the path an obstacle may stand
@@ -256,4 +324,47 @@ fn stretches_by(
 /// beside for long enough to print its name over.
 fn stretches_named(o: &crate::mission::Obstacle, bars: &[[f64; 2]]) -> bool {
     !o.name.is_empty() && bars.iter().any(|[a, b]| b - a > 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 50: a deck 126 m long across a straight path is drawn over
+    /// the stretch the path passes under it (its 5 m width and the
+    /// formation's reach each side), not over its length; a mast beside
+    /// the path, out of reach, has no stretch but its closest point.
+    #[test]
+    fn a_deck_across_the_path_is_drawn_where_the_path_passes_under_it() {
+        let path = [
+            Point3::new(-70.0, -9.0, 10.0),
+            Point3::new(70.0, -9.0, 10.0),
+        ];
+        let along = cumulative(&path);
+        let mut deck = crate::mission::Obstacle::standing("deck", Point2::origin(), 0.0, 25.0);
+        deck.footprint = vec![
+            Point2::new(-2.5, -63.0),
+            Point2::new(2.5, -63.0),
+            Point2::new(2.5, 63.0),
+            Point2::new(-2.5, 63.0),
+        ];
+        deck.base = 22.0;
+        deck.settle();
+        let reach = 5.15;
+        let (stretches, _) = stretches_by(&path, &along, &deck.prism(), reach, 140.0);
+        assert_eq!(stretches.len(), 1, "{stretches:?}");
+        let [a, b] = stretches[0];
+        let step = 140.0 / 400.0;
+        assert!((a - (70.0 - 2.5 - reach)).abs() <= step, "{a}");
+        assert!((b - (70.0 + 2.5 + reach)).abs() <= step, "{b}");
+        let mast = crate::mission::Obstacle::standing("mast", Point2::new(30.0, 0.0), 1.0, 30.0);
+        let (none, closest) = stretches_by(&path, &along, &mast.prism(), reach, 140.0);
+        assert!(none.is_empty());
+        let (s, d) = closest.unwrap_or_default();
+        assert!(
+            (s - 100.0).abs() <= step && (d - 8.0).abs() < 1e-2,
+            "{s} {d}"
+        );
+        assert!(d <= reach + NEAR, "near enough to be drawn as a bar");
+    }
 }
