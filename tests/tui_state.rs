@@ -1772,3 +1772,68 @@ fn g_flies_the_live_plan_on_the_map() {
         }
     }
 }
+
+/// Issue 50: the designer edits the route's vias: `g` with an obstacle
+/// selected adds a gate between it and its nearest (one undo step), its
+/// names edited in the inspector (an unknown one refused, naming the
+/// nearest); without one, a via point at the view's centre; `Del` removes
+/// the selected via; the map draws each (‖1, ⊙2).
+#[test]
+fn g_adds_a_gate_or_a_via_point_with_undo() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/missions/viaduct-inspection.toml"
+    );
+    let mut m = skyform::mission::load(std::path::Path::new(path))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    m.route.via.clear();
+    let mut app = App::new(Document::new(m, None), std::env::temp_dir());
+    let pier = app
+        .mission()
+        .obstacles
+        .iter()
+        .position(|o| o.name == "pier 3")
+        .unwrap_or_else(|| panic!("no pier 3"));
+    app.update(Action::Select(Item::Obstacle(pier)));
+    app.update(Action::AddVia);
+    let via = &app.mission().route.via;
+    assert_eq!(via.len(), 1);
+    let pair = via[0].between.clone().unwrap_or_default();
+    assert_eq!(pair[0], "pier 3");
+    assert!(pair[1] == "pier 2" || pair[1] == "pier 4", "{pair:?}");
+    assert_eq!(*app.selected(), Item::Via(0));
+    type_into(&mut app, "and", "pier 4");
+    assert_eq!(
+        app.mission().route.via[0].between,
+        Some(["pier 3".to_owned(), "pier 4".to_owned()])
+    );
+    type_into(&mut app, "and", "pier 44");
+    assert!(
+        app.status().is_some_and(|s| s
+            .text
+            .contains("no obstacle is named 'pier 44' (did you mean 'pier 4'?)")),
+        "{:?}",
+        app.status()
+    );
+    app.update(Action::Select(Item::Start));
+    app.update(Action::AddVia);
+    let point = app.mission().route.via[1].point.expect("a via point");
+    assert_eq!(point.z, app.mission().route.start.z);
+    // Off the viaduct (the view's centre is pier 4's).
+    type_into(&mut app, "x (m)", "-40");
+    type_into(&mut app, "y (m)", "40");
+    let mut terminal = ratatui::Terminal::new(ratatui::backend::TestBackend::new(160, 48))
+        .unwrap_or_else(|e| panic!("{e}"));
+    terminal
+        .draw(|frame| {
+            skyform::tui::view::draw(frame, &app, std::time::Instant::now());
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+    let screen = terminal.backend().to_string();
+    assert!(screen.contains("‖1") && screen.contains("⊙2"), "{screen}");
+    app.update(Action::Delete);
+    assert_eq!(app.mission().route.via.len(), 1);
+    app.update(Action::Undo);
+    assert_eq!(app.mission().route.via.len(), 2, "undo brings it back");
+}

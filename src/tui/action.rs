@@ -75,6 +75,9 @@ pub enum Action {
 
     /// A new obstacle at the point, or at the view's centre.
     AddObstacle(Option<Point2<f64>>),
+    /// A place the route must take (`[[route.via]]`): a gate by the
+    /// selected obstacle, else a point at the view's centre.
+    AddVia,
     ToggleAddTool,
     Duplicate,
     Delete,

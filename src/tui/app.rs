@@ -362,7 +362,7 @@ impl App {
                     Err(text) => self.status.error(text),
                 }
             }
-            SelectNext | SelectPrevious | Select(_) | Nudge(..) | AddObstacle(_)
+            SelectNext | SelectPrevious | Select(_) | Nudge(..) | AddObstacle(_) | AddVia
             | ToggleAddTool | Duplicate | Delete | AddSlot | CyclePreset | CycleShape
             | ToggleWaypoint | ToggleInspect | ToggleVertices | FieldUp | FieldDown
             | EditStart(_) | EditInput(_) | EditBackspace | EditClear | EditCommit | EditCancel

@@ -206,6 +206,13 @@ impl Editor {
                 });
             }
             Duplicate => self.duplicate(status),
+            AddVia => {
+                let p = around
+                    .panned_center
+                    .unwrap_or(self.mission().bounds.center_xy());
+                self.add_via(p, status);
+                return Some(Request::ShowMap);
+            }
             ToggleInspect => self.toggle_inspect(status),
             ToggleVertices => self.toggle_vertices(status),
             Delete => self.delete(status),
@@ -421,6 +428,59 @@ impl Editor {
         }
     }
 
+    /// `g`: a place the route must take. With an obstacle selected, the gap
+    /// between it and the nearest obstacle in the altitude band (a gate:
+    /// change either name in the inspector); else a point at `at`, at the
+    /// start's altitude. Selected, to edit; `Del` removes it.
+    fn add_via(&mut self, at: Point2<f64>, status: &mut StatusLine) {
+        let m = self.mission();
+        let via = match self.selected {
+            Item::Obstacle(i) if i < m.obstacles.len() => {
+                let here = m.prism(&m.obstacles[i]);
+                let band = m.bounds.z;
+                let nearest = m
+                    .obstacles
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, o)| *j != i && o.within(band))
+                    .map(|(_, o)| {
+                        let (p, q) = crate::base::geometry::nearest_points(&here, &m.prism(o));
+                        (o.name.clone(), (q - p).norm())
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1));
+                let Some((other, _)) = nearest else {
+                    status.error("a gate needs a second obstacle in the altitude band");
+                    return;
+                };
+                crate::mission::Via {
+                    between: Some([m.obstacles[i].name.clone(), other]),
+                    point: None,
+                    radius: None,
+                }
+            }
+            _ => {
+                let z = m.route.start.z.clamp(m.bounds.z[0], m.bounds.z[1]);
+                crate::mission::Via {
+                    between: None,
+                    point: Some(nalgebra::Point3::new(
+                        mission::round_mm(at.x),
+                        mission::round_mm(at.y),
+                        z,
+                    )),
+                    radius: None,
+                }
+            }
+        };
+        let label = via.label();
+        self.edit(status, |m| m.route.via.push(via));
+        let k = self.mission().route.via.len() - 1;
+        self.select(Item::Via(k));
+        status.say(format!(
+            "route via {}: {label}: the route must take it, after the vias before it (u undoes)",
+            k + 1
+        ));
+    }
+
     fn toggle_inspect(&mut self, status: &mut StatusLine) {
         if let Item::Obstacle(i) = self.selected
             && let Some(o) = self.mission().obstacles.get(i)
@@ -626,6 +686,7 @@ impl Editor {
             | Item::Vertex(_, _)
             | Item::Start
             | Item::Goal
+            | Item::Via(_)
             | Item::FleetTarget(_) => {
                 if let Some(p) = self.position_of(&item) {
                     let to = p + Vector2::new(dx * s, dy * s);
@@ -659,6 +720,8 @@ impl Editor {
             Item::Goal => Some(m.route.goal.xy()),
             Item::Slot(i) => m.formation.slots.get(*i).map(|s| Point2::new(s.x, s.y)),
             Item::FleetTarget(i) => m.fleet.targets.get(*i).map(|t| t.centre()),
+            // A via point moves; a gate is where its obstacles are.
+            Item::Via(i) => m.route.via.get(*i)?.point.map(|p| p.xy()),
             _ => None,
         }
     }
@@ -714,6 +777,20 @@ impl Editor {
                     }
                 });
                 status.say("fleet target deleted (u to undo)");
+            }
+            Item::Via(i) => {
+                self.edit(status, |m| {
+                    if i < m.route.via.len() {
+                        m.route.via.remove(i);
+                    }
+                });
+                let left = self.mission().route.via.len();
+                self.select(if left > 0 {
+                    Item::Via(i.min(left - 1))
+                } else {
+                    Item::Goal
+                });
+                status.say(format!("route via {} deleted (u to undo)", i + 1));
             }
             Item::Waypoint(between) => {
                 self.edit(status, |m| {
@@ -872,6 +949,12 @@ fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
         Item::FleetTarget(i) => {
             if let Some(t) = m.fleet.targets.get_mut(*i) {
                 t.move_to(p);
+            }
+        }
+        Item::Via(i) => {
+            if let Some(q) = m.route.via.get_mut(*i).and_then(|v| v.point.as_mut()) {
+                q.x = p.x;
+                q.y = p.y;
             }
         }
         _ => {}

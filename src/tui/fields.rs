@@ -25,6 +25,9 @@ pub enum Item {
     Bounds,
     Start,
     Goal,
+    /// A place the route must take (`[[route.via]]`, its index): a gate
+    /// between two obstacles, or a point.
+    Via(usize),
     /// The `[terrain]` height map (listed when the mission has one).
     Terrain,
     Obstacle(usize),
@@ -52,6 +55,10 @@ impl Item {
             Item::Bounds => "Bounds".into(),
             Item::Start => "Start".into(),
             Item::Goal => "Goal".into(),
+            Item::Via(i) => match mission.route.via.get(*i) {
+                Some(v) => format!("Route via {} ({})", i + 1, v.label()),
+                None => format!("Route via {}", i + 1),
+            },
             Item::Terrain => "Terrain".into(),
             Item::Obstacle(i) => match mission.obstacles.get(*i) {
                 Some(o) => format!("Obstacle {} '{}'", i + 1, o.name),
@@ -82,6 +89,7 @@ impl Item {
                 .is_some_and(|o| *v < o.footprint.len()),
             Item::Slot(i) => *i < mission.formation.slots.len(),
             Item::FleetTarget(i) => *i < mission.fleet.targets.len(),
+            Item::Via(i) => *i < mission.route.via.len(),
             Item::Terrain => mission.terrain.is_some(),
             Item::Waypoint([a, b]) => {
                 let named = |n: &String| mission.obstacles.iter().any(|o| &o.name == n);
@@ -106,6 +114,7 @@ impl Item {
             Item::Bounds => root.key("bounds"),
             Item::Start => root.key("route").key("start"),
             Item::Goal => root.key("route").key("goal"),
+            Item::Via(i) => root.key("route").key("via").index(*i),
             Item::Terrain => root.key("terrain"),
             Item::Formation => root.key("formation"),
             Item::Slot(i) => root.key("formation").key("slots").index(*i),
@@ -122,9 +131,11 @@ impl Item {
     /// `reconfiguration.waypoints`, if it has one yet).
     fn index(&self, m: &Mission) -> Option<usize> {
         match self {
-            Item::Obstacle(i) | Item::Slot(i) | Item::FleetTarget(i) | Item::Vertex(i, _) => {
-                Some(*i)
-            }
+            Item::Obstacle(i)
+            | Item::Slot(i)
+            | Item::FleetTarget(i)
+            | Item::Via(i)
+            | Item::Vertex(i, _) => Some(*i),
             Item::Waypoint([a, b]) => m.reconfiguration.position(a, b),
             _ => None,
         }
@@ -134,6 +145,7 @@ impl Item {
 /// The items the map's next/previous keys cycle through, in order.
 pub fn map_items(mission: &Mission) -> Vec<Item> {
     let mut items = vec![Item::Mission, Item::Bounds, Item::Start, Item::Goal];
+    items.extend((0..mission.route.via.len()).map(Item::Via));
     if mission.terrain.is_some() {
         items.push(Item::Terrain);
     }

@@ -372,6 +372,12 @@ fn table() -> Vec<KeyRow> {
         },
         KeyRow {
             group: "Edit",
+            keys: "g".into(),
+            help: "route via: a gate by the selected obstacle, else a point",
+            bindings: vec![bind(Key::Char('g'), When::Pane(Pane::Map), Action::AddVia)],
+        },
+        KeyRow {
+            group: "Edit",
             keys: "i".into(),
             help: "inspect the selected obstacle (eq. 8) or stop inspecting it",
             bindings: vec![bind(Key::Char('i'), When::Always, Action::ToggleInspect)],
@@ -428,7 +434,7 @@ fn table() -> Vec<KeyRow> {
         KeyRow {
             group: "Run",
             keys: "G".into(),
-            help: "flight check of the shown plan ([flight])",
+            help: "flight check of the plan on the map, live or not ([flight])",
             bindings: vec![bind(Key::Char('G'), When::Always, Action::FlightCheck)],
         },
     ]);

@@ -24,6 +24,7 @@ pub(super) fn of(item: &Item) -> &'static Table {
         Item::Bounds => &BOUNDS,
         Item::Start => &START,
         Item::Goal => &GOAL,
+        Item::Via(_) => &VIA,
         Item::Terrain => &TERRAIN,
         Item::Obstacle(_) => &OBSTACLE,
         Item::Vertex(_, _) => &VERTEX,
@@ -125,6 +126,17 @@ static TERRAIN: Table = Table { base: &[Key("terrain")], derived: &[], fields: &
     Spec { name: "pixel x", unit: "m", keys: &["pixel_size"], get: |m, _| num(m.terrain.as_ref()?.pixel_size[0]), set: |m, _, t| put(&mut terrain(m)?.pixel_size[0], number(t)) },
     Spec { name: "pixel y", unit: "m", keys: &["pixel_size"], get: |m, _| num(m.terrain.as_ref()?.pixel_size[1]), set: |m, _, t| put(&mut terrain(m)?.pixel_size[1], number(t)) },
     Spec { name: "lookup", unit: "", keys: &["lookup"], get: |m, _| text(lookup_name(m.terrain.as_ref()?.lookup)), set: |m, _, t| put(&mut terrain(m)?.lookup, lookup(t)) },
+]};
+
+/// A `[[route.via]]`: a gate's two obstacles, or a point and its radius.
+#[rustfmt::skip]
+static VIA: Table = Table { base: &[Key("route"), Key("via"), Index], derived: &[], fields: &[
+    Spec { name: "between", unit: "", keys: &["between"], get: |m, i| text(&via_at(m, i)?.between.as_ref()?[0]), set: |m, i, t| set_between(m, i, 0, t) },
+    Spec { name: "and", unit: "", keys: &["between"], get: |m, i| text(&via_at(m, i)?.between.as_ref()?[1]), set: |m, i, t| set_between(m, i, 1, t) },
+    Spec { name: "x", unit: "m", keys: &["point"], get: |m, i| num(via_at(m, i)?.point?.x), set: |m, i, t| set_via_point(m, i, 0, t) },
+    Spec { name: "y", unit: "m", keys: &["point"], get: |m, i| num(via_at(m, i)?.point?.y), set: |m, i, t| set_via_point(m, i, 1, t) },
+    Spec { name: "z", unit: "m", keys: &["point"], get: |m, i| num(via_at(m, i)?.point?.z), set: |m, i, t| set_via_point(m, i, 2, t) },
+    Spec { name: "radius", unit: "m", keys: &["radius"], get: |m, i| { let v = via_at(m, i)?; v.point?; num(v.radius()) }, set: |m, i, t| { let r = number(t)?; via(m, i)?.radius = Some(r); Ok(()) } },
 ]};
 
 #[rustfmt::skip]
@@ -571,6 +583,48 @@ fn set_spacing(m: &mut Mission, t: &str) -> Result<(), String> {
 }
 
 // The selected item in the mission, to read (`…_at`) and to write.
+
+fn via_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m crate::mission::Via> {
+    match item {
+        Item::Via(i) => m.route.via.get(*i),
+        _ => None,
+    }
+}
+
+fn via<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut crate::mission::Via, String> {
+    match item {
+        Item::Via(i) => m.route.via.get_mut(*i).ok_or("no such via".into()),
+        _ => Err("not a via".into()),
+    }
+}
+
+/// One of a gate's two obstacles, by name (an obstacle the mission has).
+fn set_between(m: &mut Mission, item: &Item, k: usize, text: &str) -> Result<(), String> {
+    if !m.obstacles.iter().any(|o| o.name == text) {
+        let near = crate::mission::nearest_name(text, m.obstacles.iter().map(|o| o.name.as_str()));
+        return Err(format!(
+            "no obstacle is named '{text}'{}",
+            near.map(|n| format!(" (did you mean '{n}'?)"))
+                .unwrap_or_default()
+        ));
+    }
+    let v = via(m, item)?;
+    let pair = v
+        .between
+        .as_mut()
+        .ok_or("a via point: it has no obstacles")?;
+    pair[k] = text.to_owned();
+    Ok(())
+}
+
+/// One coordinate (0-2) of a via point.
+fn set_via_point(m: &mut Mission, item: &Item, axis: usize, text: &str) -> Result<(), String> {
+    let value = number(text)?;
+    let v = via(m, item)?;
+    let p = v.point.as_mut().ok_or("a gate: it has no point")?;
+    p[axis] = value;
+    Ok(())
+}
 
 /// A fleet target the formation forms around.
 fn around_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m FleetTarget> {

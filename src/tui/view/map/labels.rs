@@ -109,9 +109,13 @@ pub(super) fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewp
             let c = t.centre();
             labels.reserve(c.x, c.y, 2);
         }
+        for (_, at) in super::via_marks(m) {
+            labels.reserve(at.x, at.y, 2);
+        }
         // IWPs (eq. 9): enabled ones bright, disabled ones dim, the
         // selected one highlighted and named.
-        for w in app.iwps() {
+        // A gate of the route is drawn as its via (‖), not as an IWP.
+        for w in app.iwps().iter().filter(|w| w.gate.is_none()) {
             let selected = *app.selected() == Item::Waypoint(w.between.clone());
             let (glyph, style) = match (selected, w.enabled) {
                 (true, true) => ("◆", Style::default().black().on_yellow()),

@@ -471,6 +471,20 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
             color: Color::Blue,
         });
     }
+    // The route's vias: a gate (‖) at its gap's middle, a point (⊙).
+    for (k, at) in via_marks(m) {
+        let style = if *app.selected() == Item::Via(k) {
+            Style::default().black().on_yellow().bold()
+        } else {
+            Style::default().fg(Color::LightGreen).bold()
+        };
+        let glyph = if m.route.via[k].point.is_some() {
+            "⊙"
+        } else {
+            "‖"
+        };
+        ctx.print(at.x, at.y, Span::styled(format!("{glyph}{}", k + 1), style));
+    }
     for (k, t) in m.fleet.targets.iter().enumerate() {
         let style = if *app.selected() == Item::FleetTarget(k) {
             Style::default().black().on_yellow().bold()
@@ -571,6 +585,27 @@ pub fn folded_hint(app: &App, width: u16) -> TextLine<'static> {
         ],
         width.saturating_sub(2),
     )
+}
+
+/// Where each route via is marked on the map: a via point at its point, a
+/// gate at the middle of its two obstacles' nearest points (none for a
+/// gate naming an obstacle the mission does not have).
+pub(super) fn via_marks(m: &crate::mission::Mission) -> Vec<(usize, Point2<f64>)> {
+    m.route
+        .via
+        .iter()
+        .enumerate()
+        .filter_map(|(k, v)| {
+            if let Some(p) = v.point {
+                return Some((k, p.xy()));
+            }
+            let [a, b] = v.between.as_ref()?;
+            let find = |n: &str| m.obstacles.iter().find(|o| o.name == n);
+            let (pa, pb) = (m.prism(find(a)?), m.prism(find(b)?));
+            let (p, q) = crate::base::geometry::nearest_points(&pa, &pb);
+            Some((k, nalgebra::center(&p, &q)))
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -91,6 +91,21 @@ pub(super) fn draw_side(frame: &mut Frame, app: &App, area: Rect) {
                 area,
                 result.is_none(),
             );
+            // The route's vias, each a line up the altitudes where the path
+            // takes it (nearest along the path), numbered.
+            for (k, at) in super::via_marks(m) {
+                if let Some((s, _)) = closest_along(&centroid, &along, &at) {
+                    ctx.draw(&Line::new(s, 0.0, s, top * 0.95, Color::LightGreen));
+                    ctx.print(
+                        s,
+                        top * 0.97,
+                        Span::styled(
+                            format!("via {}", k + 1),
+                            Style::default().fg(Color::LightGreen),
+                        ),
+                    );
+                }
+            }
             ctx.layer();
             if let Some((o, view)) = &result {
                 let mut canvas = OnCanvas {
