@@ -14,7 +14,7 @@
 //! of the first generated site of `tests/sites` with a 4 × 3 grid and two
 //! walls whose gaps both need a reconfiguration.
 
-#[path = "../tests/sites/mod.rs"]
+#[path = "../tests/all/sites/mod.rs"]
 mod sites;
 
 use std::f64::consts::FRAC_PI_4;
@@ -109,7 +109,7 @@ fn post(name: String, x: f64, y: f64, radius: f64) -> Obstacle {
     Obstacle::standing(name, Point2::new(x, y), radius, 30.0)
 }
 
-/// The two missions of the route stage's refusal tests (`tests/theta_pso.rs`):
+/// The two missions of the route stage's refusal tests (`tests/all/theta_pso.rs`):
 /// a wall across a 100 m field whose one gap (0.6 m) is narrower than one
 /// UAV, and a start ringed by 24 poles.
 fn no_corridor() -> [(&'static str, Mission); 2] {

@@ -18,7 +18,7 @@
 //! `write DIR N [FIRST]` writes N sites of the chosen family as mission
 //! files, to run them from the command line.
 
-#[path = "../tests/sites/mod.rs"]
+#[path = "../tests/all/sites/mod.rs"]
 mod sites;
 
 use std::collections::BTreeMap;

@@ -4,7 +4,7 @@
 //! origin, ECEF → geodetic in closed form with one correction step), not a
 //! flat-earth approximation: FLATLO's squadron spans tens of kilometres,
 //! where the ground plane of the ENU frame is already 100 m above the
-//! ellipsoid (at 35 km; `tests/export.rs` holds the vectors).
+//! ellipsoid (at 35 km; `tests/all/export.rs` holds the vectors).
 //!
 //! Missions read latitude/longitude positions through it (`geodetic.rs`)
 //! and the exports write through it, so a point written either way is the
