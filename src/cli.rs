@@ -838,12 +838,30 @@ fn run_pipeline(
         Ok(o) => o,
         // No plan exists within the planner's model: not an error of the
         // program or the file, the answer (with the place that closes the way).
-        Err(crate::pipelines::PipelineError::NoRoute(reason)) => {
+        Err(crate::pipelines::PipelineError::NoRoute(no_plan)) => {
             if progress.terminal {
                 eprintln!();
             }
             report_recording(finished.as_ref());
-            println!("result       NO PLAN: {reason}");
+            println!("result       NO PLAN: {no_plan}");
+            // Scripts and the designer read why, and what closes the way.
+            if let Some(target) = json {
+                let record = serde_json::json!({
+                    "pipeline": kind,
+                    "mission": mission.name,
+                    "seed": seed.unwrap_or(mission.seed),
+                    "result": "no plan",
+                    "reason": no_plan.reason,
+                    "obstacles": no_plan.obstacles,
+                });
+                let text = serde_json::to_string_pretty(&record).unwrap_or_default();
+                if target.as_os_str() == "-" {
+                    println!("{text}");
+                } else if let Err(e) = crate::base::atomic::write(target, text.as_bytes()) {
+                    eprintln!("error: cannot write {}: {e}", target.display());
+                    return exit::ERROR;
+                }
+            }
             return exit::INFEASIBLE;
         }
         Err(e) => {

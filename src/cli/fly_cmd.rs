@@ -61,6 +61,15 @@ pub struct FlyArgs {
     /// re-planning as needed, and report that plan and the fields to set.
     #[arg(long, value_name = "SHARE")]
     pub target: Option<f64>,
+    /// Estimate the odds of breaking 2 r_Q and r_Q down to 10⁻⁶ and below
+    /// by subset simulation (a few thousand flights where brute force
+    /// would need millions): each limit's probability, its 95 % interval
+    /// and coefficient of variation, and the most likely failing flight.
+    #[arg(long, conflicts_with_all = ["target", "flight"])]
+    pub rare: bool,
+    /// Flights per level of `--rare` (at least 10; more: a tighter interval).
+    #[arg(long, value_name = "N", default_value_t = 1000, requires = "rare")]
+    pub per_level: usize,
     /// A Rerun recording of the check: the plan as written, the p99
     /// envelope of each UAV as a tube, the worst flights as flown.
     #[command(flatten)]
@@ -111,6 +120,9 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
     };
     if let Some(k) = args.flight {
         return replay(&setup, seed, k);
+    }
+    if args.rare {
+        return rare(&setup, args, seed, &cancel);
     }
     let terminal = std::io::stderr().is_terminal();
     let progress = |done: usize, total: usize| {
@@ -418,4 +430,104 @@ fn replay(setup: &Setup, seed: u64, k: usize) -> u8 {
         println!("  a vehicle had not reached its last waypoint at the horizon");
     }
     if broke { exit::INFEASIBLE } else { exit::OK }
+}
+
+/// `--rare`: each limit's probability by subset simulation, printed and
+/// (`--json`) written as `{"separation": {estimate, low, high, method,
+/// flights, …}, "clearance": {…}}`. Exit 2 when either estimate is at
+/// least one in a million.
+fn rare(setup: &Setup, args: &FlyArgs, seed: u64, cancel: &CancelToken) -> u8 {
+    use flight::rare::{self, Limit, RareOptions};
+    let terminal = std::io::stderr().is_terminal();
+    let options = RareOptions {
+        per_level: args.per_level.max(10),
+        seed,
+        threads: args.threads,
+    };
+    println!(
+        "rare-event odds of {} ({}, {} flights a level, seed {seed})",
+        setup.mission.name,
+        rare::METHOD,
+        options.per_level
+    );
+    let mut estimates = Vec::new();
+    for limit in [Limit::Separation, Limit::Clearance] {
+        let progress = |done: usize, level: usize| {
+            if terminal && done.is_multiple_of(50) {
+                eprint!("\r{}: level {level}, {done} flights", limit.words());
+            }
+        };
+        let e = match rare::estimate(setup, limit, options, &progress, cancel) {
+            Ok(e) => e,
+            Err(e) => return said(&e),
+        };
+        if terminal {
+            eprintln!();
+        }
+        print!("{}", rare_text(&e));
+        estimates.push(e);
+    }
+    if let Some(path) = &args.json {
+        let json = serde_json::json!({
+            "mission": setup.mission.name,
+            "seed": seed,
+            "per_level": options.per_level,
+            "separation": estimates[0],
+            "clearance": estimates[1],
+        });
+        let text = match serde_json::to_string_pretty(&json) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("error: the estimate as JSON: {e}");
+                return exit::ERROR;
+            }
+        };
+        if let Err(e) = atomic::write(path, text.as_bytes()) {
+            eprintln!("error: {}: {e}", path.display());
+            return exit::ERROR;
+        }
+    }
+    if estimates.iter().any(|e| e.estimate >= 1e-6) {
+        exit::INFEASIBLE
+    } else {
+        exit::OK
+    }
+}
+
+/// One limit's estimate in words.
+pub fn rare_text(e: &flight::rare::Estimate) -> String {
+    let mut out = if e.bound {
+        format!(
+            "  {:<24} below {:.1e}: no flight broke it in {} levels ({} flights)\n",
+            e.limit.words(),
+            e.high,
+            e.levels.len(),
+            e.flights
+        )
+    } else {
+        format!(
+            "  {:<24} P = {:.2e} (95 % {:.2e} to {:.2e}, c.o.v. {:.2}), {} flights, {} level(s)\n",
+            e.limit.words(),
+            e.estimate,
+            e.low,
+            e.high,
+            e.cov,
+            e.flights,
+            e.levels.len()
+        )
+    };
+    if let Some(f) = &e.most_likely {
+        out += &format!(
+            "    most likely failure: {} at t = {:.1} s, {:.2} m past the limit ({})\n",
+            f.what,
+            f.t,
+            -f.room,
+            if f.at.0 == 0 {
+                format!("level 0, flight {}", f.at.1)
+            } else {
+                format!("level {}, chain {}, move {}", f.at.0, f.at.1, f.at.2)
+            }
+        );
+    }
+    out
 }

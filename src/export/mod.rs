@@ -122,6 +122,12 @@ pub struct Planned {
     pub verdict: String,
     /// Why the files' limits are not the run's (`ExportRules::limits_note`).
     pub limits_note: Option<String>,
+    /// The acceptance radius every `NAV_WAYPOINT` writes (param2), metres:
+    /// for a multicopter the one the flight check flies
+    /// (`flight.acceptance_radius`), so the file and the check take a
+    /// waypoint alike (issue 52); `None` (fixed wing, not flown by the
+    /// check): the tolerance, at least 0.1 m.
+    pub acceptance: Option<f64>,
 }
 
 impl Planned {
@@ -131,6 +137,8 @@ impl Planned {
     pub fn from_outcome(mission: &Mission, outcome: &crate::outcome::Outcome) -> Self {
         let rules = outcome.face().export_rules(mission);
         let tracks = outcome.reference_tracks();
+        let acceptance = matches!(rules.airframe, Airframe::Multicopter)
+            .then_some(mission.flight.acceptance_radius);
         let legs = tracks
             .iter()
             .map(|t| match rules.airframe {
@@ -149,6 +157,7 @@ impl Planned {
             loiter_radius: rules.loiter_radius,
             verdict: outcome.headline(),
             limits_note: rules.limits_note,
+            acceptance,
         }
     }
 
@@ -597,7 +606,7 @@ pub fn items(
     let fixed_wing = planned.pipeline.fixed_wing();
     // Ground speed for multicopters, airspeed for fixed wing (still air).
     let speed_type = if fixed_wing { 0.0 } else { 1.0 };
-    let accept = tolerance.max(0.1);
+    let accept = planned.acceptance.unwrap_or(tolerance.max(0.1));
     let mut out = Vec::with_capacity(plan.waypoints.len() + 4);
     let Some(first) = plan.waypoints.first() else {
         return (home, out);

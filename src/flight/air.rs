@@ -11,6 +11,20 @@ use rand_distr::StandardNormal;
 
 use crate::mission::{FlightParams, Turbulence};
 
+/// Where a flight's randomness comes from: standard normal draws, taken in
+/// the order the flight asks for them. A check draws them from one ChaCha8
+/// stream per flight; the rare-event estimate (`rare.rs`) holds them as a
+/// vector it moves (every input of a flight is one of these draws).
+pub trait Normals {
+    fn normal(&mut self) -> f64;
+}
+
+impl Normals for ChaCha8Rng {
+    fn normal(&mut self) -> f64 {
+        self.sample(StandardNormal)
+    }
+}
+
 const FOOT: f64 = 0.3048;
 
 /// The Dryden low-altitude scales at height `h` metres above the ground
@@ -58,14 +72,14 @@ pub struct FirstOrder(f64);
 
 impl FirstOrder {
     /// A stationary draw.
-    pub fn new(rng: &mut ChaCha8Rng) -> Self {
-        FirstOrder(rng.sample(StandardNormal))
+    pub fn new(rng: &mut impl Normals) -> Self {
+        FirstOrder(rng.normal())
     }
 
     /// Advances by `dt` with time constant `tau`; the value in units of σ.
-    pub fn step(&mut self, rng: &mut ChaCha8Rng, dt: f64, tau: f64) -> f64 {
+    pub fn step(&mut self, rng: &mut impl Normals, dt: f64, tau: f64) -> f64 {
         let phi = (-dt / tau).exp();
-        let n: f64 = rng.sample(StandardNormal);
+        let n = rng.normal();
         self.0 = phi * self.0 + (1.0 - phi * phi).max(0.0).sqrt() * n;
         self.0
     }
@@ -86,15 +100,15 @@ fn stationary() -> Matrix2<f64> {
 
 impl SecondOrder {
     /// A stationary draw.
-    pub fn new(rng: &mut ChaCha8Rng) -> Self {
-        let (a, b): (f64, f64) = (rng.sample(StandardNormal), rng.sample(StandardNormal));
+    pub fn new(rng: &mut impl Normals) -> Self {
+        let (a, b) = (rng.normal(), rng.normal());
         // Cholesky of P: [[1, 0], [½, ½]].
         SecondOrder(Vector2::new(a, 0.5 * a + 0.5 * b))
     }
 
     /// Advances by `dt` with time constant `tau`; the output in units of σ.
     /// Exact: x ← Φx + w, Φ = e^{A dt}, w ~ N(0, P − ΦPΦᵀ) (P stationary).
-    pub fn step(&mut self, rng: &mut ChaCha8Rng, dt: f64, tau: f64) -> f64 {
+    pub fn step(&mut self, rng: &mut impl Normals, dt: f64, tau: f64) -> f64 {
         let phi = (-dt / tau).exp();
         let transition = Matrix2::new(phi, 0.0, phi * dt / tau, phi);
         let p = stationary();
@@ -102,7 +116,7 @@ impl SecondOrder {
         let l11 = q[(0, 0)].max(0.0).sqrt();
         let l21 = if l11 > 0.0 { q[(1, 0)] / l11 } else { 0.0 };
         let l22 = (q[(1, 1)] - l21 * l21).max(0.0).sqrt();
-        let (a, b): (f64, f64) = (rng.sample(StandardNormal), rng.sample(StandardNormal));
+        let (a, b) = (rng.normal(), rng.normal());
         self.0 = transition * self.0 + Vector2::new(l11 * a, l21 * a + l22 * b);
         (3f64.sqrt() * self.0.x + (1.0 - 3f64.sqrt()) * self.0.y) / std::f64::consts::SQRT_2
     }
@@ -125,7 +139,7 @@ pub struct Air {
 }
 
 impl Air {
-    pub fn new(p: &FlightParams, rng: &mut ChaCha8Rng) -> Self {
+    pub fn new(p: &FlightParams, rng: &mut impl Normals) -> Self {
         // From `wind_from_deg` (clockwise from north) the air moves the other way.
         let to = (p.wind_from_deg + 180.0).to_radians();
         let along = Vector3::new(to.sin(), to.cos(), 0.0);
@@ -149,7 +163,7 @@ impl Air {
     /// meets eddies).
     pub fn step(
         &mut self,
-        rng: &mut ChaCha8Rng,
+        rng: &mut impl Normals,
         dt: f64,
         h: f64,
         velocity: &Vector3<f64>,
@@ -179,7 +193,7 @@ impl Gnss {
     /// The part of the error common to every receiver of a flight
     /// (`own = false`) or one receiver's own part (`own = true`): their
     /// variances are `gnss_own_share` apart and add to the σ² given.
-    pub fn new(p: &FlightParams, own: bool, rng: &mut ChaCha8Rng) -> Self {
+    pub fn new(p: &FlightParams, own: bool, rng: &mut impl Normals) -> Self {
         let share = p.gnss_own_share.clamp(0.0, 1.0);
         let k = if own {
             share.sqrt()
@@ -191,8 +205,7 @@ impl Gnss {
             p.gnss_sigma_horizontal,
             p.gnss_sigma_vertical,
         ) * k;
-        let draw = |rng: &mut ChaCha8Rng| -> f64 { rng.sample(StandardNormal) };
-        let error = Vector3::new(draw(rng), draw(rng), draw(rng)).component_mul(&sigma);
+        let error = Vector3::new(rng.normal(), rng.normal(), rng.normal()).component_mul(&sigma);
         Gnss {
             error,
             sigma,
@@ -201,11 +214,11 @@ impl Gnss {
     }
 
     /// The error after `dt` more seconds, metres ENU.
-    pub fn step(&mut self, rng: &mut ChaCha8Rng, dt: f64) -> Vector3<f64> {
+    pub fn step(&mut self, rng: &mut impl Normals, dt: f64) -> Vector3<f64> {
         let phi = (-dt / self.tau).exp();
         let spread = (1.0 - phi * phi).max(0.0).sqrt();
         for axis in 0..3 {
-            let n: f64 = rng.sample(StandardNormal);
+            let n = rng.normal();
             self.error[axis] = phi * self.error[axis] + spread * self.sigma[axis] * n;
         }
         self.error

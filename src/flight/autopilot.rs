@@ -38,11 +38,20 @@ pub struct Gains {
 
 impl Default for Gains {
     fn default() -> Self {
+        Gains::of(&crate::mission::Vehicle::default())
+    }
+}
+
+impl Gains {
+    /// The proportional gains `[vehicle]` states (PX4's by default); the
+    /// integral and derivative terms stay PX4's (MPC_XY_VEL_I/D_ACC 0.4,
+    /// 0.2; MPC_Z_VEL_I/D_ACC 2, 0).
+    pub fn of(v: &crate::mission::Vehicle) -> Self {
         Gains {
-            position_xy: 0.95,
-            position_z: 1.0,
-            velocity_xy: [1.8, 0.4, 0.2],
-            velocity_z: [4.0, 2.0, 0.0],
+            position_xy: v.position_gain_xy,
+            position_z: v.position_gain_z,
+            velocity_xy: [v.velocity_gain_xy, 0.4, 0.2],
+            velocity_z: [v.velocity_gain_z, 2.0, 0.0],
         }
     }
 }
@@ -80,6 +89,7 @@ impl<'a> Autopilot<'a> {
     pub fn new(
         plan: &'a VehiclePlan,
         limits: VehicleLimits,
+        gains: Gains,
         body: Body,
         acceptance: f64,
         takeoff: f64,
@@ -93,7 +103,7 @@ impl<'a> Autopilot<'a> {
             plan,
             schedule: Flight::new(plan),
             limits,
-            gains: Gains::default(),
+            gains,
             body,
             acceptance,
             takeoff,
@@ -274,7 +284,7 @@ mod tests {
         let limits = Vehicle::default().limits(0);
         let plan = hovering(limits);
         let body = Body::from_params(&FleetParams::default());
-        let mut pilot = Autopilot::new(&plan, limits, body, 2.0, 0.0);
+        let mut pilot = Autopilot::new(&plan, limits, Gains::default(), body, 2.0, 0.0);
         let dt = 0.01;
         let (mut t10, mut t90, mut most, mut after8) = (None, None, 0.0f64, 0.0f64);
         for k in 0..1200 {
@@ -309,7 +319,7 @@ mod tests {
         let limits = Vehicle::default().limits(0);
         let plan = hovering(limits);
         let body = Body::from_params(&FleetParams::default());
-        let mut pilot = Autopilot::new(&plan, limits, body, 2.0, 0.0);
+        let mut pilot = Autopilot::new(&plan, limits, Gains::default(), body, 2.0, 0.0);
         let (dt, wind) = (0.01, Vector3::new(8.0, 0.0, 0.0));
         let mut worst = 0.0f64;
         for k in 0..3000 {

@@ -15,14 +15,14 @@
 pub mod air;
 pub mod autopilot;
 mod margin;
+pub mod rare;
 mod report;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use nalgebra::{Point3, Vector3};
+use rand::SeedableRng;
 use rand::rngs::ChaCha8Rng;
-use rand::{RngExt, SeedableRng};
-use rand_distr::StandardNormal;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -39,6 +39,7 @@ pub use margin::{
 };
 pub use report::{Report, Share, Spread, wilson};
 
+use air::Normals;
 use autopilot::Autopilot;
 
 /// Flights are sampled for distances every this many steps (20 Hz at the
@@ -268,24 +269,38 @@ pub fn fly(setup: &Setup, seed: u64, k: usize, keep_tracks: bool) -> Flown {
 
 /// [`fly`], keeping each sample's cross-track error when `keep_spread`.
 fn fly_keeping(setup: &Setup, seed: u64, k: usize, keep_tracks: bool, keep_spread: bool) -> Flown {
-    let p = &setup.mission.flight;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(k as u64);
+    fly_on(setup, &mut rng, k, keep_tracks, keep_spread)
+}
+
+/// Flies one flight (numbered `k` in its report) on the standard normal
+/// draws of `rng`: the skews, the air, the fixes, in that order.
+fn fly_on(
+    setup: &Setup,
+    rng: &mut impl Normals,
+    k: usize,
+    keep_tracks: bool,
+    keep_spread: bool,
+) -> Flown {
+    let p = &setup.mission.flight;
     let body = Body::from_params(&setup.mission.fleet);
+    let gains = autopilot::Gains::of(&setup.mission.vehicle);
     let n = setup.plans.len();
     let mut takeoff = Vec::with_capacity(n);
     let mut fixes = Vec::with_capacity(n);
     let mut pilots: Vec<Autopilot> = Vec::with_capacity(n);
-    let mut air = air::Air::new(p, &mut rng);
-    let mut common = air::Gnss::new(p, false, &mut rng);
+    let mut air = air::Air::new(p, rng);
+    let mut common = air::Gnss::new(p, false, rng);
     for plan in &setup.plans {
-        let skew: f64 = rng.sample::<f64, _>(StandardNormal) * p.takeoff_skew;
+        let skew = rng.normal() * p.takeoff_skew;
         let start = plan.waypoints.first().map_or(0.0, |w| w.t) + skew;
         takeoff.push(skew);
-        fixes.push(air::Gnss::new(p, true, &mut rng));
+        fixes.push(air::Gnss::new(p, true, rng));
         pilots.push(Autopilot::new(
             plan,
             setup.mission.vehicle.limits(plan.vehicle),
+            gains,
             body,
             p.acceptance_radius,
             start,
@@ -296,8 +311,12 @@ fn fly_keeping(setup: &Setup, seed: u64, k: usize, keep_tracks: bool, keep_sprea
     let mut tracks = keep_tracks.then(|| vec![Vec::new(); n]);
     let mut spread: Option<Vec<Vec<f32>>> = keep_spread.then(|| vec![Vec::new(); n]);
     let dt = p.step;
-    let steps = setup.steps();
-    let start = setup.start();
+    // The flight begins with the earliest take-off: a negative skew flies
+    // early (issue 52: the clock began at the plan's start, so an early
+    // vehicle waited and flew on time).
+    let early = takeoff.iter().copied().fold(0.0, f64::min);
+    let start = setup.start() + early;
+    let steps = setup.steps() + (-early / dt).ceil() as usize;
     let mut positions = vec![Point3::origin(); n];
     let mut passes = Passes::new(setup, n);
     let mut finished = false;
@@ -332,10 +351,10 @@ fn fly_keeping(setup: &Setup, seed: u64, k: usize, keep_tracks: bool, keep_sprea
             height += (here.z - setup.mission.ground(here.x, here.y)) / n as f64;
             velocity += pilot.velocity() / n as f64;
         }
-        let wind = air.step(&mut rng, dt, height, &velocity);
-        let shared = common.step(&mut rng, dt);
+        let wind = air.step(rng, dt, height, &velocity);
+        let shared = common.step(rng, dt);
         for (pilot, own) in pilots.iter_mut().zip(&mut fixes) {
-            let gnss = shared + own.step(&mut rng, dt);
+            let gnss = shared + own.step(rng, dt);
             pilot.step(t, dt, &gnss, &wind, p.drag);
         }
     }

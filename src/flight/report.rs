@@ -455,6 +455,7 @@ fn worst(setup: &Setup, flown: &[Flown]) -> Option<Worst> {
 /// The air and the autopilot in one line.
 fn conditions(setup: &Setup) -> String {
     let p = &setup.mission.flight;
+    let v = &setup.mission.vehicle;
     let turbulence = match p.turbulence {
         Turbulence::None => "no turbulence".to_owned(),
         t => {
@@ -469,7 +470,9 @@ fn conditions(setup: &Setup) -> String {
     };
     format!(
         "wind {:.1} m/s from {:.0}°, {turbulence}; GNSS σ {:.2} m horizontal, {:.2} m vertical, \
-         τ {:.0} s; take-off skew σ {:.2} s; acceptance radius {:.1} m; step {} s",
+         τ {:.0} s; take-off skew σ {:.2} s; acceptance radius {:.1} m (written in the files); \
+         autopilot gains: position {:.2} /s xy, {:.2} /s z, velocity {:.2} /s xy, {:.2} /s z \
+         ([vehicle], PX4's MPC_*_P by default), drag {:.2} /s; step {} s",
         p.wind_speed,
         p.wind_from_deg,
         p.gnss_sigma_horizontal,
@@ -477,6 +480,11 @@ fn conditions(setup: &Setup) -> String {
         p.gnss_correlation_time,
         p.takeoff_skew,
         p.acceptance_radius,
+        v.position_gain_xy,
+        v.position_gain_z,
+        v.velocity_gain_xy,
+        v.velocity_gain_z,
+        p.drag,
         p.step
     )
 }

@@ -378,6 +378,16 @@ pub struct Vehicle {
     pub max_acceleration_up: f64,
     /// Largest downward acceleration, m/s² (PX4 MPC_ACC_DOWN_MAX: 3).
     pub max_acceleration_down: f64,
+    /// The autopilot's horizontal position gain, 1/s (PX4 MPC_XY_P: 0.95):
+    /// with the velocity gain, how stiffly the flight check's vehicle holds
+    /// its track against a gust (docs/flight-check.md).
+    pub position_gain_xy: f64,
+    /// Vertical position gain, 1/s (PX4 MPC_Z_P: 1).
+    pub position_gain_z: f64,
+    /// Horizontal velocity gain, 1/s (PX4 MPC_XY_VEL_P_ACC: 1.8).
+    pub velocity_gain_xy: f64,
+    /// Vertical velocity gain, 1/s (PX4 MPC_Z_VEL_P_ACC: 4).
+    pub velocity_gain_z: f64,
     /// UAVs with limits of their own (a heavier camera ship, say):
     /// `uavs = [{ uav = 2, max_speed = 8.0 }]`, UAVs numbered from 1; a
     /// limit not given is the formation's.
@@ -394,6 +404,10 @@ impl Default for Vehicle {
             max_acceleration: 5.0,
             max_acceleration_up: 4.0,
             max_acceleration_down: 3.0,
+            position_gain_xy: 0.95,
+            position_gain_z: 1.0,
+            velocity_gain_xy: 1.8,
+            velocity_gain_z: 4.0,
             uavs: Vec::new(),
         }
     }

@@ -144,7 +144,7 @@ pub enum PipelineError {
     /// θ-PSO's route stage found no way from start to goal within its model;
     /// the text names what closes it.
     #[error("{0}")]
-    NoRoute(String),
+    NoRoute(NoPlan),
     /// The transport between a distributed fleet's processes failed (a
     /// process that never answered, a mission that differs): in words,
     /// naming the step and the agents.
@@ -283,4 +283,19 @@ pub fn live_limits(checks: &[(f64, f64, &str)]) -> Vec<String> {
             )
         })
         .collect()
+}
+
+/// Why no plan exists, as a run says it (`NO PLAN: …`) and writes it
+/// (`--json`): the reason in words, and the obstacles that close the way
+/// (or the gate that cannot be kept), by name.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct NoPlan {
+    pub reason: String,
+    pub obstacles: Vec<String>,
+}
+
+impl std::fmt::Display for NoPlan {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.reason)
+    }
 }

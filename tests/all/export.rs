@@ -258,6 +258,7 @@ fn a_climbing_leg_is_written_at_its_ground_speed_and_its_climb_rate_is_judged() 
         loiter_radius: 0.0,
         verdict: String::new(),
         limits_note: None,
+        acceptance: None,
     };
     let ok = planned(climbing(1.0));
     let plans = export::reduce(&ok, None, 0.01);

@@ -93,6 +93,90 @@ fn a_calm_flight_is_the_files_as_written_to_5_cm() {
     }
 }
 
+/// Issue 52, item 0: a take-off skew is flown as drawn, early ones early.
+/// In calm air on exact fixes each vehicle flies its files shifted by its
+/// own skew, to 5 cm at every sampled instant (the clock began at the
+/// plan's start, so a negative skew was flown on time: 1.5 m off here).
+#[test]
+fn early_take_offs_fly_early_and_late_ones_late() {
+    let mut m = bridge();
+    calm(&mut m);
+    m.flight.takeoff_skew = 0.5;
+    let planned = planned(&m, 1);
+    let setup = Setup::new(&m, &planned).unwrap_or_else(|e| panic!("{e}"));
+    let mut early = 0;
+    for k in 0..4 {
+        let f = flight::fly(&setup, 7, k, true);
+        assert!(f.finished);
+        let tracks = f.tracks.as_ref().expect("tracks kept");
+        for (v, plan) in setup.plans.iter().enumerate() {
+            let skew = f.takeoff[v];
+            early += usize::from(skew < -0.05);
+            let schedule = Flight::new(plan);
+            for &(t, p) in &tracks[v] {
+                let d = (schedule.at(t - skew).0 - p).norm();
+                assert!(
+                    d <= 0.05,
+                    "flight {k}, UAV {} (skew {skew:+.2} s) is {d:.3} m off its files \
+                     shifted by its skew at t = {t:.2} s",
+                    v + 1
+                );
+            }
+        }
+    }
+    assert!(early > 0, "no early take-off drawn in 4 flights");
+}
+
+/// Issue 52, item 0: the files write the acceptance radius the check
+/// flies (`flight.acceptance_radius`), one number in both; the report's
+/// conditions state it and the autopilot's gains.
+#[test]
+fn the_files_write_the_acceptance_radius_the_check_flies() {
+    let mut m = bridge();
+    m.flight.acceptance_radius = 1.25;
+    m.vehicle.velocity_gain_xy = 2.5;
+    let planned = planned(&m, 1);
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let options = skyform::export::Options {
+        formats: vec![skyform::export::Format::Plan],
+        out_dir: dir.path().to_path_buf(),
+        tolerance: None,
+        force: false,
+    };
+    let done =
+        skyform::export::export(&m, "bridge", &planned, &options).unwrap_or_else(|e| panic!("{e}"));
+    let mut radii = Vec::new();
+    for file in &done.files {
+        let text = std::fs::read_to_string(&file.path).unwrap_or_else(|e| panic!("{e}"));
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}"));
+        for item in v["mission"]["items"]
+            .as_array()
+            .cloned()
+            .unwrap_or_default()
+        {
+            if item["command"] == 16 {
+                radii.extend(item["params"][1].as_f64());
+            }
+        }
+    }
+    assert!(!radii.is_empty());
+    assert!(radii.iter().all(|r| *r == 1.25), "{radii:?}");
+    let setup = Setup::new(&m, &planned).unwrap_or_else(|e| panic!("{e}"));
+    let options = flight::Options {
+        flights: 2,
+        seed: 1,
+        threads: None,
+    };
+    let report = flight::check(&setup, options, &|_, _| {}, &CancelToken::new())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let text = report.text(false);
+    assert!(
+        text.contains("acceptance radius 1.2 m (written in the files)")
+            && text.contains("velocity 2.50 /s xy"),
+        "{text}"
+    );
+}
+
 /// The bridge in the issue's weather: 5 m/s from the west, light Dryden
 /// turbulence, GNSS σ 1 m, take-off skew σ 0.3 s (its shipped `[flight]`).
 fn windy_setup(m: &Mission) -> (Planned, u64) {

@@ -26,6 +26,8 @@ mod inspector_places;
 mod mission_files;
 mod mission_save;
 mod mission_validation;
+mod passages;
+mod rare;
 mod recording;
 mod spso;
 mod terrain;

@@ -1017,7 +1017,9 @@ fn a_walled_in_start_is_refused_by_the_route_stage_naming_the_ring() {
     );
     // 2 π 6 m / 24 − 1.4 m: each gap is 0.17 m, narrower than one UAV.
     assert!(
-        why.contains("is 0.17 m: narrower than one UAV (2 (r_Q + the safety margin) = 1.00 m)"),
+        why.contains(
+            "is 0.17 m: 0.83 m too narrow for one UAV (2 (r_Q + the safety margin) = 1.00 m)"
+        ),
         "{why}"
     );
 }
@@ -1056,7 +1058,7 @@ fn refusal(m: &Mission) -> String {
         &CancelToken::new(),
     );
     match refused {
-        Err(PipelineError::NoRoute(why)) => why,
+        Err(PipelineError::NoRoute(why)) => why.reason,
         other => panic!("expected the route stage to refuse: {other:?}"),
     }
 }
@@ -1071,7 +1073,7 @@ fn a_wall_without_a_gap_any_shape_fits_is_refused_naming_the_wall() {
         "{why}"
     );
     assert!(
-        why.contains("'north post 0' | 'south post 0', is 0.60 m: narrower than one UAV"),
+        why.contains("'north post 0' | 'south post 0', is 0.60 m: 0.40 m too narrow for one UAV"),
         "{why}"
     );
     // From one end of the wall to the other, by name.
@@ -1999,7 +2001,7 @@ fn an_impossible_gate_is_no_plan_and_an_unused_iwp_choice_says_why() {
         &CancelToken::new(),
     ) {
         Err(PipelineError::NoRoute(reason)) => assert_eq!(
-            reason,
+            reason.reason,
             "route.via 1 (between 'pier 3' and 'pier 5') cannot be kept: 'pier 4' stands in the gap"
         ),
         other => panic!("{:?}", other.map(|o| o.feasible())),

@@ -73,6 +73,21 @@ impl Checker {
             ("max_acceleration_down", v.max_acceleration_down),
         ];
         self.vehicle_limits(path, &speeds, &accelerations);
+        for (key, gain) in [
+            ("position_gain_xy", v.position_gain_xy),
+            ("position_gain_z", v.position_gain_z),
+            ("velocity_gain_xy", v.velocity_gain_xy),
+            ("velocity_gain_z", v.velocity_gain_z),
+        ] {
+            self.positive(path.key(key), gain, " /s");
+            self.at_most(
+                path.key(key),
+                gain,
+                physical::GAIN,
+                " /s",
+                "a gain above 50 /s is faster than a multicopter's attitude loop follows",
+            );
+        }
         for (i, own) in v.uavs.iter().enumerate() {
             let at = path.key("uavs").index(i);
             if own.uav == 0 || own.uav > f.slots.len() {

@@ -67,6 +67,9 @@ mod physical {
     pub const FORMATION_SPEED_WARNING: f64 = 50.0;
     /// m/s²: 10 g, beyond any multicopter autopilot's acceleration limit.
     pub const ACCELERATION: f64 = 98.0665;
+    /// Per second: an autopilot's position or velocity gain (PX4's are
+    /// 0.95-4; a multicopter's attitude loop does not follow 50).
+    pub const GAIN: f64 = 50.0;
     /// Metres: a "UAV" bigger than this is not one.
     pub const UAV_RADIUS: f64 = 50.0;
 }

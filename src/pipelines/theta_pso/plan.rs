@@ -86,13 +86,16 @@ fn admit(mission: &Mission) -> Result<(), PipelineError> {
             .into_iter()
             .find_map(|i| Some((i.gate?, i)).filter(|(_, i)| i.unusable.is_some()))
     {
-        return Err(PipelineError::NoRoute(format!(
-            "route.via {} (between '{}' and '{}') cannot be kept: {}",
-            g + 1,
-            iwp.between[0],
-            iwp.between[1],
-            iwp.unusable.unwrap_or_default()
-        )));
+        return Err(PipelineError::NoRoute(crate::pipelines::NoPlan {
+            reason: format!(
+                "route.via {} (between '{}' and '{}') cannot be kept: {}",
+                g + 1,
+                iwp.between[0],
+                iwp.between[1],
+                iwp.unusable.clone().unwrap_or_default()
+            ),
+            obstacles: iwp.between.to_vec(),
+        }));
     }
     let errors: Vec<String> = diagnostics(mission)
         .into_iter()
@@ -149,7 +152,16 @@ fn route_stage(
             &problem.iwps,
             problem.cost.margin(),
         )
-        .map_err(|blocked| PipelineError::NoRoute(blocked.reason))?,
+        .map_err(|blocked| {
+            PipelineError::NoRoute(crate::pipelines::NoPlan {
+                obstacles: blocked
+                    .obstacles
+                    .iter()
+                    .filter_map(|&k| mission.obstacles.get(k).map(|o| o.name.clone()))
+                    .collect(),
+                reason: blocked.reason,
+            })
+        })?,
     };
     problem.follow(mission, &corridor);
     observer.on_event(Event::Log(

@@ -187,7 +187,8 @@ pub fn explain(
         let (p, q) = (obstacles[i].0, obstacles[j].0);
         let why = if gap < 2.0 * r_q {
             format!(
-                "narrower than one UAV (2 (r_Q + the safety margin) = {:.2} m)",
+                "{:.2} m too narrow for one UAV (2 (r_Q + the safety margin) = {:.2} m)",
+                2.0 * r_q - gap,
                 2.0 * r_q
             )
         } else if let Some(iwp) = iwps
