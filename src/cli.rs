@@ -21,6 +21,7 @@ pub mod eval_cmd;
 pub mod export_cmd;
 pub mod fly_cmd;
 pub mod import_cmd;
+pub mod merge_cmd;
 pub mod sweep_cmd;
 
 /// Terminal mission designer for multi-UAV formations.
@@ -128,6 +129,13 @@ pub enum Command {
     /// any number of threads. Exit status: 0 no flight broke a limit, 1
     /// error, 2 some flight did, 130 cancelled. See docs/flight-check.md.
     Fly(fly_cmd::FlyArgs),
+    /// Merge the parts of a sharded flight check (`skyform fly … --shard
+    /// I/N --json PART`, run anywhere: a Slurm array, a Kubernetes Indexed
+    /// Job, a Ray cluster) into the report one process gives, bit for bit.
+    /// Checks the parts are one check's and cover every flight once, plans
+    /// the mission they carry again, and prints (and with --json writes)
+    /// the report. Exit status as `skyform fly`. See docs/flight-check.md.
+    Merge(merge_cmd::MergeArgs),
     /// Bring a site survey's obstacles into a mission: GeoJSON (RFC 7946),
     /// KML or KMZ, as Google Earth, QGIS or OpenStreetMap draw them.
     ///
@@ -480,6 +488,7 @@ pub fn main() -> ExitCode {
         }
         Command::Export(args) => ExitCode::from(export_cmd::export_command(&args)),
         Command::Fly(args) => ExitCode::from(fly_cmd::fly_command(&args)),
+        Command::Merge(args) => ExitCode::from(merge_cmd::merge_command(&args)),
         Command::Import(args) => ExitCode::from(import_cmd::import_command(&args)),
         Command::Eval(args) => ExitCode::from(eval_cmd::eval_command(&args)),
         Command::Sweep(args) => ExitCode::from(sweep_cmd::sweep_command(&args)),

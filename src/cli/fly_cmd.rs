@@ -70,6 +70,12 @@ pub struct FlyArgs {
     /// Flights per level of `--rare` (at least 10; more: a tighter interval).
     #[arg(long, value_name = "N", default_value_t = 1000, requires = "rare")]
     pub per_level: usize,
+    /// Fly only shard I of N of the check (I from 0: a contiguous share of
+    /// the flight numbers) and write its flights to the --json file, a part
+    /// for `skyform merge`: the merged parts give the report one process
+    /// gives, bit for bit, whichever machines ran them.
+    #[arg(long, value_name = "I/N", requires = "json", conflicts_with_all = ["target", "rare", "flight"])]
+    pub shard: Option<String>,
     /// A Rerun recording of the check: the plan as written, the p99
     /// envelope of each UAV as a tube, the worst flights as flown.
     #[command(flatten)]
@@ -123,6 +129,9 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
     }
     if args.rare {
         return rare(&setup, args, seed, &cancel);
+    }
+    if let Some(shard) = &args.shard {
+        return super::merge_cmd::fly_shard(&setup, &mission, args, seed, shard, &cancel);
     }
     let terminal = std::io::stderr().is_terminal();
     let progress = |done: usize, total: usize| {
@@ -336,7 +345,7 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
 }
 
 /// A check that did not end, said on stderr: its exit status.
-fn said(e: &FlightError) -> u8 {
+pub(super) fn said(e: &FlightError) -> u8 {
     if *e == FlightError::Cancelled {
         eprintln!("cancelled");
         exit::CANCELLED

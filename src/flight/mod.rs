@@ -17,6 +17,7 @@ pub mod autopilot;
 mod margin;
 pub mod rare;
 mod report;
+pub mod shard;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -24,7 +25,7 @@ use nalgebra::{Point3, Vector3};
 use rand::SeedableRng;
 use rand::rngs::ChaCha8Rng;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::base::geometry::{Prism, segment_point_distance_3d};
 use crate::export::reverify::Flight;
@@ -214,7 +215,7 @@ pub fn vehicle_pairs(n: usize) -> impl Iterator<Item = (usize, usize)> {
 pub type Track = Vec<(f64, Point3<f64>)>;
 
 /// The closest two things came in one flight.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Closest {
     /// Metres (vehicle to vehicle, or vehicle to the obstacle's surface).
     pub distance: f64,
@@ -238,7 +239,7 @@ impl Closest {
 /// One flight: each pair's closest approach, each vehicle's least
 /// clearance to each obstacle near it, each vehicle's largest cross-track
 /// error, and whether every vehicle finished.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Flown {
     pub flight: usize,
     /// Pairs (i, j), i < j, in order.
@@ -609,16 +610,36 @@ fn fly_all(
     cancel: &CancelToken,
 ) -> Result<Vec<Flown>, FlightError> {
     setup.within_budget(options.flights)?;
+    fly_range(
+        setup,
+        options,
+        0..options.flights,
+        keep_spread,
+        progress,
+        cancel,
+    )
+}
+
+/// Flights `range` of a check (a shard's, or all), in flight order.
+fn fly_range(
+    setup: &Setup,
+    options: Options,
+    range: std::ops::Range<usize>,
+    keep_spread: bool,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &CancelToken,
+) -> Result<Vec<Flown>, FlightError> {
     let done = AtomicUsize::new(0);
+    let total = range.len();
     let flown: Vec<Option<Flown>> = on_threads(options.threads, || {
-        (0..options.flights)
+        range
             .into_par_iter()
             .map(|k| {
                 if cancel.is_cancelled() {
                     return None;
                 }
                 let flown = fly_keeping(setup, options.seed, k, false, keep_spread);
-                progress(done.fetch_add(1, Ordering::Relaxed) + 1, options.flights);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
                 Some(flown)
             })
             .collect()

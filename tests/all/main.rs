@@ -9,6 +9,7 @@ mod common;
 mod sites;
 
 mod architecture;
+mod campaign;
 mod chart;
 mod cli;
 mod export;

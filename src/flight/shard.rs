@@ -1,0 +1,199 @@
+//! A check split into shards that run anywhere and merge into the report
+//! one process gives, bit for bit (`skyform fly --shard I/N --json PART`,
+//! `skyform merge PART…`).
+//!
+//! Each flight is already a function of (seed, flight number), so shard I
+//! of N flies a contiguous range of flight numbers and writes them, with
+//! the mission it flew (as TOML), into its part. The merge checks that the
+//! parts are one check's (the same mission, pipeline, seed and flights)
+//! and cover every flight once, plans the mission again (plans are seeded:
+//! the same plan), and builds the report from the flights in their order,
+//! as `check` does. Which machine, scheduler or order ran the shards does
+//! not matter; the engine that runs them is the user's (a Slurm array, a
+//! Kubernetes Indexed Job, a Ray cluster: docs/flight-check.md).
+
+use std::ops::Range;
+
+use serde::{Deserialize, Serialize};
+
+use super::{FlightError, Flown, Options, Setup, fly_range};
+use crate::pipelines::{CancelToken, Kind};
+
+/// What a part file says it is.
+pub const PART_FORMAT: &str = "skyform flight-check part 1";
+
+/// Shard `index` of `count` (0-based index; written `I/N` on the command
+/// line with I from 0).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl Shard {
+    /// `"I/N"`, 0 ≤ I < N.
+    pub fn parse(text: &str) -> Result<Shard, String> {
+        let (i, n) = text
+            .split_once('/')
+            .ok_or_else(|| format!("'{text}': write the shard as I/N (shard I of N, from 0)"))?;
+        let index: usize = i
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{text}': '{i}' is not a shard number"))?;
+        let count: usize = n
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{text}': '{n}' is not a number of shards"))?;
+        if count == 0 || index >= count {
+            return Err(format!(
+                "'{text}': shards are numbered 0 to N - 1 (N at least 1)"
+            ));
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The flight numbers of this shard of `flights`: contiguous, the
+    /// shards' ranges in order covering 0..flights once.
+    pub fn range(self, flights: usize) -> Range<usize> {
+        let at = |i: usize| i * flights / self.count;
+        at(self.index)..at(self.index + 1)
+    }
+}
+
+/// One shard's flights and what they belong to.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Part {
+    pub format: String,
+    /// The mission flown, as TOML (the merge plans it again).
+    pub mission: String,
+    pub pipeline: Kind,
+    pub seed: u64,
+    /// Flights of the whole check.
+    pub flights: usize,
+    pub shard: Shard,
+    /// This shard's flights, in flight order.
+    pub flown: Vec<Flown>,
+}
+
+/// Flies shard `shard` of the check `options` of `setup`: its part.
+pub fn fly_shard(
+    setup: &Setup,
+    mission_toml: String,
+    pipeline: Kind,
+    options: Options,
+    shard: Shard,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &CancelToken,
+) -> Result<Part, FlightError> {
+    setup.within_budget(options.flights)?;
+    let flown = fly_range(
+        setup,
+        options,
+        shard.range(options.flights),
+        false,
+        progress,
+        cancel,
+    )?;
+    Ok(Part {
+        format: PART_FORMAT.to_owned(),
+        mission: mission_toml,
+        pipeline,
+        seed: options.seed,
+        flights: options.flights,
+        shard,
+        flown,
+    })
+}
+
+/// Why parts do not merge.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum MergeError {
+    #[error("no part to merge")]
+    Empty,
+    #[error("part {0}: not a skyform flight-check part (format '{1}')")]
+    Format(usize, String),
+    #[error(
+        "part {part} is of another check than part 1: its {what} differs \
+         (merge the parts of one `skyform fly --shard` run)"
+    )]
+    Mismatch { part: usize, what: &'static str },
+    #[error("flight {0} is in no part: a shard is missing")]
+    Missing(usize),
+    #[error("flight {0} is in two parts: a shard is given twice")]
+    Twice(usize),
+}
+
+/// The flights of `parts`, checked to be one check's and complete, in
+/// flight order; and the first part (its mission, pipeline, seed,
+/// flights). Parts are numbered from 1 in errors, in the order given.
+pub fn merge(parts: Vec<Part>) -> Result<(Part, Vec<Flown>), MergeError> {
+    let first = parts.first().cloned().ok_or(MergeError::Empty)?;
+    let mut slots: Vec<Option<Flown>> = vec![None; first.flights];
+    for (i, part) in parts.into_iter().enumerate() {
+        if part.format != PART_FORMAT {
+            return Err(MergeError::Format(i + 1, part.format));
+        }
+        let differs = [
+            ("mission", part.mission != first.mission),
+            ("pipeline", part.pipeline != first.pipeline),
+            ("seed", part.seed != first.seed),
+            ("number of flights", part.flights != first.flights),
+        ];
+        if let Some((what, _)) = differs.iter().find(|(_, d)| *d) {
+            return Err(MergeError::Mismatch { part: i + 1, what });
+        }
+        for f in part.flown {
+            let Some(slot) = slots.get_mut(f.flight) else {
+                return Err(MergeError::Mismatch {
+                    part: i + 1,
+                    what: "number of flights",
+                });
+            };
+            if slot.is_some() {
+                return Err(MergeError::Twice(f.flight));
+            }
+            *slot = Some(f);
+        }
+    }
+    let flown = slots
+        .into_iter()
+        .enumerate()
+        .map(|(k, f)| f.ok_or(MergeError::Missing(k)))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((
+        Part {
+            flown: Vec::new(),
+            ..first
+        },
+        flown,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_cover_every_flight_once_in_order() {
+        for flights in [0, 1, 7, 1000, 1001] {
+            for count in 1..=9 {
+                let mut next = 0;
+                for index in 0..count {
+                    let r = Shard { index, count }.range(flights);
+                    assert_eq!(r.start, next, "{flights} flights, shard {index}/{count}");
+                    next = r.end;
+                }
+                assert_eq!(next, flights);
+            }
+        }
+    }
+
+    #[test]
+    fn a_shard_is_written_i_of_n_from_zero() {
+        assert_eq!(Shard::parse("2/4"), Ok(Shard { index: 2, count: 4 }));
+        for bad in ["4/4", "1/0", "x/4", "3", "-1/4"] {
+            let e = Shard::parse(bad).expect_err(bad);
+            assert!(e.contains(bad), "{e}");
+        }
+    }
+}

@@ -1,0 +1,144 @@
+//! Issue 52, item 4: a check split into shards merges into the report one
+//! process gives, bit for bit, and a campaign's shards run on a real
+//! distributed engine (a local Ray cluster) merge the same way.
+
+use std::path::{Path, PathBuf};
+
+use skyform::export::Planned;
+use skyform::flight::shard::{self, MergeError, Part, Shard};
+use skyform::flight::{self, Options, Report, Setup};
+use skyform::mission::{self, Mission};
+use skyform::outcome;
+use skyform::pipelines::theta_pso::PlanOptions;
+use skyform::pipelines::{CancelToken, Kind, Silent};
+
+fn bridge() -> Mission {
+    mission::default_mission().mission
+}
+
+fn planned(m: &Mission) -> Planned {
+    let o = outcome::run(
+        Kind::ThetaPso,
+        m,
+        1,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    Planned::from_outcome(m, &o)
+}
+
+fn parts(setup: &Setup, m: &Mission, options: Options, count: usize) -> Vec<Part> {
+    (0..count)
+        .map(|index| {
+            let part = shard::fly_shard(
+                setup,
+                mission::to_toml_string(m).unwrap_or_else(|e| panic!("{e}")),
+                Kind::ThetaPso,
+                options,
+                Shard { index, count },
+                &|_, _| {},
+                &CancelToken::new(),
+            )
+            .unwrap_or_else(|e| panic!("{e}"));
+            // Through the file format, as a part written elsewhere would be.
+            let text = serde_json::to_string(&part).unwrap_or_else(|e| panic!("{e}"));
+            serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}"))
+        })
+        .collect()
+}
+
+/// 4 shards of 120 flights, each written and read back as JSON, merged in
+/// another order, give the report of one process to the byte.
+#[test]
+fn four_shards_merged_are_one_process_bit_for_bit() {
+    let m = bridge();
+    let planned = planned(&m);
+    let setup = Setup::new(&m, &planned).unwrap_or_else(|e| panic!("{e}"));
+    let options = Options {
+        flights: 120,
+        seed: 1,
+        threads: None,
+    };
+    let one = flight::check(&setup, options, &|_, _| {}, &CancelToken::new())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut parts = parts(&setup, &m, options, 4);
+    assert_eq!(parts[1].flown.first().map(|f| f.flight), Some(30));
+    parts.reverse();
+    let (first, flown) = shard::merge(parts.clone()).unwrap_or_else(|e| panic!("{e}"));
+    let merged = Report::new(&setup, options, &flown, &flight::as_written(&setup));
+    let json = |r: &Report| serde_json::to_string_pretty(r).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(json(&merged), json(&one));
+    assert_eq!(first.flights, 120);
+
+    // A shard missing, a shard twice, a part of another check: refused.
+    assert_eq!(
+        shard::merge(parts[1..].to_vec()).map(|_| ()),
+        Err(MergeError::Missing(90))
+    );
+    let mut twice = parts.clone();
+    twice.push(parts[0].clone());
+    assert_eq!(shard::merge(twice).map(|_| ()), Err(MergeError::Twice(90)));
+    let mut other = parts.clone();
+    other[2].seed = 2;
+    assert_eq!(
+        shard::merge(other).map(|_| ()),
+        Err(MergeError::Mismatch {
+            part: 3,
+            what: "seed"
+        })
+    );
+}
+
+/// The Python of the venv with `tests/campaign/requirements.txt` (Ray):
+/// `SKYFORM_CAMPAIGN_VENV`; skipped without it, except under CI.
+fn campaign_python() -> Option<PathBuf> {
+    match std::env::var_os("SKYFORM_CAMPAIGN_VENV") {
+        Some(venv) => Some(PathBuf::from(venv).join("bin").join("python")),
+        None => {
+            assert!(
+                std::env::var_os("CI").is_none(),
+                "CI is set but SKYFORM_CAMPAIGN_VENV is not: .ci/run must create the campaign's venv"
+            );
+            eprintln!(
+                "skipped: set SKYFORM_CAMPAIGN_VENV to a venv with tests/campaign/requirements.txt"
+            );
+            None
+        }
+    }
+}
+
+/// A campaign (the bridge × two weathers, 4 shards each) runs its shards
+/// as tasks on a local single-node Ray cluster; each case's merged report
+/// is the single process's, byte for byte (tests/campaign/ray_campaign.py).
+#[test]
+fn a_campaign_runs_its_shards_on_a_ray_cluster_and_merges_to_one_process() {
+    let Some(python) = campaign_python() else {
+        return;
+    };
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let out = std::process::Command::new(python)
+        .arg(root.join("tests/campaign/ray_campaign.py"))
+        .args(["--skyform", env!("CARGO_BIN_EXE_skyform")])
+        .arg("--out")
+        .arg(dir.path())
+        .arg("--mission")
+        .arg(root.join("missions/bridge-inspection.toml"))
+        .args(["--flights", "100", "--shards", "4"])
+        .env("RAY_USAGE_STATS_ENABLED", "0")
+        .output()
+        .unwrap_or_else(|e| panic!("{e}"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
+    assert!(stdout.contains("ray cluster: 1 node(s)"), "{stdout}");
+    assert_eq!(
+        stdout
+            .matches("4 shards on Ray merged == one process")
+            .count(),
+        2,
+        "{stdout}"
+    );
+}
