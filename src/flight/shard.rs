@@ -85,15 +85,10 @@ pub fn fly_shard(
     progress: &(dyn Fn(usize, usize) + Sync),
     cancel: &CancelToken,
 ) -> Result<Part, FlightError> {
-    setup.within_budget(options.flights)?;
-    let flown = fly_range(
-        setup,
-        options,
-        shard.range(options.flights),
-        false,
-        progress,
-        cancel,
-    )?;
+    // A shard is one process's work: the budget bounds its own flights.
+    let range = shard.range(options.flights);
+    setup.within_budget(range.len())?;
+    let flown = fly_range(setup, options, range, false, progress, cancel)?;
     Ok(Part {
         format: PART_FORMAT.to_owned(),
         mission: mission_toml,
