@@ -6,6 +6,7 @@
 
 use serde::Serialize;
 
+use super::report::{Share, Worst};
 use super::{FlightError, Options, Report, Setup, check};
 use crate::export::Planned;
 use crate::mission::Mission;
@@ -20,6 +21,12 @@ pub struct Tried {
     /// The vehicles' spacing as a multiple of the mission's (1: as drawn).
     pub spacing: f64,
     pub share: Option<f64>,
+    /// The flights that broke 2 r_Q and r_Q, each with its 95 % interval
+    /// (`None`: no plan to fly), for scripts to read without parsing `note`.
+    pub separation: Option<Share>,
+    pub clearance: Option<Share>,
+    /// The worst flight of the try: the least room to a limit.
+    pub worst: Option<Worst>,
     pub note: String,
 }
 
@@ -273,6 +280,9 @@ pub fn find_margin(
                     margin: m,
                     spacing,
                     share: None,
+                    separation: None,
+                    clearance: None,
+                    worst: None,
                     note: why,
                 });
                 return Ok(None);
@@ -284,6 +294,9 @@ pub fn find_margin(
             margin: m,
             spacing,
             share: Some(report.break_any.share),
+            separation: Some(report.break_separation),
+            clearance: Some(report.break_clearance),
+            worst: report.worst.clone(),
             note: tried_note(&report),
         });
         Ok(Some(report))

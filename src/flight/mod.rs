@@ -38,7 +38,7 @@ pub use margin::{
     MARGIN_RESOLUTION, MAX_MARGIN, MAX_SPACING, MarginLimit, MarginSearch, Tried, find_margin,
     margin_field, passing_plan, with_margin, with_spacing,
 };
-pub use report::{Report, Share, Spread, wilson};
+pub use report::{Report, Share, Spread, Worst, wilson};
 
 use air::Normals;
 use autopilot::Autopilot;

@@ -109,6 +109,10 @@ fn campaign_python() -> Option<PathBuf> {
     }
 }
 
+fn file(path: &Path) -> std::fs::File {
+    std::fs::File::create(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 /// A campaign (the bridge × two weathers, 4 shards each) runs its shards
 /// as tasks on a local single-node Ray cluster; each case's merged report
 /// is the single process's, byte for byte (tests/campaign/ray_campaign.py).
@@ -119,7 +123,7 @@ fn a_campaign_runs_its_shards_on_a_ray_cluster_and_merges_to_one_process() {
     };
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
-    let out = std::process::Command::new(python)
+    let mut child = std::process::Command::new(python)
         .arg(root.join("tests/campaign/ray_campaign.py"))
         .args(["--skyform", env!("CARGO_BIN_EXE_skyform")])
         .arg("--out")
@@ -128,11 +132,24 @@ fn a_campaign_runs_its_shards_on_a_ray_cluster_and_merges_to_one_process() {
         .arg(root.join("missions/bridge-inspection.toml"))
         .args(["--flights", "100", "--shards", "4"])
         .env("RAY_USAGE_STATS_ENABLED", "0")
-        .output()
+        .stdout(file(&dir.path().join("stdout")))
+        .stderr(file(&dir.path().join("stderr")))
+        .spawn()
         .unwrap_or_else(|e| panic!("{e}"));
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
+    // Bounded: a cluster that does not come up ends the test, not CI.
+    let started = std::time::Instant::now();
+    while child.try_wait().ok().flatten().is_none() {
+        if started.elapsed() > std::time::Duration::from_secs(600) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the Ray campaign took over 600 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(200));
+    }
+    let status = child.wait().unwrap_or_else(|e| panic!("{e}"));
+    let read = |name: &str| std::fs::read_to_string(dir.path().join(name)).unwrap_or_default();
+    let (stdout, stderr) = (read("stdout"), read("stderr"));
+    assert_eq!(status.code(), Some(0), "{stdout}\n{stderr}");
     assert!(stdout.contains("ray cluster: 1 node(s)"), "{stdout}");
     assert_eq!(
         stdout

@@ -312,6 +312,23 @@ fn the_margin_search_returns_a_margin_whose_check_meets_the_target() {
     let check = flight::check(&setup, options, &|_, _| {}, &CancelToken::new())
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(check.break_any, report.break_any);
+    // Issue 52, item 3: each try is structured: the shares of each limit
+    // with their intervals and the worst flight, as its check gave them.
+    let found = search
+        .tried
+        .iter()
+        .find(|t| (t.margin - margin).abs() < 1e-9 && t.share.is_some())
+        .expect("the margin found was tried");
+    assert_eq!(found.separation, Some(report.break_separation));
+    assert_eq!(found.clearance, Some(report.break_clearance));
+    assert_eq!(found.worst, report.worst);
+    for t in search.tried.iter().filter(|t| t.share.is_some()) {
+        let (s, c) = (t.separation.expect("2 r_Q"), t.clearance.expect("r_Q"));
+        assert!(s.low <= s.share && s.share <= s.high, "{t:?}");
+        assert!(t.share >= Some(s.share.max(c.share)), "{t:?}");
+    }
+    let json = serde_json::to_value(&search).unwrap_or_else(|e| panic!("{e}"));
+    assert!(json["tried"][0]["clearance"]["high"].is_number(), "{json}");
 }
 
 /// Issue 39, item 5: the gust generator's spectrum is the Dryden formula's
