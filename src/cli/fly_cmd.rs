@@ -331,6 +331,31 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
             exit::INFEASIBLE
         }
     };
+    if let (Some(near), Some(b)) = (&search.nearest, &search.better_fixes) {
+        let at = if near.spacing == 1.0 {
+            format!("{:.2} m", near.margin)
+        } else {
+            format!("{:.2} m, spacing ×{:.2}", near.margin, near.spacing)
+        };
+        println!(
+            "fixes        at the nearest try ({at}), {} fixes (GNSS σ {} m horizontal, {} m vertical: \
+             flight.gnss_sigma_horizontal, gnss_sigma_vertical) {}: {} of {} flights break a limit \
+             ({:.2} %, 95 % CI {:.2}-{:.2} %)",
+            b.grade,
+            b.sigma_horizontal,
+            b.sigma_vertical,
+            if b.meets {
+                "meet the target"
+            } else {
+                "still miss it"
+            },
+            b.share.count,
+            b.share.of,
+            100.0 * b.share.share,
+            100.0 * b.share.low,
+            100.0 * b.share.high
+        );
+    }
     println!("tried        {}", tried.join("; "));
     if let Some(report) = &search.report {
         print!("{}", report.text(args.verbose));

@@ -55,7 +55,35 @@ pub struct MarginSearch {
     /// is below [`MAX_SPACING`] (its `margin` is the scale).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spacing_limit: Option<MarginLimit>,
+    /// When no try met the target: the try that came nearest (the least
+    /// share of flights breaking a limit, the smaller margin on a tie) and
+    /// the first finer GNSS grade that meets the target there, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nearest: Option<Tried>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub better_fixes: Option<BetterFixes>,
 }
+
+/// A finer GNSS grade flown at the nearest try's margin and spacing.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BetterFixes {
+    /// The grade's name ("RTK fixed").
+    pub grade: &'static str,
+    pub sigma_horizontal: f64,
+    pub sigma_vertical: f64,
+    /// Whether it meets the target there; `share`: the flights that broke
+    /// a limit with it.
+    pub meets: bool,
+    pub share: Share,
+}
+
+/// GNSS grades from coarse to fine, σ horizontal and vertical, metres:
+/// SBAS-corrected single frequency, RTK float, RTK fixed (typical figures).
+pub const GNSS_GRADES: [(&str, f64, f64); 3] = [
+    ("SBAS", 0.5, 0.8),
+    ("RTK float", 0.2, 0.3),
+    ("RTK fixed", 0.02, 0.03),
+];
 
 impl MarginSearch {
     /// Whether the search found a plan whose check meets the target.
@@ -319,6 +347,8 @@ pub fn find_margin(
         tried: Vec::new(),
         limit: cap.map(|(m, why)| MarginLimit { margin: m, why }),
         spacing_limit: None,
+        nearest: None,
+        better_fixes: None,
     };
     let keeps_all = |r: &Report| r.break_any.share <= target;
     match found {
@@ -368,7 +398,66 @@ pub fn find_margin(
         _ => {}
     }
     search.tried = tried;
+    if !search.met() {
+        search.nearest = search
+            .tried
+            .iter()
+            .filter(|t| t.share.is_some())
+            .min_by(|a, b| {
+                a.share
+                    .partial_cmp(&b.share)
+                    .unwrap_or(std::cmp::Ordering::Equal)
+                    .then(a.margin.total_cmp(&b.margin))
+            })
+            .cloned();
+        if let Some(near) = &search.nearest {
+            search.better_fixes =
+                better_fixes(pipeline, mission, target, options, plan, cancel, near)?;
+        }
+    }
     Ok(search)
+}
+
+/// What finer fixes would do at the nearest try: the GNSS grades finer than
+/// the mission's flown there in turn, the first that meets the target (or
+/// the finest, which does not).
+fn better_fixes(
+    pipeline: Kind,
+    mission: &Mission,
+    target: f64,
+    options: Options,
+    plan: &mut dyn FnMut(&Mission) -> Result<Planned, String>,
+    cancel: &CancelToken,
+    near: &Tried,
+) -> Result<Option<BetterFixes>, FlightError> {
+    let mut changed = mission.clone();
+    with_margin(&mut changed, pipeline, near.margin);
+    with_spacing(&mut changed, pipeline, near.spacing);
+    let Ok(planned) = plan(&changed) else {
+        return Ok(None);
+    };
+    let mut last = None;
+    for (grade, h, v) in GNSS_GRADES {
+        if h >= mission.flight.gnss_sigma_horizontal {
+            continue;
+        }
+        changed.flight.gnss_sigma_horizontal = h;
+        changed.flight.gnss_sigma_vertical = v.min(mission.flight.gnss_sigma_vertical);
+        let setup = Setup::new(&changed, &planned)?;
+        let report = check(&setup, options, &|_, _| {}, cancel)?;
+        let meets = report.break_any.share <= target;
+        last = Some(BetterFixes {
+            grade,
+            sigma_horizontal: h,
+            sigma_vertical: changed.flight.gnss_sigma_vertical,
+            meets,
+            share: report.break_any,
+        });
+        if meets {
+            break;
+        }
+    }
+    Ok(last)
 }
 
 /// A try's counts, and its worst place when a flight broke a limit.

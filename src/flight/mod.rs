@@ -35,8 +35,8 @@ use crate::pipelines::CancelToken;
 use crate::pipelines::fleet::quadrotor::Body;
 
 pub use margin::{
-    MARGIN_RESOLUTION, MAX_MARGIN, MAX_SPACING, MarginLimit, MarginSearch, Tried, find_margin,
-    margin_field, passing_plan, with_margin, with_spacing,
+    BetterFixes, GNSS_GRADES, MARGIN_RESOLUTION, MAX_MARGIN, MAX_SPACING, MarginLimit,
+    MarginSearch, Tried, find_margin, margin_field, passing_plan, with_margin, with_spacing,
 };
 pub use report::{Report, Share, Spread, Worst, wilson};
 

@@ -525,4 +525,21 @@ fn the_margin_search_stops_at_what_an_inspection_allows_and_says_so() {
         "{:?}",
         search.tried
     );
+    // Issue 52, item 3: with no answer, the nearest try (the least share
+    // broken) and what finer fixes do there (σ 3 m: from SBAS's 0.5 m on,
+    // the first grade that meets the target, or the finest tried).
+    let nearest = search.nearest.as_ref().expect("the nearest try");
+    let least = search
+        .tried
+        .iter()
+        .filter_map(|t| t.share)
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(nearest.share, Some(least), "{:?}", search.tried);
+    let fixes = search.better_fixes.as_ref().expect("finer fixes flown");
+    assert!(fixes.sigma_horizontal < 3.0, "{fixes:?}");
+    assert_eq!(fixes.meets, fixes.share.share <= 0.0, "{fixes:?}");
+    assert!(
+        fixes.meets || fixes.grade == flight::GNSS_GRADES[2].0,
+        "stopped before the finest grade without meeting the target: {fixes:?}"
+    );
 }
