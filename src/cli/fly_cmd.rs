@@ -331,6 +331,33 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
             exit::INFEASIBLE
         }
     };
+    print_fixes(&search);
+    println!("tried        {}", tried.join("; "));
+    if let Some(report) = &search.report {
+        print!("{}", report.text(args.verbose));
+    }
+    if let (Some(path), Ok(text)) = (&args.json, serde_json::to_string_pretty(&search))
+        && let Err(e) = atomic::write(path, text.as_bytes())
+    {
+        eprintln!("error: {}: {e}", path.display());
+        return exit::ERROR;
+    }
+    code
+}
+
+/// A check that did not end, said on stderr: its exit status.
+pub(super) fn said(e: &FlightError) -> u8 {
+    if *e == FlightError::Cancelled {
+        eprintln!("cancelled");
+        exit::CANCELLED
+    } else {
+        eprintln!("error: {e}");
+        exit::ERROR
+    }
+}
+
+/// The `fixes` line: what finer GNSS fixes do at the nearest try.
+fn print_fixes(search: &flight::MarginSearch) {
     if let (Some(near), Some(b)) = (&search.nearest, &search.better_fixes) {
         let at = if near.spacing == 1.0 {
             format!("{:.2} m", near.margin)
@@ -355,28 +382,6 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
             100.0 * b.share.low,
             100.0 * b.share.high
         );
-    }
-    println!("tried        {}", tried.join("; "));
-    if let Some(report) = &search.report {
-        print!("{}", report.text(args.verbose));
-    }
-    if let (Some(path), Ok(text)) = (&args.json, serde_json::to_string_pretty(&search))
-        && let Err(e) = atomic::write(path, text.as_bytes())
-    {
-        eprintln!("error: {}: {e}", path.display());
-        return exit::ERROR;
-    }
-    code
-}
-
-/// A check that did not end, said on stderr: its exit status.
-pub(super) fn said(e: &FlightError) -> u8 {
-    if *e == FlightError::Cancelled {
-        eprintln!("cancelled");
-        exit::CANCELLED
-    } else {
-        eprintln!("error: {e}");
-        exit::ERROR
     }
 }
 

@@ -282,6 +282,10 @@ fn smallest(
 /// so ([`MarginSearch::limit`], [`MarginSearch::spacing_limit`]). `plan`
 /// plans a mission (`Err`: no plan, and why). The share is the flights' own
 /// (its 95 % interval is in the report).
+///
+/// Long (~125 lines) because the search's three steps (the margin, the
+/// spacing, the margin again) and what it says when none meets the target
+/// share one record of tries, and read in the order the docs give them.
 pub fn find_margin(
     pipeline: Kind,
     mission: &Mission,
@@ -399,23 +403,28 @@ pub fn find_margin(
     }
     search.tried = tried;
     if !search.met() {
-        search.nearest = search
-            .tried
-            .iter()
-            .filter(|t| t.share.is_some())
-            .min_by(|a, b| {
-                a.share
-                    .partial_cmp(&b.share)
-                    .unwrap_or(std::cmp::Ordering::Equal)
-                    .then(a.margin.total_cmp(&b.margin))
-            })
-            .cloned();
+        search.nearest = nearest(&search.tried);
         if let Some(near) = &search.nearest {
             search.better_fixes =
                 better_fixes(pipeline, mission, target, options, plan, cancel, near)?;
         }
     }
     Ok(search)
+}
+
+/// The try that came nearest the target: the least share of flights
+/// breaking a limit, the smaller margin on a tie.
+fn nearest(tried: &[Tried]) -> Option<Tried> {
+    tried
+        .iter()
+        .filter(|t| t.share.is_some())
+        .min_by(|a, b| {
+            a.share
+                .partial_cmp(&b.share)
+                .unwrap_or(std::cmp::Ordering::Equal)
+                .then(a.margin.total_cmp(&b.margin))
+        })
+        .cloned()
 }
 
 /// What finer fixes would do at the nearest try: the GNSS grades finer than
