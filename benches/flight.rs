@@ -9,23 +9,28 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use skyform::export::Planned;
 use skyform::flight::{self, Options, Setup};
-use skyform::mission;
+use skyform::mission::{self, Mission};
 use skyform::outcome;
 use skyform::pipelines::theta_pso::PlanOptions;
 use skyform::pipelines::{CancelToken, Kind, Silent};
 
-fn benches(c: &mut Criterion) {
-    let m = mission::default_mission().mission;
+/// The θ-PSO plan of `m` on seed 1, as its files fly it.
+fn planned(m: &Mission) -> Planned {
     let o = outcome::run(
         Kind::ThetaPso,
-        &m,
+        m,
         1,
         PlanOptions::default(),
         &mut Silent,
         &CancelToken::new(),
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    let planned = Planned::from_outcome(&m, &o);
+    Planned::from_outcome(m, &o)
+}
+
+fn benches(c: &mut Criterion) {
+    let m = mission::default_mission().mission;
+    let planned = planned(&m);
     let setup = Setup::new(&m, &planned).unwrap_or_else(|e| panic!("{e}"));
     let mut group = c.benchmark_group("flight");
     group.sample_size(10);
@@ -54,16 +59,7 @@ fn rare(c: &mut Criterion) {
     let mut m = mission::default_mission().mission;
     m.flight.gnss_sigma_horizontal = 0.3;
     m.formation.obstacle_margin = 1.2;
-    let o = outcome::run(
-        Kind::ThetaPso,
-        &m,
-        1,
-        PlanOptions::default(),
-        &mut Silent,
-        &CancelToken::new(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let planned = Planned::from_outcome(&m, &o);
+    let planned = planned(&m);
     let setup = Setup::new(&m, &planned).unwrap_or_else(|e| panic!("{e}"));
     let mut group = c.benchmark_group("rare");
     group.sample_size(10);

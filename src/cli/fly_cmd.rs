@@ -164,8 +164,14 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
             return code;
         }
     }
-    if let Some(path) = &args.json {
-        let text = match serde_json::to_string_pretty(&report) {
+    report_written(&report, args.json.as_deref())
+}
+
+/// A check's report written as JSON to `json` (atomically), and the exit
+/// status it gives: 2 when some flight broke a limit, 0 when none did.
+pub(super) fn report_written(report: &flight::Report, json: Option<&std::path::Path>) -> u8 {
+    if let Some(path) = json {
+        let text = match serde_json::to_string_pretty(report) {
             Ok(t) => t,
             Err(e) => {
                 eprintln!("error: the report as JSON: {e}");

@@ -163,22 +163,5 @@ pub fn merge_command(args: &MergeArgs) -> u8 {
     };
     let report = flight::Report::new(&setup, options, &flown, &flight::as_written(&setup));
     print!("{}", report.text(args.verbose));
-    if let Some(path) = &args.json {
-        let text = match serde_json::to_string_pretty(&report) {
-            Ok(t) => t,
-            Err(e) => {
-                eprintln!("error: the report as JSON: {e}");
-                return exit::ERROR;
-            }
-        };
-        if let Err(e) = atomic::write(path, text.as_bytes()) {
-            eprintln!("error: {}: {e}", path.display());
-            return exit::ERROR;
-        }
-    }
-    if report.break_separation.count > 0 || report.break_clearance.count > 0 {
-        exit::INFEASIBLE
-    } else {
-        exit::OK
-    }
+    super::fly_cmd::report_written(&report, args.json.as_deref())
 }

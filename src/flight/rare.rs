@@ -420,6 +420,14 @@ pub fn estimate(
             step: if level == 0 { 0.0 } else { step },
             acceptance: last_acceptance,
         });
+        // What makes this level's samples' inputs again.
+        let replay = Replay {
+            starts: &chain_starts,
+            fates: &chains_fates,
+            step,
+            moves,
+            d,
+        };
         if last {
             product *= share;
             let failing = order
@@ -429,21 +437,7 @@ pub fn estimate(
                 .min_by(|&a, &b| samples[a].0.norm2.total_cmp(&samples[b].0.norm2));
             let most_likely = failing.map(|i| {
                 let (sample, at) = samples[i];
-                let u = inputs_of(
-                    setup,
-                    limit,
-                    options,
-                    level,
-                    at,
-                    &Replay {
-                        starts: &chain_starts,
-                        fates: &chains_fates,
-                        step,
-                        moves,
-                        d,
-                    },
-                    cancel,
-                );
+                let u = inputs_of(setup, limit, options, level, at, &replay, cancel);
                 let flown = fly_on(setup, &mut Reading { u: &u, at: 0 }, 0, false, false);
                 let (r, what, t) = room(setup, &flown, limit);
                 Failure {
@@ -485,21 +479,7 @@ pub fn estimate(
             .iter()
             .map(|&i| {
                 let (sample, at) = samples[i];
-                let u = inputs_of(
-                    setup,
-                    limit,
-                    options,
-                    level,
-                    at,
-                    &Replay {
-                        starts: &chain_starts,
-                        fates: &chains_fates,
-                        step,
-                        moves,
-                        d,
-                    },
-                    cancel,
-                );
+                let u = inputs_of(setup, limit, options, level, at, &replay, cancel);
                 (u, sample)
             })
             .collect();

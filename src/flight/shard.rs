@@ -112,6 +112,11 @@ pub enum MergeError {
          (merge the parts of one `skyform fly --shard` run)"
     )]
     Mismatch { part: usize, what: &'static str },
+    #[error(
+        "part 1 says the check has {0} flights, over the limit of {max} a check may fly",
+        max = crate::mission::MAX_FLIGHTS
+    )]
+    TooMany(usize),
     #[error("flight {0} is in no part: a shard is missing")]
     Missing(usize),
     #[error("flight {0} is in two parts: a shard is given twice")]
@@ -123,6 +128,11 @@ pub enum MergeError {
 /// flights). Parts are numbered from 1 in errors, in the order given.
 pub fn merge(parts: Vec<Part>) -> Result<(Part, Vec<Flown>), MergeError> {
     let first = parts.first().cloned().ok_or(MergeError::Empty)?;
+    // A part is a file anyone may hand in: its count is checked before it
+    // sizes anything.
+    if first.flights > crate::mission::MAX_FLIGHTS {
+        return Err(MergeError::TooMany(first.flights));
+    }
     let mut slots: Vec<Option<Flown>> = vec![None; first.flights];
     for (i, part) in parts.into_iter().enumerate() {
         if part.format != PART_FORMAT {

@@ -30,4 +30,4 @@ pub use presets::{
 };
 pub use source::{FieldPath, LineCol, PathSegment, SourceMap};
 pub use template::{name_for, template, template_text};
-pub use validate::{compact, compact_digits, validate};
+pub use validate::{MAX_FLIGHTS, compact, compact_digits, validate};

@@ -80,6 +80,13 @@ fn four_shards_merged_are_one_process_bit_for_bit() {
     let mut twice = parts.clone();
     twice.push(parts[0].clone());
     assert_eq!(shard::merge(twice).map(|_| ()), Err(MergeError::Twice(90)));
+    // A part that claims more flights than a check may fly sizes nothing.
+    let mut huge = parts.clone();
+    huge[0].flights = usize::MAX;
+    assert_eq!(
+        shard::merge(huge).map(|_| ()),
+        Err(MergeError::TooMany(usize::MAX))
+    );
     let mut other = parts.clone();
     other[2].seed = 2;
     assert_eq!(

@@ -18,6 +18,7 @@ use crate::mission::model::GRAVITY as G;
 
 mod fleet;
 mod flight;
+pub use flight::MAX_FLIGHTS;
 mod formation;
 mod pipelines;
 mod site;
