@@ -232,6 +232,7 @@ impl Problem {
         let free = seeding::free_waypoints(mission, corridor);
         self.builder.set_free_waypoints(free);
         self.builder.set_squeeze(corridor.squeeze.clone());
+        self.builder.widen_to(&mission.bounds, &corridor.points);
         let inspected = mission.obstacles.iter().filter(|o| o.inspect).count();
         self.space = SearchSpace::uniform(3 * free + inspected, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2);
     }

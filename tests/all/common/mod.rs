@@ -12,3 +12,4 @@ pub fn skyform(args: &[&str]) -> Output {
         .output()
         .unwrap_or_else(|e| panic!("cannot start skyform: {e}"))
 }
+pub mod oracle;

@@ -314,6 +314,21 @@ impl PathBuilder {
             .collect()
     }
 
+    /// Widens the decoding box (within the bounds `b`) to hold every point
+    /// of `route`: a corridor squeezed in single file between an obstacle
+    /// and the bounds runs closer to them than r_F (the column's UAVs
+    /// follow the path), where a box shrunk by r_F could never decode a
+    /// waypoint (issue 51: an aisle against the bounds).
+    pub fn widen_to(&mut self, b: &crate::mission::Bounds, route: &[Point2<f64>]) {
+        for (d, range) in [b.x, b.y].into_iter().enumerate() {
+            for p in route {
+                let v = if d == 0 { p.x } else { p.y };
+                self.bounds[d][0] = self.bounds[d][0].min(v).max(range[0]);
+                self.bounds[d][1] = self.bounds[d][1].max(v).min(range[1]);
+            }
+        }
+    }
+
     /// Paths of this builder fly squeezed through `map`'s regions.
     pub fn set_squeeze(&mut self, map: Option<std::sync::Arc<SqueezeMap>>) {
         self.squeeze = map;

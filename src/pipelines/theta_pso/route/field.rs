@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use nalgebra::Point2;
 
-use crate::base::geometry::polygon_signed_distance;
+use crate::base::geometry::{polygon_signed_distance, segment_point_distance, segments_cross};
 
 /// An obstacle as the field sees it: its footprint in the plane, a disc
 /// (`center`, `radius`) or a polygon whose bounding circle the disc is.
@@ -37,6 +37,32 @@ impl Disc {
         match &self.polygon {
             Some(v) => polygon_signed_distance(v, &p),
             None => (p - self.center).norm() - self.radius,
+        }
+    }
+
+    /// Distance from the segment `a`-`b` to the footprint (0 where they
+    /// touch or cross): exact, for the straights that join an exact passage
+    /// to the grid (`route::landing`).
+    pub fn gap_to_segment(&self, a: Point2<f64>, b: Point2<f64>) -> f64 {
+        match &self.polygon {
+            None => (segment_point_distance(&a, &b, &self.center) - self.radius).max(0.0),
+            Some(v) => {
+                if polygon_signed_distance(v, &a) <= 0.0 {
+                    return 0.0;
+                }
+                let mut best = f64::INFINITY;
+                for i in 0..v.len() {
+                    let (p, q) = (v[i], v[(i + 1) % v.len()]);
+                    if segments_cross(&a, &b, &p, &q) {
+                        return 0.0;
+                    }
+                    best = best
+                        .min(segment_point_distance(&a, &b, &p))
+                        .min(segment_point_distance(&p, &q, &a))
+                        .min(segment_point_distance(&p, &q, &b));
+                }
+                best
+            }
         }
     }
 
@@ -130,6 +156,14 @@ impl Field {
 
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// Whether `p` lies on the grid (within its cells).
+    pub fn contains(&self, p: Point2<f64>) -> bool {
+        let half = self.cell / 2.0;
+        let (x0, y0) = (self.origin.x - half, self.origin.y - half);
+        (x0..=x0 + self.nx as f64 * self.cell).contains(&p.x)
+            && (y0..=y0 + self.ny as f64 * self.cell).contains(&p.y)
     }
 
     /// The cell holding `p`, clamped onto the grid.

@@ -25,23 +25,31 @@
 //! When no route exists the stage names what closes the way (`blocked`): the
 //! chain of obstacles between the reached and the unreached part of the site,
 //! which bounds it runs between, and why its widest gap does not let the
-//! formation through. The grid resolution makes the search complete up to
-//! the cell size; the disc model makes it conservative (a plan the route
-//! stage finds keeps every UAV clear; a formation turned to just the right
-//! heading might squeeze through where the disc model says it cannot).
+//! formation through. The grid guides the search but never closes a
+//! passage between two obstacles, or an obstacle and the bounds: each IWP's
+//! crossing and each gap the grid may not resolve is a straight of its own,
+//! decided on exact geometry and joined to the grid (`gaps`,
+//! `Site::landing`), at any cell size (issue 51). The disc model makes it
+//! conservative (a plan the route stage finds keeps every UAV clear; a
+//! formation turned to just the right heading might squeeze through where
+//! the disc model says it cannot).
 //!
-//! Long (~1265 lines) because it holds the stage's driver and everything built around the
-//! search it runs: the site (shape, layers, levels), the stops and jumps, and the corridor
-//! assembled from the steps, pulled tight, carried through crossings and given its squeeze
-//! map; the search, the field, the guide and the refusal's words are already submodules.
+//! Long (~950 lines) because it holds the stage's driver and the site it searches: the
+//! shape, layers and levels, the cells' open bits, the landings that join exact passages to
+//! the grid, the stops and the jumps; the search, the field, the gaps, the guide, the
+//! corridor's assembly, the squeeze map and the refusal's words are submodules.
 
 mod blocked;
+mod corridor;
 pub mod field;
+mod gaps;
 mod guide;
 pub mod levels;
 mod reuse;
 mod search;
+mod squeeze;
 
+use std::collections::HashMap;
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
 
@@ -50,13 +58,14 @@ use serde::{Deserialize, Serialize};
 
 pub use reuse::reuse;
 
+use self::corridor::{assemble, through_crossings};
 use self::field::{Disc, Field};
 use self::guide::Guide;
 use self::levels::Levels;
-use self::search::{Graph, Jump, LAYERS, Step, bit, climb_bit};
+use self::search::{Graph, Jump, LAYERS, bit, climb_bit};
+use self::squeeze::squeeze_map;
 use super::iwp::{Iwp, Shape as FormationShape, column_spacing, min_pair_distance};
 use super::path::{PathBuilder, SqueezeMap};
-use crate::base::geometry::segments_cross;
 use crate::mission::{Mission, Obstacle};
 
 /// Angles tried round each inspected obstacle.
@@ -70,6 +79,11 @@ const MAX_STATES: f64 = 2_000_000.0;
 /// The same for a search over several levels (cell × layer × level ×
 /// stage): about 100 MB at most, once per run, when the flat search failed.
 const MAX_STACKED_STATES: f64 = 6_000_000.0;
+/// Cells a crossing's end may be carried out to meet the grid (`Site::landing`).
+const LANDING_CELLS: usize = 6;
+/// Metres a passage's straight may run out to meet the grid: through the
+/// depth of what stands either side of it (an aisle between bays 8 m deep).
+const LANDING_METRES: f64 = 12.0;
 /// Extra spacing the squeezed shape keeps beyond 2 r_Q between two UAVs.
 const SQUEEZE_SPACING_MARGIN: f64 = 0.05;
 
@@ -178,6 +192,13 @@ impl Shape {
                 f64::INFINITY
             },
         ]
+    }
+
+    /// Whether the smallest shrink keeps every UAV clear at a centroid
+    /// `clearance` from the nearest obstacle and `inside` from the bounds.
+    fn shrink_fits(&self, clearance: f64, inside: f64) -> bool {
+        let reach = self.smallest * self.reach;
+        clearance >= reach + self.r_q + self.margin - 1e-9 && inside >= reach - 1e-9
     }
 
     /// The scale that keeps every UAV clear at a centroid `clearance` from
@@ -387,6 +408,75 @@ impl Site {
             .collect()
     }
 
+    /// Where a straight leaving `p` (a point the formation may stand at,
+    /// clear by exact geometry: a crossing's end) along `out` meets the
+    /// grid at `level`: `p`'s own cell when it is open (layer 0: the jump
+    /// as before), else [`Site::landing_from`]. At coarse cells a
+    /// crossing's end may lie in a cell whose centre is near the posts it
+    /// passes: without the landing the grid would decide the passage
+    /// closed (issue 51).
+    fn landing(
+        &self,
+        level: usize,
+        p: Point2<f64>,
+        out: nalgebra::Vector2<f64>,
+    ) -> Option<(usize, Point2<f64>, usize)> {
+        let here = self.field().index_of(p);
+        if (0..LAYERS).any(|l| self.open[here] & bit(level, l) != 0) {
+            return Some((here, p, 0));
+        }
+        self.landing_from(level, p, out, 0)
+    }
+
+    /// The first point q on the straight from `p` along `out` (at a third
+    /// of a cell's steps, out to [`LANDING_CELLS`] cells or
+    /// [`LANDING_METRES`], whichever is farther) whose cell is open in a
+    /// layer no wider than `widest` whose need the straight p → q keeps
+    /// from every obstacle in the way (exact): its cell, q and that layer.
+    fn landing_from(
+        &self,
+        level: usize,
+        p: Point2<f64>,
+        out: nalgebra::Vector2<f64>,
+        widest: usize,
+    ) -> Option<(usize, Point2<f64>, usize)> {
+        let field = self.field();
+        let discs = &self.at[level].discs;
+        let step = field.cell() / 3.0;
+        let steps = (3 * LANDING_CELLS).max((LANDING_METRES / step).ceil() as usize);
+        let out = out / out.norm().max(1e-12);
+        // Only the obstacles the straight could come near.
+        let reach = step * steps as f64 + self.need[0];
+        let near: Vec<&Disc> = discs
+            .iter()
+            .filter(|d| (d.center - p).norm() - d.radius < reach)
+            .collect();
+        for k in 1..=steps {
+            let q = p + out * (step * k as f64);
+            let cell = field.index_of(q);
+            if !field.contains(q) {
+                return None;
+            }
+            let layer = (widest..LAYERS).find(|&l| {
+                self.open[cell] & bit(level, l) != 0
+                    && near
+                        .iter()
+                        .all(|d| d.gap_to_segment(p, q) >= self.need[l] - 1e-9)
+            });
+            if let Some(layer) = layer {
+                return Some((cell, q, layer));
+            }
+            // The straight itself closed: no landing on it.
+            if near
+                .iter()
+                .any(|d| d.gap_to_segment(p, q) < self.need[LAYERS - 1] - 1e-9)
+            {
+                return None;
+            }
+        }
+        None
+    }
+
     /// The half run of the ramp of a climb between level `pair` and the one above.
     fn ramp(&self, pair: usize) -> f64 {
         let [lo, hi] = self.levels.hull(pair);
@@ -535,23 +625,7 @@ fn find_at(
     let field = site.field();
     let levels = &site.levels;
     let stage_of_crossing = |c: usize| order.iter().position(|s| *s == Stop::Crossing(c));
-    let mut jumps = Vec::new();
-    for (c, [a, z]) in crossings.iter().enumerate() {
-        // At the levels where both sides of its gap stand in the way.
-        for level in (0..levels.len()).filter(|&l| overlaps(windows[c], levels.span(l))) {
-            for (direction, (from, to)) in [(*a, *z), (*z, *a)].into_iter().enumerate() {
-                jumps.push(Jump {
-                    from: field.index_of(from),
-                    to: field.index_of(to),
-                    length: (to - from).norm(),
-                    pass_at: stage_of_crossing(c),
-                    crossing: true,
-                    tag: 2 * c + direction,
-                    level,
-                });
-            }
-        }
-    }
+    let (mut jumps, landed) = crossing_jumps(&site, &crossings, &windows, &stage_of_crossing);
     // The user's via points: a stop of no length at the point's cell, at
     // the level of its altitude (any, flat), in whatever layer it is reached.
     let via_points = builder.via_points();
@@ -598,6 +672,7 @@ fn find_at(
                             crossing: false,
                             tag: 2 * crossings.len() + candidates.len(),
                             level,
+                            widest: 0,
                         });
                         candidates.push((i, phi, on_left, ends));
                     }
@@ -617,8 +692,12 @@ fn find_at(
             crossing: true,
             tag: via_tag + k,
             level,
+            widest: 0,
         });
     }
+    // The gaps the grid may not resolve, each a straight of its own.
+    let gap_tag = via_tag + via_points.len();
+    let gap_ends = gaps::jumps(&site, mission, iwps, gap_tag, &mut jumps);
     let climb_cost = site.climb_costs();
     let graph = Graph {
         field,
@@ -661,14 +740,64 @@ fn find_at(
         &steps,
         [start, goal],
         &crossings,
+        &landed,
         &candidates,
         &points,
+        &gap_ends,
         builder.inspections().len(),
     );
     through_crossings(&site, builder, &mut corridor);
     corridor.squeeze = site.squeeze_of(&corridor, mission);
     corridor.coarse_cell = (field.cell() > 1.5 * FINEST_CELL).then_some(field.cell());
     Ok(corridor)
+}
+
+/// Each crossing's jumps, either way, at the levels where both sides of
+/// its gap stand in the way, its ends carried out to meet the grid where
+/// their own cells are shut (`Site::landing`); and where they were, by
+/// (tag, level): the points the search's cells stand for.
+#[allow(clippy::type_complexity)]
+fn crossing_jumps(
+    site: &Site,
+    crossings: &[[Point2<f64>; 2]],
+    windows: &[[f64; 2]],
+    stage_of_crossing: &dyn Fn(usize) -> Option<usize>,
+) -> (Vec<Jump>, HashMap<(usize, usize), [Point2<f64>; 2]>) {
+    let overlaps = |a: [f64; 2], b: [f64; 2]| a[0] <= b[1] + 1e-9 && b[0] <= a[1] + 1e-9;
+    let levels = &site.levels;
+    let mut jumps = Vec::new();
+    let mut landed = HashMap::new();
+    for (c, [a, z]) in crossings.iter().enumerate() {
+        for level in (0..levels.len()).filter(|&l| overlaps(windows[c], levels.span(l))) {
+            let ends = [*a, *z];
+            let (Some(la), Some(lz)) = (
+                site.landing(level, *a, a - z),
+                site.landing(level, *z, z - a),
+            ) else {
+                continue;
+            };
+            let lands = [la, lz];
+            for direction in 0..2 {
+                let (from, to) = (lands[direction], lands[1 - direction]);
+                let tag = 2 * c + direction;
+                let off = (from.1 - ends[direction]).norm() + (to.1 - ends[1 - direction]).norm();
+                if off > 0.0 {
+                    landed.insert((tag, level), [from.1, to.1]);
+                }
+                jumps.push(Jump {
+                    from: from.0,
+                    to: to.0,
+                    length: (a - z).norm() + off,
+                    pass_at: stage_of_crossing(c),
+                    crossing: true,
+                    tag,
+                    level,
+                    widest: from.2.max(to.2),
+                });
+            }
+        }
+    }
+    (jumps, landed)
 }
 
 /// Why the search at `site`'s levels reached no corridor: the chain of
@@ -821,536 +950,6 @@ fn shrink([lo, hi]: [f64; 2], by: f64) -> [f64; 2] {
     } else {
         let mid = (lo + hi) / 2.0;
         [mid, mid]
-    }
-}
-
-/// The search's steps as a corridor: runs of cells pulled tight within their
-/// mode, the jumps kept exact, each climb a short ramp round its cell.
-///
-/// Long (~195 lines): one walk over the steps (runs, layer changes, climbs, jumps), then the
-/// ramps laid out; over a quarter of it is rustfmt spreading the seven calls of its `flush`
-/// closure (which borrows the walk's vectors) over eight lines each.
-#[allow(clippy::too_many_arguments)]
-fn assemble(
-    site: &Site,
-    steps: &[Step],
-    [start, goal]: [Point2<f64>; 2],
-    crossings: &[[Point2<f64>; 2]],
-    candidates: &[(usize, f64, bool, [Point2<f64>; 2])],
-    via_points: &[Point2<f64>],
-    inspections: usize,
-) -> Corridor {
-    let field = site.field();
-    let levels = &site.levels;
-    let height = |level: usize| levels.altitude(level);
-    let first = levels.start;
-    let mut points = vec![start];
-    let mut heights = vec![height(first)];
-    let mut legs = Vec::new();
-    let mut passes = vec![(0.0, true); inspections];
-    // Climbs: the index of the leg that climbs, and its ramp's half run.
-    let mut climbs: Vec<(usize, f64)> = Vec::new();
-    // The current run: its points and mode.
-    let mut run: Vec<Point2<f64>> = vec![start];
-    let (mut layer, mut level) = (0, first);
-    let flush = |run: &mut Vec<Point2<f64>>,
-                 (layer, level): (usize, usize),
-                 points: &mut Vec<Point2<f64>>,
-                 heights: &mut Vec<f64>,
-                 legs: &mut Vec<Leg>,
-                 end: Point2<f64>| {
-        run.push(end);
-        let pulled = pull_tight(field, &site.open, bit(level, layer), run);
-        for p in pulled.into_iter().skip(1) {
-            if (p - points[points.len() - 1]).norm() > 1e-9 {
-                points.push(p);
-                heights.push(height(level));
-                legs.push(Leg::Free { layer });
-            }
-        }
-        run.clear();
-    };
-    for (k, step) in steps.iter().enumerate().skip(1) {
-        let last = k + 1 == steps.len();
-        match *step {
-            Step::Cell {
-                cell,
-                layer: l,
-                level: v,
-            } => {
-                let here = field.center(cell);
-                if v != level {
-                    // A climb: up (or down) at this cell, from the run so far.
-                    flush(
-                        &mut run,
-                        (layer, level),
-                        &mut points,
-                        &mut heights,
-                        &mut legs,
-                        here,
-                    );
-                    let pair = v.min(level);
-                    let run_half = site.ramp(pair);
-                    // Climbs through several levels at one cell are one ramp.
-                    match climbs.last_mut() {
-                        Some((leg, half)) if *leg + 1 == legs.len() && points[*leg] == here => {
-                            *half = half.min(run_half);
-                            *heights.last_mut().unwrap_or(&mut 0.0) = height(v);
-                        }
-                        _ => {
-                            climbs.push((legs.len(), run_half));
-                            points.push(here);
-                            heights.push(height(v));
-                            legs.push(Leg::Free { layer: l });
-                        }
-                    }
-                    run.push(here);
-                    (layer, level) = (l, v);
-                    if last {
-                        flush(
-                            &mut run,
-                            (layer, level),
-                            &mut points,
-                            &mut heights,
-                            &mut legs,
-                            goal,
-                        );
-                    }
-                } else if l != layer {
-                    // A change of layer: a vertex where the transition is.
-                    flush(
-                        &mut run,
-                        (layer, level),
-                        &mut points,
-                        &mut heights,
-                        &mut legs,
-                        here,
-                    );
-                    run.push(here);
-                    layer = l;
-                } else if last {
-                    flush(
-                        &mut run,
-                        (layer, level),
-                        &mut points,
-                        &mut heights,
-                        &mut legs,
-                        goal,
-                    );
-                } else {
-                    run.push(here);
-                }
-            }
-            Step::Jump {
-                tag,
-                layer: l,
-                level: v,
-                ..
-            } => {
-                let (ends, leg) = if tag < 2 * crossings.len() {
-                    let [a, z] = crossings[tag / 2];
-                    let ends = if tag % 2 == 0 { [a, z] } else { [z, a] };
-                    (ends, Some(Leg::Crossing(tag / 2)))
-                } else if tag < 2 * crossings.len() + candidates.len() {
-                    let (i, phi, on_left, ends) = candidates[tag - 2 * crossings.len()];
-                    passes[i] = (phi, on_left);
-                    (ends, Some(Leg::Pass(i)))
-                } else {
-                    // A via point: a corner of the route, no leg of its own.
-                    let p = via_points[tag - 2 * crossings.len() - candidates.len()];
-                    ([p, p], None)
-                };
-                flush(
-                    &mut run,
-                    (layer, level),
-                    &mut points,
-                    &mut heights,
-                    &mut legs,
-                    ends[0],
-                );
-                if let Some(leg) = leg {
-                    points.push(ends[1]);
-                    heights.push(height(v));
-                    legs.push(leg);
-                } else if points.last() != Some(&ends[0]) {
-                    // The run was already at the point (pulled tight onto it).
-                    points.push(ends[0]);
-                    heights.push(height(v));
-                    legs.push(Leg::Free { layer });
-                }
-                run.push(ends[1]);
-                (layer, level) = (l, v);
-                if last {
-                    flush(
-                        &mut run,
-                        (layer, level),
-                        &mut points,
-                        &mut heights,
-                        &mut legs,
-                        goal,
-                    );
-                }
-            }
-        }
-    }
-    if points.last() != Some(&goal) {
-        flush(
-            &mut run,
-            (layer, level),
-            &mut points,
-            &mut heights,
-            &mut legs,
-            goal,
-        );
-    }
-    // Each climb, a vertical leg at its cell, becomes a ramp: its foot back
-    // along the leg before, its top on along the leg after, each within the
-    // ramp's half run of the cell (clear at every altitude between).
-    for &(leg, half) in &climbs {
-        let c = points[leg];
-        if leg > 0 {
-            let before = points[leg - 1];
-            let back = (before - c).norm();
-            if back > 1e-9 {
-                points[leg] = c + (before - c) * (half.min(0.45 * back) / back);
-            }
-        }
-        if leg + 2 < points.len() {
-            let after = points[leg + 2];
-            let on = (after - c).norm();
-            if on > 1e-9 {
-                points[leg + 1] = c + (after - c) * (half.min(0.45 * on) / on);
-            }
-        }
-    }
-    let mut corridor = Corridor {
-        points,
-        legs,
-        passes,
-        length: 0.0,
-        heights: if levels.is_flat() {
-            Vec::new()
-        } else {
-            heights
-        },
-        coarse_cell: None,
-        squeeze: None,
-    };
-    corridor.length = polyline_length(&corridor);
-    corridor
-}
-
-/// The corridor's free legs in the nominal shape across an IWP's gate,
-/// taken through its crossing as the path builder will fly them
-/// (`PathBuilder::crossing_leg` puts a crossing into every leg across its
-/// gate, at the altitudes where the gap stands in the way, unless a squeeze
-/// already carries the formation through in a shape that fits): the
-/// crossing's straight put in, and the
-/// corridor's points standing on that straight (a run pulled tight through a
-/// gap in single file bends at its ends) left out, so the path does not
-/// double back over the straight. A crossing whose approach or exit the
-/// site closes is left as it was.
-fn through_crossings(site: &Site, builder: &PathBuilder, corridor: &mut Corridor) {
-    let crossings = builder.crossings();
-    let gates = builder.crossing_gates();
-    let windows = builder.crossing_windows();
-    let field = site.field();
-    let height = |corridor: &Corridor, i: usize| corridor.heights.get(i).copied();
-    let level_of = |z: Option<f64>| z.and_then(|z| site.levels.level_of(z)).unwrap_or(0);
-    let mut placed: Vec<usize> = corridor
-        .legs
-        .iter()
-        .filter_map(|l| match l {
-            Leg::Crossing(c) => Some(*c),
-            _ => None,
-        })
-        .collect();
-    let mut k = 0;
-    while k < corridor.legs.len() {
-        // Only in the nominal shape: a leg flown squeezed (shrunk, in a
-        // column) passes the gaps its shape fits as the squeeze carries it.
-        let Leg::Free { layer: 0 } = corridor.legs[k] else {
-            k += 1;
-            continue;
-        };
-        let layer = 0;
-        let (a, b) = (corridor.points[k], corridor.points[k + 1]);
-        let level = level_of(height(corridor, k));
-        let span = site.levels.span(level);
-        // The first gate the leg crosses, from its start.
-        let hit = (0..crossings.len())
-            .filter(|&c| windows[c][0] <= span[1] + 1e-9 && span[0] <= windows[c][1] + 1e-9)
-            .filter(|&c| {
-                // As the path builder: once each, none within another's straight.
-                !placed.iter().any(|&p| {
-                    p == c || builder.crossings_overlap(p, c) || builder.crossings_overlap(c, p)
-                })
-            })
-            .filter(|&c| segments_cross(&a, &b, &gates[c][0], &gates[c][1]))
-            .min_by(|&c, &d| {
-                let at = |g: &[Point2<f64>; 2]| (nalgebra::center(&g[0], &g[1]) - a).norm();
-                at(&gates[c]).total_cmp(&at(&gates[d]))
-            });
-        let Some(c) = hit else {
-            k += 1;
-            continue;
-        };
-        let [p, q] = crossings[c];
-        let (enter, leave) = if (q - p).dot(&(b - a)) >= 0.0 {
-            (p, q)
-        } else {
-            (q, p)
-        };
-        let centre = nalgebra::center(&p, &q);
-        let n = (leave - enter) / (leave - enter).norm().max(1e-12);
-        let reach = (leave - enter).norm() / 2.0;
-        let half_gate = (gates[c][1] - gates[c][0]).norm() / 2.0;
-        let on_straight = |x: Point2<f64>| {
-            let d = x - centre;
-            d.dot(&n).abs() <= reach && (d.x * n.y - d.y * n.x).abs() <= half_gate
-        };
-        // Points on the straight before the leg's end, and after its start.
-        let mut first = k;
-        while first > 0
-            && matches!(corridor.legs[first - 1], Leg::Free { .. })
-            && on_straight(corridor.points[first])
-        {
-            first -= 1;
-        }
-        let mut last = k + 1;
-        while last + 1 < corridor.points.len()
-            && matches!(corridor.legs[last], Leg::Free { .. })
-            && on_straight(corridor.points[last])
-        {
-            last += 1;
-        }
-        let open = |x: Point2<f64>, y: Point2<f64>| {
-            search::visible(field, &site.open, bit(level, layer), x, y)
-        };
-        let (from, to) = (corridor.points[first], corridor.points[last]);
-        if !(open(from, enter) && open(leave, to)) {
-            k += 1;
-            continue;
-        }
-        let z = height(corridor, k);
-        placed.push(c);
-        corridor.points.splice(first + 1..last, [enter, leave]);
-        corridor.legs.splice(
-            first..last,
-            [Leg::Free { layer }, Leg::Crossing(c), Leg::Free { layer }],
-        );
-        if let Some(z) = z {
-            corridor.heights.splice(first + 1..last, [z, z]);
-        }
-        k = first + 2;
-    }
-    corridor.length = polyline_length(corridor);
-}
-
-/// The corridor's length, metres (its heights' climbs included).
-fn polyline_length(corridor: &Corridor) -> f64 {
-    let z = |i: usize| corridor.heights.get(i).copied().unwrap_or(0.0);
-    corridor
-        .points
-        .windows(2)
-        .enumerate()
-        .map(|(i, w)| (w[1] - w[0]).norm().hypot(z(i + 1) - z(i)))
-        .sum()
-}
-
-/// The run's points with every corner removed that a straight line on open
-/// cells can skip: from each kept point, the farthest one in sight.
-fn pull_tight(field: &Field, open: &[u64], bit: u64, run: &[Point2<f64>]) -> Vec<Point2<f64>> {
-    if run.len() <= 2 {
-        return run.to_vec();
-    }
-    let mut kept = vec![run[0]];
-    let mut anchor = 0;
-    while anchor + 1 < run.len() {
-        // The farthest point of the run in sight (from the far end back).
-        let next = ((anchor + 2)..run.len())
-            .rev()
-            .find(|&j| search::visible(field, open, bit, run[anchor], run[j]))
-            .unwrap_or(anchor + 1);
-        kept.push(run[next]);
-        anchor = next;
-    }
-    kept
-}
-
-/// The squeezed regions the corridor passes: the connected cells where only
-/// the shrink fits (flown at the scale the corridor needs through it) or
-/// only the column does, at the level each leg is flown at; `None` when the
-/// corridor never squeezes.
-fn squeeze_map(site: &Site, corridor: &Corridor, mission: &Mission) -> Option<Arc<SqueezeMap>> {
-    let field = site.field();
-    let open = &site.open;
-    let shape = &site.shape;
-    // The narrowest layer a cell is open in at `level`, when it is not open
-    // in the nominal one.
-    let narrow = |i: usize, level: usize| -> Option<usize> {
-        (open[i] & bit(level, 0) == 0)
-            .then(|| (1..LAYERS).find(|&l| open[i] & bit(level, l) != 0))
-            .flatten()
-    };
-    let level_of_leg = |leg: usize| {
-        corridor
-            .heights
-            .get(leg)
-            .and_then(|z| site.levels.level_of(*z))
-            .unwrap_or(0)
-    };
-    let mut region = vec![0u16; field.len()];
-    let mut shapes: Vec<FormationShape> = Vec::new();
-    // The level whose obstacles name the squeezes' sides.
-    let mut named: Option<usize> = None;
-    for (k, (leg, w)) in corridor
-        .legs
-        .iter()
-        .zip(corridor.points.windows(2))
-        .enumerate()
-    {
-        if matches!(leg, Leg::Free { layer: 0 } | Leg::Pass(_)) {
-            continue;
-        }
-        let level = level_of_leg(k);
-        let Level {
-            field: at, discs, ..
-        } = &site.at[level];
-        let (a, b) = (w[0], w[1]);
-        let steps = (((b - a).norm() / (field.cell() / 3.0)).ceil() as usize).max(1);
-        for j in 0..=steps {
-            let p = a + (b - a) * (j as f64 / steps as f64);
-            let i = field.index_of(p);
-            let Some(layer) = narrow(i, level) else {
-                continue;
-            };
-            if region[i] == 0 {
-                if shapes.len() >= u16::MAX as usize - 1 {
-                    break;
-                }
-                shapes.push(match (layer, shape.column) {
-                    (2, Some(column)) => column,
-                    _ => FormationShape::Shrink { scale: 1.0 },
-                });
-                named.get_or_insert(level);
-                let label = shapes.len() as u16;
-                flood(field, &mut region, i, label, &|c| {
-                    narrow(c, level) == Some(layer)
-                });
-            }
-            let r = region[i] as usize - 1;
-            if let FormationShape::Shrink { scale } = &mut shapes[r] {
-                let fits = shape.scale_for(
-                    at.clearance_at(p, discs),
-                    mission
-                        .bounds
-                        .horizontal_margin(&nalgebra::Point3::new(p.x, p.y, 0.0)),
-                );
-                *scale = scale.min(fits);
-            }
-        }
-    }
-    let named = &site.at[named?];
-    let free = chebyshev_distance(field, &region);
-    let extent = region_extent(field, &region);
-    Some(Arc::new(SqueezeMap {
-        field: named.field.clone(),
-        region,
-        shapes,
-        obstacle_of: named
-            .obstacles
-            .iter()
-            .map(|(k, d)| (*k, d.center))
-            .collect(),
-        free,
-        extent,
-    }))
-}
-
-/// The box holding every point whose cell is in a region.
-fn region_extent(field: &Field, region: &[u16]) -> [Point2<f64>; 2] {
-    // A point belongs to the cell whose centre is nearest: half a cell (and
-    // a hair) beyond the region cells' centres.
-    let pad = field.cell() * 0.5 + 1e-9;
-    let mut extent = [
-        Point2::new(f64::INFINITY, f64::INFINITY),
-        Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-    ];
-    for (i, _) in region.iter().enumerate().filter(|(_, r)| **r > 0) {
-        let c = field.center(i);
-        extent[0] = extent[0].inf(&Point2::new(c.x - pad, c.y - pad));
-        extent[1] = extent[1].sup(&Point2::new(c.x + pad, c.y + pad));
-    }
-    extent
-}
-
-/// Per cell, the Chebyshev distance in cells to the nearest cell with a
-/// region (0 on one), capped at 255: the two passes of the 8-neighbour
-/// chamfer (each from the neighbours already passed), exact for this metric.
-fn chebyshev_distance(field: &Field, region: &[u16]) -> Vec<u8> {
-    let (nx, ny) = field.size();
-    let mut d: Vec<u8> = region
-        .iter()
-        .map(|&r| if r > 0 { 0 } else { 255 })
-        .collect();
-    let at = |d: &[u8], x: usize, y: usize| d[y * nx + x].saturating_add(1);
-    for y in 0..ny {
-        for x in 0..nx {
-            let mut v = d[y * nx + x];
-            if x > 0 {
-                v = v.min(at(&d, x - 1, y));
-            }
-            if y > 0 {
-                v = v.min(at(&d, x, y - 1));
-                if x > 0 {
-                    v = v.min(at(&d, x - 1, y - 1));
-                }
-                if x + 1 < nx {
-                    v = v.min(at(&d, x + 1, y - 1));
-                }
-            }
-            d[y * nx + x] = v;
-        }
-    }
-    for y in (0..ny).rev() {
-        for x in (0..nx).rev() {
-            let mut v = d[y * nx + x];
-            if x + 1 < nx {
-                v = v.min(at(&d, x + 1, y));
-            }
-            if y + 1 < ny {
-                v = v.min(at(&d, x, y + 1));
-                if x + 1 < nx {
-                    v = v.min(at(&d, x + 1, y + 1));
-                }
-                if x > 0 {
-                    v = v.min(at(&d, x - 1, y + 1));
-                }
-            }
-            d[y * nx + x] = v;
-        }
-    }
-    d
-}
-
-/// Labels the connected narrow cells round `seed` with `label`.
-fn flood(
-    field: &Field,
-    region: &mut [u16],
-    seed: usize,
-    label: u16,
-    narrow: &dyn Fn(usize) -> bool,
-) {
-    let mut stack = vec![seed];
-    region[seed] = label;
-    while let Some(i) = stack.pop() {
-        for j in field.neighbourhood(i) {
-            if region[j] == 0 && narrow(j) {
-                region[j] = label;
-                stack.push(j);
-            }
-        }
     }
 }
 

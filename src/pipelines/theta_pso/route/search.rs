@@ -47,6 +47,10 @@ pub struct Jump {
     pub tag: usize,
     /// The level it is flown at (it lands there too).
     pub level: usize,
+    /// The widest layer it may be entered in (0: any): a jump joined to
+    /// the grid by straights clear only for a narrower shape
+    /// (`route::Site::landing`) is entered in that shape or narrower.
+    pub widest: usize,
 }
 
 /// What the search works on.
@@ -267,7 +271,7 @@ pub fn search(
         }
         for &j in index.at(cell) {
             let jump = &graph.jumps[j];
-            if jump.level != level {
+            if jump.level != level || layer < jump.widest {
                 continue;
             }
             let next_stage = match jump.pass_at {

@@ -1,6 +1,7 @@
 use super::*;
 use crate::pipelines::theta_pso::route::guide::Guide;
 use crate::pipelines::theta_pso::route::search::{self, Graph, Jump, LEVEL_BITS, Step};
+use crate::pipelines::theta_pso::route::squeeze::{chebyshev_distance, region_extent};
 
 /// The room `at_with_room` reports is never wrong: within it of the
 /// sampled point no point is in a region, so the path builder may skip
@@ -141,6 +142,7 @@ fn the_guided_search_finds_a_route_as_short_as_dijkstras() {
         crossing: true,
         tag: 0,
         level: 0,
+        widest: 0,
     }];
     let graph = Graph {
         field: &field,
