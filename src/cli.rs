@@ -862,6 +862,7 @@ fn run_pipeline(
                     "result": "no plan",
                     "reason": no_plan.reason,
                     "obstacles": no_plan.obstacles,
+                    "passages": no_plan.passages,
                 });
                 let text = serde_json::to_string_pretty(&record).unwrap_or_default();
                 if target.as_os_str() == "-" {

@@ -292,6 +292,21 @@ pub fn live_limits(checks: &[(f64, f64, &str)]) -> Vec<String> {
 pub struct NoPlan {
     pub reason: String,
     pub obstacles: Vec<String>,
+    /// The passages that close the way, widest first (empty when the
+    /// refusal is not about a passage).
+    pub passages: Vec<Passage>,
+}
+
+/// A passage between two obstacles too narrow for the formation, as a
+/// refusal names it and `--json` writes it (so scripts and the designer
+/// can draw it): the two obstacles, the gap's width, the width the
+/// narrowest shape needs there, and the gap's two ends (ENU metres).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Passage {
+    pub between: [String; 2],
+    pub width: f64,
+    pub needs: f64,
+    pub ends: [[f64; 2]; 2],
 }
 
 impl std::fmt::Display for NoPlan {

@@ -137,6 +137,24 @@ fn an_aisle_five_cm_too_narrow_is_refused_naming_it_and_the_json_says_so() {
             .is_some_and(|o| o.iter().any(|n| n == "bay 1.5")),
         "{v}"
     );
+    // The blocking passages, widest first, with their ends to draw: the
+    // aisle, 0.81 m of the 0.86 m one UAV needs, between the two bays'
+    // facing edges (bay 1.4 from y = -13.5 + 2 × 3.1, 2.6 m wide; bay 1.5
+    // 0.81 m on).
+    let widest = &v["passages"][0];
+    assert_eq!(widest["between"], serde_json::json!(["bay 1.4", "bay 1.5"]));
+    assert!(
+        (widest["width"].as_f64().unwrap_or(0.0) - 0.81).abs() < 1e-9,
+        "{v}"
+    );
+    assert!(
+        (widest["needs"].as_f64().unwrap_or(0.0) - 0.86).abs() < 1e-9,
+        "{v}"
+    );
+    let ends = &widest["ends"];
+    let y = |k: usize| ends[k][1].as_f64().unwrap_or(f64::NAN);
+    assert!((y(0) - (-13.5 + 2.0 * 3.1 + 2.6)).abs() < 1e-9, "{v}");
+    assert!((y(1) - y(0) - 0.81).abs() < 1e-9, "{v}");
 }
 
 /// Issue 51: `check` on a row of footprints with 2.5 m aisles warns of no

@@ -16,7 +16,7 @@
 
 use nalgebra::Vector3;
 
-use crate::mission::Mission;
+use crate::mission::{Formation, Mission};
 
 /// Where a pass runs, for one obstacle and the nominal shape: the distance of
 /// the centroid's line from the obstacle's axis with the obstacle on the
@@ -142,7 +142,13 @@ impl PassGeometry {
 /// end (a flight check's margin of 2.5 m against the bridge's [1, 5] m), so
 /// the pass aims at the middle of what both allow; with the default margins
 /// (0.6 m under a 1 m lower end) nothing moves.
-fn flown_band([d_min, d_max]: [f64; 2], least_clearance: f64) -> Result<[f64; 2], String> {
+///
+/// A band left thinner than [`LEAST_FLOWN_BAND`] is refused too: a pass
+/// cannot be held in a few centimetres (issue 51: an obstacle margin of
+/// 4.5 m against the viaduct's [2, 5] m left 5 cm, and the swarm searched
+/// for 40 s and 500 MB before failing verification).
+fn flown_band([d_min, d_max]: [f64; 2], f: &Formation) -> Result<[f64; 2], String> {
+    let least_clearance = f.least_clearance();
     if least_clearance >= d_max {
         return Err(format!(
             "its stand-off band ends at {d_max} m, within the {least_clearance:.2} m a plan keeps \
@@ -150,8 +156,30 @@ fn flown_band([d_min, d_max]: [f64; 2], least_clearance: f64) -> Result<[f64; 2]
              no UAV may come close enough to inspect it"
         ));
     }
-    Ok([d_min.max(least_clearance), d_max])
+    let lower = d_min.max(least_clearance);
+    if d_max - lower < LEAST_FLOWN_BAND - 1e-9 {
+        let why = if least_clearance > d_min {
+            let most = d_max - LEAST_FLOWN_BAND - f.uav_radius - f.safety_margin;
+            format!(
+                "it leaves {:.2} m above the {least_clearance:.2} m a plan keeps from every \
+                 obstacle (r_Q + formation.safety_margin + formation.obstacle_margin); lower \
+                 formation.obstacle_margin to {:.2} m or less, or widen the band",
+                d_max - lower,
+                most.max(0.0)
+            )
+        } else {
+            format!("it is {:.2} m wide; widen it", d_max - d_min)
+        };
+        return Err(format!(
+            "a pass needs at least {LEAST_FLOWN_BAND} m of stand-off band to be held in, and {why}"
+        ));
+    }
+    Ok([lower, d_max])
 }
+
+/// The least stand-off band a pass is aimed into, metres: half a metre, a
+/// quarter either side of the pass's line.
+pub const LEAST_FLOWN_BAND: f64 = 0.5;
 
 /// The pass geometry of every inspected obstacle, or the first reason one
 /// cannot be flown, with its obstacle index.
@@ -178,11 +206,11 @@ pub fn pass_geometries(mission: &Mission) -> Result<Vec<(usize, PassGeometry)>, 
                     ));
                 }
                 let band =
-                    flown_band(o.stand_off_band(f), f.least_clearance()).map_err(|e| (k, e))?;
+                    flown_band(o.stand_off_band(f), f).map_err(|e| (k, e))?;
                 return Ok((k, PassGeometry::face(&f.slots, band, f.inspection_pass)));
             }
             let written = o.stand_off_band(f);
-            let band = flown_band(written, f.least_clearance()).map_err(|e| (k, e))?;
+            let band = flown_band(written, f).map_err(|e| (k, e))?;
             PassGeometry::new(&f.slots, o.radius, band, f.inspection_pass)
                 .map(|g| (k, g))
                 .map_err(|e| {
@@ -203,12 +231,17 @@ mod tests {
 
     #[test]
     fn a_pass_aims_into_the_band_above_the_clearance_the_plan_keeps() {
+        let with_margin = |margin: f64| {
+            let mut f = Formation::default();
+            (f.uav_radius, f.safety_margin, f.obstacle_margin) = (0.5, 0.1, margin);
+            f
+        };
         // Default margins under the band's lower end: the band as written.
-        assert_eq!(flown_band([1.0, 5.0], 0.6), Ok([1.0, 5.0]));
+        assert_eq!(flown_band([1.0, 5.0], &with_margin(0.0)), Ok([1.0, 5.0]));
         // A margin past it: the pass aims above it, and the facing UAV's
         // distance over the bridge's 6 m pass stays in [3.05, 5] m.
-        let band = flown_band([1.0, 5.0], 3.05).expect("room above 3.05 m");
-        assert_eq!(band, [3.05, 5.0]);
+        let band = flown_band([1.0, 5.0], &with_margin(2.45)).expect("room above 3.05 m");
+        assert!((band[0] - 3.05).abs() < 1e-12 && band[1] == 5.0, "{band:?}");
         let slots = [
             Vector3::new(0.0, 2.0, 0.0),
             Vector3::new(-2.0, -1.0, 0.0),
@@ -219,7 +252,18 @@ mod tests {
             assert!(lo >= 3.05 && hi <= 5.0, "facing UAV at {lo:.2}-{hi:.2} m");
         }
         // No room left: refused, naming the fields.
-        let refused = flown_band([1.0, 5.0], 5.2).expect_err("no room");
+        let refused = flown_band([1.0, 5.0], &with_margin(4.6)).expect_err("no room");
         assert!(refused.contains("formation.obstacle_margin"), "{refused}");
+        // Issue 51: 5 cm left (the viaduct's [2, 5] m at a 4.35 m margin)
+        // is refused, naming the most margin that leaves half a metre.
+        let refused = flown_band([2.0, 5.0], &with_margin(4.35)).expect_err("5 cm");
+        assert!(
+            refused.contains("leaves 0.05 m above the 4.95 m")
+                && refused.contains("lower formation.obstacle_margin to 3.90 m or less"),
+            "{refused}"
+        );
+        // Half a metre is enough.
+        let band = flown_band([2.0, 5.0], &with_margin(3.9)).expect("half a metre");
+        assert!((band[0] - 4.5).abs() < 1e-12, "{band:?}");
     }
 }

@@ -95,6 +95,7 @@ fn admit(mission: &Mission) -> Result<(), PipelineError> {
                 iwp.unusable.clone().unwrap_or_default()
             ),
             obstacles: iwp.between.to_vec(),
+            passages: Vec::new(),
         }));
     }
     let errors: Vec<String> = diagnostics(mission)
@@ -158,6 +159,21 @@ fn route_stage(
                     .obstacles
                     .iter()
                     .filter_map(|&k| mission.obstacles.get(k).map(|o| o.name.clone()))
+                    .collect(),
+                passages: blocked
+                    .passages
+                    .iter()
+                    .map(
+                        |&([p, q], width, needs, [a, b])| crate::pipelines::Passage {
+                            between: [
+                                mission.obstacles[p].name.clone(),
+                                mission.obstacles[q].name.clone(),
+                            ],
+                            width,
+                            needs,
+                            ends: [[a.x, a.y], [b.x, b.y]],
+                        },
+                    )
                     .collect(),
                 reason: blocked.reason,
             })

@@ -62,9 +62,7 @@ pub fn theta_pso(o: &ThetaPsoOutcome, verbose: bool) -> String {
         }
     };
     let coarse = o.corridor.coarse_cell.map_or_else(String::new, |cell| {
-        format!(
-            " (a large site, searched at {cell:.2} m cells: a way narrower than that may be missed)"
-        )
+        format!(" (a large site, searched at {cell:.2} m cells; gaps judged on exact geometry)")
     });
     let _ = writeln!(
         s,

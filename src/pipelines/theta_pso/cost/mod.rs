@@ -906,17 +906,35 @@ struct Scratch {
 /// circle's radius, so r^S − d is the clearance short of r_Q + margin, as
 /// for a cylinder), integrated by the midpoint rule at 0.2 m or finer.
 pub fn violation_along(p: &Point3<f64>, q: &Point3<f64>, c: &Prism, safe: f64) -> f64 {
+    /// Samples judged at once by their middle's clearance.
+    const SKIP_BLOCK: usize = 8;
     if !c.polygon.is_empty() {
         let length = (q - p).norm();
         let n = ((length / 0.2).ceil() as usize).clamp(2, 64);
         let step = length / n as f64;
-        return (0..n)
-            .map(|i| {
-                let at = p + (q - p) * ((i as f64 + 0.5) / n as f64);
-                (1.0 - (c.radius + c.clearance(&at)) / safe).max(0.0)
-            })
-            .sum::<f64>()
-            * step;
+        // The integrand is 0 wherever the clearance reaches safe − R, and
+        // the clearance changes by no more than the distance moved: a
+        // block of samples whose middle is that far plus half the block
+        // clear adds nothing, and is skipped (the same sum, bit for bit:
+        // only zeros are left out). A long wall's bounding circle takes in
+        // every piece of the path, so most pieces are skipped whole.
+        let free = safe - c.radius;
+        let at = |i: f64| p + (q - p) * (i / n as f64);
+        let mut total = 0.0;
+        let mut block = 0;
+        while block < n {
+            let end = (block + SKIP_BLOCK).min(n);
+            let middle = at((block + end) as f64 / 2.0);
+            if c.clearance(&middle) - step * (end - block) as f64 / 2.0 >= free {
+                block = end;
+                continue;
+            }
+            for i in block..end {
+                total += (1.0 - (c.radius + c.clearance(&at(i as f64 + 0.5))) / safe).max(0.0);
+            }
+            block = end;
+        }
+        return total * step;
     }
     let (a, b) = (p.xy(), q.xy());
     let ab = b - a;

@@ -18,6 +18,9 @@ use crate::mission::Mission;
 use crate::pipelines::theta_pso::iwp::Iwp;
 use crate::pipelines::theta_pso::path::PathBuilder;
 
+/// Passages a refusal lists at most (a wall of a hundred posts has 99).
+const MAX_PASSAGES: usize = 20;
+
 /// The sides of the bounds, in the order `side_of` numbers them.
 const SIDES: [&str; 4] = ["west", "east", "south", "north"];
 
@@ -136,6 +139,7 @@ pub fn explain(
                  (even shrunk it needs {need:.2} m from every obstacle and stays inside the bounds)"
             ),
             obstacles: Vec::new(),
+            passages: Vec::new(),
         };
     };
     let members: Vec<usize> = (0..n).filter(|&i| root(&mut parent, i) == chain).collect();
@@ -214,13 +218,50 @@ pub fn explain(
             name(j)
         )
     });
+    let passages = narrow_passages(mission, obstacles, &members, need);
     super::Blocked {
         reason: format!(
             "no corridor from start to goal{stuck}: {span} close the way {place}{gap_text}{}",
             resolution_note(field.cell())
         ),
         obstacles: members.iter().map(|&i| obstacles[i].0).collect(),
+        passages,
     }
+}
+
+/// Every gap between `members` too narrow to pass (under 2 `need`), widest
+/// first (at most [`MAX_PASSAGES`]), with its ends, for scripts and the
+/// designer to draw.
+fn narrow_passages(
+    mission: &Mission,
+    obstacles: &[(usize, Disc)],
+    members: &[usize],
+    need: f64,
+) -> Vec<super::BlockedPassage> {
+    let mut passages: Vec<super::BlockedPassage> = members
+        .iter()
+        .flat_map(|&i| members.iter().map(move |&j| (i, j)))
+        .filter(|(i, j)| i < j)
+        .filter_map(|(i, j)| {
+            let gap = obstacles[i].1.gap_to(&obstacles[j].1);
+            (gap < 2.0 * need).then(|| {
+                let (a, b) = super::gaps::nearest(&obstacles[i].1, &obstacles[j].1);
+                // As the words say it: one UAV's width (what verification
+                // holds) where not even one fits, else the route's need.
+                let one = 2.0 * mission.formation.least_clearance();
+                let needs = if gap < one { one } else { 2.0 * need };
+                (
+                    [obstacles[i].0, obstacles[j].0],
+                    gap.max(0.0),
+                    needs,
+                    [a, b],
+                )
+            })
+        })
+        .collect();
+    passages.sort_by(|a, b| b.1.total_cmp(&a.1));
+    passages.truncate(MAX_PASSAGES);
+    passages
 }
 
 /// What a coarse search cannot see. The grid is as fine as 0.2 m, but a
@@ -232,7 +273,9 @@ fn resolution_note(cell: f64) -> String {
     if cell > 1.5 * FINEST_CELL {
         format!(
             " (this large site was searched at {cell:.2} m cells, not the finest {FINEST_CELL:.2} m: \
-             a way that fits by less than about {cell:.2} m may not be found)"
+             every gap between two obstacles, or an obstacle and the bounds, was judged on exact \
+             geometry; a way bent between three or more that fits by less than about {cell:.2} m \
+             may not be found)"
         )
     } else {
         String::new()

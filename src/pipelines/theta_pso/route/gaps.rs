@@ -54,7 +54,7 @@ impl Gap {
 }
 
 /// The nearest points of two footprints (`a`'s, then `b`'s), for two apart.
-fn nearest(a: &Disc, b: &Disc) -> (Point2<f64>, Point2<f64>) {
+pub(super) fn nearest(a: &Disc, b: &Disc) -> (Point2<f64>, Point2<f64>) {
     let on_circle = |d: &Disc, toward: Point2<f64>| {
         let v = toward - d.center;
         d.center + v * (d.radius / v.norm().max(1e-12))

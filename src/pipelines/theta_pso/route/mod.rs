@@ -144,7 +144,14 @@ pub struct Blocked {
     pub reason: String,
     /// The obstacles that close the way (indices into `mission.obstacles`).
     pub obstacles: Vec<usize>,
+    /// The gaps between them too narrow to pass, widest first: the two
+    /// obstacles (indices), the width, the width needed, the gap's ends.
+    pub passages: Vec<BlockedPassage>,
 }
+
+/// A gap that closes the way: the two obstacles (indices into
+/// `mission.obstacles`), its width, the width needed, its ends.
+pub type BlockedPassage = ([usize; 2], f64, f64, [Point2<f64>; 2]);
 
 /// What the route stage needs of the formation.
 struct Shape {
@@ -597,6 +604,7 @@ fn with_altitudes(mission: &Mission, blocked: Blocked, z_box: [f64; 2]) -> Block
     Blocked {
         reason: format!("{}; they stand{reach}: {over}{under}", blocked.reason),
         obstacles: blocked.obstacles,
+        passages: blocked.passages,
     }
 }
 
