@@ -668,13 +668,33 @@ impl CostModel {
             for w in samples.windows(2) {
                 let (a, b) = (w[0], w[1]);
                 motion.read_into(b, current, &mut reader);
+                // A circle round every UAV's piece of this interval: an
+                // obstacle whose axis stands `safe` beyond it adds nothing
+                // (each piece lies in the circle, so each UAV's distance to
+                // the axis is at least that), and is passed over whole.
+                // The same for each UAV: a piece whose start stands `safe`
+                // plus the longest piece from the axis.
+                let (middle, spread) = enclosing(previous, current);
+                let longest = previous
+                    .iter()
+                    .zip(current.iter())
+                    .map(|(p, q)| (q.xy() - p.xy()).norm_squared())
+                    .fold(0.0, f64::max)
+                    .sqrt();
                 for &(k, (n0, n1)) in near.iter() {
                     if b < n0 || a > n1 {
                         continue;
                     }
                     let c = &self.obstacles[k];
                     let safe = c.radius + self.uav_radius + self.margin;
+                    if (middle - c.center).norm() - spread >= safe {
+                        continue;
+                    }
+                    let far = (safe + longest) * (safe + longest);
                     for (p, q) in previous.iter().zip(current.iter()) {
+                        if (p.xy() - c.center).norm_squared() >= far {
+                            continue;
+                        }
                         sums.obstacle += violation_along(p, q, c, safe);
                     }
                 }
@@ -889,6 +909,28 @@ struct Scratch {
     samples: Vec<f64>,
     previous: Vec<Point3<f64>>,
     current: Vec<Point3<f64>>,
+}
+
+/// The middle of the points' bounding box (in the plane) and the farthest
+/// point's distance from it: a circle holding every point, so every
+/// segment between them.
+fn enclosing(a: &[Point3<f64>], b: &[Point3<f64>]) -> (nalgebra::Point2<f64>, f64) {
+    let (mut lo, mut hi) = (
+        nalgebra::Point2::new(f64::INFINITY, f64::INFINITY),
+        nalgebra::Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
+    for p in a.iter().chain(b) {
+        lo = nalgebra::Point2::new(lo.x.min(p.x), lo.y.min(p.y));
+        hi = nalgebra::Point2::new(hi.x.max(p.x), hi.y.max(p.y));
+    }
+    let middle = nalgebra::center(&lo, &hi);
+    let spread = a
+        .iter()
+        .chain(b)
+        .map(|p| (p.xy() - middle).norm_squared())
+        .fold(0.0, f64::max)
+        .sqrt();
+    (middle, spread)
 }
 
 /// ∫ max(1 − d / R, 0) dℓ along the straight piece p-q of a UAV's path

@@ -211,3 +211,35 @@ fn a_sharp_turn_spread_over_close_corners_is_never_free() {
     let hairpin = turning_excess(&path(0.4, &[180.0]), 1.0);
     assert!((hairpin - 90.0 * deg).abs() < 1e-9);
 }
+
+/// The circle the cost culls obstacles by holds every UAV's piece of an
+/// interval (so an obstacle `safe` beyond it adds nothing), and is no
+/// larger than the points need: the farthest one is on it.
+#[test]
+fn the_enclosing_circle_holds_every_piece() {
+    use nalgebra::Point3;
+    let a = [
+        Point3::new(0.0, 0.0, 5.0),
+        Point3::new(3.0, -1.0, 6.0),
+        Point3::new(-2.0, 4.0, 5.0),
+    ];
+    let b = [
+        Point3::new(0.5, 0.2, 5.0),
+        Point3::new(3.6, -0.7, 6.0),
+        Point3::new(-1.4, 4.5, 5.0),
+    ];
+    let (middle, spread) = super::enclosing(&a, &b);
+    let mut farthest: f64 = 0.0;
+    for (p, q) in a.iter().zip(&b) {
+        for k in 0..=10 {
+            let x = p + (q - p) * (k as f64 / 10.0);
+            let d = (x.xy() - middle).norm();
+            assert!(
+                d <= spread + 1e-12,
+                "{x} is {d} from the middle, spread {spread}"
+            );
+            farthest = farthest.max(d);
+        }
+    }
+    assert!((farthest - spread).abs() < 1e-12, "{farthest} vs {spread}");
+}
