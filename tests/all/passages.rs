@@ -260,6 +260,17 @@ fn row(s: &Sweep) -> Mission {
         s.offset
     };
     let reach = width.max(length) * 2.0;
+    // A footprint along the row from `a` to `b`, `half` deep either side.
+    let strip = |name: String, a: f64, b: f64, half: f64| {
+        let mut o = Obstacle::standing(name, Point2::origin(), 0.0, 30.0);
+        o.footprint = vec![
+            middle + along * a - across * half,
+            middle + along * b - across * half,
+            middle + along * b + across * half,
+            middle + along * a + across * half,
+        ];
+        o
+    };
     let mut pieces = Vec::new();
     for (k, sign) in [-1.0f64, 1.0].into_iter().enumerate() {
         if s.at_bound && k == 1 {
@@ -276,33 +287,17 @@ fn row(s: &Sweep) -> Mission {
                     edge += sign * (0.8 + 0.5);
                 }
                 Side::Bay => {
-                    let (a, b) = (edge, edge + sign * 2.6);
-                    let mut o = Obstacle::standing(name, Point2::origin(), 0.0, 30.0);
-                    o.footprint = vec![
-                        middle + along * a - across * 4.0,
-                        middle + along * b - across * 4.0,
-                        middle + along * b + across * 4.0,
-                        middle + along * a + across * 4.0,
-                    ];
-                    pieces.push(o);
+                    pieces.push(strip(name, edge, edge + sign * 2.6, 4.0));
                     edge += sign * (2.6 + 0.5);
                 }
             }
         }
-        let mut wall = Obstacle::standing(
+        pieces.push(strip(
             format!("{} wall", ["west", "east"][k]),
-            Point2::origin(),
-            0.0,
-            30.0,
-        );
-        let (a, b) = (edge, sign * reach);
-        wall.footprint = vec![
-            middle + along * a - across * 0.5,
-            middle + along * b - across * 0.5,
-            middle + along * b + across * 0.5,
-            middle + along * a + across * 0.5,
-        ];
-        pieces.push(wall);
+            edge,
+            sign * reach,
+            0.5,
+        ));
     }
     for mut o in pieces {
         o.overfly = false;

@@ -245,7 +245,10 @@ fn narrow_passages(
         .filter_map(|(i, j)| {
             let gap = obstacles[i].1.gap_to(&obstacles[j].1);
             (gap < 2.0 * need).then(|| {
-                let (a, b) = super::gaps::nearest(&obstacles[i].1, &obstacles[j].1);
+                let (a, b) = crate::base::geometry::nearest_points(
+                    &obstacles[i].1.prism(),
+                    &obstacles[j].1.prism(),
+                );
                 // As the words say it: one UAV's width (what verification
                 // holds) where not even one fits, else the route's need.
                 let one = 2.0 * mission.formation.least_clearance();

@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use nalgebra::Point2;
 
-use crate::base::geometry::{polygon_signed_distance, segment_point_distance, segments_cross};
+use crate::base::geometry::{Prism, polygon_signed_distance};
 
 /// An obstacle as the field sees it: its footprint in the plane, a disc
 /// (`center`, `radius`) or a polygon whose bounding circle the disc is.
@@ -40,29 +40,17 @@ impl Disc {
         }
     }
 
-    /// Distance from the segment `a`-`b` to the footprint (0 where they
-    /// touch or cross): exact, for the straights that join an exact passage
-    /// to the grid (`route::landing`).
-    pub fn gap_to_segment(&self, a: Point2<f64>, b: Point2<f64>) -> f64 {
-        match &self.polygon {
-            None => (segment_point_distance(&a, &b, &self.center) - self.radius).max(0.0),
-            Some(v) => {
-                if polygon_signed_distance(v, &a) <= 0.0 {
-                    return 0.0;
-                }
-                let mut best = f64::INFINITY;
-                for i in 0..v.len() {
-                    let (p, q) = (v[i], v[(i + 1) % v.len()]);
-                    if segments_cross(&a, &b, &p, &q) {
-                        return 0.0;
-                    }
-                    best = best
-                        .min(segment_point_distance(&a, &b, &p))
-                        .min(segment_point_distance(&p, &q, &a))
-                        .min(segment_point_distance(&p, &q, &b));
-                }
-                best
-            }
+    /// The footprint as the shared geometry reads it (no heights: the
+    /// field is one level's plane), for its exact queries (nearest points,
+    /// a segment's distance).
+    pub fn prism(&self) -> Prism {
+        let polygon = self.polygon.clone().unwrap_or_else(|| Arc::from([]));
+        Prism {
+            center: self.center,
+            radius: self.radius,
+            polygon,
+            base: 0.0,
+            height: 0.0,
         }
     }
 

@@ -23,7 +23,7 @@ use nalgebra::{Point2, Vector2};
 use super::Site;
 use super::field::Disc;
 use super::search::{Jump, LAYERS};
-use crate::base::geometry::polygon_nearest;
+use crate::base::geometry::nearest_points;
 use crate::mission::Bounds;
 
 /// A straight through a gap: its ends (where it meets the grid) and the
@@ -50,37 +50,6 @@ impl Gap {
             widest: self.layer,
         };
         [jump(0), jump(1)]
-    }
-}
-
-/// The nearest points of two footprints (`a`'s, then `b`'s), for two apart.
-pub(super) fn nearest(a: &Disc, b: &Disc) -> (Point2<f64>, Point2<f64>) {
-    let on_circle = |d: &Disc, toward: Point2<f64>| {
-        let v = toward - d.center;
-        d.center + v * (d.radius / v.norm().max(1e-12))
-    };
-    match (&a.polygon, &b.polygon) {
-        (None, None) => (on_circle(a, b.center), on_circle(b, a.center)),
-        (None, Some(q)) => {
-            let on_b = polygon_nearest(q, &a.center);
-            (on_circle(a, on_b), on_b)
-        }
-        (Some(_), None) => {
-            let (on_b, on_a) = nearest(b, a);
-            (on_a, on_b)
-        }
-        (Some(p), Some(q)) => {
-            let from = |x: &[Point2<f64>], y: &[Point2<f64>]| {
-                x.iter()
-                    .map(|v| (*v, polygon_nearest(y, v)))
-                    .min_by(|s, t| (s.0 - s.1).norm().total_cmp(&(t.0 - t.1).norm()))
-            };
-            match (from(p, q), from(q, p).map(|(on_b, on_a)| (on_a, on_b))) {
-                (Some(s), Some(t)) if (t.0 - t.1).norm() < (s.0 - s.1).norm() => t,
-                (Some(s), _) => s,
-                _ => (a.center, b.center),
-            }
-        }
     }
 }
 
@@ -137,7 +106,7 @@ pub fn find(
             if apart >= 2.0 * need[0] + slack || has_iwp(*p, *q) {
                 continue;
             }
-            let (a, b) = nearest(dp, dq);
+            let (a, b) = nearest_points(&dp.prism(), &dq.prism());
             let gap = (b - a).norm();
             let widest = (0..LAYERS).find(|&l| gap >= 2.0 * need[l]);
             let Some(widest) = widest else { continue };

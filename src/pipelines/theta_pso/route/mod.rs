@@ -454,9 +454,10 @@ impl Site {
         let out = out / out.norm().max(1e-12);
         // Only the obstacles the straight could come near.
         let reach = step * steps as f64 + self.need[0];
-        let near: Vec<&Disc> = discs
+        let near: Vec<crate::base::geometry::Prism> = discs
             .iter()
             .filter(|d| (d.center - p).norm() - d.radius < reach)
+            .map(Disc::prism)
             .collect();
         for k in 1..=steps {
             let q = p + out * (step * k as f64);
@@ -468,7 +469,7 @@ impl Site {
                 self.open[cell] & bit(level, l) != 0
                     && near
                         .iter()
-                        .all(|d| d.gap_to_segment(p, q) >= self.need[l] - 1e-9)
+                        .all(|d| d.segment_distance(&p, &q) >= self.need[l] - 1e-9)
             });
             if let Some(layer) = layer {
                 return Some((cell, q, layer));
@@ -476,7 +477,7 @@ impl Site {
             // The straight itself closed: no landing on it.
             if near
                 .iter()
-                .any(|d| d.gap_to_segment(p, q) < self.need[LAYERS - 1] - 1e-9)
+                .any(|d| d.segment_distance(&p, &q) < self.need[LAYERS - 1] - 1e-9)
             {
                 return None;
             }
