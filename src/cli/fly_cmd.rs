@@ -170,24 +170,39 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
 /// A check's report written as JSON to `json` (atomically), and the exit
 /// status it gives: 2 when some flight broke a limit, 0 when none did.
 pub(super) fn report_written(report: &flight::Report, json: Option<&std::path::Path>) -> u8 {
-    if let Some(path) = json {
-        let text = match serde_json::to_string_pretty(report) {
-            Ok(t) => t,
-            Err(e) => {
-                eprintln!("error: the report as JSON: {e}");
-                return exit::ERROR;
-            }
-        };
-        if let Err(e) = atomic::write(path, text.as_bytes()) {
-            eprintln!("error: {}: {e}", path.display());
-            return exit::ERROR;
-        }
+    if let Some(path) = json
+        && let Err(status) = json_written(report, "the report", path, true)
+    {
+        return status;
     }
     if report.break_separation.count > 0 || report.break_clearance.count > 0 {
         exit::INFEASIBLE
     } else {
         exit::OK
     }
+}
+
+/// `value` written as JSON to `path` (atomically; `pretty` for a person to
+/// read), or, saying why and naming `what`, the exit status of the failure.
+pub(super) fn json_written(
+    value: &impl serde::Serialize,
+    what: &str,
+    path: &std::path::Path,
+    pretty: bool,
+) -> Result<(), u8> {
+    let text = if pretty {
+        serde_json::to_string_pretty(value)
+    } else {
+        serde_json::to_string(value)
+    };
+    let text = text.map_err(|e| {
+        eprintln!("error: {what} as JSON: {e}");
+        exit::ERROR
+    })?;
+    atomic::write(path, text.as_bytes()).map_err(|e| {
+        eprintln!("error: {}: {e}", path.display());
+        exit::ERROR
+    })
 }
 
 /// The recording of a check (`--rrd`, `--connect`, `--spawn`): the scene,
@@ -520,16 +535,8 @@ fn rare(setup: &Setup, args: &FlyArgs, seed: u64, cancel: &CancelToken) -> u8 {
             "separation": estimates[0],
             "clearance": estimates[1],
         });
-        let text = match serde_json::to_string_pretty(&json) {
-            Ok(t) => t,
-            Err(e) => {
-                eprintln!("error: the estimate as JSON: {e}");
-                return exit::ERROR;
-            }
-        };
-        if let Err(e) = atomic::write(path, text.as_bytes()) {
-            eprintln!("error: {}: {e}", path.display());
-            return exit::ERROR;
+        if let Err(status) = json_written(&json, "the estimate", path, true) {
+            return status;
         }
     }
     if estimates.iter().any(|e| e.estimate >= 1e-6) {

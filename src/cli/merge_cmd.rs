@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use super::exit;
 use super::fly_cmd::{FlyArgs, said};
-use crate::base::atomic;
 use crate::flight::{self, Options, Setup};
 use crate::mission::Mission;
 use crate::pipelines::CancelToken;
@@ -59,24 +58,10 @@ pub fn fly_shard(
     let breaks = part
         .flown
         .iter()
-        .filter(|f| {
-            f.pairs.iter().any(|c| c.distance < setup.closest)
-                || f.obstacles
-                    .iter()
-                    .flatten()
-                    .any(|c| c.distance < setup.clearance)
-        })
+        .filter(|f| f.broke_separation(setup) || f.broke_clearance(setup))
         .count();
-    let text = match serde_json::to_string(&part) {
-        Ok(t) => t,
-        Err(e) => {
-            eprintln!("error: the part as JSON: {e}");
-            return exit::ERROR;
-        }
-    };
-    if let Err(e) = atomic::write(path, text.as_bytes()) {
-        eprintln!("error: {}: {e}", path.display());
-        return exit::ERROR;
+    if let Err(status) = super::fly_cmd::json_written(&part, "the part", path, false) {
+        return status;
     }
     println!(
         "shard {}/{} of {} flights of \"{}\" (seed {seed}): flights {}-{}, {breaks} broke a limit; \

@@ -263,6 +263,21 @@ pub struct Flown {
     pub spread: Option<Vec<Vec<f32>>>,
 }
 
+impl Flown {
+    /// Whether some pair came closer than `setup.closest` (2 r_Q + margin).
+    pub fn broke_separation(&self, setup: &Setup) -> bool {
+        self.pairs.iter().any(|c| c.distance < setup.closest)
+    }
+
+    /// Whether some vehicle came closer than `setup.clearance` to an obstacle.
+    pub fn broke_clearance(&self, setup: &Setup) -> bool {
+        self.obstacles
+            .iter()
+            .flatten()
+            .any(|c| c.distance < setup.clearance)
+    }
+}
+
 /// Flies flight `k` of the check seeded `seed`.
 pub fn fly(setup: &Setup, seed: u64, k: usize, keep_tracks: bool) -> Flown {
     fly_keeping(setup, seed, k, keep_tracks, false)

@@ -217,28 +217,11 @@ impl Report {
                 }
             })
             .collect();
-        let broke_separation = flown
-            .iter()
-            .filter(|f| f.pairs.iter().any(|c| c.distance < setup.closest))
-            .count();
-        let broke_clearance = flown
-            .iter()
-            .filter(|f| {
-                f.obstacles
-                    .iter()
-                    .flatten()
-                    .any(|c| c.distance < setup.clearance)
-            })
-            .count();
+        let broke_separation = flown.iter().filter(|f| f.broke_separation(setup)).count();
+        let broke_clearance = flown.iter().filter(|f| f.broke_clearance(setup)).count();
         let broke_any = flown
             .iter()
-            .filter(|f| {
-                f.pairs.iter().any(|c| c.distance < setup.closest)
-                    || f.obstacles
-                        .iter()
-                        .flatten()
-                        .any(|c| c.distance < setup.clearance)
-            })
+            .filter(|f| f.broke_separation(setup) || f.broke_clearance(setup))
             .count();
         let inspections = setup
             .inspected
