@@ -10,6 +10,10 @@
 //!   step every 16 ms (a 60 Hz mouse); the time from the last step to the
 //!   plan of the final position. Target ≤ 150 ms, and never more than one
 //!   run at work (a superseded one winding down aside).
+//! - `live/orchard_nudge_1m` (issue 51): a tree beside the route of
+//!   `tests/all/sites/orchard.rs` (200 trees, twelve UAVs in a 4 × 3 grid)
+//!   nudged 1 m east and back, with live planning on by default. Target:
+//!   median ≤ 100 ms.
 //! - `live/flatlo_spacing`: FLATLO's paper case, Δ_d typed in alternately
 //!   18,300 and 18,400 m. Target: median ≤ 60 ms.
 //! - `live/validate_bridge`: the rules every run holds the bridge to
@@ -20,6 +24,9 @@
 //!
 //! Criterion's figure is the mean per edit over a sample; the median and
 //! p95 over every edit of the run are printed at the end of each group.
+
+#[path = "../tests/all/sites/orchard.rs"]
+mod orchard;
 
 use std::time::{Duration, Instant};
 
@@ -34,16 +41,18 @@ use skyform::tui::fixtures::type_into;
 
 const SETTLE: Duration = Duration::from_secs(30);
 
-fn bridge_app() -> (App, usize) {
-    let m = mission::default_mission().mission;
+/// The designer on `m`, live planning on by default (asserted) and its
+/// first plan in, with `obstacle`'s index.
+fn live_app(m: mission::Mission, obstacle: &str) -> (App, usize) {
     let k = m
         .obstacles
         .iter()
-        .position(|o| o.name == "pier 3")
-        .unwrap_or_else(|| panic!("the bridge has a pier 3"));
+        .position(|o| o.name == obstacle)
+        .unwrap_or_else(|| panic!("'{}' has an obstacle '{obstacle}'", m.name));
+    let name = m.name.clone();
     let mut app = App::new(Document::new(m, None), std::env::temp_dir());
     app.enable_live();
-    assert!(app.board().live().is_on(), "the bridge is planned live");
+    assert!(app.board().live().is_on(), "{name} is planned live");
     assert!(app.settle_live(SETTLE));
     (app, k)
 }
@@ -78,8 +87,9 @@ fn report(name: &str, mut all: Vec<Duration>, cold: Option<Duration>) {
     );
 }
 
-fn bridge(c: &mut Criterion) {
-    let (mut app, k) = bridge_app();
+/// `obstacle` nudged 1 m east, then back west, and so on: the time from
+/// each nudge to its plan.
+fn nudges(c: &mut Criterion, name: &str, app: &mut App, k: usize, samples: usize) {
     let cold = app
         .board()
         .live()
@@ -89,21 +99,29 @@ fn bridge(c: &mut Criterion) {
     let mut all = Vec::new();
     let mut east = true;
     let mut group = c.benchmark_group("live");
-    group.sample_size(50);
-    group.bench_function("bridge_nudge_1m", |b| {
+    group.sample_size(samples);
+    group.bench_function(name, |b| {
         b.iter_custom(|iterations| {
             (0..iterations)
                 .map(|_| {
                     let step = if east { 1.0 } else { -1.0 };
                     east = !east;
-                    let took = edit_and_settle(&mut app, Action::Nudge(step, 0.0));
+                    let took = edit_and_settle(app, Action::Nudge(step, 0.0));
                     all.push(took);
                     took
                 })
                 .sum()
         })
     });
-    report("live/bridge_nudge_1m", std::mem::take(&mut all), cold);
+    report(&format!("live/{name}"), all, cold);
+    group.finish();
+}
+
+fn bridge(c: &mut Criterion) {
+    let (mut app, k) = live_app(mission::default_mission().mission, "pier 3");
+    nudges(c, "bridge_nudge_1m", &mut app, k, 50);
+    let mut all = Vec::new();
+    let mut group = c.benchmark_group("live");
 
     // The drag: 20 steps of 0.25 m, one every 16 ms, then the plan.
     let start = {
@@ -214,6 +232,25 @@ fn flatlo(c: &mut Criterion) {
     group.finish();
 }
 
+/// Issue 51: live planning on by default for a site of 200 obstacles and
+/// twelve UAVs; the tree of the middle row nearest the route nudged.
+fn orchard(c: &mut Criterion) {
+    let m = orchard::orchard(1);
+    let near_route = m
+        .obstacles
+        .iter()
+        .filter(|o| o.name.starts_with("tree 5."))
+        .min_by(|a, b| {
+            (a.center.y - 81.0)
+                .abs()
+                .total_cmp(&(b.center.y - 81.0).abs())
+        })
+        .map(|o| o.name.clone())
+        .unwrap_or_else(|| panic!("the orchard has a fifth row"));
+    let (mut app, k) = live_app(m, &near_route);
+    nudges(c, "orchard_nudge_1m", &mut app, k, 20);
+}
+
 fn validation(c: &mut Criterion) {
     let m = mission::default_mission().mission;
     let mut group = c.benchmark_group("live");
@@ -226,5 +263,5 @@ fn validation(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bridge, flatlo, validation);
+criterion_group!(benches, bridge, orchard, flatlo, validation);
 criterion_main!(benches);

@@ -270,7 +270,7 @@ pub fn largest_factor<'a>(factors: &[(&'a str, f64)]) -> &'a str {
 
 /// The sizes over the live limits among `checks` (each a figure, its limit
 /// and what it is, `#` standing for the figure), in words:
-/// "126 obstacles (live up to 60)".
+/// "221 obstacles (live up to 200)".
 pub fn live_limits(checks: &[(f64, f64, &str)]) -> Vec<String> {
     checks
         .iter()

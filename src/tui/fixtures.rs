@@ -54,8 +54,15 @@ pub fn crowded_mission(n: usize) -> Mission {
 
 /// The bridge with 114 oaks in six rows north of the route (7 m apart: no
 /// gap among them is an IWP) and three masts south of it: a survey's
-/// 126 obstacles, over live planning's 60 (issue 36).
+/// 126 obstacles (issue 36).
 pub fn bridge_with_oaks() -> Mission {
+    bridge_with_oak_rows(6)
+}
+
+/// The bridge with `rows` rows of 19 oaks north of the route, the site
+/// stretched north to hold them, and three masts south of it: with 11 rows,
+/// 221 obstacles, over live planning's 200 (issue 51).
+pub fn bridge_with_oak_rows(rows: usize) -> Mission {
     let mut m = mission::default_mission().mission;
     m.name = "Bridge among oaks".into();
     let tree = |name: String, x: f64, y: f64, kind: &str| Obstacle {
@@ -74,12 +81,13 @@ pub fn bridge_with_oaks() -> Mission {
         wire: None,
         inspect_side: None,
     };
-    for k in 0..114 {
+    for k in 0..19 * rows {
         let (column, row) = (k % 19, k / 19);
         let (x, y) = (5.0 + 7.0 * column as f64, 62.0 + 7.0 * row as f64);
         m.obstacles
             .push(tree(format!("oak {}", k + 1), x, y, "tree"));
     }
+    m.bounds.y[1] = m.bounds.y[1].max(61.0 + 7.0 * rows as f64);
     for (k, x) in [30.0, 60.0, 100.0].into_iter().enumerate() {
         m.obstacles
             .push(tree(format!("mast {}", k + 1), x, 10.0, "mast"));

@@ -618,31 +618,31 @@ fn the_plan_follows_an_obstacle_moved_across_it_and_idles_after() {
     assert_eq!(s.wait_exit(Duration::from_secs(10)), 0);
 }
 
-/// Issue 36, item 7, in a real terminal at 80 × 24: a 126-obstacle site
+/// Issue 36, item 7, in a real terminal at 80 × 24: a 221-obstacle site
 /// opens with live planning off and says why (the obstacles over live
-/// planning's 60) and that `L` turns it on; `/` finds a mast by name,
+/// planning's 200) and that `L` turns it on; `/` finds a mast by name,
 /// selects it and the map draws its name; `L` plans live anyway.
 #[test]
-fn a_126_obstacle_site_says_why_live_is_off_and_finds_a_mast_at_80_by_24() {
+fn a_221_obstacle_site_says_why_live_is_off_and_finds_a_mast_at_80_by_24() {
     let dir = tempfile::tempdir().unwrap();
     let state = tempfile::tempdir().unwrap();
     let file = dir.path().join("site.toml");
-    let mut m = skyform::tui::fixtures::bridge_with_oaks();
+    let mut m = skyform::tui::fixtures::bridge_with_oak_rows(11);
     m.theta_pso.swarm_size = 20;
     m.theta_pso.iterations = 10;
     std::fs::write(&file, mission::to_toml_string(&m).unwrap()).unwrap();
     let mut s = launch_sized(&file, state.path(), 24, 80);
     s.wait_for(
-        "live planning off: 126 obstacles (live up to 60); L turns it on",
+        "live planning off: 221 obstacles (live up to 200); L turns it on",
         Duration::from_secs(30),
     );
     assert!(!s.contents().contains("live 1"), "{}", s.contents());
     step(&mut s, "/", "type part of an obstacle");
-    step(&mut s, "mast 2", "1 of 1: Obstacle 125 'mast 2'");
+    step(&mut s, "mast 2", "1 of 1: Obstacle 220 'mast 2'");
     step(
         &mut s,
         "\r",
-        "Obstacle 125 'mast 2': the one match for 'mast 2'",
+        "Obstacle 220 'mast 2': the one match for 'mast 2'",
     );
     // Its name on the map's canvas (not only on the status line and the
     // map's bottom line).
@@ -658,7 +658,7 @@ fn a_126_obstacle_site_says_why_live_is_off_and_finds_a_mast_at_80_by_24() {
     step(
         &mut s,
         "L",
-        "live planning on: 126 obstacles (live up to 60)",
+        "live planning on: 221 obstacles (live up to 200)",
     );
     s.wait_for("live 1", Duration::from_secs(300));
     s.send("q");

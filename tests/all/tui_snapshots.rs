@@ -607,7 +607,15 @@ fn map_rows(screen: &str, columns: usize) -> Vec<String> {
 /// The bridge among 114 oaks and three masts, quick to plan (the
 /// obstacles alone are over live planning's sizes).
 fn oak_site() -> skyform::mission::Mission {
-    let mut m = bridge_with_oaks();
+    small_swarm(bridge_with_oaks())
+}
+
+/// The oaks in eleven rows: 221 obstacles, over live planning's 200.
+fn wood_site() -> skyform::mission::Mission {
+    small_swarm(skyform::tui::fixtures::bridge_with_oak_rows(11))
+}
+
+fn small_swarm(mut m: skyform::mission::Mission) -> skyform::mission::Mission {
     m.theta_pso.swarm_size = 20;
     m.theta_pso.iterations = 10;
     m
@@ -621,17 +629,20 @@ fn obstacle_named(app: &App, name: &str) -> usize {
         .unwrap_or_else(|| panic!("no obstacle '{name}'"))
 }
 
-/// Issue 36, item 7: a 126-obstacle site opens with live planning off and
+/// Issue 36, item 7: a site over live planning's limits (221 obstacles
+/// since issue 51 raised them to 200) opens with live planning off and
 /// says why (the size over `outcome::interactive`'s limit, with its
 /// figure) and that `L` turns it on, on the status line and in the empty
-/// jobs panel; `L` does, and a live plan comes in.
+/// jobs panel; `L` does, and a live plan comes in. The 126 of issue 36 are
+/// now planned live.
 #[test]
-fn a_126_obstacle_site_says_why_live_planning_is_off_and_l_turns_it_on() {
-    let m = oak_site();
-    assert_eq!(m.obstacles.len(), 126);
+fn a_221_obstacle_site_says_why_live_planning_is_off_and_l_turns_it_on() {
+    assert!(skyform::outcome::over_live_limits(Kind::ThetaPso, &oak_site()).is_empty());
+    let m = wood_site();
+    assert_eq!(m.obstacles.len(), 221);
     assert_eq!(
         skyform::outcome::over_live_limits(Kind::ThetaPso, &m),
-        ["126 obstacles (live up to 60)"]
+        ["221 obstacles (live up to 200)"]
     );
     let mut app = App::new(
         Document::new(m, Some(PathBuf::from("site.toml"))),
@@ -639,7 +650,7 @@ fn a_126_obstacle_site_says_why_live_planning_is_off_and_l_turns_it_on() {
     );
     app.enable_live();
     assert!(!app.board().live().is_on());
-    let why = "live planning off: 126 obstacles (live up to 60); L turns it on";
+    let why = "live planning off: 221 obstacles (live up to 200); L turns it on";
     let screen = render(&app, Instant::now());
     assert!(
         rows_of(&screen).last().is_some_and(|r| r.contains(why)),
@@ -660,7 +671,7 @@ fn a_126_obstacle_site_says_why_live_planning_is_off_and_l_turns_it_on() {
     assert!(app.board().live().is_on(), "L turns it on anyway");
     assert_eq!(
         app.status().map(|s| s.text.as_str()),
-        Some("live planning on: 126 obstacles (live up to 60), re-plans may take seconds")
+        Some("live planning on: 221 obstacles (live up to 200), re-plans may take seconds")
     );
     assert!(app.board().live().held_off().is_none());
     assert!(app.settle_live(Duration::from_secs(600)));
@@ -1153,4 +1164,43 @@ fn the_side_view_under_a_deck_draws_it_where_the_path_passes_under() {
         .unwrap_or_else(|| panic!("{screen}"));
     assert_eq!(row.matches("deck").count(), 1, "{row}");
     insta::assert_snapshot!(screen);
+}
+
+/// Issue 51: live planning is on by default for a site of 200 obstacles and
+/// twelve UAVs (the orchard of `sites::orchard`); a tree nudged 1 m is
+/// re-planned from the plan before (warm), and the plan passes
+/// verification. Its time is `cargo bench --bench live -- orchard`'s.
+#[test]
+fn an_orchard_of_200_trees_and_twelve_uavs_is_planned_live() {
+    let m = crate::sites::orchard::orchard(1);
+    assert_eq!((m.obstacles.len(), m.formation.slots.len()), (200, 12));
+    assert!(skyform::outcome::over_live_limits(Kind::ThetaPso, &m).is_empty());
+    let tree = obstacle_named_in(&m, "tree 5.10");
+    let mut app = App::new(Document::new(m, None), PathBuf::from("."));
+    app.enable_live();
+    assert!(app.board().live().is_on(), "live planning is on by default");
+    assert!(app.settle_live(Duration::from_secs(600)));
+    app.update(Action::Select(Item::Obstacle(tree)));
+    app.update(Action::Nudge(1.0, 0.0));
+    assert!(app.settle_live(Duration::from_secs(600)));
+    let job = app
+        .board()
+        .live()
+        .latest()
+        .expect("a live plan of the nudge");
+    assert_eq!(
+        job.mission.obstacles[tree].center,
+        app.mission().obstacles[tree].center
+    );
+    let outcome = job.outcome.as_ref().expect("the plan came in");
+    let plan = outcome.theta_pso().expect("a θ-PSO plan");
+    assert!(plan.warm_start.is_some(), "re-planned warm");
+    assert!(outcome.ok(), "{}", outcome.headline());
+}
+
+fn obstacle_named_in(m: &skyform::mission::Mission, name: &str) -> usize {
+    m.obstacles
+        .iter()
+        .position(|o| o.name == name)
+        .unwrap_or_else(|| panic!("no obstacle '{name}'"))
 }

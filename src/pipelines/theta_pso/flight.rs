@@ -28,6 +28,7 @@ use super::trajectory::{self, Flight};
 use super::verify::{self, Verification};
 use crate::mission::Mission;
 use crate::pipelines::PipelineError;
+use nalgebra::{Point2, Point3};
 
 /// Times a corner's tolerance is cut (to a quarter, then to nothing).
 const RETRIES: usize = 2;
@@ -52,9 +53,10 @@ pub fn fly(
     let span = super::path::heading_span(mission);
     let planned = corners(&path.points);
     let floor = mission.theta_pso.clearance_margin.max(0.0);
-    let mut tolerances: Vec<f64> = slack_near(mission, path, &planned)
+    let widest = MAX_TOLERANCE.max(floor);
+    let mut tolerances: Vec<f64> = slack_near(mission, path, &planned, 2.0 * widest)
         .into_iter()
-        .map(|slack| (0.5 * slack).clamp(floor, MAX_TOLERANCE.max(floor)))
+        .map(|slack| (0.5 * slack).clamp(floor, widest))
         .collect();
     let mut share = super::timing::PLANNED_SHARE;
     let generate = |tolerances: &[f64], share: f64| {
@@ -104,11 +106,14 @@ pub fn fly(
 /// its reach in the planned geometry (untimed, every 0.25 m of the centroid
 /// path): clearance to every obstacle beyond r_Q + the safety margin, the
 /// distance inside the x-y bounds and the altitude band, and each pair's
-/// distance beyond 2 r_Q + the margin. Metres; ∞ with nothing near.
+/// distance beyond 2 r_Q + the margin. Metres, at most `enough` (any slack
+/// that large gives the corner its widest arc), so only the obstacles within
+/// `enough` of where the UAVs fly near the corner are read.
 fn slack_near(
     mission: &Mission,
     path: &CentroidPath,
     planned: &[super::path::rounding::Corner],
+    enough: f64,
 ) -> Vec<f64> {
     let f = &mission.formation;
     let span = super::path::heading_span(mission);
@@ -118,7 +123,10 @@ fn slack_near(
     let cylinders: Vec<_> = mission.obstacles.iter().map(|o| mission.prism(o)).collect();
     let ground = mission.ground_model();
     let b = &mission.bounds;
+    let lc = f.least_clearance();
     let mut here = Vec::new();
+    let mut flown: Vec<Point3<f64>> = Vec::new();
+    let mut near = Vec::new();
     let mut reader = super::motion::Reader::default();
     planned
         .iter()
@@ -128,19 +136,37 @@ fn slack_near(
                 (c.arc + reach).min(motion.length()),
             );
             let steps = ((to - from) / 0.25).ceil().max(1.0) as usize;
-            let mut slack = f64::INFINITY;
+            flown.clear();
             for k in 0..=steps {
                 motion.read_into(
                     from + (to - from) * k as f64 / steps as f64,
                     &mut here,
                     &mut reader,
                 );
-                for (n, p) in here.iter().enumerate() {
-                    for cylinder in &cylinders {
+                flown.extend_from_slice(&here);
+            }
+            // The obstacles within `enough` of the box the UAVs fly in.
+            let (low, high) = flown.iter().fold(
+                (
+                    Point2::new(f64::INFINITY, f64::INFINITY),
+                    Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+                ),
+                |(lo, hi), p| (lo.inf(&p.xy()), hi.sup(&p.xy())),
+            );
+            near.clear();
+            near.extend(cylinders.iter().filter(|c| {
+                let outside = (c.center - c.center.sup(&low).inf(&high)).norm();
+                outside - c.radius - lc < enough
+            }));
+            let mut slack = enough;
+            let uavs = here.len().max(1);
+            for sample in flown.chunks(uavs) {
+                for (n, p) in sample.iter().enumerate() {
+                    for cylinder in &near {
                         // Only what can be near: the bound on the slack.
                         let far = cylinder.horizontal_distance(p) - cylinder.radius;
-                        if far - f.least_clearance() < slack {
-                            slack = slack.min(cylinder.clearance(p) - f.least_clearance());
+                        if far - lc < slack {
+                            slack = slack.min(cylinder.clearance(p) - lc);
                         }
                     }
                     let height = p.z - ground.as_ref().map_or(0.0, |g| g.at(p.x, p.y));
@@ -148,7 +174,7 @@ fn slack_near(
                         .min(b.horizontal_margin(p))
                         .min(height - b.z[0])
                         .min(b.z[1] - height);
-                    for q in &here[n + 1..] {
+                    for q in &sample[n + 1..] {
                         slack = slack.min((q - p).norm() - f.closest_pair());
                     }
                 }

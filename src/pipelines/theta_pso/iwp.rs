@@ -34,7 +34,7 @@
 //! (narrower than one UAV, blocked, never in the way at a common altitude)
 //! is unusable with the reason, which refuses the plan (`NO PLAN`).
 //!
-//! Long (~860 lines) because it is eq. 9 and Fig. 2 together: the shapes, the widths they
+//! Long (~960 lines) because it is eq. 9 and Fig. 2 together: the shapes, the widths they
 //! need, the crossing's hold against each obstacle as the crossing sees it (a disc, a
 //! footprint's edges), each pair's IWP (or gate) with why none, read as one reading.
 
@@ -484,6 +484,7 @@ fn capsule_on_line(a: Vector2<f64>, b: Vector2<f64>, y0: f64, r: f64) -> Option<
 /// it is held; when it cannot, the IWP is unusable.
 fn crossing_hold(
     mission: &Mission,
+    circles: &[Circle],
     pair: [usize; 2],
     center: Point2<f64>,
     normal: Vector2<f64>,
@@ -509,10 +510,31 @@ fn crossing_hold(
     }
     let held = shape.map_or_else(|| f.slots.clone(), |s| s.offsets(&f.slots, 1.0));
     let in_band = |k: &usize| stands_in(mission, &obstacles[*k], window);
+    // Broad phase: a conflict within `zone` of the gap along the crossing
+    // is a UAV (at most `reach` from the centroid) within `clearance` of
+    // the obstacle, so one whose bounding circle keeps farther than that
+    // from the gap's middle has none. On a forest of 200 this is most of
+    // them, for every IWP.
+    let reach = approaching
+        .iter()
+        .chain([&held])
+        .flatten()
+        .map(|o| o.xy().norm())
+        .fold(0.0, f64::max);
+    let near = |zone: f64, clearance: f64| -> Vec<usize> {
+        (0..circles.len())
+            .filter(|&k| {
+                let (c, r) = circles[k];
+                (c - center).norm() - r < zone + reach + clearance
+            })
+            .filter(in_band)
+            .collect()
+    };
     let mut depth: f64 = 0.0;
+    let at_the_wall = near(wall_zone, r_q + margin);
     for sign in [1.0, -1.0] {
         let forward = normal * sign;
-        for k in (0..obstacles.len()).filter(in_band) {
+        for &k in &at_the_wall {
             let seen = Seen::of(&obstacles[k], center, forward);
             for o in approaching.iter().flatten() {
                 if let Some((lo, hi)) = seen.conflict(o, r_q + margin) {
@@ -542,9 +564,11 @@ fn crossing_hold(
         }
         _ => (hold, hold + heading_span(mission)),
     };
+    let along = hold.max(line);
+    let on_the_hold = near(along, r_q);
     for sign in [1.0, -1.0] {
         let forward = normal * sign;
-        for k in (0..obstacles.len()).filter(in_band) {
+        for &k in &on_the_hold {
             let seen = Seen::of(&obstacles[k], center, forward);
             // Only where the UAV is on the straight: a column's UAVs beyond
             // it are on the path's other legs, which the cost judges.
@@ -553,8 +577,8 @@ fn crossing_hold(
                 (lo < hi).then_some((lo, hi))
             };
             // Held over the hold, and (a rigid shape) on along its straight
-            // as it turns back: nothing may stand in its way there either.
-            let along = hold.max(line);
+            // as it turns back (`along`): nothing may stand in its way there
+            // either.
             if held
                 .iter()
                 .filter_map(|o| seen.conflict(o, r_q).and_then(|c| on_line(o, c)))
@@ -578,6 +602,19 @@ fn stands_in(mission: &Mission, o: &crate::mission::Obstacle, window: [f64; 2]) 
     o.within(mission.bounds.z) && under < window[1] && over > window[0]
 }
 
+/// An obstacle's bounding circle (centre, radius): the broad phase of the
+/// pairs and of the crossings, read once per search rather than from each
+/// obstacle at every turn.
+type Circle = (Point2<f64>, f64);
+
+fn bounding_circles(mission: &Mission) -> Vec<Circle> {
+    mission
+        .obstacles
+        .iter()
+        .map(|o| (o.center, o.radius))
+        .collect()
+}
+
 /// Every IWP of the mission by eq. 9, with the operator's choices applied.
 ///
 /// Long (~120 lines) because it is eq. 9 over each pair of obstacles in order (the altitudes
@@ -589,17 +626,25 @@ pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
     let too_narrow = 2.0 * r_q;
     let fits_formation = 2.0 * (f.radius() + r_q);
     let obstacles = &mission.obstacles;
+    let circles = bounding_circles(mission);
+    let gates = mission.route.via.iter().any(|v| v.between.is_some());
     let mut found = Vec::new();
     for p in 0..obstacles.len() {
         for q in (p + 1)..obstacles.len() {
+            // Eq. 9 places no IWP between two obstacles the whole formation
+            // passes between (a gate the user names has one all the same):
+            // their bounding circles say so, on a forest for most pairs.
+            let ((cp, rp), (cq, rq)) = (circles[p], circles[q]);
+            if !gates && (cp - cq).norm() - rp - rq >= fits_formation {
+                continue;
+            }
             let (a, b) = (&obstacles[p], &obstacles[q]);
             let gate = gate_of(mission, &a.name, &b.name);
-            if let Some(iwp) = pair_iwp(mission, p, q, gate, too_narrow, fits_formation) {
-                found.push(iwp);
-            }
+            let iwp = pair_iwp(mission, &circles, p, q, gate, too_narrow, fits_formation);
+            found.extend(iwp);
         }
     }
-    prefer_columns_in_sequence(mission, &mut found);
+    prefer_columns_in_sequence(mission, &circles, &mut found);
     found
 }
 
@@ -613,7 +658,16 @@ pub fn why_no_iwp(mission: &Mission, p: usize, q: usize) -> String {
     let route = format!(
         "to make the route pass between them, add [[route.via]] between = [\"{a}\", \"{b}\"]"
     );
-    match pair_iwp(mission, p, q, Some(usize::MAX), too_narrow, fits_formation) {
+    let circles = bounding_circles(mission);
+    match pair_iwp(
+        mission,
+        &circles,
+        p,
+        q,
+        Some(usize::MAX),
+        too_narrow,
+        fits_formation,
+    ) {
         Some(iwp) => match iwp.unusable {
             Some(reason) => reason,
             None if iwp.gap >= fits_formation => format!(
@@ -648,6 +702,7 @@ fn gate_of(mission: &Mission, a: &str, b: &str) -> Option<usize> {
 /// the user named cannot be kept.
 fn pair_iwp(
     mission: &Mission,
+    circles: &[Circle],
     p: usize,
     q: usize,
     gate: Option<usize>,
@@ -722,14 +777,16 @@ fn pair_iwp(
     } else if gap >= fits_formation {
         gate?;
     }
-    let blocker = obstacles.iter().enumerate().find(|(k, o)| {
-        *k != p
-            && *k != q
+    let blocker = circles.iter().enumerate().find_map(|(k, (c, r))| {
+        let o = &obstacles[k];
+        (k != p
+            && k != q
+            && segment_point_distance(&p_p, &p_q, c) < r + r_q
             && stands_in(mission, o, window)
-            && segment_point_distance(&p_p, &p_q, &o.center) < o.radius + r_q
-            && (o.footprint.is_empty() || o.prism().segment_distance(&p_p, &p_q) < r_q)
+            && (o.footprint.is_empty() || o.prism().segment_distance(&p_p, &p_q) < r_q))
+            .then_some(o)
     });
-    if let Some((_, o)) = blocker {
+    if let Some(o) = blocker {
         gate?;
         refusal.get_or_insert_with(|| format!("'{}' stands in the gap", o.name));
     }
@@ -749,8 +806,9 @@ fn pair_iwp(
     let position = Point2::from((p_p.coords + p_q.coords) / 2.0);
     let normal = Vector2::new(-u.y, u.x);
     let margin = mission.theta_pso.clearance_margin.max(0.0);
-    let hold_for =
-        |shape: Option<Shape>| crossing_hold(mission, [p, q], position, normal, shape, window);
+    let hold_for = |shape: Option<Shape>| {
+        crossing_hold(mission, circles, [p, q], position, normal, shape, window)
+    };
     let resolved = if let Some(reason) = refusal {
         Err(reason)
     } else if shape_choice == ShapeChoice::Auto {
@@ -803,7 +861,7 @@ fn pair_iwp(
 /// Where `auto` chose a rigid shape for either, its column is taken
 /// instead when the site leaves room for it: a column's straight runs
 /// through the posts only.
-fn prefer_columns_in_sequence(mission: &Mission, iwps: &mut [Iwp]) {
+fn prefer_columns_in_sequence(mission: &Mission, circles: &[Circle], iwps: &mut [Iwp]) {
     let auto = |iwp: &Iwp| {
         iwp.is_via()
             && iwp.choice == ShapeChoice::Auto
@@ -842,6 +900,7 @@ fn prefer_columns_in_sequence(mission: &Mission, iwps: &mut [Iwp]) {
         }
         if let Ok((hold, straight)) = crossing_hold(
             mission,
+            circles,
             iwp.obstacles,
             iwp.position,
             iwp.normal,

@@ -82,6 +82,10 @@ pub struct WarmStart {
 const WARM_TOLERANCE: f64 = 1e-3;
 const WARM_STALL: usize = 8;
 
+/// A warm-started swarm's particles: the earlier plan, a few about it and
+/// the corridor's seeds, up to this many (fewer when `swarm_size` is).
+const WARM_SWARM: usize = 25;
+
 /// Everything a θ-PSO run produces.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThetaPsoOutcome {
@@ -211,7 +215,11 @@ impl Problem {
     /// The search for `mission`, or the first inspected obstacle whose pass
     /// cannot be flown (its index and why).
     pub fn new(mission: &Mission) -> Result<Self, (usize, String)> {
-        let iwps = find_iwps(mission);
+        Self::given(mission, find_iwps(mission))
+    }
+
+    /// [`Self::new`] with the mission's IWPs already found.
+    pub fn given(mission: &Mission, iwps: Vec<Iwp>) -> Result<Self, (usize, String)> {
         let passes = inspection::pass_geometries(mission)?;
         let builder = PathBuilder::new(mission, &iwps, &passes);
         let cost = CostModel::new(mission, &iwps);
@@ -272,8 +280,13 @@ const UNUSABLE_WARNED: usize = 3;
 /// (warnings: the plan goes round) and inspection passes that cannot hold
 /// eq. 8 (errors). Shown by `check` and the designer beside validation.
 pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
+    diagnostics_given(mission, &find_iwps(mission))
+}
+
+/// [`diagnostics`] with the mission's IWPs already found (a run finds them
+/// once, for its admission and its search).
+pub fn diagnostics_given(mission: &Mission, iwps: &[Iwp]) -> Vec<Diagnostic> {
     let mut out = Vec::new();
-    let iwps = find_iwps(mission);
     // IWPs under the default shape that cannot be used: on a maze or a
     // forest there are hundreds (pairs of posts on two walls no route
     // takes), so beyond a few they are one warning per reason; an IWP with
@@ -301,7 +314,7 @@ pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
             ));
         }
     }
-    out.extend(unused_choices(mission, &iwps));
+    out.extend(unused_choices(mission, iwps));
     let defaulted: Vec<Iwp> = iwps
         .iter()
         .filter(|i| i.enabled && i.unusable.is_some() && !chosen(i) && i.gate.is_none())
@@ -330,8 +343,8 @@ pub fn diagnostics(mission: &Mission) -> Vec<Diagnostic> {
             ));
         }
     }
-    for iwp in iwps.into_iter().filter(|i| i.gate.is_none()) {
-        if grouped && !chosen(&iwp) {
+    for iwp in iwps.iter().filter(|i| i.gate.is_none()) {
+        if grouped && !chosen(iwp) {
             continue;
         }
         if let (true, Some(reason)) = (iwp.enabled, &iwp.unusable) {

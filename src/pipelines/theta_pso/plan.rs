@@ -15,8 +15,8 @@ use serde::Serialize;
 
 use super::{
     CentroidPath, CostTerms, Iwp, PlanOptions, PlannedPass, Problem, ThetaPsoOutcome, Trajectory,
-    USABLE_LOGGED, Verification, WARM_STALL, WARM_TOLERANCE, WarmStart, benchmark, budget, cost,
-    diagnostics, flight, reference, repair, route, seeding, trajectory, trajectory_samples,
+    USABLE_LOGGED, Verification, WARM_STALL, WARM_SWARM, WARM_TOLERANCE, WarmStart, benchmark,
+    budget, cost, flight, reference, repair, route, seeding, trajectory, trajectory_samples,
     unusable, verify,
 };
 use crate::base::swarm::{self, SwarmConfig};
@@ -58,8 +58,10 @@ pub fn plan_warm(
     if mission.theta_pso.cost == crate::mission::CostKind::Spso {
         return benchmark::plan(mission, seed, observer, cancel);
     }
-    admit(mission)?;
-    let mut problem = intermediate_waypoints(mission, observer)?;
+    // Found once: the admission and the search read the same IWPs.
+    let iwps = super::find_iwps(mission);
+    admit(mission, &iwps)?;
+    let mut problem = intermediate_waypoints(mission, iwps, observer)?;
     let corridor = route_stage(mission, &mut problem, warm, observer)?;
     let starts = seed_swarm(mission, &problem, &corridor, seed, warm, observer);
     let mut search = Search::default();
@@ -76,14 +78,14 @@ pub fn plan_warm(
 
 /// Before Fig. 3's first line: a valid mission within the run's budget,
 /// with no IWP or inspection already known to be impossible.
-fn admit(mission: &Mission) -> Result<(), PipelineError> {
+fn admit(mission: &Mission, iwps: &[Iwp]) -> Result<(), PipelineError> {
     crate::pipelines::require_valid(mission)?;
     crate::pipelines::require_within_budget(budget(mission))?;
     // A gate the user asked for that no formation can take: no plan keeps
     // the route as written.
     if mission.route.via.iter().any(|v| v.between.is_some())
-        && let Some((g, iwp)) = super::find_iwps(mission)
-            .into_iter()
+        && let Some((g, iwp)) = iwps
+            .iter()
             .find_map(|i| Some((i.gate?, i)).filter(|(_, i)| i.unusable.is_some()))
     {
         return Err(PipelineError::NoRoute(crate::pipelines::NoPlan {
@@ -98,7 +100,7 @@ fn admit(mission: &Mission) -> Result<(), PipelineError> {
             passages: Vec::new(),
         }));
     }
-    let errors: Vec<String> = diagnostics(mission)
+    let errors: Vec<String> = super::diagnostics_given(mission, iwps)
         .into_iter()
         .filter(|d| d.is_error())
         .map(|d| d.to_string())
@@ -112,10 +114,12 @@ fn admit(mission: &Mission) -> Result<(), PipelineError> {
 /// The IWPs (eq. 9, Fig. 2) and the problem the swarm solves over them.
 fn intermediate_waypoints(
     mission: &Mission,
+    iwps: Vec<Iwp>,
     observer: &mut dyn Observer,
 ) -> Result<Problem, PipelineError> {
     observer.on_event(Event::Stage("intermediate waypoints"));
-    let problem = Problem::new(mission).map_err(|(_, e)| PipelineError::InvalidMission(e))?;
+    let problem =
+        Problem::given(mission, iwps).map_err(|(_, e)| PipelineError::InvalidMission(e))?;
     log_iwps(observer, &problem.iwps);
     Ok(problem)
 }
@@ -213,7 +217,7 @@ fn seed_swarm(
     // The earlier plan first: it stands where this one most likely is.
     let mut warmed = seeding::warm(problem, w, seed);
     warmed.extend(starts);
-    warmed.truncate(mission.theta_pso.swarm_size.max(1));
+    warmed.truncate(mission.theta_pso.swarm_size.clamp(1, WARM_SWARM));
     observer.on_event(Event::Log(
         Level::Info,
         &format!(
@@ -654,7 +658,12 @@ fn run_swarm(
     cancel: &CancelToken,
 ) -> (swarm::SwarmResult, Vec<f64>, bool) {
     let config = SwarmConfig {
-        particles: p.swarm_size,
+        // A warm start searches about the earlier plan: a smaller swarm.
+        particles: if stall.is_some() {
+            p.swarm_size.min(WARM_SWARM)
+        } else {
+            p.swarm_size
+        },
         iterations: p.iterations,
         inertia: p.inertia,
         cognitive: p.cognitive,

@@ -26,6 +26,7 @@
 
 #![allow(dead_code)]
 
+pub mod orchard;
 pub mod three_d;
 
 use nalgebra::{Point2, Point3, Vector2, Vector3};
