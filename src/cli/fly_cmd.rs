@@ -258,7 +258,8 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
     };
     eprintln!(
         "searching the margin from the obstacles, then the spacing if the pairs need it: {} flights \
-         per try (0, then 0.25 m doubling, then halving to {} m)",
+         per try, the same flights each try (0, then as far as the flights fell short, then \
+         between the last that failed and the first that met, to {} m)",
         options.flights,
         flight::MARGIN_RESOLUTION
     );

@@ -289,9 +289,11 @@ impl<'a> Flight<'a> {
     /// 0-based index of the waypoint the vehicle flies to (or holds at) at t.
     pub fn leg(&self, t: f64) -> usize {
         let last = self.arrive.len().saturating_sub(1);
-        (0..self.depart.len())
-            .find(|&i| t <= self.depart[i])
-            .unwrap_or(last)
+        // Departures never go back in time (each leg starts where the one
+        // before ended), so the first not before t is a binary search: the
+        // flight check asks this of every vehicle at every step.
+        let i = self.depart.partition_point(|&d| d < t);
+        if i < self.depart.len() { i } else { last }
     }
 
     /// Position and velocity at t (holding at the ends).

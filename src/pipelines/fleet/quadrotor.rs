@@ -28,6 +28,9 @@ pub struct Body {
     pub attitude_gains: [f64; 2],
     pub max_thrust: f64,
     pub max_tilt: f64,
+    /// tan(max_tilt), which every command reads (the flight check's
+    /// vehicles ask for one at every step).
+    tan_tilt: f64,
 }
 
 /// Thrust N along body z, torque N·m in the body frame.
@@ -48,6 +51,7 @@ impl Body {
             attitude_gains: p.attitude_gains,
             max_thrust: p.max_thrust,
             max_tilt: p.max_tilt_deg.to_radians(),
+            tan_tilt: p.max_tilt_deg.to_radians().tan(),
         }
     }
 
@@ -88,7 +92,7 @@ impl Body {
         // Tilt and thrust limits: keep the vertical part, shorten the horizontal.
         f.z = f.z.max(0.1 * self.mass * G);
         let horizontal = f.xy().norm();
-        let allowed = f.z * self.max_tilt.tan();
+        let allowed = f.z * self.tan_tilt;
         if horizontal > allowed {
             let scale = allowed / horizontal;
             f.x *= scale;
