@@ -3,11 +3,15 @@
 //! plan breaks a limit in at most P of its flights; each try planned and
 //! flown again through [`super::check`]. The steps and the limits it stops
 //! at: docs/flight-check.md, "Margins".
+//!
+//! Long (~720 lines) because the search is one procedure read top to bottom (the rooms it
+//! walks on, its three steps, the limits it stops at, what it says when none meets the
+//! target), and its unit tests drive it on modelled flights.
 
 use serde::Serialize;
 
 use super::report::{Share, Worst};
-use super::{FlightError, Options, Report, Rooms, Setup, check, check_rooms};
+use super::{FlightError, Options, Report, Setup, check};
 use crate::export::Planned;
 use crate::mission::Mission;
 use crate::pipelines::{CancelToken, Kind};
@@ -204,6 +208,49 @@ fn valid_up_to(
     let step = MARGIN_RESOLUTION;
     let inside = base + (((low - base) / step).ceil() - 1.0).max(0.0) * step;
     Some(((100.0 * inside).round() / 100.0, why))
+}
+
+/// Each flight's least room to the two limits, metres (negative: broken):
+/// the closest any vehicle came to an obstacle less r_Q, and the closest
+/// pair less 2 r_Q (∞ with nothing to approach). The margin search reads
+/// how far its next try must move from these, not only from the counts.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Rooms {
+    pub clearance: Vec<f64>,
+    pub separation: Vec<f64>,
+}
+
+impl Rooms {
+    fn of(setup: &Setup, flown: &[super::Flown]) -> Self {
+        let least = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::INFINITY, f64::min);
+        Rooms {
+            clearance: flown
+                .iter()
+                .map(|f| {
+                    least(&mut f.obstacles.iter().flatten().map(|c| c.distance)) - setup.clearance
+                })
+                .collect(),
+            separation: flown
+                .iter()
+                .map(|f| least(&mut f.pairs.iter().map(|c| c.distance)) - setup.closest)
+                .collect(),
+        }
+    }
+}
+
+/// [`check`], with each flight's [`Rooms`].
+fn check_rooms(
+    setup: &Setup,
+    options: Options,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &CancelToken,
+) -> Result<(Report, Rooms), FlightError> {
+    let flown = super::fly_all(setup, options, false, progress, cancel)?;
+    let rooms = Rooms::of(setup, &flown);
+    Ok((
+        Report::new(setup, options, &flown, &super::as_written(setup)),
+        rooms,
+    ))
 }
 
 /// The most tries one step of the search makes (each a plan and a check).

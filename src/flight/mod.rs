@@ -602,49 +602,6 @@ pub fn check(
     Ok(Report::new(setup, options, &flown, &as_written(setup)))
 }
 
-/// Each flight's least room to the two limits, metres (negative: broken):
-/// the closest any vehicle came to an obstacle less r_Q, and the closest
-/// pair less 2 r_Q (∞ with nothing to approach). The margin search reads
-/// how far its next try must move from these, not only from the counts.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Rooms {
-    pub clearance: Vec<f64>,
-    pub separation: Vec<f64>,
-}
-
-impl Rooms {
-    fn of(setup: &Setup, flown: &[Flown]) -> Self {
-        let least = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::INFINITY, f64::min);
-        Rooms {
-            clearance: flown
-                .iter()
-                .map(|f| {
-                    least(&mut f.obstacles.iter().flatten().map(|c| c.distance)) - setup.clearance
-                })
-                .collect(),
-            separation: flown
-                .iter()
-                .map(|f| least(&mut f.pairs.iter().map(|c| c.distance)) - setup.closest)
-                .collect(),
-        }
-    }
-}
-
-/// [`check`], with each flight's [`Rooms`].
-pub fn check_rooms(
-    setup: &Setup,
-    options: Options,
-    progress: &(dyn Fn(usize, usize) + Sync),
-    cancel: &CancelToken,
-) -> Result<(Report, Rooms), FlightError> {
-    let flown = fly_all(setup, options, false, progress, cancel)?;
-    let rooms = Rooms::of(setup, &flown);
-    Ok((
-        Report::new(setup, options, &flown, &as_written(setup)),
-        rooms,
-    ))
-}
-
 /// [`check`], and what a recording of it shows, from the same flights
 /// (their cross-track samples kept: about 5 kB a vehicle-minute).
 pub fn check_recorded(
