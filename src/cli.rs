@@ -243,10 +243,11 @@ pub enum RunCommand {
         /// Evaluate the swarm on one thread (same result, slower).
         #[arg(long)]
         sequential: bool,
-        /// Start part of the swarm from the plan in FILE (a JSON object with
-        /// `waypoints` and `pass_angles`: a run's outcome, or the
-        /// `warm_start` record of a warm-started one, to repeat it) and stop
-        /// the swarm once it settles, as the designer's live re-plans do.
+        /// Search about the plan in FILE (a JSON object with `waypoints` and
+        /// `pass_angles`: a run's outcome, or the `warm_start` record of a
+        /// warm-started one, to repeat it) with a swarm of at most 25 (that
+        /// plan, ten particles about it, the corridor's first seeds), and
+        /// stop it once it settles, as the designer's live re-plans do.
         #[arg(long, value_name = "FILE")]
         warm_from: Option<PathBuf>,
         #[command(flatten)]
