@@ -7,9 +7,10 @@
 //! ([`super::legs`]), between the positions the file stores (1e-7°,
 //! float32). The CSV: its samples as written, in straight lines between
 //! them. The flights are sampled at the planned tracks' instants and handed
-//! to the pipeline's own verification
-//! ([`crate::pipelines::theta_pso::verify::verify_within`]) with the hard
-//! limits. Also measured: the largest distance between where a vehicle flies
+//! to θ-PSO's verification
+//! ([`crate::pipelines::theta_pso::verify::verify_within`], for every
+//! pipeline's files: issue 53 would give this floor a verification of its
+//! own) with the hard limits the plan was held to. Also measured: the largest distance between where a vehicle flies
 //! and where its track has it at the same instant (the deviation), the
 //! largest difference between when a vehicle reaches a waypoint and when
 //! the plan says (the timing error), and every leg's commanded speed and

@@ -3,9 +3,9 @@
 //! A track is what one vehicle is planned to do: its position and velocity
 //! (metres and m/s, ENU) at increasing times (seconds from the common start).
 //! θ-PSO gives each UAV's trajectory (eqs. 12-15); FLATLO each aircraft's
-//! reference (Algorithms 1-2 at its common-arrival airspeed: the plan, not the
-//! one noisy simulated flight of it); the fleet each quadrotor's simulated
-//! flight (its only plan: the references jump every τ). Exports, views and
+//! flown track (the point-mass model tracking its reference under the
+//! controller, RK4: what verification judged); the fleet each quadrotor's
+//! simulated flight (its only plan: the references jump every τ). Exports, views and
 //! recordings read tracks instead of each outcome's own fields.
 
 /// One colour per vehicle, the same on the designer's map and in the

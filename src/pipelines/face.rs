@@ -3,8 +3,9 @@
 //!
 //! Each pipeline implements both in its own `face.rs`; the registration in
 //! `pipelines/mod.rs` hands a [`super::Kind`] its face and an
-//! [`super::Outcome`] its outcome's, in the only two matches over the
-//! pipelines. The CLI, the designer, the sweep, the recorder and the exports
+//! [`super::Outcome`] its outcome's; its nine matches over the pipelines
+//! (the faces, the requests, the outcome's accessors) are the
+//! registration. The CLI, the designer, the sweep, the recorder and the exports
 //! read a pipeline through these two traits, so a new pipeline's words,
 //! verdict, summary, tracks and budget live with it, not in the front ends.
 
