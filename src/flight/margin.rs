@@ -222,18 +222,9 @@ pub struct Rooms {
 
 impl Rooms {
     fn of(setup: &Setup, flown: &[super::Flown]) -> Self {
-        let least = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::INFINITY, f64::min);
         Rooms {
-            clearance: flown
-                .iter()
-                .map(|f| {
-                    least(&mut f.obstacles.iter().flatten().map(|c| c.distance)) - setup.clearance
-                })
-                .collect(),
-            separation: flown
-                .iter()
-                .map(|f| least(&mut f.pairs.iter().map(|c| c.distance)) - setup.closest)
-                .collect(),
+            clearance: flown.iter().map(|f| f.clearance_room(setup)).collect(),
+            separation: flown.iter().map(|f| f.separation_room(setup)).collect(),
         }
     }
 }
@@ -454,7 +445,7 @@ pub fn find_margin(
         ));
         (r, shift)
     };
-    let slots_apart = closest_slots(mission);
+    let slots_apart = crate::mission::min_pair_distance(&mission.formation.slots);
     let by_spacing = |(r, rooms): (Report, Rooms)| {
         let shift = shift_to_target(&rooms.separation, target, 1.0 / slots_apart);
         (r, shift)
@@ -547,15 +538,6 @@ pub fn find_margin(
         }
     }
     Ok(search)
-}
-
-/// The closest two slots of the mission's formation, metres (∞ for one):
-/// how much a pair's room grows per unit of spacing scale.
-fn closest_slots(mission: &Mission) -> f64 {
-    let slots = &mission.formation.slots;
-    super::vehicle_pairs(slots.len())
-        .map(|(i, j)| (slots[i] - slots[j]).norm())
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// The try that came nearest the target: the least share of flights

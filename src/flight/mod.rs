@@ -264,17 +264,29 @@ pub struct Flown {
 }
 
 impl Flown {
+    /// The least room to 2 r_Q (+ margin) over the flight, metres: the
+    /// closest pair less `setup.closest` (negative: broken; ∞ for one
+    /// vehicle).
+    pub fn separation_room(&self, setup: &Setup) -> f64 {
+        let closest = self.pairs.iter().map(|c| c.distance);
+        closest.fold(f64::INFINITY, f64::min) - setup.closest
+    }
+
+    /// The least room to r_Q (+ margins) from the obstacles over the
+    /// flight, metres: the closest any vehicle came less `setup.clearance`.
+    pub fn clearance_room(&self, setup: &Setup) -> f64 {
+        let closest = self.obstacles.iter().flatten().map(|c| c.distance);
+        closest.fold(f64::INFINITY, f64::min) - setup.clearance
+    }
+
     /// Whether some pair came closer than `setup.closest` (2 r_Q + margin).
     pub fn broke_separation(&self, setup: &Setup) -> bool {
-        self.pairs.iter().any(|c| c.distance < setup.closest)
+        self.separation_room(setup) < 0.0
     }
 
     /// Whether some vehicle came closer than `setup.clearance` to an obstacle.
     pub fn broke_clearance(&self, setup: &Setup) -> bool {
-        self.obstacles
-            .iter()
-            .flatten()
-            .any(|c| c.distance < setup.clearance)
+        self.clearance_room(setup) < 0.0
     }
 }
 

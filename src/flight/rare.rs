@@ -217,10 +217,14 @@ fn room(setup: &Setup, flown: &Flown, limit: Limit) -> (f64, String, f64) {
     best
 }
 
-/// Flies the inputs `u`: its room to `limit`.
+/// Flies the inputs `u`: its room to `limit` (the number alone: this is
+/// every flight of every level, so nothing is put in words).
 fn fly_inputs(setup: &Setup, u: &[f32], limit: Limit) -> f64 {
     let flown = fly_on(setup, &mut Reading { u, at: 0 }, 0, false, false);
-    room(setup, &flown, limit).0
+    match limit {
+        Limit::Separation => flown.separation_room(setup),
+        Limit::Clearance => flown.clearance_room(setup),
+    }
 }
 
 /// One sample of a level: its room and |u|².

@@ -622,11 +622,7 @@ fn small_swarm(mut m: skyform::mission::Mission) -> skyform::mission::Mission {
 }
 
 fn obstacle_named(app: &App, name: &str) -> usize {
-    app.mission()
-        .obstacles
-        .iter()
-        .position(|o| o.name == name)
-        .unwrap_or_else(|| panic!("no obstacle '{name}'"))
+    obstacle_named_in(app.mission(), name)
 }
 
 /// Issue 36, item 7: a site over live planning's limits (221 obstacles

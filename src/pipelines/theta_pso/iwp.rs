@@ -191,16 +191,9 @@ pub fn vertical_half_height(offsets: &[Vector3<f64>]) -> f64 {
     offsets.iter().map(|o| o.z.abs()).fold(0.0, f64::max)
 }
 
-/// Smallest distance between two slots (∞ for fewer than two).
-pub fn min_pair_distance(offsets: &[Vector3<f64>]) -> f64 {
-    let mut best = f64::INFINITY;
-    for i in 0..offsets.len() {
-        for j in (i + 1)..offsets.len() {
-            best = best.min((offsets[i] - offsets[j]).norm());
-        }
-    }
-    best
-}
+/// Smallest distance between two slots (∞ for fewer than two): the
+/// mission's, which the presets read too.
+pub use crate::mission::min_pair_distance;
 
 /// The spacing of the alignment column: the closest nominal pair, at
 /// least 2 r_Q + the safety margin.

@@ -263,7 +263,7 @@ pub fn verify_within(
                 // obstacle at least that far past both the limit and the
                 // worst so far changes neither, so it is passed over.
                 if let Some(worst) = clearance.check.worst {
-                    let below = (p.xy() - c.center).norm() - c.radius;
+                    let below = c.horizontal_distance(&p) - c.radius;
                     if below >= worst && below >= clearance.check.limit {
                         continue;
                     }
