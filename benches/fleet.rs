@@ -31,7 +31,10 @@ fn decision(c: &mut Criterion) {
                 desired: 1.732,
             })
             .to_vec(),
-        obstacles: vec![cost::Detected::disc(Point2::new(1.0, -1.0), 0.1)],
+        obstacles: vec![skyform::base::shape::Footprint::circle(
+            Point2::new(1.0, -1.0),
+            0.1,
+        )],
         rho: p.rho,
         safety: p.safety_distance,
         sigma: p.sigma,

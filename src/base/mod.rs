@@ -8,5 +8,6 @@ pub mod detour;
 pub mod geometry;
 pub mod nearest;
 pub mod ode;
+pub mod shape;
 pub mod swarm;
 pub mod terrain;

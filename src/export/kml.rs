@@ -26,8 +26,9 @@ use super::{Placement, Planned, VehiclePlan, noun};
 use crate::mission::{Mission, Obstacle};
 use crate::outcome::tracks::vehicle_color;
 
-/// Points on each circle (an obstacle, a band's edge).
-const CIRCLE_POINTS: usize = 48;
+/// How far an outline drawn in the KML (an obstacle, a band's edge) may
+/// stray inside a curve: a centimetre, finer than a survey.
+const OUTLINE_TOLERANCE: f64 = 0.01;
 
 /// The folder of vehicle `i` (0-based), as readers find it: "UAV 1",
 /// "aircraft 1", "agent 1".
@@ -312,18 +313,15 @@ fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> 
     }
     let ring_at = |z: f64| {
         let at = |p: &Point2<f64>| absolute(placement, &Point3::new(p.x, p.y, ground + z));
-        if o.footprint.is_empty() {
-            circle(&o.center, o.radius, at)
-        } else {
-            // The footprint as surveyed, closed, counter-clockwise (KML's
-            // outer boundary winding).
-            let mut ring: Vec<_> = o.footprint.iter().map(at).collect();
-            if signed_area(&o.footprint) < 0.0 {
-                ring.reverse();
-            }
-            ring.push(ring[0]);
-            ring
+        // The outline (a footprint as surveyed, a curve at a centimetre),
+        // closed, counter-clockwise (KML's outer boundary winding).
+        let outline = o.outline().ring(OUTLINE_TOLERANCE);
+        let mut ring: Vec<_> = outline.iter().map(at).collect();
+        if signed_area(&outline) < 0.0 {
+            ring.reverse();
         }
+        ring.push(ring[0]);
+        ring
     };
     let geometry = if o.base > 0.0 {
         let (top, bottom) = (ring_at(o.height), ring_at(o.base));
@@ -343,11 +341,7 @@ fn obstacle(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> 
     } else {
         polygon(ring_at(o.height), Vec::new(), AltitudeMode::Absolute, true)
     };
-    let outline = if o.footprint.is_empty() {
-        format!("radius {} m", o.radius)
-    } else {
-        format!("footprint of {} vertices", o.footprint.len())
-    };
+    let outline = o.outline().words();
     let mut text = if o.base > 0.0 {
         format!(
             "{outline}, from {} to {} m above the ground",
@@ -392,17 +386,9 @@ fn signed_area(v: &[Point2<f64>]) -> f64 {
 /// footprint its outline offset by each (`geo`'s buffer, round corners).
 fn band(mission: &Mission, o: &Obstacle, placement: &Placement) -> Kml<f64> {
     let [d_min, d_max] = o.stand_off_band(&mission.formation);
-    let (outer, inner) = if o.footprint.len() >= 3 {
-        let offset = |d: f64| footprint_offset(&o.footprint, d, |p| on_ground(placement, p));
-        (offset(d_max), offset(d_min.max(1e-3)))
-    } else {
-        (
-            circle(&o.center, o.radius + d_max, |p| on_ground(placement, p)),
-            circle(&o.center, o.radius + d_min.max(1e-3), |p| {
-                on_ground(placement, p)
-            }),
-        )
-    };
+    let outline = o.outline().ring(OUTLINE_TOLERANCE);
+    let offset = |d: f64| footprint_offset(&outline, d, |p| on_ground(placement, p));
+    let (outer, inner) = (offset(d_max), offset(d_min.max(1e-3)));
     placemark(
         &format!("{} band", o.name),
         format!(
@@ -493,24 +479,6 @@ fn polygon(
         altitude_mode: mode,
         ..Polygon::default()
     })
-}
-
-/// A closed ring of [`CIRCLE_POINTS`] points about `center`,
-/// counter-clockwise, each placed by `at`.
-fn circle(
-    center: &Point2<f64>,
-    radius: f64,
-    at: impl Fn(&Point2<f64>) -> Coord<f64>,
-) -> Vec<Coord<f64>> {
-    (0..=CIRCLE_POINTS)
-        .map(|k| {
-            let a = (k % CIRCLE_POINTS) as f64 * std::f64::consts::TAU / CIRCLE_POINTS as f64;
-            at(&Point2::new(
-                center.x + radius * a.cos(),
-                center.y + radius * a.sin(),
-            ))
-        })
-        .collect()
 }
 
 /// Through the decimal text, so the file shows the short form.

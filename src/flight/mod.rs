@@ -27,7 +27,8 @@ use rand::rngs::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::base::geometry::{Prism, segment_point_distance_3d};
+use crate::base::geometry::segment_point_distance_3d;
+use crate::base::shape::Prism;
 use crate::export::reverify::Flight;
 use crate::export::{Placement, Planned, VehiclePlan, reduce};
 use crate::mission::Mission;

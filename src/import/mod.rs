@@ -393,7 +393,7 @@ fn narrowest_aisle<'a>(
                 continue;
             }
             let (pa, pb) = (a.prism(), b.prism());
-            let (p, q) = crate::base::geometry::nearest_points(&pa, &pb);
+            let (p, q) = crate::base::shape::nearest_points(&*pa.outline, &*pb.outline);
             if pa.outward(&q) <= 0.0 || pb.outward(&p) <= 0.0 {
                 continue; // touching or overlapping: one building
             }

@@ -143,7 +143,7 @@ impl Mission {
 
     /// Obstacle `o` as a cylinder in the ENU frame: with terrain, standing on
     /// the ground under its centre (its height is above that ground).
-    pub fn prism(&self, o: &Obstacle) -> crate::base::geometry::Prism {
+    pub fn prism(&self, o: &Obstacle) -> crate::base::shape::Prism {
         let mut c = o.prism();
         if self.terrain.is_some() {
             let ground = self.ground(o.center.x, o.center.y);

@@ -10,6 +10,8 @@
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
+use crate::base::shape::{Footprint, Polygon, Prism};
+
 use super::model::{Formation, is_yes, is_zero, unset, unset_point, yes};
 
 /// A vertical prism from `base` (the ground unless set) up to `height`: a
@@ -298,13 +300,25 @@ impl Obstacle {
         self.top() + clearance > band[1] && self.base - clearance < band[0]
     }
 
+    /// Its shape in the plane, as the file writes it: a polygon when it has
+    /// a footprint (a wire's is its box), else a circle. Every planner,
+    /// check, drawing and export reads the shape through this; a new shape
+    /// is read here.
+    pub fn outline(&self) -> Footprint {
+        if self.footprint.is_empty() {
+            Footprint::circle(self.center, self.radius)
+        } else {
+            Footprint::new(Polygon::bounded(&self.footprint, self.center, self.radius))
+        }
+    }
+
     /// The solid the planner keeps clear of: up to the sky when it may not
     /// be flown over.
-    pub fn prism(&self) -> crate::base::geometry::Prism {
-        crate::base::geometry::Prism {
+    pub fn prism(&self) -> Prism {
+        Prism {
             center: self.center,
             radius: self.radius,
-            polygon: self.footprint.as_slice().into(),
+            outline: self.outline(),
             base: self.base,
             height: self.top(),
         }
@@ -332,10 +346,8 @@ impl Obstacle {
     pub fn shape_name(&self) -> &'static str {
         if self.is_wire() {
             "wire"
-        } else if self.footprint.is_empty() {
-            "cylinder"
         } else {
-            "footprint"
+            self.outline().kind()
         }
     }
 

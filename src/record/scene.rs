@@ -16,16 +16,18 @@ fn obstacle_color(o: &Obstacle) -> rerun::Color {
     }
 }
 
-/// A footprint's prism as a closed mesh from its base to its top: the
-/// footprint triangulated (ear clipping, `geo`) for the caps, a quad per
-/// edge for the sides. `None` for a cylinder.
+/// An obstacle's prism as a closed mesh from its base to its top: its
+/// outline (a footprint's own vertices, a curve's ring at a centimetre)
+/// triangulated (ear clipping, `geo`) for the caps, a quad per edge for the
+/// sides. `None` for a disc, which Rerun draws as a cylinder.
 fn footprint_mesh(o: &Obstacle) -> Option<rerun::Mesh3D> {
     use geo::TriangulateEarcut;
-    if o.footprint.len() < 3 {
+    let shape = o.outline();
+    if shape.disc().is_some() {
         return None;
     }
-    let ring: Vec<geo::Coord<f64>> = o
-        .footprint
+    let ring: Vec<geo::Coord<f64>> = shape
+        .ring(0.01)
         .iter()
         .map(|p| geo::coord! { x: p.x, y: p.y })
         .collect();
@@ -102,7 +104,7 @@ pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStrea
     let o: Vec<_> = m
         .obstacles
         .iter()
-        .filter(|o| o.footprint.is_empty())
+        .filter(|o| o.outline().disc().is_some())
         .collect();
     if !o.is_empty() {
         stream.log_static(

@@ -444,7 +444,10 @@ impl Editor {
                     .enumerate()
                     .filter(|(j, o)| *j != i && o.within(band))
                     .map(|(_, o)| {
-                        let (p, q) = crate::base::geometry::nearest_points(&here, &m.prism(o));
+                        let (p, q) = crate::base::shape::nearest_points(
+                            &*here.outline,
+                            &*m.prism(o).outline,
+                        );
                         (o.name.clone(), (q - p).norm())
                     })
                     .min_by(|a, b| a.1.total_cmp(&b.1));

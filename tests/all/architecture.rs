@@ -602,3 +602,96 @@ fn long_files_and_functions_say_why_and_how_long() {
         wrong.join("\n  ")
     );
 }
+
+/// The places that read an obstacle's polygon as the file writes it (its
+/// `footprint` vertices), each with why: the polygon's file form (read,
+/// validated, imported, its vertices edited on the map). Everything else
+/// asks the shape (`Obstacle::outline`, `base::shape::Outline`).
+const READS_THE_FOOTPRINT_FIELD: &[(&str, &str)] = &[
+    (
+        "src/mission/obstacle.rs",
+        "the file form, and the registration that makes it a shape (`outline`)",
+    ),
+    (
+        "src/mission/validate/site.rs",
+        "the footprint's rules as written: vertices, a simple polygon",
+    ),
+    (
+        "src/import/merge.rs",
+        "a re-import compares the surveyed vertices with the file's",
+    ),
+    (
+        "src/import/mod.rs",
+        "the survey's polygons written as footprints",
+    ),
+    (
+        "src/import/pieces.rs",
+        "the survey's polygons written as footprints",
+    ),
+    (
+        "src/tui/editor.rs",
+        "a footprint's vertices stepped through, added, moved and deleted",
+    ),
+    ("src/tui/fields.rs", "a vertex as an item of the inspector"),
+    (
+        "src/tui/fields/table.rs",
+        "a vertex's coordinates as inspector fields",
+    ),
+    ("src/tui/input.rs", "a vertex picked with the mouse"),
+    (
+        "src/tui/view/map/mod.rs",
+        "a selected footprint's vertices drawn as handles",
+    ),
+];
+
+/// Issue 53's "a shape is a type": outside `src/base/shape/` no file
+/// branches on how an obstacle's shape is stored (its `footprint` field, a
+/// prism's polygon), but the listed file-form places; a new place fails
+/// here: ask the shape (`Obstacle::outline`, `Outline`) instead. The third
+/// shape that shows it is `tests/all/shapes.rs`.
+#[test]
+fn outside_the_shape_module_only_the_file_form_reads_a_footprint() {
+    let reads = |file: &Path| -> Vec<String> {
+        let text = std::fs::read_to_string(file).unwrap_or_default();
+        text.lines()
+            .take_while(|line| !line.starts_with("#[cfg(test)]"))
+            .map(|line| line.split("//").next().unwrap_or(""))
+            .filter(|code| {
+                [".footprint", ".polygon"].iter().any(|n| {
+                    code.match_indices(n).any(|(i, _)| {
+                        !code[i + n.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+                    })
+                })
+            })
+            .map(str::to_owned)
+            .collect()
+    };
+    let mut reading: Vec<String> = rust_files(Path::new("src"))
+        .into_iter()
+        .filter(|p| !p.starts_with("src/base/shape"))
+        .filter(|p| p.file_name().is_none_or(|n| n != "tests.rs"))
+        .filter(|p| !reads(p).is_empty())
+        .map(|p| p.to_string_lossy().replace('\\', "/"))
+        .collect();
+    reading.sort();
+    let listed: Vec<&str> = READS_THE_FOOTPRINT_FIELD.iter().map(|(f, _)| *f).collect();
+    let new: Vec<_> = reading
+        .iter()
+        .filter(|f| !listed.contains(&f.as_str()))
+        .collect();
+    let gone: Vec<_> = listed
+        .iter()
+        .filter(|f| !reading.iter().any(|r| r == *f))
+        .collect();
+    assert!(
+        new.is_empty(),
+        "these files read an obstacle's footprint field; ask its shape instead: {:?}",
+        new.iter()
+            .map(|f| (f, reads(Path::new(f.as_str()))))
+            .collect::<Vec<_>>()
+    );
+    assert!(
+        gone.is_empty(),
+        "these files no longer read it: take them off the list: {gone:?}"
+    );
+}

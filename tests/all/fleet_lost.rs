@@ -113,7 +113,7 @@ fn a_lost_agents_region_grows_at_its_last_speed_up_to_its_reach() {
     let flown = simulation.run(&mut link, &mut Silent, &CancelToken::new());
     assert!(flown.is_ok());
     assert_eq!(simulation.lost().len(), 1);
-    let radius = |k: usize| simulation.lost_region(0, k).radius;
+    let radius = |k: usize| simulation.lost_region(0, k).radius();
     let heard = step - 1; // its last state is the step before it was lost
     assert_eq!(
         radius(heard),
@@ -130,8 +130,8 @@ fn a_lost_agents_region_grows_at_its_last_speed_up_to_its_reach() {
     assert!(reach > r2 && reach < 2.0, "up to its reach: {reach} m");
     assert_eq!(radius(heard + 2_000_000), reach, "and no further");
     assert_eq!(
-        simulation.lost_region(0, heard + 10).center,
-        simulation.lost_region(0, heard + 20).center,
+        simulation.lost_region(0, heard + 10).center(),
+        simulation.lost_region(0, heard + 20).center(),
         "about where it was last heard"
     );
 }

@@ -30,6 +30,7 @@ mod mission_validation;
 mod passages;
 mod rare;
 mod recording;
+mod shapes;
 mod spso;
 mod terrain;
 mod terrain_view;

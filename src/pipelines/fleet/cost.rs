@@ -12,6 +12,8 @@
 use nalgebra::{Point2, Vector2};
 use serde::Serialize;
 
+use crate::base::shape::Footprint;
+
 /// Below this exponent exp() is under 1e-13 of the terms it is added to.
 const NEGLIGIBLE: f64 = -30.0;
 
@@ -38,39 +40,8 @@ pub struct Neighbour {
     pub desired: f64,
 }
 
-/// A detected obstacle (within d_obs): a vertical cylinder, or a polygon
-/// footprint (`radius` then its bounding circle's).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Detected {
-    pub center: Point2<f64>,
-    pub radius: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub polygon: Option<std::sync::Arc<[Point2<f64>]>>,
-}
-
-impl Detected {
-    /// A disc (a lost agent's region).
-    pub fn disc(center: Point2<f64>, radius: f64) -> Self {
-        Detected {
-            center,
-            radius,
-            polygon: None,
-        }
-    }
-
-    /// d_ik of eq. 9: the distance from `p` to the obstacle's nearest point
-    /// (negative inside), the footprint's own for a polygon
-    /// (`base::geometry::Prism::outward`, as the other pipelines measure).
-    pub fn distance(&self, p: &Point2<f64>) -> f64 {
-        match &self.polygon {
-            Some(v) => crate::base::geometry::polygon_signed_distance(v, p),
-            None => (p - self.center).norm() - self.radius,
-        }
-    }
-}
-
 /// Everything agent i's planner knows at a decision.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Observation {
     /// x_i(t).
     pub position: Point2<f64>,
@@ -79,7 +50,10 @@ pub struct Observation {
     /// d_ip^d.
     pub target_distance: f64,
     pub neighbours: Vec<Neighbour>,
-    pub obstacles: Vec<Detected>,
+    /// The obstacles within d_obs; eq. 9's d_ik is the distance to a
+    /// footprint's nearest point (negative inside), as the other pipelines
+    /// measure.
+    pub obstacles: Vec<Footprint>,
     /// ρ, c, σ.
     pub rho: f64,
     pub safety: f64,
@@ -104,7 +78,7 @@ impl Observation {
             cost += CONSTRAINT * (self.keep_apart - distance).max(0.0);
         }
         for o in &self.obstacles {
-            let distance = o.distance(&next);
+            let distance = o.signed_distance(&next);
             cost += obstacle_penalty(distance, self.safety, self.sigma);
             cost += CONSTRAINT * (self.keep_clear - distance).max(0.0);
         }
@@ -135,20 +109,16 @@ mod tests {
             .iter()
             .map(|&[x, y]| Point2::new(x, y))
             .collect();
-        let (center, radius) = crate::base::geometry::bounding_circle(&wall);
-        let o = Detected {
-            center,
-            radius,
-            polygon: Some(wall.into()),
-        };
+        let o = Footprint::new(crate::base::shape::Polygon::new(wall));
+        let (center, radius) = o.bounding_circle();
         let beside = Point2::new(5.0, 2.0);
-        assert!((o.distance(&beside) - 1.0).abs() < 1e-12);
+        assert!((o.signed_distance(&beside) - 1.0).abs() < 1e-12);
         assert!((beside - center).norm() - radius < 0.0, "inside the circle");
-        assert!((o.distance(&Point2::new(12.0, 0.5)) - 2.0).abs() < 1e-12);
-        assert!((o.distance(&Point2::new(5.0, 0.5)) + 0.5).abs() < 1e-12);
+        assert!((o.signed_distance(&Point2::new(12.0, 0.5)) - 2.0).abs() < 1e-12);
+        assert!((o.signed_distance(&Point2::new(5.0, 0.5)) + 0.5).abs() < 1e-12);
         // The penalty follows: at c it is 1 (eq. 9).
         let at_c = Point2::new(5.0, 1.8);
-        assert!((obstacle_penalty(o.distance(&at_c), 0.8, 0.4) - 1.0).abs() < 1e-9);
+        assert!((obstacle_penalty(o.signed_distance(&at_c), 0.8, 0.4) - 1.0).abs() < 1e-9);
     }
 
     /// Eq. 9 with Table 1's c = 0.8 m, σ = 0.4.

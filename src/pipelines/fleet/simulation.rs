@@ -21,7 +21,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::agent::Planner;
-use super::cost::{Detected, Neighbour, Observation};
+use super::cost::{Neighbour, Observation};
 use super::judge::{formation_error, tolerance_of};
 use super::network::{Message, Network};
 use super::quadrotor::{self, Body, State};
@@ -31,6 +31,7 @@ use super::{
     scenario,
 };
 use crate::base::ode::rk4_step;
+use crate::base::shape::Footprint;
 use crate::mission::{FleetParams, FleetPush, Mission};
 use crate::pipelines::{CancelToken, Completion, Event, Level, Observer};
 
@@ -171,7 +172,7 @@ pub struct Snapshot {
     /// A scheduled round (every τ): everyone decides, neighbour lists rebuilt.
     scheduled: bool,
     /// Where each lost agent may be now ([`Simulation::lost_region`]).
-    lost: Vec<(usize, Detected)>,
+    lost: Vec<(usize, Footprint)>,
 }
 
 /// What the run has recorded so far, on the sample grid.
@@ -213,7 +214,7 @@ pub struct Simulation<'m> {
     seed: u64,
     scenario: Scenario,
     /// The obstacles in the flight plane (the fleet flies over the others).
-    obstacles: Vec<Detected>,
+    obstacles: Vec<Footprint>,
     body: Body,
     /// The agents flown here, and their indices in the fleet.
     flights: Vec<Flight>,
@@ -261,11 +262,7 @@ impl<'m> Simulation<'m> {
             .obstacles
             .iter()
             .filter(|o| o.spans(p.altitude))
-            .map(|o| Detected {
-                center: o.center,
-                radius: o.radius,
-                polygon: (!o.footprint.is_empty()).then(|| o.footprint.as_slice().into()),
-            })
+            .map(|o| o.outline())
             .collect();
         let local: Vec<usize> = local.into_iter().filter(|&i| i < n).collect();
         let flights = local
@@ -500,7 +497,7 @@ impl<'m> Simulation<'m> {
     /// its last reference Y_j and holds it there; so the disc grows with the
     /// news's age at its last speed ‖v_j‖, up to ‖Y_j − x_j‖ plus its
     /// stopping distance at the tilt limit, ‖v_j‖² / (2 g tan θ_max).
-    pub fn lost_region(&self, j: usize, k: usize) -> Detected {
+    pub fn lost_region(&self, j: usize, k: usize) -> Footprint {
         let m = &self.current[j];
         let speed = m.velocity.norm();
         let age = k.saturating_sub(m.step) as f64 * self.clock.dt;
@@ -511,7 +508,7 @@ impl<'m> Simulation<'m> {
             f64::INFINITY
         };
         let reach = (m.reference - m.position).norm() + stop;
-        Detected::disc(m.position, (speed * age).min(reach))
+        Footprint::circle(m.position, (speed * age).min(reach))
     }
 
     /// Records (and checks) the snapshot: samples, closest approaches, the
@@ -679,7 +676,7 @@ impl<'m> Simulation<'m> {
                         || now
                             .lost
                             .iter()
-                            .any(|(_, r)| (r.center - positions[i]).norm() - r.radius < c))
+                            .any(|(_, r)| (r.center() - positions[i]).norm() - r.radius() < c))
             })
             .collect()
     }
@@ -744,7 +741,7 @@ impl<'m> Simulation<'m> {
                 .obstacles
                 .iter()
                 .chain(now.lost.iter().map(|(_, r)| r))
-                .filter(|o| o.distance(&me) <= p.detection_range)
+                .filter(|o| o.signed_distance(&me) <= p.detection_range)
                 .cloned()
                 .collect(),
             rho: p.rho,

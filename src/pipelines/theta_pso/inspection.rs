@@ -191,9 +191,11 @@ pub fn pass_geometries(mission: &Mission) -> Result<Vec<(usize, PassGeometry)>, 
         .enumerate()
         .filter(|(_, o)| o.inspect)
         .map(|(k, o)| {
-            if !o.footprint.is_empty() {
-                let longest = (0..o.footprint.len())
-                    .map(|i| (o.footprint[(i + 1) % o.footprint.len()] - o.footprint[i]).norm())
+            let outline = o.outline();
+            let corners = outline.corners();
+            if !corners.is_empty() {
+                let longest = (0..corners.len())
+                    .map(|i| (corners[(i + 1) % corners.len()] - corners[i]).norm())
                     .fold(0.0, f64::max);
                 if longest < f.inspection_pass {
                     return Err((

@@ -41,7 +41,8 @@
 use nalgebra::{Point2, Vector2, Vector3};
 use serde::Serialize;
 
-use crate::base::geometry::{nearest_points, segment_point_distance};
+use crate::base::geometry::segment_point_distance;
+use crate::base::shape::nearest_points;
 use crate::mission::{Formation, Mission, ShapeChoice};
 
 /// An intermediate waypoint between two obstacles.
@@ -217,6 +218,10 @@ pub fn column_spacing(formation: &Formation) -> f64 {
     }
 }
 
+/// A curved outline that is not a disc (no shape today) is seen through
+/// its ring: chords no more than this inside the curve.
+const RING_TOLERANCE: f64 = 0.01;
+
 /// What a column leaves of d_com at its ends, and beyond 2 r_Q between two
 /// UAVs, metres (room for the sampling).
 const COLUMN_SPARE: f64 = 0.05;
@@ -380,15 +385,16 @@ impl Seen {
             let d = p - center;
             Vector2::new(d.dot(&forward), d.dot(&left))
         };
-        if o.footprint.len() >= 3 {
-            Seen::Outline(o.footprint.iter().map(frame).collect())
-        } else {
-            let c = frame(&o.center);
+        let outline = o.outline();
+        if let Some((c, radius)) = outline.disc() {
+            let c = frame(&c);
             Seen::Disc {
                 x: c.x,
                 y: c.y,
-                radius: o.radius,
+                radius,
             }
+        } else {
+            Seen::Outline(outline.ring(RING_TOLERANCE).iter().map(frame).collect())
         }
     }
 
@@ -733,7 +739,8 @@ fn pair_iwp(
             )
         });
     }
-    let (p_p, p_q, gap, u) = if a.footprint.is_empty() && b.footprint.is_empty() {
+    let (pa, pb) = (a.prism(), b.prism());
+    let (p_p, p_q, gap, u) = if pa.outline.disc().is_some() && pb.outline.disc().is_some() {
         let axis = b.center - a.center;
         let distance = axis.norm();
         if distance == 0.0 {
@@ -749,8 +756,7 @@ fn pair_iwp(
         if gate.is_none() && (a.center - b.center).norm() - a.radius - b.radius >= fits_formation {
             return None;
         }
-        let (pa, pb) = (a.prism(), b.prism());
-        let (p_p, p_q) = nearest_points(&pa, &pb);
+        let (p_p, p_q) = nearest_points(&*pa.outline, &*pb.outline);
         let apart = pa.outward(&p_q) > 0.0 && pb.outward(&p_p) > 0.0;
         let gap = if apart { (p_q - p_p).norm() } else { -1.0 };
         (p_p, p_q, gap, (p_q - p_p) / gap.abs().max(1e-12))
@@ -776,7 +782,7 @@ fn pair_iwp(
             && k != q
             && segment_point_distance(&p_p, &p_q, c) < r + r_q
             && stands_in(mission, o, window)
-            && (o.footprint.is_empty() || o.prism().segment_distance(&p_p, &p_q) < r_q))
+            && (o.outline().disc().is_some() || o.prism().segment_distance(&p_p, &p_q) < r_q))
             .then_some(o)
     });
     if let Some(o) = blocker {

@@ -99,11 +99,7 @@ pub fn lower_bound(mission: &Mission, iwps: &[Iwp], resolution: f64) -> Option<R
         .map(|o| {
             // A footprint's inscribed circle about its bounding centre (none
             // when that centre is outside it): the bound stays a lower bound.
-            let inner = if o.footprint.is_empty() {
-                o.radius
-            } else {
-                (-crate::base::geometry::polygon_signed_distance(&o.footprint, &o.center)).max(0.0)
-            };
+            let inner = (-o.outline().signed_distance(&o.center)).max(0.0);
             let reach = inner + f.least_clearance();
             let rho = shapes
                 .iter()

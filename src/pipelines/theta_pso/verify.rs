@@ -514,34 +514,8 @@ pub struct InspectionResult {
 /// The bearing (degrees clockwise from north, [0, 360)) of the outward
 /// normal of `o`'s side nearest `p`: a footprint's nearest edge's, a
 /// cylinder's radius through `p`.
-pub fn face_bearing(o: &crate::base::geometry::Prism, p: &Point3<f64>) -> f64 {
-    let q = o.nearest_on_outline(&p.xy());
-    let normal = if o.polygon.is_empty() {
-        q - o.center
-    } else {
-        let outline = &o.polygon;
-        let n = outline.len();
-        let edge = (0..n)
-            .min_by(|&a, &b| {
-                let d = |i: usize| {
-                    crate::base::geometry::segment_point_distance(
-                        &outline[i],
-                        &outline[(i + 1) % n],
-                        &q,
-                    )
-                };
-                d(a).total_cmp(&d(b))
-            })
-            .unwrap_or(0);
-        let d = outline[(edge + 1) % n] - outline[edge];
-        let out = nalgebra::Vector2::new(d.y, -d.x);
-        // Either winding: the normal pointing away from the footprint.
-        if o.outward(&(q + out.normalize() * 1e-3)) > o.outward(&(q - out.normalize() * 1e-3)) {
-            out
-        } else {
-            -out
-        }
-    };
+pub fn face_bearing(o: &crate::base::shape::Prism, p: &Point3<f64>) -> f64 {
+    let normal = o.outline.normal(&p.xy());
     normal.x.atan2(normal.y).to_degrees().rem_euclid(360.0)
 }
 
@@ -550,16 +524,16 @@ pub fn face_bearing(o: &crate::base::geometry::Prism, p: &Point3<f64>) -> f64 {
 /// edge whose outward normal is nearest that bearing (its corners are on
 /// it), a cylinder's the quarter of its surface facing that way (within
 /// 45°).
-pub fn on_side(o: &crate::base::geometry::Prism, p: &Point3<f64>, side: f64) -> bool {
+pub fn on_side(o: &crate::base::shape::Prism, p: &Point3<f64>, side: f64) -> bool {
     let q = o.nearest_on_outline(&p.xy());
     let b = side.to_radians();
     let normal = nalgebra::Vector2::new(b.sin(), b.cos());
-    if o.polygon.len() < 3 {
+    if o.outline.corners().len() < 3 {
         let face = face_bearing(o, p);
         let d = (face - side).rem_euclid(360.0);
         return d.min(360.0 - d) <= 45.0 + 1e-9;
     }
-    let mut outline: Vec<nalgebra::Point2<f64>> = o.polygon.to_vec();
+    let mut outline: Vec<nalgebra::Point2<f64>> = o.outline.corners().to_vec();
     let n = outline.len();
     let area: f64 = (0..n)
         .map(|i| outline[i].coords.perp(&outline[(i + 1) % n].coords))

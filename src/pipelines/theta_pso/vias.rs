@@ -70,7 +70,7 @@ pub fn verify_vias(mission: &Mission, trajectories: &[Trajectory]) -> Vec<ViaRes
                     continue;
                 };
                 let (pa, pb) = (mission.prism(oa), mission.prism(ob));
-                let (ga, gb) = crate::base::geometry::nearest_points(&pa, &pb);
+                let (ga, gb) = crate::base::shape::nearest_points(&*pa.outline, &*pb.outline);
                 let (low, high) = (oa.base.max(ob.base), oa.top().min(ob.top()));
                 let crossing = centres.windows(2).enumerate().find_map(|(k, w)| {
                     let (p, q) = (w[0], w[1]);

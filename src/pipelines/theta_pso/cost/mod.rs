@@ -43,7 +43,7 @@ use super::iwp::{Iwp, Shape};
 use super::motion::{Motion, Reader};
 use super::path::Hint;
 use super::path::{CentroidPath, heading_span};
-use crate::base::geometry::Prism;
+use crate::base::shape::Prism;
 use crate::mission::{Bounds, Mission, ThetaPsoParams};
 use serde::Serialize;
 
@@ -944,13 +944,14 @@ fn enclosing(a: &[Point3<f64>], b: &[Point3<f64>]) -> (nalgebra::Point2<f64>, f6
 /// level piece below the top; above it, h is the axis distance at the closest
 /// point (which counts the height over the top disc).
 ///
-/// A polygon footprint has no axis: d is R + its clearance (R its bounding
-/// circle's radius, so r^S − d is the clearance short of r_Q + margin, as
-/// for a cylinder), integrated by the midpoint rule at 0.2 m or finer.
+/// Any other footprint (a polygon, any shape not a disc) has no axis: d is
+/// R + its clearance (R its bounding circle's radius, so r^S − d is the
+/// clearance short of r_Q + margin, as for a cylinder), integrated by the
+/// midpoint rule at 0.2 m or finer.
 pub fn violation_along(p: &Point3<f64>, q: &Point3<f64>, c: &Prism, safe: f64) -> f64 {
     /// Samples judged at once by their middle's clearance.
     const SKIP_BLOCK: usize = 8;
-    if !c.polygon.is_empty() {
+    if c.outline.disc().is_none() {
         let length = (q - p).norm();
         let n = ((length / 0.2).ceil() as usize).clamp(2, 64);
         let step = length / n as f64;

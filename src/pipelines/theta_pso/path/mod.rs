@@ -253,7 +253,7 @@ impl PathBuilder {
                 z_range: mission
                     .inspection_altitudes(&mission.obstacles[k])
                     .unwrap_or_else(|| band_for(vertical_half_height(nominal))),
-                face: anticlockwise(&mission.obstacles[k].footprint),
+                face: anticlockwise(mission.obstacles[k].outline().corners()),
                 side: mission.obstacles[k]
                     .inspect_side
                     .as_ref()

@@ -259,15 +259,15 @@ mod tests {
     use nalgebra::Vector2;
 
     use super::*;
-    use crate::pipelines::theta_pso::route::field::Disc;
+    use crate::base::shape::Footprint;
     use crate::pipelines::theta_pso::trajectory::Reconfiguration;
 
     /// A squeeze map over 40 m × 40 m with these discs (mission indices 10,
     /// 11, …), no region marked: only `sides` is asked.
     fn map(centres: &[(f64, f64)]) -> SqueezeMap {
-        let discs: Vec<Disc> = centres
+        let discs: Vec<Footprint> = centres
             .iter()
-            .map(|&(x, y)| Disc::round(Point2::new(x, y), 3.0))
+            .map(|&(x, y)| Footprint::circle(Point2::new(x, y), 3.0))
             .collect();
         let field = Field::new([[0.0, 40.0], [0.0, 40.0]], &discs, 0.5, 20.0);
         let cells = field.len();
@@ -278,7 +278,7 @@ mod tests {
             obstacle_of: discs
                 .iter()
                 .enumerate()
-                .map(|(k, d)| (10 + k, d.center))
+                .map(|(k, d)| (10 + k, d.center()))
                 .collect(),
             free: vec![0; cells],
             extent: [Point2::new(0.0, 0.0), Point2::new(40.0, 40.0)],

@@ -11,9 +11,10 @@
 
 use nalgebra::Point2;
 
-use super::field::{Disc, Field};
+use super::field::Field;
 use super::search::Reached;
 use super::{FINEST_CELL, Stop};
+use crate::base::shape::{Footprint, gap_between, nearest_points};
 use crate::mission::Mission;
 use crate::pipelines::theta_pso::iwp::Iwp;
 use crate::pipelines::theta_pso::path::PathBuilder;
@@ -32,7 +33,7 @@ pub fn explain(
     mission: &Mission,
     iwps: &[Iwp],
     field: &Field,
-    obstacles: &[(usize, Disc)],
+    obstacles: &[(usize, Footprint)],
     reached: &Reached,
     order: &[super::Stop],
     builder: &PathBuilder,
@@ -101,7 +102,7 @@ pub fn explain(
         i
     }
     let b = &mission.bounds;
-    let gap_of = |a: &Disc, c: &Disc| a.gap_to(c);
+    let gap_of = |a: &Footprint, c: &Footprint| gap_between(&**a, &**c);
     for i in 0..n {
         for j in (i + 1)..n {
             if gap_of(&obstacles[i].1, &obstacles[j].1) < 2.0 * need {
@@ -111,13 +112,13 @@ pub fn explain(
         }
         let d = &obstacles[i].1;
         let to_side = [
-            d.center.x - b.x[0],
-            b.x[1] - d.center.x,
-            d.center.y - b.y[0],
-            b.y[1] - d.center.y,
+            d.center().x - b.x[0],
+            b.x[1] - d.center().x,
+            d.center().y - b.y[0],
+            b.y[1] - d.center().y,
         ];
         for (side, distance) in to_side.iter().enumerate() {
-            if distance - d.radius < need + squeezed_reach {
+            if distance - d.radius() < need + squeezed_reach {
                 let (ri, rs) = (root(&mut parent, i), root(&mut parent, n + side));
                 parent[ri] = rs;
             }
@@ -234,7 +235,7 @@ pub fn explain(
 /// designer to draw.
 fn narrow_passages(
     mission: &Mission,
-    obstacles: &[(usize, Disc)],
+    obstacles: &[(usize, Footprint)],
     members: &[usize],
     need: f64,
 ) -> Vec<super::BlockedPassage> {
@@ -243,12 +244,9 @@ fn narrow_passages(
         .flat_map(|&i| members.iter().map(move |&j| (i, j)))
         .filter(|(i, j)| i < j)
         .filter_map(|(i, j)| {
-            let gap = obstacles[i].1.gap_to(&obstacles[j].1);
+            let gap = gap_between(&*obstacles[i].1, &*obstacles[j].1);
             (gap < 2.0 * need).then(|| {
-                let (a, b) = crate::base::geometry::nearest_points(
-                    &obstacles[i].1.prism(),
-                    &obstacles[j].1.prism(),
-                );
+                let (a, b) = nearest_points(&*obstacles[i].1, &*obstacles[j].1);
                 // As the words say it: one UAV's width (what verification
                 // holds) where not even one fits, else the route's need.
                 let one = 2.0 * mission.formation.least_clearance();
@@ -286,8 +284,8 @@ fn resolution_note(cell: f64) -> String {
 }
 
 /// The two members farthest apart (the same one twice for a single member).
-fn extremes(members: &[usize], obstacles: &[(usize, Disc)]) -> (usize, usize) {
-    let at = |i: usize| -> Point2<f64> { obstacles[i].1.center };
+fn extremes(members: &[usize], obstacles: &[(usize, Footprint)]) -> (usize, usize) {
+    let at = |i: usize| -> Point2<f64> { obstacles[i].1.center() };
     let mut best = (members[0], members[0], -1.0);
     for &i in members {
         for &j in members {

@@ -7,72 +7,9 @@
 //! conservative). The route stage reads it at two reaches, the nominal shape
 //! and the smallest shrink, so one field serves both.
 
-use std::sync::Arc;
-
 use nalgebra::Point2;
 
-use crate::base::geometry::{Prism, polygon_signed_distance};
-
-/// An obstacle as the field sees it: its footprint in the plane, a disc
-/// (`center`, `radius`) or a polygon whose bounding circle the disc is.
-#[derive(Debug, Clone)]
-pub struct Disc {
-    pub center: Point2<f64>,
-    pub radius: f64,
-    pub polygon: Option<Arc<[Point2<f64>]>>,
-}
-
-impl Disc {
-    /// A plain disc.
-    pub fn round(center: Point2<f64>, radius: f64) -> Self {
-        Disc {
-            center,
-            radius,
-            polygon: None,
-        }
-    }
-
-    /// Signed distance from `p` to the footprint's edge (negative inside).
-    pub fn gap(&self, p: Point2<f64>) -> f64 {
-        match &self.polygon {
-            Some(v) => polygon_signed_distance(v, &p),
-            None => (p - self.center).norm() - self.radius,
-        }
-    }
-
-    /// The footprint as the shared geometry reads it (no heights: the
-    /// field is one level's plane), for its exact queries (nearest points,
-    /// a segment's distance).
-    pub fn prism(&self) -> Prism {
-        let polygon = self.polygon.clone().unwrap_or_else(|| Arc::from([]));
-        Prism {
-            center: self.center,
-            radius: self.radius,
-            polygon,
-            base: 0.0,
-            height: 0.0,
-        }
-    }
-
-    /// The distance between two footprints' edges (negative where they
-    /// overlap, as deep as a disc's): between polygons, the least of
-    /// every vertex's distance to the other, which for two apart is
-    /// attained at a vertex of one of them.
-    pub fn gap_to(&self, other: &Disc) -> f64 {
-        match (&self.polygon, &other.polygon) {
-            (None, _) => other.gap(self.center) - self.radius,
-            (Some(_), None) => self.gap(other.center) - other.radius,
-            (Some(a), Some(b)) => {
-                let of = |from: &[Point2<f64>], to: &[Point2<f64>]| {
-                    from.iter()
-                        .map(|v| polygon_signed_distance(to, v))
-                        .fold(f64::INFINITY, f64::min)
-                };
-                of(a, b).min(of(b, a))
-            }
-        }
-    }
-}
+use crate::base::shape::Footprint;
 
 /// A grid of clearances over a rectangle.
 #[derive(Debug, Clone)]
@@ -94,7 +31,7 @@ pub struct Field {
 impl Field {
     /// The field over `area` ([x range, y range]) with cells of `cell`
     /// metres, clearances read up to `cap` (beyond it a cell is simply clear).
-    pub fn new(area: [[f64; 2]; 2], discs: &[Disc], cell: f64, cap: f64) -> Self {
+    pub fn new(area: [[f64; 2]; 2], discs: &[Footprint], cell: f64, cap: f64) -> Self {
         let [x, y] = area;
         let nx = (((x[1] - x[0]) / cell).ceil() as usize).max(1);
         let ny = (((y[1] - y[0]) / cell).ceil() as usize).max(1);
@@ -103,14 +40,15 @@ impl Field {
         let mut nearest = vec![u32::MAX; nx * ny];
         for (k, d) in discs.iter().enumerate() {
             // Only the cells within the cap of the disc's edge can change.
-            let reach = d.radius + cap;
-            let (lo_x, hi_x) = span(d.center.x - reach, d.center.x + reach, origin.x, cell, nx);
-            let (lo_y, hi_y) = span(d.center.y - reach, d.center.y + reach, origin.y, cell, ny);
+            let (center, radius) = d.bounding_circle();
+            let reach = radius + cap;
+            let (lo_x, hi_x) = span(center.x - reach, center.x + reach, origin.x, cell, nx);
+            let (lo_y, hi_y) = span(center.y - reach, center.y + reach, origin.y, cell, ny);
             for iy in lo_y..hi_y {
                 let cy = origin.y + iy as f64 * cell;
                 for ix in lo_x..hi_x {
                     let cx = origin.x + ix as f64 * cell;
-                    let gap = d.gap(Point2::new(cx, cy)) as f32;
+                    let gap = d.signed_distance(&Point2::new(cx, cy)) as f32;
                     let i = iy * nx + ix;
                     if gap < clearance[i] {
                         clearance[i] = gap;
@@ -179,14 +117,14 @@ impl Field {
     /// Clearance at a point: the exact distance to the nearest disc when one
     /// is within the cap of its cell (`discs` as given to `new`), the cap
     /// otherwise.
-    pub fn clearance_at(&self, p: Point2<f64>, discs: &[Disc]) -> f64 {
+    pub fn clearance_at(&self, p: Point2<f64>, discs: &[Footprint]) -> f64 {
         let i = self.index_of(p);
         // The nearest disc of the cell is the nearest of the point's within
         // half a cell's diagonal; look at the cell's and its neighbours'.
         let mut best = self.cap;
         for j in self.neighbourhood(i) {
             if let Some(d) = self.nearest_disc(j).and_then(|k| discs.get(k)) {
-                best = best.min(d.gap(p));
+                best = best.min(d.signed_distance(&p));
             }
         }
         best
@@ -284,8 +222,8 @@ mod tests {
     #[test]
     fn the_field_is_the_distance_to_the_nearest_edge() {
         let discs = [
-            Disc::round(Point2::new(5.0, 5.0), 1.0),
-            Disc::round(Point2::new(8.0, 5.0), 0.5),
+            Footprint::circle(Point2::new(5.0, 5.0), 1.0),
+            Footprint::circle(Point2::new(8.0, 5.0), 0.5),
         ];
         let f = Field::new([[0.0, 10.0], [0.0, 10.0]], &discs, 0.5, 3.0);
         let at = |x: f64, y: f64| f.clearance(f.index_of(Point2::new(x, y)));

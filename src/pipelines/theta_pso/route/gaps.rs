@@ -21,9 +21,8 @@
 use nalgebra::{Point2, Vector2};
 
 use super::Site;
-use super::field::Disc;
 use super::search::{Jump, LAYERS};
-use crate::base::geometry::nearest_points;
+use crate::base::shape::nearest_points;
 use crate::mission::Bounds;
 
 /// A straight through a gap: its ends (where it meets the grid) and the
@@ -53,19 +52,6 @@ impl Gap {
     }
 }
 
-/// The point of `d`'s footprint nearest the line through `on` with unit
-/// normal `n` pointing out of the site, and its distance to the line.
-fn nearest_to_side(d: &Disc, on: Point2<f64>, n: Vector2<f64>) -> (Point2<f64>, f64) {
-    match &d.polygon {
-        None => (d.center + n * d.radius, (on - d.center).dot(&n) - d.radius),
-        Some(v) => v
-            .iter()
-            .map(|p| (*p, (on - p).dot(&n)))
-            .min_by(|s, t| s.1.total_cmp(&t.1))
-            .unwrap_or((d.center, f64::INFINITY)),
-    }
-}
-
 /// The passages at `level` the grid may miss, each joined to the grid, for
 /// the obstacle pairs with no IWP (`has_iwp`) and between each obstacle and
 /// the bounds.
@@ -80,7 +66,11 @@ pub fn find(
     let need = site.need;
     let obstacles = &site.at[level].obstacles;
     let discs = &site.at[level].discs;
-    let clear = |p: Point2<f64>, layer: usize| discs.iter().all(|d| d.gap(p) >= need[layer] - 1e-9);
+    let clear = |p: Point2<f64>, layer: usize| {
+        discs
+            .iter()
+            .all(|d| d.signed_distance(&p) >= need[layer] - 1e-9)
+    };
     let mut found = Vec::new();
     let mut through = |middle: Point2<f64>, across: Vector2<f64>, widest: usize| {
         let Some(layer) = (widest..LAYERS).find(|&l| clear(middle, l)) else {
@@ -102,11 +92,11 @@ pub fn find(
     for (i, (p, dp)) in obstacles.iter().enumerate() {
         for (q, dq) in &obstacles[i + 1..] {
             // A quick reject on the bounding circles, then the exact gap.
-            let apart = (dp.center - dq.center).norm() - dp.radius - dq.radius;
+            let apart = (dp.center() - dq.center()).norm() - dp.radius() - dq.radius();
             if apart >= 2.0 * need[0] + slack || has_iwp(*p, *q) {
                 continue;
             }
-            let (a, b) = nearest_points(&dp.prism(), &dq.prism());
+            let (a, b) = nearest_points(&**dp, &**dq);
             let gap = (b - a).norm();
             let widest = (0..LAYERS).find(|&l| gap >= 2.0 * need[l]);
             let Some(widest) = widest else { continue };
@@ -127,10 +117,10 @@ pub fn find(
     let column = LAYERS - 1;
     for (_, d) in obstacles {
         for &(on, n) in &sides {
-            if (on - d.center).dot(&n) - d.radius >= need[column] + slack {
+            if (on - d.center()).dot(&n) - d.radius() >= need[column] + slack {
                 continue;
             }
-            let (a, gap) = nearest_to_side(d, on, n);
+            let (a, gap) = d.nearest_to_line(&on, &n);
             if gap < need[column] || gap >= need[column] + slack {
                 continue;
             }

@@ -59,14 +59,15 @@ use serde::{Deserialize, Serialize};
 pub use reuse::reuse;
 
 use self::corridor::{assemble, through_crossings};
-use self::field::{Disc, Field};
+use self::field::Field;
 use self::guide::Guide;
 use self::levels::Levels;
 use self::search::{Graph, Jump, LAYERS, bit, climb_bit};
 use self::squeeze::squeeze_map;
 use super::iwp::{Iwp, Shape as FormationShape, column_spacing, min_pair_distance};
 use super::path::{PathBuilder, SqueezeMap};
-use crate::mission::{Mission, Obstacle};
+use crate::base::shape::Footprint;
+use crate::mission::Mission;
 
 /// Angles tried round each inspected obstacle.
 const PASS_ANGLES: usize = 16;
@@ -222,22 +223,14 @@ impl Shape {
 
 /// The obstacles in the way of a formation flying anywhere in `span`, as
 /// discs (see [`levels::blocks`]).
-fn blocking(mission: &Mission, span: [f64; 2]) -> Vec<(usize, Disc)> {
+fn blocking(mission: &Mission, span: [f64; 2]) -> Vec<(usize, Footprint)> {
     mission
         .obstacles
         .iter()
         .enumerate()
         .filter(|(_, o)| levels::blocks(mission, o, span))
-        .map(|(k, o)| (k, disc_of(o)))
+        .map(|(k, o)| (k, o.outline()))
         .collect()
-}
-
-fn disc_of(o: &Obstacle) -> Disc {
-    Disc {
-        center: o.center,
-        radius: o.radius,
-        polygon: (!o.footprint.is_empty()).then(|| o.footprint.as_slice().into()),
-    }
 }
 
 /// Cost of a metre climbed or descended between levels, in metres of
@@ -256,8 +249,8 @@ fn ramp(dz: f64, cell: f64) -> f64 {
 /// One level of the search: what stands in the way there.
 pub(crate) struct Level {
     /// The obstacles in the way (mission index, disc) and their discs alone.
-    obstacles: Vec<(usize, Disc)>,
-    discs: Vec<Disc>,
+    obstacles: Vec<(usize, Footprint)>,
+    discs: Vec<Footprint>,
     /// The clearance field to them.
     field: Field,
 }
@@ -323,7 +316,7 @@ impl Site {
         let at: Vec<Level> = (0..levels.len())
             .map(|l| {
                 let obstacles = blocking(mission, levels.span(l));
-                let discs: Vec<Disc> = obstacles.iter().map(|(_, d)| d.clone()).collect();
+                let discs: Vec<Footprint> = obstacles.iter().map(|(_, d)| d.clone()).collect();
                 let field = Field::new([b.x, b.y], &discs, cell, cap);
                 Level {
                     obstacles,
@@ -365,7 +358,7 @@ impl Site {
         // Where the formation may climb between two levels: every altitude
         // between them clear by the layer's need and the ramp's run.
         for (pair, run) in ramps.iter().enumerate() {
-            let discs: Vec<Disc> = blocking(mission, levels.hull(pair))
+            let discs: Vec<Footprint> = blocking(mission, levels.hull(pair))
                 .into_iter()
                 .map(|(_, d)| d)
                 .collect();
@@ -454,10 +447,9 @@ impl Site {
         let out = out / out.norm().max(1e-12);
         // Only the obstacles the straight could come near.
         let reach = step * steps as f64 + self.need[0];
-        let near: Vec<crate::base::geometry::Prism> = discs
+        let near: Vec<&Footprint> = discs
             .iter()
-            .filter(|d| (d.center - p).norm() - d.radius < reach)
-            .map(Disc::prism)
+            .filter(|d| (d.center() - p).norm() - d.radius() < reach)
             .collect();
         for k in 1..=steps {
             let q = p + out * (step * k as f64);
@@ -832,7 +824,7 @@ fn explain(
         (&site.at[0].field, &site.at[0].obstacles)
     } else {
         // In the way at every level: nothing the search tried passes them.
-        let kept: Vec<(usize, Disc)> = site.at[0]
+        let kept: Vec<(usize, Footprint)> = site.at[0]
             .obstacles
             .iter()
             .filter(|(k, _)| {
@@ -842,7 +834,7 @@ fn explain(
             })
             .cloned()
             .collect();
-        let discs: Vec<Disc> = kept.iter().map(|(_, d)| d.clone()).collect();
+        let discs: Vec<Footprint> = kept.iter().map(|(_, d)| d.clone()).collect();
         let geometry = site.field();
         let b = &mission.bounds;
         everywhere = (

@@ -148,7 +148,7 @@ pub(super) fn squeeze_map(
         obstacle_of: named
             .obstacles
             .iter()
-            .map(|(k, d)| (*k, d.center))
+            .map(|(k, d)| (*k, d.center()))
             .collect(),
         free,
         extent,

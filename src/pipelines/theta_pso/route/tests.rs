@@ -117,10 +117,10 @@ fn the_guided_search_finds_a_route_as_short_as_dijkstras() {
     for k in 0..30 {
         let y = k as f64;
         if !(14.0..17.0).contains(&y) {
-            discs.push(Disc::round(Point2::new(15.0, y), 0.5));
+            discs.push(Footprint::circle(Point2::new(15.0, y), 0.5));
         }
         if !(5.0..7.0).contains(&y) {
-            discs.push(Disc::round(Point2::new(30.0, y), 0.5));
+            discs.push(Footprint::circle(Point2::new(30.0, y), 0.5));
         }
     }
     let field = Field::new([[0.0, 45.0], [0.0, 30.0]], &discs, 0.25, 6.0);

@@ -222,14 +222,15 @@ pub(super) fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewp
         let width = Span::raw(label.as_str()).width() as f64;
         // Beside the outline at its centre's height: a footprint's own
         // extent across, not its bounding circle's (a long beam's is wide).
-        let (west, east) = if o.footprint.is_empty() {
-            (o.center.x - o.radius, o.center.x + o.radius)
-        } else {
-            o.footprint
+        let shape = o.outline();
+        let (west, east) = match shape.disc() {
+            Some((c, r)) => (c.x - r, c.x + r),
+            None => shape
+                .ring(scale)
                 .iter()
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
                     (lo.min(p.x), hi.max(p.x))
-                })
+                }),
         };
         let spots = [
             (east + scale, o.center.y),

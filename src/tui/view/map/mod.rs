@@ -371,11 +371,11 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     });
     let safe = m.formation.safe_radius();
     // Safe radii first, lightly, so obstacles and paths draw over them.
-    for o in m.obstacles.iter().filter(|o| o.footprint.is_empty()) {
+    for (center, radius) in m.obstacles.iter().filter_map(|o| o.outline().disc()) {
         ctx.draw(&Ring {
-            x: o.center.x,
-            y: o.center.y,
-            radius: o.radius + safe,
+            x: center.x,
+            y: center.y,
+            radius: radius + safe,
             color: Color::DarkGray,
             dot,
         });
@@ -403,20 +403,31 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
         } else {
             Color::LightRed
         };
-        if o.footprint.is_empty() {
+        let shape = o.outline();
+        if let Some((center, radius)) = shape.disc() {
             ctx.draw(&Ring {
-                x: o.center.x,
-                y: o.center.y,
-                radius: o.radius,
+                x: center.x,
+                y: center.y,
+                radius,
                 color,
                 dot,
             });
+            if selected {
+                // A filled centre so a small selected obstacle is easy to see.
+                ctx.draw(&Ring {
+                    x: center.x,
+                    y: center.y,
+                    radius: radius * 0.5,
+                    color,
+                    dot,
+                });
+            }
         } else {
-            // The footprint's outline, closed.
-            let outline: Vec<(f64, f64)> = o
-                .footprint
+            // The outline, closed, drawn to a dot's width.
+            let ring = shape.ring(dot);
+            let outline: Vec<(f64, f64)> = ring
                 .iter()
-                .chain(o.footprint.first())
+                .chain(ring.first())
                 .map(|p| (p.x, p.y))
                 .collect();
             ctx.draw(&Polyline {
@@ -424,16 +435,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
                 color,
             });
         }
-        if selected && o.footprint.is_empty() {
-            // A filled centre so a small selected obstacle is easy to see.
-            ctx.draw(&Ring {
-                x: o.center.x,
-                y: o.center.y,
-                radius: o.radius * 0.5,
-                color,
-                dot,
-            });
-        } else if selected {
+        if selected && shape.disc().is_none() {
             // A selected footprint's corners, the one being edited filled.
             for (v, q) in o.footprint.iter().enumerate() {
                 let edited = *app.selected() == Item::Vertex(i, v);
@@ -602,7 +604,7 @@ pub(super) fn via_marks(m: &crate::mission::Mission) -> Vec<(usize, Point2<f64>)
             let [a, b] = v.between.as_ref()?;
             let find = |n: &str| m.obstacles.iter().find(|o| o.name == n);
             let (pa, pb) = (m.prism(find(a)?), m.prism(find(b)?));
-            let (p, q) = crate::base::geometry::nearest_points(&pa, &pb);
+            let (p, q) = crate::base::shape::nearest_points(&*pa.outline, &*pb.outline);
             Some((k, nalgebra::center(&p, &q)))
         })
         .collect()

@@ -300,7 +300,7 @@ const NEAR: f64 = 5.0;
 fn stretches_by(
     points: &[Point3<f64>],
     along: &[f64],
-    prism: &crate::base::geometry::Prism,
+    prism: &crate::base::shape::Prism,
     reach: f64,
     length: f64,
 ) -> (Vec<[f64; 2]>, Option<(f64, f64)>) {
