@@ -17,11 +17,14 @@ pub use crate::record::{Finished, Recorder};
 /// What to run: a seed, how the run may use the machine, and the
 /// pipeline's own request (which pipeline, and what only it reads: θ-PSO's
 /// warm start, the fleet's agent processes).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Run {
     pub seed: u64,
     pub options: PlanOptions,
     pub request: Request,
+    /// What was found of the mission's revision already (the designer's),
+    /// for the run to read instead of finding it again.
+    pub revision: Option<std::sync::Arc<crate::pipelines::Revision>>,
 }
 
 /// What a run left: the outcome (or why there is none) and the recording.
@@ -44,6 +47,7 @@ impl Run {
             seed,
             options: PlanOptions::default(),
             request: request.into(),
+            revision: None,
         }
     }
 
@@ -94,6 +98,7 @@ impl Run {
             mission,
             self.seed,
             self.options,
+            self.revision.as_deref(),
             observer,
             cancel,
         )

@@ -144,6 +144,7 @@ pub fn passing_plan(
         seed,
         options: crate::pipelines::PlanOptions::default(),
         request: &request,
+        revision: None,
     };
     let outcome = pipeline
         .face()
@@ -176,7 +177,7 @@ fn invalid_with(
     change(&mut changed);
     let rules = crate::pipelines::validate(&changed);
     let is_error = |d: &crate::mission::Diagnostic| d.severity == crate::mission::Severity::Error;
-    let findings = || pipeline.face().findings(&changed);
+    let findings = || pipeline.face().findings(&changed, None);
     rules
         .into_iter()
         .find(is_error)

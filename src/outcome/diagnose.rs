@@ -11,13 +11,9 @@ use crate::mission::{self, Checked, Diagnostic, Mission, Report, SourceMap};
 
 /// Validation and every pipeline's own findings, errors and warnings.
 pub fn diagnose(mission: &Mission) -> Vec<Diagnostic> {
-    let mut all = crate::pipelines::validate(mission);
     // A pipeline's findings only mean something on a mission that follows the
     // rules; on one that does not, the rules' errors are the news.
-    if !all.iter().any(Diagnostic::is_error) {
-        all.extend(pipeline_findings(mission));
-    }
-    all
+    crate::pipelines::Revision::of(mission).diagnostics()
 }
 
 /// What the pipelines say of a mission that follows the rules: their budgets
@@ -33,7 +29,7 @@ fn pipeline_findings(mission: &Mission) -> Vec<Diagnostic> {
         .flat_map(|kind| kind.face().budget(mission));
     let findings = Kind::ALL
         .into_iter()
-        .flat_map(|kind| kind.face().findings(mission));
+        .flat_map(|kind| kind.face().findings(mission, None));
     budgets.chain(findings).collect()
 }
 

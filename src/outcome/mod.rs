@@ -59,16 +59,26 @@ pub fn run(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<Outcome, PipelineError> {
-    run_request(&kind.request(), mission, seed, options, observer, cancel)
+    run_request(
+        &kind.request(),
+        mission,
+        seed,
+        options,
+        None,
+        observer,
+        cancel,
+    )
 }
 
 /// [`run`], the pipeline asked `request` (its own request type: θ-PSO's
-/// warm start, say). The one place a run is handed to its pipeline.
+/// warm start, say), reading what was found of the mission's `revision`
+/// already, if anything. The one place a run is handed to its pipeline.
 pub fn run_request(
     request: &Request,
     mission: &Mission,
     seed: u64,
     options: PlanOptions,
+    revision: Option<&crate::pipelines::Revision>,
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<Outcome, PipelineError> {
@@ -76,6 +86,7 @@ pub fn run_request(
         seed,
         options,
         request,
+        revision,
     };
     request.kind().face().run(mission, ask, observer, cancel)
 }

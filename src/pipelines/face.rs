@@ -142,6 +142,10 @@ pub struct Ask<'a> {
     pub seed: u64,
     pub options: PlanOptions,
     pub request: &'a super::Request,
+    /// What was found of this revision of the mission already (the
+    /// designer's, on every edit): the run reads it instead of finding it
+    /// again. `None`: the run finds its own.
+    pub revision: Option<&'a super::Revision>,
 }
 
 /// A pipeline: its words, its limits and its run. One unit value per
@@ -220,8 +224,14 @@ pub trait Pipeline: Sync {
     /// What it says of a mission that follows the rules, before a run
     /// (θ-PSO: IWPs no shape can pass, inspections eq. 8 cannot hold;
     /// FLATLO: airspeeds and bounds predicted from its references).
-    fn findings(&self, _mission: &Mission) -> Vec<Diagnostic> {
+    fn findings(&self, _mission: &Mission, _prepared: Option<&super::Prepared>) -> Vec<Diagnostic> {
         Vec::new()
+    }
+    /// What it finds of a mission that follows the rules once per
+    /// revision, for its findings and its run to read (θ-PSO: the IWPs);
+    /// kept in the [`super::Revision`].
+    fn prepare(&self, _mission: &Mission) -> Option<super::Prepared> {
+        None
     }
     /// Its predicted size against the documented limits (`limits`).
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic>;

@@ -11,6 +11,7 @@
 pub mod chart;
 pub mod face;
 pub mod interface;
+pub mod revision;
 pub mod sketch;
 pub mod table;
 
@@ -25,6 +26,7 @@ pub use face::{
     Verdict,
 };
 pub use interface::*;
+pub use revision::{Prepared, Revision};
 
 /// The planning pipelines: what `outcome::run` runs, what a track came
 /// from, what the CLI's `--pipeline` and the designer's run keys name. Its

@@ -7,8 +7,10 @@
 //! rather than counting edits, so undoing back to the saved state clears it.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use crate::mission::{self, Diagnostic, Mission, MissionError};
+use crate::pipelines::Revision;
 
 /// Undo steps kept; the oldest are forgotten first.
 const HISTORY_LIMIT: usize = 500;
@@ -25,7 +27,11 @@ pub struct Document {
     redo: Vec<Mission>,
     /// The mission before the gesture (drag) in progress, if any.
     gesture: Option<Mission>,
-    /// `validate(mission)`, refreshed after every change.
+    /// What was found of the mission as it is (its diagnostics, each
+    /// pipeline's preparation: θ-PSO's IWPs), once after every change; the
+    /// map, the inspector and the live run read it.
+    revision: Arc<Revision>,
+    /// `revision`'s diagnostics.
     diagnostics: Vec<Diagnostic>,
     /// The text the mission was read from (or last saved as): saves edit it
     /// in place, so the user's comments and layout stay.
@@ -40,7 +46,8 @@ pub struct Document {
 
 impl Document {
     pub fn new(mission: Mission, path: Option<PathBuf>) -> Self {
-        let diagnostics = crate::outcome::diagnose::diagnose(&mission);
+        let revision = Arc::new(Revision::of(&mission));
+        let diagnostics = revision.diagnostics();
         Document {
             saved: mission.clone(),
             never_saved: false,
@@ -49,6 +56,7 @@ impl Document {
             undo: Vec::new(),
             redo: Vec::new(),
             gesture: None,
+            revision,
             diagnostics,
             source: None,
             changes: 0,
@@ -129,6 +137,17 @@ impl Document {
         &self.diagnostics
     }
 
+    /// What was found of the mission as it is, once (see `revision`).
+    pub fn revision(&self) -> Arc<Revision> {
+        Arc::clone(&self.revision)
+    }
+
+    /// Finds the revision's diagnostics and preparations, after a change.
+    fn look(&mut self) {
+        self.revision = Arc::new(Revision::of(&self.mission));
+        self.diagnostics = self.revision.diagnostics();
+    }
+
     pub fn error_count(&self) -> usize {
         self.diagnostics.iter().filter(|d| d.is_error()).count()
     }
@@ -168,7 +187,7 @@ impl Document {
             return self.edit(change);
         }
         change(&mut self.mission);
-        self.diagnostics = crate::outcome::diagnose::diagnose(&self.mission);
+        self.look();
     }
 
     pub fn end_gesture(&mut self) {
@@ -195,7 +214,7 @@ impl Document {
             Some(previous) => {
                 self.redo
                     .push(std::mem::replace(&mut self.mission, previous));
-                self.diagnostics = crate::outcome::diagnose::diagnose(&self.mission);
+                self.look();
                 true
             }
             None => false,
@@ -208,7 +227,7 @@ impl Document {
         match self.redo.pop() {
             Some(next) => {
                 self.undo.push(std::mem::replace(&mut self.mission, next));
-                self.diagnostics = crate::outcome::diagnose::diagnose(&self.mission);
+                self.look();
                 true
             }
             None => false,
@@ -266,7 +285,7 @@ impl Document {
 
     fn changed(&mut self) {
         self.changes += 1;
-        self.diagnostics = crate::outcome::diagnose::diagnose(&self.mission);
+        self.look();
     }
 }
 

@@ -275,7 +275,7 @@ impl Editor {
     /// After any change to the mission: keep the selection valid, recompute IWPs.
     fn refresh(&mut self) {
         let m = self.doc.mission();
-        self.iwps = iwps_despite_choices(m, self.doc.diagnostics());
+        self.iwps = iwps_despite_choices(m, &self.doc.revision());
         if !self.selected.exists(m) {
             self.selected = match self.selected {
                 Item::Vertex(i, _) if i < m.obstacles.len() => Item::Obstacle(i),
@@ -892,7 +892,8 @@ impl Editor {
 /// The IWPs (eq. 9) of a mission whose only errors, if any, are in IWP
 /// choices: those choices are left out, so the map still marks every IWP
 /// while the user fixes the choice. Any other error: none.
-fn iwps_despite_choices(m: &Mission, diagnostics: &[mission::Diagnostic]) -> Vec<Iwp> {
+fn iwps_despite_choices(m: &Mission, revision: &crate::pipelines::Revision) -> Vec<Iwp> {
+    let diagnostics = revision.diagnostics();
     let mut bad = Vec::new();
     for d in diagnostics.iter().filter(|d| d.is_error()) {
         match d.path.0.as_slice() {
@@ -906,7 +907,14 @@ fn iwps_despite_choices(m: &Mission, diagnostics: &[mission::Diagnostic]) -> Vec
         }
     }
     if bad.is_empty() {
-        return find_iwps(m);
+        // Found with the revision's findings already.
+        return match revision
+            .prepared(crate::pipelines::Kind::ThetaPso)
+            .and_then(|p| p.downcast_ref::<Vec<Iwp>>())
+        {
+            Some(iwps) => iwps.clone(),
+            None => find_iwps(m),
+        };
     }
     let mut clean = m.clone();
     let mut k = 0;

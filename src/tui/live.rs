@@ -218,6 +218,9 @@ impl Live {
         let id = self.next_id;
         self.next_id += 1;
         let mut run = Run::new(self.pipeline, mission.seed);
+        // What the edit already found (θ-PSO's IWPs, the findings): read,
+        // not found again.
+        run.revision = Some(doc.revision());
         // A pipeline with warm starts (θ-PSO) starts from the last plan.
         if let Some(request) = self
             .latest

@@ -1657,6 +1657,39 @@ fn live_planning_follows_edits_pauses_on_errors_and_stops_when_off() {
     assert!(app.shown().is_some_and(|j| app.is_stale(j)));
 }
 
+/// Issue 53, "once per revision": on the bridge with live planning, the
+/// IWPs (eq. 9) are found once per edit, by the edit: the map, the
+/// inspector, the findings and the live run read that one search
+/// (`pipelines::Revision`), and the live plan is still of the mission as
+/// edited and passes verification.
+#[test]
+fn a_live_replan_finds_the_iwps_once_per_edit() {
+    use skyform::pipelines::theta_pso::iwp::searches;
+    let wait = Duration::from_secs(120);
+    let mut m = default_mission().mission;
+    m.name = "IWPs once per edit".into();
+    let name = m.name.clone();
+    let mut app = App::new(Document::new(m, None), std::env::temp_dir());
+    assert_eq!(searches::of(&name), 1, "opening the mission: one search");
+    assert!(!app.iwps().is_empty(), "the map has the bridge's IWP");
+    assert!(app.start_live(skyform::pipelines::Kind::ThetaPso).is_ok());
+    assert!(app.settle_live(wait));
+    assert_eq!(searches::of(&name), 1, "the first live plan read it");
+    for (k, edit) in [(0.0, -1.0), (1.0, 0.0), (0.0, 1.0)]
+        .into_iter()
+        .enumerate()
+    {
+        app.update(Action::Select(Item::Obstacle(1)));
+        app.update(Action::Nudge(edit.0, edit.1));
+        assert!(app.settle_live(wait));
+        assert_eq!(searches::of(&name), 2 + k, "edit {}: one search", k + 1);
+        let job = app.shown().expect("a live plan");
+        assert_eq!(&job.mission, app.mission(), "of the mission as edited");
+        let o = job.outcome.as_ref().and_then(|o| o.theta_pso()).unwrap();
+        assert!(o.feasible(), "edit {}: not feasible", k + 1);
+    }
+}
+
 /// Issue 37, a footprint's vertices edited with undo: `c` selects the
 /// first corner of a selected footprint, `n` steps to the next, a nudge
 /// moves it (its bounding circle follows), `d` adds a vertex halfway to the

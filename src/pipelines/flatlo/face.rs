@@ -76,7 +76,11 @@ impl Pipeline for Flatlo {
         recording::PLOTS
     }
 
-    fn findings(&self, mission: &Mission) -> Vec<Diagnostic> {
+    fn findings(
+        &self,
+        mission: &Mission,
+        _prepared: Option<&crate::pipelines::Prepared>,
+    ) -> Vec<Diagnostic> {
         super::diagnostics(mission)
     }
 

@@ -84,7 +84,11 @@ impl Pipeline for Fleet {
 
     /// A written `fleet.duration` shorter than the fleet needs to reach its
     /// last target at its cruise speed.
-    fn findings(&self, mission: &Mission) -> Vec<Diagnostic> {
+    fn findings(
+        &self,
+        mission: &Mission,
+        _prepared: Option<&crate::pipelines::Prepared>,
+    ) -> Vec<Diagnostic> {
         super::duration_finding(mission).into_iter().collect()
     }
 

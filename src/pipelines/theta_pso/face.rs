@@ -97,8 +97,21 @@ impl Pipeline for ThetaPso {
         recording::PLOTS
     }
 
-    fn findings(&self, mission: &Mission) -> Vec<Diagnostic> {
-        super::diagnostics(mission)
+    fn findings(
+        &self,
+        mission: &Mission,
+        prepared: Option<&crate::pipelines::Prepared>,
+    ) -> Vec<Diagnostic> {
+        match prepared.and_then(|p| p.downcast_ref::<Vec<super::Iwp>>()) {
+            Some(iwps) => super::diagnostics_given(mission, iwps),
+            None => super::diagnostics(mission),
+        }
+    }
+
+    /// The IWPs (eq. 9), found once per revision: the findings, the map
+    /// and the run read them.
+    fn prepare(&self, mission: &Mission) -> Option<crate::pipelines::Prepared> {
+        Some(std::sync::Arc::new(super::find_iwps(mission)))
     }
 
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic> {
@@ -133,7 +146,16 @@ impl Pipeline for ThetaPso {
             crate::pipelines::Request::ThetaPso(own) => own.warm.as_deref(),
             _ => None,
         };
-        super::plan_warm(mission, ask.seed, ask.options, warm, observer, cancel).map(Outcome::from)
+        super::plan::plan_given(
+            mission,
+            ask.seed,
+            ask.options,
+            warm,
+            ask.revision,
+            observer,
+            cancel,
+        )
+        .map(Outcome::from)
     }
 }
 

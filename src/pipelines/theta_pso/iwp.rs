@@ -620,6 +620,7 @@ fn bounding_circles(mission: &Mission) -> Vec<Circle> {
 /// both block, the gap and its ends, what else stands in it, the operator's choice, the shape
 /// and its hold), each test reading the figures of the one before.
 pub fn find_iwps(mission: &Mission) -> Vec<Iwp> {
+    searches::count(&mission.name);
     let f = &mission.formation;
     let r_q = f.least_clearance();
     let too_narrow = 2.0 * r_q;
@@ -910,6 +911,32 @@ fn prefer_columns_in_sequence(mission: &Mission, circles: &[Circle], iwps: &mut 
             iwp.hold = hold;
             iwp.straight = straight;
         }
+    }
+}
+
+/// How many times the IWPs of a mission, by name, were searched for in
+/// this process: what shows that an edit finds them once (a test reads
+/// it; a mission name per test keeps tests apart).
+pub mod searches {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+
+    fn table() -> &'static Mutex<HashMap<String, usize>> {
+        static TABLE: OnceLock<Mutex<HashMap<String, usize>>> = OnceLock::new();
+        TABLE.get_or_init(Mutex::default)
+    }
+
+    pub(super) fn count(name: &str) {
+        if let Ok(mut t) = table().lock() {
+            *t.entry(name.to_owned()).or_default() += 1;
+        }
+    }
+
+    /// The searches for the mission named `name` so far.
+    pub fn of(name: &str) -> usize {
+        table()
+            .lock()
+            .map_or(0, |t| t.get(name).copied().unwrap_or(0))
     }
 }
 

@@ -21,7 +21,9 @@ use super::{
 };
 use crate::base::swarm::{self, SwarmConfig};
 use crate::mission::Mission;
-use crate::pipelines::{CancelToken, Completion, Event, Level, Observer, PipelineError};
+use crate::pipelines::{
+    CancelToken, Completion, Event, Kind, Level, Observer, PipelineError, Revision,
+};
 
 /// Plans `mission` with `seed`. Reports to `observer`, stops early (keeping
 /// the best so far) when `cancel` is set. Fails on an invalid mission and
@@ -55,12 +57,33 @@ pub fn plan_warm(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<ThetaPsoOutcome, PipelineError> {
+    plan_given(mission, seed, options, warm, None, observer, cancel)
+}
+
+/// [`plan_warm`] on a mission whose `revision` was already looked at (the
+/// designer's, on each edit): its IWPs and its findings are read, not found
+/// again. `None`: found here, once.
+pub fn plan_given(
+    mission: &Mission,
+    seed: u64,
+    options: PlanOptions,
+    warm: Option<&WarmStart>,
+    revision: Option<&Revision>,
+    observer: &mut dyn Observer,
+    cancel: &CancelToken,
+) -> Result<ThetaPsoOutcome, PipelineError> {
     if mission.theta_pso.cost == crate::mission::CostKind::Spso {
         return benchmark::plan(mission, seed, observer, cancel);
     }
     // Found once: the admission and the search read the same IWPs.
-    let iwps = super::find_iwps(mission);
-    admit(mission, &iwps)?;
+    let given = revision
+        .and_then(|r| r.prepared(Kind::ThetaPso))
+        .and_then(|p| p.downcast_ref::<Vec<Iwp>>());
+    let iwps = match given {
+        Some(iwps) => iwps.clone(),
+        None => super::find_iwps(mission),
+    };
+    admit(mission, &iwps, revision)?;
     let mut problem = intermediate_waypoints(mission, iwps, observer)?;
     let corridor = route_stage(mission, &mut problem, warm, observer)?;
     let starts = seed_swarm(mission, &problem, &corridor, seed, warm, observer);
@@ -78,9 +101,18 @@ pub fn plan_warm(
 
 /// Before Fig. 3's first line: a valid mission within the run's budget,
 /// with no IWP or inspection already known to be impossible.
-fn admit(mission: &Mission, iwps: &[Iwp]) -> Result<(), PipelineError> {
-    crate::pipelines::require_valid(mission)?;
-    crate::pipelines::require_within_budget(budget(mission))?;
+fn admit(
+    mission: &Mission,
+    iwps: &[Iwp],
+    revision: Option<&Revision>,
+) -> Result<(), PipelineError> {
+    match revision {
+        Some(r) => r.admit_rules(Kind::ThetaPso)?,
+        None => {
+            crate::pipelines::require_valid(mission)?;
+            crate::pipelines::require_within_budget(budget(mission))?;
+        }
+    }
     // A gate the user asked for that no formation can take: no plan keeps
     // the route as written.
     if mission.route.via.iter().any(|v| v.between.is_some())
@@ -99,6 +131,9 @@ fn admit(mission: &Mission, iwps: &[Iwp]) -> Result<(), PipelineError> {
             obstacles: iwp.between.to_vec(),
             passages: Vec::new(),
         }));
+    }
+    if let Some(r) = revision {
+        return r.admit_findings(Kind::ThetaPso);
     }
     let errors: Vec<String> = super::diagnostics_given(mission, iwps)
         .into_iter()

@@ -1,0 +1,119 @@
+//! A mission at one revision and what was found of it, once: the rules'
+//! diagnostics, every pipeline's predicted size and findings, and what each
+//! pipeline prepared for a run (θ-PSO: its IWPs). The designer finds them on
+//! each edit and passes them on: the map, the inspector, the status line
+//! and the live run read the same, and nothing is found twice for one edit
+//! (issue 53). A run without one (the CLI, a sweep) finds its own.
+
+use std::any::Any;
+use std::sync::Arc;
+
+use super::{Kind, PipelineError};
+use crate::mission::{Diagnostic, Mission};
+
+/// What a pipeline prepared of a mission for its findings and its run;
+/// only that pipeline knows its type (`Pipeline::prepare`).
+pub type Prepared = Arc<dyn Any + Send + Sync>;
+
+/// What was found of one revision of a mission.
+#[derive(Default)]
+pub struct Revision {
+    /// The file's and the sections' rules (`pipelines::validate`).
+    rules: Vec<Diagnostic>,
+    /// Per pipeline, in `Kind::ALL`'s order: its predicted size against the
+    /// limits, its findings, what it prepared. Empty when a rule is broken
+    /// (a pipeline's findings mean nothing then).
+    own: Vec<Own>,
+}
+
+impl std::fmt::Debug for Revision {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Revision")
+            .field("diagnostics", &self.diagnostics().len())
+            .finish_non_exhaustive()
+    }
+}
+
+struct Own {
+    kind: Kind,
+    budget: Vec<Diagnostic>,
+    findings: Vec<Diagnostic>,
+    prepared: Option<Prepared>,
+}
+
+impl Revision {
+    /// Everything skyform says of `mission` before a run, found once.
+    pub fn of(mission: &Mission) -> Self {
+        let rules = super::validate(mission);
+        if rules.iter().any(Diagnostic::is_error) {
+            return Revision {
+                rules,
+                own: Vec::new(),
+            };
+        }
+        let own = Kind::ALL
+            .into_iter()
+            .map(|kind| {
+                let face = kind.face();
+                let prepared = face.prepare(mission);
+                Own {
+                    kind,
+                    budget: face.budget(mission),
+                    findings: face.findings(mission, prepared.as_ref()),
+                    prepared,
+                }
+            })
+            .collect();
+        Revision { rules, own }
+    }
+
+    /// Every diagnostic, as `check` and the designer list them: the rules,
+    /// then every pipeline's predicted size, then every pipeline's findings.
+    pub fn diagnostics(&self) -> Vec<Diagnostic> {
+        let budgets = self.own.iter().flat_map(|o| o.budget.iter());
+        let findings = self.own.iter().flat_map(|o| o.findings.iter());
+        self.rules
+            .iter()
+            .chain(budgets)
+            .chain(findings)
+            .cloned()
+            .collect()
+    }
+
+    /// What `kind` prepared (for its own run to read back).
+    pub fn prepared(&self, kind: Kind) -> Option<&Prepared> {
+        self.own.iter().find(|o| o.kind == kind)?.prepared.as_ref()
+    }
+
+    /// A run of `kind` may start as far as the rules and its limits go:
+    /// the same refusals, in the same words, as a run that finds them.
+    pub fn admit_rules(&self, kind: Kind) -> Result<(), PipelineError> {
+        refuse(&self.rules, PipelineError::InvalidMission)?;
+        refuse(&self.own_of(kind)?.budget, PipelineError::OverBudget)
+    }
+
+    /// Its findings hold no error (an inspection eq. 8 cannot hold).
+    pub fn admit_findings(&self, kind: Kind) -> Result<(), PipelineError> {
+        refuse(&self.own_of(kind)?.findings, PipelineError::InvalidMission)
+    }
+
+    fn own_of(&self, kind: Kind) -> Result<&Own, PipelineError> {
+        self.own.iter().find(|o| o.kind == kind).ok_or_else(|| {
+            PipelineError::InvalidMission("the mission was not looked at for this run".into())
+        })
+    }
+}
+
+/// The errors among `found`, one per line, as the refusal `error` makes.
+fn refuse(found: &[Diagnostic], error: fn(String) -> PipelineError) -> Result<(), PipelineError> {
+    let errors: Vec<String> = found
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.to_string())
+        .collect();
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(error(errors.join("\n")))
+    }
+}
