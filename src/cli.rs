@@ -864,6 +864,7 @@ fn run_pipeline(
                     "reason": no_plan.reason,
                     "obstacles": no_plan.obstacles,
                     "passages": no_plan.passages,
+                    "route": no_plan.route,
                 });
                 let text = serde_json::to_string_pretty(&record).unwrap_or_default();
                 if target.as_os_str() == "-" {

@@ -165,23 +165,23 @@ pub fn validate(mission: &crate::mission::Mission) -> Vec<crate::mission::Diagno
 
 /// Every pipeline's first step: a mission with errors is refused, naming them.
 pub fn require_valid(mission: &crate::mission::Mission) -> Result<(), PipelineError> {
-    refuse_errors(validate(mission), PipelineError::InvalidMission)
+    refuse_errors(&validate(mission), PipelineError::InvalidMission)
 }
 
 /// A run's predicted size over its documented limit: refused before it starts.
 pub fn require_within_budget(
     findings: Vec<crate::mission::Diagnostic>,
 ) -> Result<(), PipelineError> {
-    refuse_errors(findings, PipelineError::OverBudget)
+    refuse_errors(&findings, PipelineError::OverBudget)
 }
 
 /// The errors among `findings`, one per line, as the refusal `error` makes.
-fn refuse_errors(
-    findings: Vec<crate::mission::Diagnostic>,
+pub(crate) fn refuse_errors(
+    findings: &[crate::mission::Diagnostic],
     error: fn(String) -> PipelineError,
 ) -> Result<(), PipelineError> {
     let errors: Vec<String> = findings
-        .into_iter()
+        .iter()
         .filter(|d| d.is_error())
         .map(|d| d.to_string())
         .collect();
@@ -295,6 +295,10 @@ pub struct NoPlan {
     /// The passages that close the way, widest first (empty when the
     /// refusal is not about a passage).
     pub passages: Vec<Passage>,
+    /// The route that was tried: from the start as far as the formation
+    /// reached, to its point nearest the goal, where it turns (ENU metres;
+    /// empty when the refusal is not the route search's).
+    pub route: Vec<[f64; 2]>,
 }
 
 /// A passage between two obstacles too narrow for the formation, as a

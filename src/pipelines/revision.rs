@@ -8,6 +8,7 @@
 use std::any::Any;
 use std::sync::Arc;
 
+use super::interface::refuse_errors;
 use super::{Kind, PipelineError};
 use crate::mission::{Diagnostic, Mission};
 
@@ -88,32 +89,18 @@ impl Revision {
     /// A run of `kind` may start as far as the rules and its limits go:
     /// the same refusals, in the same words, as a run that finds them.
     pub fn admit_rules(&self, kind: Kind) -> Result<(), PipelineError> {
-        refuse(&self.rules, PipelineError::InvalidMission)?;
-        refuse(&self.own_of(kind)?.budget, PipelineError::OverBudget)
+        refuse_errors(&self.rules, PipelineError::InvalidMission)?;
+        refuse_errors(&self.own_of(kind)?.budget, PipelineError::OverBudget)
     }
 
     /// Its findings hold no error (an inspection eq. 8 cannot hold).
     pub fn admit_findings(&self, kind: Kind) -> Result<(), PipelineError> {
-        refuse(&self.own_of(kind)?.findings, PipelineError::InvalidMission)
+        refuse_errors(&self.own_of(kind)?.findings, PipelineError::InvalidMission)
     }
 
     fn own_of(&self, kind: Kind) -> Result<&Own, PipelineError> {
         self.own.iter().find(|o| o.kind == kind).ok_or_else(|| {
             PipelineError::InvalidMission("the mission was not looked at for this run".into())
         })
-    }
-}
-
-/// The errors among `found`, one per line, as the refusal `error` makes.
-fn refuse(found: &[Diagnostic], error: fn(String) -> PipelineError) -> Result<(), PipelineError> {
-    let errors: Vec<String> = found
-        .iter()
-        .filter(|d| d.is_error())
-        .map(|d| d.to_string())
-        .collect();
-    if errors.is_empty() {
-        Ok(())
-    } else {
-        Err(error(errors.join("\n")))
     }
 }

@@ -9,7 +9,7 @@
 //! The rest of the screen reaches it through [`Editor::update`] and reads it
 //! through its accessors.
 //!
-//! Long (~875 lines) because every edit the designer offers is a method here (add,
+//! Long (~970 lines) because every edit the designer offers is a method here (add,
 //! duplicate, delete, nudge, drag, presets, shapes, undo, the inspector's typed line), each
 //! going through the selection and leaving it and the IWPs current.
 
@@ -908,10 +908,7 @@ fn iwps_despite_choices(m: &Mission, revision: &crate::pipelines::Revision) -> V
     }
     if bad.is_empty() {
         // Found with the revision's findings already.
-        return match revision
-            .prepared(crate::pipelines::Kind::ThetaPso)
-            .and_then(|p| p.downcast_ref::<Vec<Iwp>>())
-        {
+        return match crate::pipelines::theta_pso::face::prepared_iwps(revision) {
             Some(iwps) => iwps.clone(),
             None => find_iwps(m),
         };

@@ -155,6 +155,37 @@ fn an_aisle_five_cm_too_narrow_is_refused_naming_it_and_the_json_says_so() {
     let y = |k: usize| ends[k][1].as_f64().unwrap_or(f64::NAN);
     assert!((y(0) - (-13.5 + 2.0 * 3.1 + 2.6)).abs() < 1e-9, "{v}");
     assert!((y(1) - y(0) - 0.81).abs() < 1e-9, "{v}");
+    // The route that was tried, to draw beside them: from the start as far
+    // as the formation reached, to its point nearest the goal; everywhere
+    // clear of the bays by more than r_Q.
+    let route: Vec<Point2<f64>> = v["route"]
+        .as_array()
+        .map(|r| {
+            r.iter()
+                .map(|p| {
+                    Point2::new(
+                        p[0].as_f64().unwrap_or(f64::NAN),
+                        p[1].as_f64().unwrap_or(f64::NAN),
+                    )
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    assert!(route.len() >= 2, "{v}");
+    let (start, goal) = (m.route.start.xy(), m.route.goal.xy());
+    assert!((route[0] - start).norm() < 0.5, "begins at the start: {v}");
+    let last = route[route.len() - 1];
+    assert!(
+        (last - goal).norm() < (start - goal).norm() - 1.0,
+        "it got on towards the goal: {last} {v}"
+    );
+    let r_q = m.formation.least_clearance();
+    for p in &route {
+        for o in &m.obstacles {
+            let d = o.outline().signed_distance(p);
+            assert!(d > r_q, "{p} is {d:.2} m from '{}': {v}", o.name);
+        }
+    }
 }
 
 /// Issue 51: `check` on a row of footprints with 2.5 m aisles warns of no

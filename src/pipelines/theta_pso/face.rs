@@ -12,6 +12,14 @@ use crate::pipelines::{
 /// θ-PSO (`Kind::ThetaPso`).
 pub struct ThetaPso;
 
+/// The IWPs θ-PSO found of `revision` (its `Pipeline::prepare`), if it
+/// was looked at.
+pub fn prepared_iwps(revision: &crate::pipelines::Revision) -> Option<&Vec<super::Iwp>> {
+    revision
+        .prepared(crate::pipelines::Kind::ThetaPso)?
+        .downcast_ref::<Vec<super::Iwp>>()
+}
+
 impl Pipeline for ThetaPso {
     fn name(&self) -> &'static str {
         "θ-PSO"
@@ -109,7 +117,7 @@ impl Pipeline for ThetaPso {
     }
 
     /// The IWPs (eq. 9), found once per revision: the findings, the map
-    /// and the run read them.
+    /// and the run read them ([`prepared_iwps`]).
     fn prepare(&self, mission: &Mission) -> Option<crate::pipelines::Prepared> {
         Some(std::sync::Arc::new(super::find_iwps(mission)))
     }

@@ -76,9 +76,7 @@ pub fn plan_given(
         return benchmark::plan(mission, seed, observer, cancel);
     }
     // Found once: the admission and the search read the same IWPs.
-    let given = revision
-        .and_then(|r| r.prepared(Kind::ThetaPso))
-        .and_then(|p| p.downcast_ref::<Vec<Iwp>>());
+    let given = revision.and_then(super::face::prepared_iwps);
     let iwps = match given {
         Some(iwps) => iwps.clone(),
         None => super::find_iwps(mission),
@@ -130,6 +128,7 @@ fn admit(
             ),
             obstacles: iwp.between.to_vec(),
             passages: Vec::new(),
+            route: Vec::new(),
         }));
     }
     if let Some(r) = revision {
@@ -199,6 +198,7 @@ fn route_stage(
                     .iter()
                     .filter_map(|&k| mission.obstacles.get(k).map(|o| o.name.clone()))
                     .collect(),
+                route: blocked.tried.iter().map(|p| [p.x, p.y]).collect(),
                 passages: blocked
                     .passages
                     .iter()

@@ -27,7 +27,7 @@ const SIDES: [&str; 4] = ["west", "east", "south", "north"];
 
 /// The reason of the route stage's refusal.
 ///
-/// Long (~170 lines): one case after another (a stop out of reach, a boxed-in start or goal, a wall between two bounds), each a sentence with its widths.
+/// Long (~200 lines): one case after another (a stop out of reach, a boxed-in start or goal, a wall between two bounds), each a sentence with its widths.
 #[allow(clippy::too_many_arguments)]
 pub fn explain(
     mission: &Mission,
@@ -141,6 +141,7 @@ pub fn explain(
             ),
             obstacles: Vec::new(),
             passages: Vec::new(),
+            tried: Vec::new(),
         };
     };
     let members: Vec<usize> = (0..n).filter(|&i| root(&mut parent, i) == chain).collect();
@@ -227,6 +228,7 @@ pub fn explain(
         ),
         obstacles: members.iter().map(|&i| obstacles[i].0).collect(),
         passages,
+        tried: Vec::new(),
     }
 }
 

@@ -148,6 +148,10 @@ pub struct Blocked {
     /// The gaps between them too narrow to pass, widest first: the two
     /// obstacles (indices), the width, the width needed, the gap's ends.
     pub passages: Vec<BlockedPassage>,
+    /// The route that was tried: from the start as far as the formation
+    /// reached, to its point nearest the goal (ENU metres; empty when it
+    /// could not move at all).
+    pub tried: Vec<Point2<f64>>,
 }
 
 /// A gap that closes the way: the two obstacles (indices into
@@ -598,6 +602,7 @@ fn with_altitudes(mission: &Mission, blocked: Blocked, z_box: [f64; 2]) -> Block
         reason: format!("{}; they stand{reach}: {over}{under}", blocked.reason),
         obstacles: blocked.obstacles,
         passages: blocked.passages,
+        tried: blocked.tried,
     }
 }
 
@@ -732,7 +737,11 @@ fn find_at(
     };
     let steps = match found {
         Ok(steps) => steps,
-        Err(reached) => return Err(explain(mission, iwps, builder, &site, &reached, &order)),
+        Err(reached) => {
+            let tried = search::tried(&graph, s, g, &reached);
+            let blocked = explain(mission, iwps, builder, &site, &reached, &order);
+            return Err(Blocked { tried, ..blocked });
+        }
     };
 
     let points: Vec<Point2<f64>> = via_points.iter().map(|(_, p)| p.xy()).collect();

@@ -155,6 +155,85 @@ pub fn unreachable(graph: &Graph<'_>, start: usize, goal: usize) -> Option<Reach
     Some(Reached { stage })
 }
 
+/// The route that was tried, for a refusal to draw: the shortest way from
+/// `start` through the cells `reached` (by the steps and jumps of the
+/// graph, at their lengths) to the reached cell of the furthest stage
+/// nearest `goal`, as the cells' centres where the way turns (its ends
+/// kept).
+pub fn tried(graph: &Graph<'_>, start: usize, goal: usize, reached: &Reached) -> Vec<Point2<f64>> {
+    let field = graph.field;
+    let top = reached.stage.iter().flatten().copied().max();
+    let target = (0..field.len())
+        .filter(|&c| top.is_some() && reached.stage[c] == top)
+        .min_by(|&a, &b| {
+            let d = |c: usize| (field.center(c) - field.center(goal)).norm();
+            d(a).total_cmp(&d(b))
+        });
+    let Some(target) = target else {
+        return Vec::new();
+    };
+    let jumps = jumps_from(graph);
+    let mut parent = vec![usize::MAX; field.len()];
+    let mut distance = vec![f64::INFINITY; field.len()];
+    parent[start] = start;
+    distance[start] = 0.0;
+    let mut open = BinaryHeap::from([Entry {
+        estimate: 0.0,
+        reached: 0.0,
+        state: start,
+    }]);
+    while let Some(Entry {
+        reached: d,
+        state: cell,
+        ..
+    }) = open.pop()
+    {
+        if cell == target {
+            break;
+        }
+        if d > distance[cell] {
+            continue;
+        }
+        let next = field.steps(cell).chain(
+            jumps
+                .at(cell)
+                .iter()
+                .map(|&j| (graph.jumps[j].to, graph.jumps[j].length)),
+        );
+        for (j, length) in next {
+            if reached.stage[j].is_some() && d + length < distance[j] {
+                distance[j] = d + length;
+                parent[j] = cell;
+                open.push(Entry {
+                    estimate: d + length,
+                    reached: d + length,
+                    state: j,
+                });
+            }
+        }
+    }
+    if parent[target] == usize::MAX {
+        return Vec::new();
+    }
+    let mut cells = vec![target];
+    while let Some(&c) = cells.last().filter(|&&c| c != start) {
+        cells.push(parent[c]);
+    }
+    cells.reverse();
+    let points: Vec<Point2<f64>> = cells.iter().map(|&c| field.center(c)).collect();
+    // Only where the way turns: a straight run of cells is its two ends.
+    let mut kept = vec![points[0]];
+    for w in points.windows(3) {
+        if (w[1] - w[0]).perp(&(w[2] - w[1])).abs() > 1e-9 {
+            kept.push(w[1]);
+        }
+    }
+    if points.len() > 1 {
+        kept.push(points[points.len() - 1]);
+    }
+    kept
+}
+
 /// The cheapest route from `start` to `goal` through every stage, ranked by
 /// `heuristic` (cell, mode, stage → a bound of what is left, or `None`
 /// where the goal is out of reach: the state is never entered), or the
