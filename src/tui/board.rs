@@ -480,9 +480,24 @@ impl JobBoard {
             _ => None,
         };
         let done = matches!(msg, JobMsg::Done(_, Ok(_)));
+        // A refusal of the route search is shown too: the map draws the
+        // passage that closes the way and the route that was tried.
+        let refused = matches!(
+            msg,
+            JobMsg::Done(
+                _,
+                Err(jobs::JobError::Pipeline(
+                    crate::pipelines::PipelineError::NoRoute(_)
+                ))
+            )
+        );
         let mut shown = false;
         if let Some(job) = self.jobs.iter_mut().find(|j| j.id == id) {
             job.apply(msg, now);
+            if refused {
+                self.shown = Some(id);
+                shown = true;
+            }
             if done {
                 let verb = if job.state == jobs::JobState::Cancelled {
                     "cancelled"

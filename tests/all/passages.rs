@@ -14,7 +14,7 @@ use crate::common::skyform;
 /// 0.5 m apart (no UAV passes) but for one `aisle` between bays 1.4 and
 /// 1.5, the row shifted `offset` metres across the route; the end bays run
 /// past the bounds, so the aisle is the only way. The triangle of r_Q 0.33.
-fn bays(aisle: f64, offset: f64, length: f64) -> Mission {
+pub(crate) fn bays(aisle: f64, offset: f64, length: f64) -> Mission {
     let text = format!(
         "name = \"bays\"\nseed = 1\n[bounds]\nx = [0.0, {length}]\ny = [-30.0, 30.0]\n\
          z = [3.0, 12.0]\n[route]\nstart = [5.0, 0.0, 8.0]\ngoal = [{}, 0.0, 8.0]\n\

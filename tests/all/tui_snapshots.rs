@@ -1200,3 +1200,35 @@ fn obstacle_named_in(m: &skyform::mission::Mission, name: &str) -> usize {
         .position(|o| o.name == name)
         .unwrap_or_else(|| panic!("no obstacle '{name}'"))
 }
+
+/// Issue 51: a run the route search refuses draws why on the map: the
+/// passage that closes the way, across its gap with its width and the
+/// width it needs, and the route that was tried up to it.
+#[test]
+fn a_refused_run_draws_the_passage_that_closes_the_way_and_the_route_tried() {
+    let m = crate::passages::bays(2.0 * (0.33 + 0.1) - 0.05, 0.0, 100.0);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut app = App::new(Document::new(m, None), dir.path().to_path_buf());
+    app.update(Action::Run(Kind::ThetaPso));
+    assert!(app.wait_for_jobs(Duration::from_secs(120)));
+    let job = app.shown().expect("the run is shown");
+    assert!(
+        matches!(
+            &job.state,
+            skyform::tui::jobs::JobState::Failed(skyform::tui::jobs::JobError::Pipeline(
+                skyform::pipelines::PipelineError::NoRoute(no)
+            )) if no.route.len() >= 2 && !no.passages.is_empty()
+        ),
+        "{:?}",
+        job.state
+    );
+    let screen = render_at(&app, Instant::now(), (140, 42));
+    assert!(screen.contains("✕ 0.81 m < 0.86 m"), "{screen}");
+    // Without the refusal (the same site, the aisle open) nothing is marked.
+    let open = crate::passages::bays(2.0 * (0.33 + 0.1) + 0.5, 0.0, 100.0);
+    let mut app = App::new(Document::new(open, None), dir.path().to_path_buf());
+    app.update(Action::Run(Kind::ThetaPso));
+    assert!(app.wait_for_jobs(Duration::from_secs(120)));
+    let screen = render_at(&app, Instant::now(), (140, 42));
+    assert!(!screen.contains('✕'), "{screen}");
+}
