@@ -473,37 +473,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
             color: Color::Blue,
         });
     }
-    // A refusal (NO PLAN): the route that was tried, and each passage that
-    // closes the way across its gap; the widest, the one to widen, with its
-    // width and what it needs.
-    if let Some(no) = app.shown().and_then(refusal) {
-        let tried: Vec<(f64, f64)> = no.route.iter().map(|p| (p[0], p[1])).collect();
-        ctx.draw(&Polyline {
-            points: &tried,
-            color: Color::LightYellow,
-        });
-        for (k, p) in no.passages.iter().enumerate() {
-            let [a, b] = p.ends;
-            ctx.draw(&Line {
-                x1: a[0],
-                y1: a[1],
-                x2: b[0],
-                y2: b[1],
-                color: Color::LightRed,
-            });
-            if k > 0 {
-                continue;
-            }
-            ctx.print(
-                (a[0] + b[0]) / 2.0,
-                (a[1] + b[1]) / 2.0,
-                Span::styled(
-                    format!("✕ {:.2} m < {:.2} m", p.width, p.needs),
-                    Style::default().fg(Color::LightRed).bold(),
-                ),
-            );
-        }
-    }
+    paint_refusal(ctx, app);
     // The route's vias: a gate (‖) at its gap's middle, a point (⊙).
     for (k, at) in via_marks(m) {
         let style = if *app.selected() == Item::Via(k) {
@@ -544,6 +514,40 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     paint_flight_check(ctx, app, dot);
     if shown.is_none_or(|(o, _)| !o.face().dwarfs_the_site()) {
         draw_formation_at_start(ctx, app, m, dot);
+    }
+}
+
+/// A refusal (NO PLAN) of the shown run: the route that was tried, and
+/// each passage that closes the way across its gap; the widest, the one to
+/// widen, with its width and what it needs.
+fn paint_refusal(ctx: &mut Context, app: &App) {
+    if let Some(no) = app.shown().and_then(refusal) {
+        let tried: Vec<(f64, f64)> = no.route.iter().map(|p| (p[0], p[1])).collect();
+        ctx.draw(&Polyline {
+            points: &tried,
+            color: Color::LightYellow,
+        });
+        for (k, p) in no.passages.iter().enumerate() {
+            let [a, b] = p.ends;
+            ctx.draw(&Line {
+                x1: a[0],
+                y1: a[1],
+                x2: b[0],
+                y2: b[1],
+                color: Color::LightRed,
+            });
+            if k > 0 {
+                continue;
+            }
+            ctx.print(
+                (a[0] + b[0]) / 2.0,
+                (a[1] + b[1]) / 2.0,
+                Span::styled(
+                    format!("✕ {:.2} m < {:.2} m", p.width, p.needs),
+                    Style::default().fg(Color::LightRed).bold(),
+                ),
+            );
+        }
     }
 }
 
