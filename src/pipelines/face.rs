@@ -148,47 +148,103 @@ pub struct Ask<'a> {
     pub revision: Option<&'a super::Revision>,
 }
 
+/// A pipeline's fixed words and flags: what its face says of it whatever
+/// the mission (one `static` per pipeline, read through [`Pipeline`]'s
+/// methods of the same names).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Words {
+    /// For people: `θ-PSO`.
+    pub name: &'static str,
+    /// On the command line and in file names: `theta-pso`.
+    pub slug: &'static str,
+    /// What it calls a vehicle: `UAV`.
+    pub noun: &'static str,
+    /// Its vehicles fly with fixed wings.
+    pub fixed_wing: bool,
+    /// The sweep's figure column.
+    pub figure_name: &'static str,
+    /// A sweep's two tallies: complete and good.
+    pub tallies: (&'static str, &'static str),
+    /// The verdict in one word: passed and failed.
+    pub verdicts: (&'static str, &'static str),
+    /// The headline's verdict when every hard constraint holds.
+    pub passed: &'static str,
+    /// The designer may re-plan it after every edit.
+    pub live: bool,
+    /// Its run key and the key table's words.
+    pub run_key: (char, &'static str),
+    /// Its agent-process key and words, if it flies as processes.
+    pub processes_key: Option<(char, &'static str)>,
+    /// The field that limits its speed, when not `[vehicle]`'s.
+    pub speed_field: Option<&'static str>,
+    /// What to change when its flight leaves the bounds.
+    pub bounds_advice: Option<&'static str>,
+    /// The field a flight check widens to space its vehicles apart.
+    pub spacing_field: Option<&'static str>,
+}
+
 /// A pipeline: its words, its limits and its run. One unit value per
 /// pipeline (`Kind::face`).
 pub trait Pipeline: Sync {
+    /// Its fixed words and flags, as data ([`Words`]); the methods below
+    /// read them.
+    fn words(&self) -> &'static Words;
     /// For people: `θ-PSO`.
-    fn name(&self) -> &'static str;
+    fn name(&self) -> &'static str {
+        self.words().name
+    }
     /// On the command line and in file names: `theta-pso`.
-    fn slug(&self) -> &'static str;
+    fn slug(&self) -> &'static str {
+        self.words().slug
+    }
     /// What it calls a vehicle in files and messages: `UAV`.
-    fn noun(&self) -> &'static str;
+    fn noun(&self) -> &'static str {
+        self.words().noun
+    }
     /// Its vehicles fly with fixed wings.
     fn fixed_wing(&self) -> bool {
-        false
+        self.words().fixed_wing
     }
     /// The one figure a sweep tabulates, as its column is headed.
-    fn figure_name(&self) -> &'static str;
+    fn figure_name(&self) -> &'static str {
+        self.words().figure_name
+    }
     /// What a run's two tallies are called (a sweep's columns): complete
     /// and good.
-    fn tally_words(&self) -> (&'static str, &'static str);
+    fn tally_words(&self) -> (&'static str, &'static str) {
+        self.words().tallies
+    }
     /// The verdict in one word, passed and failed (the job list).
-    fn verdict_words(&self) -> (&'static str, &'static str);
+    fn verdict_words(&self) -> (&'static str, &'static str) {
+        self.words().verdicts
+    }
     /// The headline's verdict when every hard constraint holds.
-    fn passed_phrase(&self) -> &'static str;
+    fn passed_phrase(&self) -> &'static str {
+        self.words().passed
+    }
     /// The designer may re-plan it after every edit.
-    fn live(&self) -> bool;
+    fn live(&self) -> bool {
+        self.words().live
+    }
     /// Its run key in the designer and what the key table (the help, the
     /// README) says it does.
-    fn run_key(&self) -> (char, &'static str);
+    fn run_key(&self) -> (char, &'static str) {
+        self.words().run_key
+    }
     /// The designer's key that runs it as agent processes, and its words,
     /// for one that [`Pipeline::flies_as_processes`].
     fn processes_key(&self) -> Option<(char, &'static str)> {
-        None
+        self.words().processes_key
     }
     /// The mission field that limits its vehicles' speed, when that is not
     /// the `[vehicle]` section's.
     fn speed_field(&self) -> Option<&'static str> {
-        None
+        self.words().speed_field
     }
     /// What to change when its flight leaves the bounds, where its own
     /// fields set the flight's extent; `None`: the route sets it.
     fn bounds_advice(&self) -> Option<&'static str> {
-        None
+        self.words().bounds_advice
     }
     /// The run in a few words for a sweep's first line (`θ-PSO`).
     fn describe(&self, _mission: &Mission) -> String {
@@ -208,7 +264,7 @@ pub trait Pipeline: Sync {
     /// --target` scales when the pairs break more often than the target
     /// however far the obstacles are kept. `None`: it cannot.
     fn spacing_field(&self) -> Option<&'static str> {
-        None
+        self.words().spacing_field
     }
     /// `mission` with its vehicles spaced `scale` times as far apart (the
     /// field of [`Pipeline::spacing_field`]).

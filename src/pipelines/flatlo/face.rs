@@ -5,6 +5,7 @@ use nalgebra::{Point3, Vector3};
 use super::{FlatloOutcome, chart, recording, summary};
 use crate::mission::{Diagnostic, Mission};
 use crate::pipelines::chart::{Chart, ChartView};
+use crate::pipelines::face::Words;
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
@@ -15,61 +16,34 @@ use crate::pipelines::{
 /// FLATLO (`Kind::Flatlo`).
 pub struct Flatlo;
 
+/// FLATLO's words: a flown run finishes, and passes or fails; the paper's
+/// case takes about 30 ms, so it plans live.
+static WORDS: Words = Words {
+    name: "FLATLO",
+    slug: "flatlo",
+    noun: "aircraft",
+    fixed_wing: true,
+    figure_name: "closest pair (m)",
+    tallies: ("finished", "passed"),
+    verdicts: ("pass", "FAIL"),
+    passed: "flyable, separation kept",
+    live: true,
+    run_key: (
+        'F',
+        "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
+    ),
+    processes_key: None,
+    speed_field: Some("flatlo.airspeed_range"),
+    bounds_advice: Some(
+        "widen bounds.x and bounds.y to hold the squadron's manoeuvre (flatlo.spacing, \
+         flatlo.turn_radius and flatlo.start set its extent)",
+    ),
+    spacing_field: None,
+};
+
 impl Pipeline for Flatlo {
-    fn name(&self) -> &'static str {
-        "FLATLO"
-    }
-
-    fn slug(&self) -> &'static str {
-        "flatlo"
-    }
-
-    fn noun(&self) -> &'static str {
-        "aircraft"
-    }
-
-    fn fixed_wing(&self) -> bool {
-        true
-    }
-
-    fn figure_name(&self) -> &'static str {
-        "closest pair (m)"
-    }
-
-    /// A flown run finishes, and passes or fails.
-    fn tally_words(&self) -> (&'static str, &'static str) {
-        ("finished", "passed")
-    }
-
-    fn verdict_words(&self) -> (&'static str, &'static str) {
-        ("pass", "FAIL")
-    }
-
-    fn passed_phrase(&self) -> &'static str {
-        "flyable, separation kept"
-    }
-
-    /// The paper's case takes about 30 ms.
-    fn run_key(&self) -> (char, &'static str) {
-        (
-            'F',
-            "run FLATLO, the squadron transition (select Squadron with n/p to edit it)",
-        )
-    }
-
-    fn live(&self) -> bool {
-        true
-    }
-
-    fn speed_field(&self) -> Option<&'static str> {
-        Some("flatlo.airspeed_range")
-    }
-
-    fn bounds_advice(&self) -> Option<&'static str> {
-        Some(
-            "widen bounds.x and bounds.y to hold the squadron's manoeuvre (flatlo.spacing, \
-             flatlo.turn_radius and flatlo.start set its extent)",
-        )
+    fn words(&self) -> &'static Words {
+        &WORDS
     }
 
     fn plots(&self) -> &'static [&'static [Plot]] {

@@ -5,6 +5,7 @@ use nalgebra::Point3;
 use super::{FleetOutcome, chart, recording, summary};
 use crate::mission::{Diagnostic, Mission};
 use crate::pipelines::chart::{Chart, ChartView};
+use crate::pipelines::face::Words;
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
@@ -15,53 +16,34 @@ use crate::pipelines::{
 /// The distributed fleet (`Kind::Fleet`).
 pub struct Fleet;
 
+/// The fleet's words: a flown run finishes, and passes or fails; its run
+/// is a flight of seconds, re-run by hand.
+static WORDS: Words = Words {
+    name: "fleet",
+    slug: "fleet",
+    noun: "agent",
+    fixed_wing: false,
+    figure_name: "closest agents (m)",
+    tallies: ("finished", "passed"),
+    verdicts: ("pass", "FAIL"),
+    passed: "formed, safety distance kept",
+    live: false,
+    run_key: (
+        'T',
+        "run the distributed fleet (select Fleet and its targets with n/p to edit them; d adds a target)",
+    ),
+    processes_key: Some((
+        'Z',
+        "run the fleet as agent processes over Zenoh (same as T)",
+    )),
+    speed_field: None,
+    bounds_advice: None,
+    spacing_field: None,
+};
+
 impl Pipeline for Fleet {
-    fn name(&self) -> &'static str {
-        "fleet"
-    }
-
-    fn slug(&self) -> &'static str {
-        "fleet"
-    }
-
-    fn noun(&self) -> &'static str {
-        "agent"
-    }
-
-    fn figure_name(&self) -> &'static str {
-        "closest agents (m)"
-    }
-
-    /// A flown run finishes, and passes or fails.
-    fn tally_words(&self) -> (&'static str, &'static str) {
-        ("finished", "passed")
-    }
-
-    fn verdict_words(&self) -> (&'static str, &'static str) {
-        ("pass", "FAIL")
-    }
-
-    fn passed_phrase(&self) -> &'static str {
-        "formed, safety distance kept"
-    }
-
-    /// Its run is a flight of seconds, re-run by hand.
-    fn run_key(&self) -> (char, &'static str) {
-        (
-            'T',
-            "run the distributed fleet (select Fleet and its targets with n/p to edit them; d adds a target)",
-        )
-    }
-
-    fn processes_key(&self) -> Option<(char, &'static str)> {
-        Some((
-            'Z',
-            "run the fleet as agent processes over Zenoh (same as T)",
-        ))
-    }
-
-    fn live(&self) -> bool {
-        false
+    fn words(&self) -> &'static Words {
+        &WORDS
     }
 
     /// The safety distance c, which every agent keeps from the others and

@@ -3,6 +3,7 @@
 use super::{ThetaPsoOutcome, chart, recording, summary};
 use crate::mission::{Diagnostic, Mission};
 use crate::pipelines::chart::{Chart, ChartView};
+use crate::pipelines::face::Words;
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
@@ -20,44 +21,28 @@ pub fn prepared_iwps(revision: &crate::pipelines::Revision) -> Option<&Vec<super
         .downcast_ref::<Vec<super::Iwp>>()
 }
 
+/// θ-PSO's words: a run is complete when its J is finite, good when
+/// feasible; a live run is short and deterministic.
+static WORDS: Words = Words {
+    name: "θ-PSO",
+    slug: "theta-pso",
+    noun: "UAV",
+    fixed_wing: false,
+    figure_name: "best J",
+    tallies: ("J finite", "feasible"),
+    verdicts: ("feasible", "INFEASIBLE"),
+    passed: "feasible",
+    live: true,
+    run_key: ('r', "run θ-PSO with the mission's seed"),
+    processes_key: None,
+    speed_field: None,
+    bounds_advice: None,
+    spacing_field: Some("formation.slots"),
+};
+
 impl Pipeline for ThetaPso {
-    fn name(&self) -> &'static str {
-        "θ-PSO"
-    }
-
-    fn slug(&self) -> &'static str {
-        "theta-pso"
-    }
-
-    fn noun(&self) -> &'static str {
-        "UAV"
-    }
-
-    fn figure_name(&self) -> &'static str {
-        "best J"
-    }
-
-    /// θ-PSO plans: a run is complete when its J is finite, good when
-    /// feasible.
-    fn tally_words(&self) -> (&'static str, &'static str) {
-        ("J finite", "feasible")
-    }
-
-    fn verdict_words(&self) -> (&'static str, &'static str) {
-        ("feasible", "INFEASIBLE")
-    }
-
-    fn passed_phrase(&self) -> &'static str {
-        "feasible"
-    }
-
-    /// A live run is short and deterministic.
-    fn run_key(&self) -> (char, &'static str) {
-        ('r', "run θ-PSO with the mission's seed")
-    }
-
-    fn live(&self) -> bool {
-        true
+    fn words(&self) -> &'static Words {
+        &WORDS
     }
 
     /// The SPSO benchmark names its cost, encoding and swarm.
@@ -89,10 +74,6 @@ impl Pipeline for ThetaPso {
 
     fn add_margin(&self, mission: &mut Mission, m: f64) {
         mission.formation.obstacle_margin += m;
-    }
-
-    fn spacing_field(&self) -> Option<&'static str> {
-        Some("formation.slots")
     }
 
     fn widen_spacing(&self, mission: &mut Mission, scale: f64) {
