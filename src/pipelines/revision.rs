@@ -104,3 +104,51 @@ impl Revision {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipelines::theta_pso::plan::{plan_given, plan_warm};
+    use crate::pipelines::{CancelToken, PlanOptions, Silent};
+
+    /// A θ-PSO run handed the designer's revision refuses with the same
+    /// error, in the same words, as one that looks at the mission itself
+    /// (a broken rule, a run over its limits), and plans the same plan
+    /// from the same IWPs when it may.
+    #[test]
+    fn a_run_on_a_revision_refuses_and_plans_as_one_that_looks_itself() {
+        let bridge = crate::mission::default_mission().mission;
+        let mut broken = bridge.clone();
+        broken.formation.uav_radius = -1.0;
+        let mut too_big = bridge.clone();
+        too_big.theta_pso.swarm_size = 1_000_000;
+        for (what, m) in [
+            ("valid", &bridge),
+            ("broken", &broken),
+            ("too big", &too_big),
+        ] {
+            let revision = Revision::of(m);
+            let cancel = CancelToken::new();
+            let options = PlanOptions::default();
+            let given = plan_given(m, 3, options, None, Some(&revision), &mut Silent, &cancel);
+            let alone = plan_warm(m, 3, options, None, &mut Silent, &cancel);
+            match (given, alone) {
+                (Ok(a), Ok(b)) => {
+                    assert_eq!(what, "valid");
+                    assert_eq!(a.cost.total.to_bits(), b.cost.total.to_bits(), "the same J");
+                    assert_eq!(a.iwps.len(), b.iwps.len());
+                }
+                (Err(a), Err(b)) => {
+                    assert_ne!(what, "valid");
+                    assert_eq!(a.to_string(), b.to_string(), "{what}");
+                    assert_eq!(
+                        std::mem::discriminant(&a),
+                        std::mem::discriminant(&b),
+                        "{what}"
+                    );
+                }
+                (a, b) => panic!("{what}: {:?} vs {:?}", a.err(), b.err()),
+            }
+        }
+    }
+}
