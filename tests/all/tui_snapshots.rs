@@ -112,12 +112,12 @@ fn jobs_panel_with_a_finished_result() {
     );
     // r_Q 0.5 + the safety margin 0.1.
     assert!(
-        screen.contains("✓ obstacle clearance worst 0.750 ≥ 0.6"),
+        screen.contains("✓ obstacle clearance worst 0.687 ≥ 0.6"),
         "{screen}"
     );
     // The flight's own rows, against [vehicle]'s default 12 m/s.
     assert!(
-        screen.contains("✓ horizontal speed (m/s) worst 4.138 ≤ 12"),
+        screen.contains("✓ horizontal speed (m/s) worst 4.167 ≤ 12"),
         "{screen}"
     );
     insta::assert_snapshot!(screen);

@@ -36,6 +36,18 @@ pub(super) fn squeeze_map(
             .then(|| (1..LAYERS).find(|&l| open[i] & bit(level, l) != 0))
             .flatten()
     };
+    // Whether the nominal shape fits at `p` on exact geometry: the grid
+    // shuts a cell whose centre is within half a diagonal of the need, so a
+    // narrow cell may hold points where nothing needs to squeeze. A region
+    // grown over those would squeeze the formation where it fits, into an
+    // inspection pass beside it (the viaduct at a 3.4 m obstacle margin).
+    let nominal_fits = |p: Point2<f64>, level: usize| {
+        let Level { field: at, discs, .. } = &site.at[level];
+        let inside = mission
+            .bounds
+            .horizontal_margin(&nalgebra::Point3::new(p.x, p.y, 0.0));
+        at.clearance_at(p, discs) >= site.need[0] - 1e-9 && inside >= shape.reach - 1e-9
+    };
     let level_of_leg = |leg: usize| {
         corridor
             .heights
@@ -98,6 +110,7 @@ pub(super) fn squeeze_map(
                 }
             }
             let Some(layer) = narrow(i, level)
+                .filter(|_| !nominal_fits(p, level))
                 .or(closed.then_some(leg_layer))
                 .filter(|l| *l > 0)
             else {
@@ -115,7 +128,7 @@ pub(super) fn squeeze_map(
                 named.get_or_insert(level);
                 let label = shapes.len() as u16;
                 flood(field, &mut region, i, label, &|c| {
-                    narrow(c, level) == Some(layer)
+                    narrow(c, level) == Some(layer) && !nominal_fits(field.center(c), level)
                 });
             }
             previous = Some(region[i]);
