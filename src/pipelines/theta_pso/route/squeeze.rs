@@ -18,7 +18,7 @@ use crate::pipelines::theta_pso::path::SqueezeMap;
 /// only the column does, at the level each leg is flown at; `None` when the
 /// corridor never squeezes.
 ///
-/// Long (~125 lines): one walk along the corridor's narrow legs, each point's cell joined to a
+/// Long (~135 lines): one walk along the corridor's narrow legs, each point's cell joined to a
 /// region (flooded over the cells open in the same layer, or run along a passage's straight
 /// through shut cells) and the shrink's scale narrowed to what fits there.
 pub(super) fn squeeze_map(
@@ -35,18 +35,6 @@ pub(super) fn squeeze_map(
         (open[i] & bit(level, 0) == 0)
             .then(|| (1..LAYERS).find(|&l| open[i] & bit(level, l) != 0))
             .flatten()
-    };
-    // Whether the nominal shape fits at `p` on exact geometry: the grid
-    // shuts a cell whose centre is within half a diagonal of the need, so a
-    // narrow cell may hold points where nothing needs to squeeze. A region
-    // grown over those would squeeze the formation where it fits, into an
-    // inspection pass beside it (the viaduct at a 3.4 m obstacle margin).
-    let nominal_fits = |p: Point2<f64>, level: usize| {
-        let Level { field: at, discs, .. } = &site.at[level];
-        let inside = mission
-            .bounds
-            .horizontal_margin(&nalgebra::Point3::new(p.x, p.y, 0.0));
-        at.clearance_at(p, discs) >= site.need[0] - 1e-9 && inside >= shape.reach - 1e-9
     };
     let level_of_leg = |leg: usize| {
         corridor
@@ -110,7 +98,7 @@ pub(super) fn squeeze_map(
                 }
             }
             let Some(layer) = narrow(i, level)
-                .filter(|_| !nominal_fits(p, level))
+                .filter(|_| !nominal_fits(site, mission, p, level))
                 .or(closed.then_some(leg_layer))
                 .filter(|l| *l > 0)
             else {
@@ -128,7 +116,8 @@ pub(super) fn squeeze_map(
                 named.get_or_insert(level);
                 let label = shapes.len() as u16;
                 flood(field, &mut region, i, label, &|c| {
-                    narrow(c, level) == Some(layer) && !nominal_fits(field.center(c), level)
+                    narrow(c, level) == Some(layer)
+                        && !nominal_fits(site, mission, field.center(c), level)
                 });
             }
             previous = Some(region[i]);
@@ -166,6 +155,21 @@ pub(super) fn squeeze_map(
         free,
         extent,
     }))
+}
+
+/// Whether the nominal shape fits at `p` at `level` on exact geometry. The
+/// grid shuts a cell whose centre is within half a diagonal of the need,
+/// so a narrow cell may hold points where nothing needs to squeeze; a
+/// region grown over those squeezed the formation where it fits, into an
+/// inspection pass beside it (the viaduct at a 3.4 m obstacle margin).
+fn nominal_fits(site: &Site, mission: &Mission, p: Point2<f64>, level: usize) -> bool {
+    let Level {
+        field: at, discs, ..
+    } = &site.at[level];
+    let inside = mission
+        .bounds
+        .horizontal_margin(&nalgebra::Point3::new(p.x, p.y, 0.0));
+    at.clearance_at(p, discs) >= site.need[0] - 1e-9 && inside >= site.shape.reach - 1e-9
 }
 
 /// The box holding every point whose cell is in a region.
