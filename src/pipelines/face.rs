@@ -289,6 +289,9 @@ pub trait Pipeline: Sync {
     fn prepare(&self, _mission: &Mission) -> Option<super::Prepared> {
         None
     }
+    /// What it adds to the mission's static scene in a recording, before
+    /// any run (θ-PSO: its IWPs, at mid-band); nothing by default.
+    fn scene(&self, _mission: &Mission, _out: &mut dyn super::sketch::Sketch) {}
     /// Its predicted size against the documented limits (`limits`).
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic>;
     /// The sizes that keep a run on `mission` from being planned live

@@ -97,6 +97,9 @@ pub trait Sketch {
     fn strips(&mut self, path: &str, strips: Vec<Vec<Point3<f64>>>, style: Style);
     /// Polylines from time `t` on (until the next at `path`).
     fn strips_at(&mut self, path: &str, t: f64, strips: Vec<Vec<Point3<f64>>>, style: Style);
+    /// Points shown for the whole recording, each in its own style (a
+    /// scene's marks: θ-PSO's IWPs, enabled or not).
+    fn marks(&mut self, path: &str, marks: Vec<(Point3<f64>, Style)>);
     /// Points from time `t` on.
     fn points_at(&mut self, path: &str, t: f64, points: Vec<Point3<f64>>, style: Style);
     /// A point that moves: at `positions[k]` from `times[k]`.

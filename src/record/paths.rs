@@ -26,7 +26,6 @@ pub fn footprint(name: &str) -> rerun::EntityPath {
 pub const INSPECTION: &str = "world/inspection";
 pub const ROUTE: &str = "world/route";
 pub const TERRAIN: &str = "world/terrain";
-pub const IWPS: &str = "world/iwps";
 /// The mission file as a text document.
 pub const MISSION: &str = "mission";
 

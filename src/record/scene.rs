@@ -5,7 +5,7 @@ use rerun::RecordingStream;
 
 use super::{f32x3, paths};
 use crate::mission::{Mission, Obstacle, to_toml_string};
-use crate::pipelines::theta_pso::find_iwps;
+use crate::pipelines::Kind;
 
 /// An obstacle's colour: inspected ones stand out.
 fn obstacle_color(o: &Obstacle) -> rerun::Color {
@@ -168,29 +168,12 @@ pub fn log_scene(stream: &RecordingStream, m: &Mission) -> rerun::RecordingStrea
     if let (Some(terrain), Some(map)) = (&m.terrain, m.height_map()) {
         log_terrain(stream, map, terrain.lookup)?;
     }
-    let iwps = find_iwps(m);
-    if !iwps.is_empty() {
-        let z = ((m.bounds.z[0] + m.bounds.z[1]) / 2.0) as f32;
-        stream.log_static(
-            paths::IWPS,
-            &rerun::Points3D::new(
-                iwps.iter()
-                    .map(|i| [i.position.x as f32, i.position.y as f32, z]),
-            )
-            .with_labels(iwps.iter().map(|i| {
-                let state = if i.enabled { "" } else { " (disabled)" };
-                format!("IWP {} | {}{state}", i.between[0], i.between[1])
-            }))
-            .with_radii(iwps.iter().map(|_| 0.4f32))
-            .with_colors(iwps.iter().map(|i| {
-                if i.enabled {
-                    rerun::Color::from_rgb(250, 200, 0)
-                } else {
-                    rerun::Color::from_rgb(120, 120, 120)
-                }
-            })),
-        )?;
+    // What each pipeline adds to the scene (θ-PSO: its IWPs).
+    let mut sketch = super::sketch::RerunSketch::new(stream);
+    for kind in Kind::ALL {
+        kind.face().scene(m, &mut sketch);
     }
+    sketch.result?;
     let toml = to_toml_string(m).unwrap_or_default();
     stream.log_static(
         paths::MISSION,

@@ -111,6 +111,38 @@ impl Sketch for RerunSketch<'_> {
         });
     }
 
+    /// One archetype: the positions, and each part of the style given
+    /// per point (a part no mark gives is left out).
+    fn marks(&mut self, path: &str, marks: Vec<(Point3<f64>, Style)>) {
+        let timeless = self.timeless;
+        self.then(|s| {
+            let mut archetype = rerun::Points3D::new(marks.iter().map(|(p, _)| f32x3(p)));
+            if marks.iter().all(|(_, m)| m.label.is_some()) {
+                archetype = archetype.with_labels(
+                    marks
+                        .iter()
+                        .map(|(_, m)| m.label.clone().unwrap_or_default()),
+                );
+            }
+            if marks.iter().all(|(_, m)| m.radius.is_some()) {
+                archetype =
+                    archetype.with_radii(marks.iter().map(|(_, m)| m.radius.unwrap_or_default()));
+            }
+            if marks.iter().all(|(_, m)| m.color.is_some()) {
+                archetype = archetype.with_colors(
+                    marks
+                        .iter()
+                        .map(|(_, m)| color(m.color.unwrap_or_default())),
+                );
+            }
+            if timeless {
+                s.log_static(path, &archetype)
+            } else {
+                s.log(path, &archetype)
+            }
+        });
+    }
+
     fn points_at(&mut self, path: &str, t: f64, points: Vec<Point3<f64>>, style: Style) {
         self.then(|s| {
             s.set_duration_secs("sim_time", t);

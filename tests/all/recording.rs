@@ -130,6 +130,20 @@ fn a_theta_pso_recording_holds_the_scene_the_plan_and_the_timelines() {
         assert_eq!(*h, o.height as f32, "{}", o.name);
     }
 
+    // θ-PSO's scene (`Pipeline::scene`): the bridge's one IWP, enabled
+    // (yellow), 0.4 m, at mid-band.
+    let iwps = skyform::pipelines::theta_pso::find_iwps(&m);
+    assert_eq!(iwps.len(), 1);
+    let radii = values::<f32>(&chunks, "/world/iwps", "Points3D:radii");
+    let colors = values::<u32>(&chunks, "/world/iwps", "Points3D:colors");
+    assert_eq!((radii, colors), (vec![0.4f32], vec![0xFAC800FFu32]));
+    let positions = values::<[f32; 3]>(&chunks, "/world/iwps", "Points3D:positions");
+    let mid = ((m.bounds.z[0] + m.bounds.z[1]) / 2.0) as f32;
+    assert_eq!(
+        positions,
+        vec![[iwps[0].position.x as f32, iwps[0].position.y as f32, mid]]
+    );
+
     // One moving point per UAV, and the last sim_time is the mission duration.
     let uavs: Vec<_> = paths
         .iter()

@@ -45,6 +45,10 @@ impl Pipeline for ThetaPso {
         &WORDS
     }
 
+    fn scene(&self, mission: &Mission, out: &mut dyn Sketch) {
+        recording::iwps(mission, out);
+    }
+
     /// The SPSO benchmark names its cost, encoding and swarm.
     fn describe(&self, mission: &Mission) -> String {
         let p = &mission.theta_pso;

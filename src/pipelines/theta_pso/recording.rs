@@ -23,6 +23,8 @@ pub mod paths {
     pub const CLEARANCE: &str = "theta_pso/clearance";
     pub const CENTROID: &str = "theta_pso/plan/centroid";
     pub const VIOLATIONS: &str = "theta_pso/violations";
+    /// The mission's IWPs, in the static scene beside the obstacles.
+    pub const IWPS: &str = "world/iwps";
 
     /// UAV `uav` (0-based) is named from 1.
     pub fn clearance(uav: usize) -> String {
@@ -59,6 +61,34 @@ pub const PLOTS: &[&[Plot]] = &[&[
 
 /// The plan's centroid path, white and labelled: the outcome's and each
 /// live revision's.
+/// The mission's IWPs (eq. 9) at mid-band, each labelled with its pair,
+/// yellow when enabled, grey when not: what the crossings will be.
+pub fn iwps(m: &Mission, out: &mut dyn Sketch) {
+    let iwps = super::find_iwps(m);
+    if iwps.is_empty() {
+        return;
+    }
+    let z = f64::from(((m.bounds.z[0] + m.bounds.z[1]) / 2.0) as f32);
+    let marks = iwps
+        .iter()
+        .map(|i| {
+            let state = if i.enabled { "" } else { " (disabled)" };
+            let color = if i.enabled {
+                [250, 200, 0]
+            } else {
+                [120, 120, 120]
+            };
+            (
+                Point3::new(i.position.x, i.position.y, z),
+                Style::rgb(color)
+                    .radius(0.4)
+                    .label(format!("IWP {} | {}{state}", i.between[0], i.between[1])),
+            )
+        })
+        .collect();
+    out.marks(paths::IWPS, marks);
+}
+
 pub fn centroid(o: &ThetaPsoOutcome, path: &str, out: &mut dyn Sketch) {
     out.strips(
         path,
