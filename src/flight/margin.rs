@@ -739,7 +739,6 @@ mod tests {
         assert_eq!(tried, [0.0, 0.25, 0.5, 1.0, 1.6]);
     }
 
-    /// ⌊target · N⌋ flights may break: the next least room decides.
     /// The spacing search's end (the bridge's `--target 0.001`: ×1.36
     /// keeps the pairs but breaks r_Q in 2 of 1,000 flights, ×1.39 flown
     /// on the way kept both): the spacing that kept both is the answer.
@@ -765,6 +764,7 @@ mod tests {
         );
     }
 
+    /// ⌊target · N⌋ flights may break: the next least room decides.
     #[test]
     fn the_shift_is_the_next_least_room_after_those_allowed_to_break() {
         let rooms = [-1.0, -0.5, 0.2, f64::INFINITY];

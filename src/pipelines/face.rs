@@ -290,7 +290,8 @@ pub trait Pipeline: Sync {
         None
     }
     /// What it adds to the mission's static scene in a recording, before
-    /// any run (θ-PSO: its IWPs, at mid-band); nothing by default.
+    /// any run, at paths of its own under `world/` (θ-PSO: its IWPs at
+    /// mid-band, `world/iwps`); nothing by default.
     fn scene(&self, _mission: &Mission, _out: &mut dyn super::sketch::Sketch) {}
     /// Its predicted size against the documented limits (`limits`).
     fn budget(&self, mission: &Mission) -> Vec<Diagnostic>;

@@ -111,8 +111,8 @@ impl Sketch for RerunSketch<'_> {
         });
     }
 
-    /// One archetype: the positions, and each part of the style given
-    /// per point (a part no mark gives is left out).
+    /// One archetype: the positions, and each part of the style per
+    /// point (a part that not every mark gives is left out).
     fn marks(&mut self, path: &str, marks: Vec<(Point3<f64>, Style)>) {
         let timeless = self.timeless;
         self.then(|s| {

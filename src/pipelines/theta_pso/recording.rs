@@ -59,8 +59,6 @@ pub const PLOTS: &[&[Plot]] = &[&[
     },
 ]];
 
-/// The plan's centroid path, white and labelled: the outcome's and each
-/// live revision's.
 /// The mission's IWPs (eq. 9) at mid-band, each labelled with its pair,
 /// yellow when enabled, grey when not: what the crossings will be.
 pub fn iwps(m: &Mission, out: &mut dyn Sketch) {
@@ -89,6 +87,8 @@ pub fn iwps(m: &Mission, out: &mut dyn Sketch) {
     out.marks(paths::IWPS, marks);
 }
 
+/// The plan's centroid path, white and labelled: the outcome's and each
+/// live revision's.
 pub fn centroid(o: &ThetaPsoOutcome, path: &str, out: &mut dyn Sketch) {
     out.strips(
         path,
