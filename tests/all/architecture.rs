@@ -401,43 +401,50 @@ fn names_a_pipeline(file: &Path) -> Vec<String> {
 /// (`pipelines::face`) instead.
 #[test]
 fn outside_the_pipelines_only_the_listed_places_name_a_pipeline() {
-    let mut naming = Vec::new();
-    let mut stack = vec![PathBuf::from("src")];
-    while let Some(dir) = stack.pop() {
-        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
-            let path = entry.path();
-            if path.starts_with("src/pipelines") {
-                continue;
-            }
-            if path.is_dir() {
-                stack.push(path);
-            } else if path.extension().is_some_and(|e| e == "rs")
-                && path.file_name().is_none_or(|n| n != "tests.rs")
-                && !names_a_pipeline(&path).is_empty()
-            {
-                naming.push(path.to_string_lossy().replace('\\', "/"));
-            }
-        }
-    }
-    naming.sort();
-    let mut listed: Vec<String> = KNOWS_PIPELINES_BY_NAME
-        .iter()
-        .map(|(file, _)| file.to_string())
+    only_the_listed_files(
+        "src/pipelines",
+        KNOWS_PIPELINES_BY_NAME,
+        &names_a_pipeline,
+        "these files name a pipeline; read it through its face instead",
+        "these files no longer name a pipeline: take them off the list",
+    );
+}
+
+/// The files under `src/` outside `skip` (and not a `tests.rs`) where
+/// `finds` finds something are exactly those `listed`: a new one fails
+/// with `new_why` and what was found in it, a listed one where nothing is
+/// found any more with `gone_why`.
+fn only_the_listed_files(
+    skip: &str,
+    listed: &[(&str, &str)],
+    finds: &dyn Fn(&Path) -> Vec<String>,
+    new_why: &str,
+    gone_why: &str,
+) {
+    let found: Vec<String> = rust_files(Path::new("src"))
+        .into_iter()
+        .filter(|p| !p.starts_with(skip))
+        .filter(|p| p.file_name().is_none_or(|n| n != "tests.rs"))
+        .filter(|p| !finds(p).is_empty())
+        .map(|p| p.to_string_lossy().replace('\\', "/"))
         .collect();
-    listed.sort();
-    let new: Vec<_> = naming.iter().filter(|f| !listed.contains(f)).collect();
-    let gone: Vec<_> = listed.iter().filter(|f| !naming.contains(f)).collect();
+    let listed: Vec<&str> = listed.iter().map(|(f, _)| *f).collect();
+    let new: Vec<_> = found
+        .iter()
+        .filter(|f| !listed.contains(&f.as_str()))
+        .collect();
+    let gone: Vec<_> = listed
+        .iter()
+        .filter(|f| !found.iter().any(|r| r == *f))
+        .collect();
     assert!(
         new.is_empty(),
-        "these files name a pipeline; read it through its face instead: {:?}",
+        "{new_why}: {:?}",
         new.iter()
-            .map(|f| (f, names_a_pipeline(Path::new(f.as_str()))))
+            .map(|f| (f, finds(Path::new(f.as_str()))))
             .collect::<Vec<_>>()
     );
-    assert!(
-        gone.is_empty(),
-        "these files no longer name a pipeline: take them off the list: {gone:?}"
-    );
+    assert!(gone.is_empty(), "{gone_why}: {gone:?}");
 }
 
 /// The files "Adding a pipeline" lists: the numbered items' first path.
@@ -666,32 +673,11 @@ fn outside_the_shape_module_only_the_file_form_reads_a_footprint() {
             .map(str::to_owned)
             .collect()
     };
-    let mut reading: Vec<String> = rust_files(Path::new("src"))
-        .into_iter()
-        .filter(|p| !p.starts_with("src/base/shape"))
-        .filter(|p| p.file_name().is_none_or(|n| n != "tests.rs"))
-        .filter(|p| !reads(p).is_empty())
-        .map(|p| p.to_string_lossy().replace('\\', "/"))
-        .collect();
-    reading.sort();
-    let listed: Vec<&str> = READS_THE_FOOTPRINT_FIELD.iter().map(|(f, _)| *f).collect();
-    let new: Vec<_> = reading
-        .iter()
-        .filter(|f| !listed.contains(&f.as_str()))
-        .collect();
-    let gone: Vec<_> = listed
-        .iter()
-        .filter(|f| !reading.iter().any(|r| r == *f))
-        .collect();
-    assert!(
-        new.is_empty(),
-        "these files read an obstacle's footprint field; ask its shape instead: {:?}",
-        new.iter()
-            .map(|f| (f, reads(Path::new(f.as_str()))))
-            .collect::<Vec<_>>()
-    );
-    assert!(
-        gone.is_empty(),
-        "these files no longer read it: take them off the list: {gone:?}"
+    only_the_listed_files(
+        "src/base/shape",
+        READS_THE_FOOTPRINT_FIELD,
+        &reads,
+        "these files read an obstacle's footprint field; ask its shape instead",
+        "these files no longer read it: take them off the list",
     );
 }
