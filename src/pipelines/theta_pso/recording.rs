@@ -66,7 +66,7 @@ pub fn iwps(m: &Mission, out: &mut dyn Sketch) {
     if iwps.is_empty() {
         return;
     }
-    let z = f64::from(((m.bounds.z[0] + m.bounds.z[1]) / 2.0) as f32);
+    let z = (m.bounds.z[0] + m.bounds.z[1]) / 2.0;
     let marks = iwps
         .iter()
         .map(|i| {
