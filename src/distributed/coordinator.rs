@@ -173,8 +173,7 @@ pub fn coordinate(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<FleetOutcome, PipelineError> {
-    crate::pipelines::require_valid(mission)?;
-    crate::pipelines::require_within_budget(fleet::budget(mission))?;
+    crate::pipelines::require_admissible(mission, fleet::budget)?;
     let fail = PipelineError::Transport;
     if options.processes == 0 {
         return Err(fail("at least one agent process is needed".into()));

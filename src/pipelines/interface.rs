@@ -163,16 +163,15 @@ pub fn validate(mission: &crate::mission::Mission) -> Vec<crate::mission::Diagno
     all
 }
 
-/// Every pipeline's first step: a mission with errors is refused, naming them.
-pub fn require_valid(mission: &crate::mission::Mission) -> Result<(), PipelineError> {
-    refuse_errors(&validate(mission), PipelineError::InvalidMission)
-}
-
-/// A run's predicted size over its documented limit: refused before it starts.
-pub fn require_within_budget(
-    findings: Vec<crate::mission::Diagnostic>,
+/// Every pipeline's first step: a mission with errors is refused, naming
+/// them; then a run whose predicted size (`budget`, read only of a valid
+/// mission) is over its documented limit.
+pub fn require_admissible(
+    mission: &crate::mission::Mission,
+    budget: fn(&crate::mission::Mission) -> Vec<crate::mission::Diagnostic>,
 ) -> Result<(), PipelineError> {
-    refuse_errors(&findings, PipelineError::OverBudget)
+    refuse_errors(&validate(mission), PipelineError::InvalidMission)?;
+    refuse_errors(&budget(mission), PipelineError::OverBudget)
 }
 
 /// The errors among `findings`, one per line, as the refusal `error` makes.

@@ -541,8 +541,7 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<FlatloOutcome, PipelineError> {
-    crate::pipelines::require_valid(mission)?;
-    crate::pipelines::require_within_budget(budget(mission))?;
+    crate::pipelines::require_admissible(mission, budget)?;
     // What `check` predicts from the references: an unflyable airspeed, or a
     // squadron that leaves the bounds it starts in, is refused before flying.
     let unflyable: Vec<String> = diagnostics(mission)

@@ -398,8 +398,7 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<FleetOutcome, PipelineError> {
-    crate::pipelines::require_valid(mission)?;
-    crate::pipelines::require_within_budget(budget(mission))?;
+    crate::pipelines::require_admissible(mission, budget)?;
     observer.on_event(Event::Stage("scenario"));
     let mut simulation = Simulation::new(mission, seed);
     observer.on_event(Event::Stage("flight"));

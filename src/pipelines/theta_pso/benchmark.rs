@@ -41,8 +41,7 @@ pub fn plan(
     observer: &mut dyn Observer,
     cancel: &CancelToken,
 ) -> Result<ThetaPsoOutcome, PipelineError> {
-    crate::pipelines::require_valid(mission)?;
-    crate::pipelines::require_within_budget(super::budget(mission))?;
+    crate::pipelines::require_admissible(mission, super::budget)?;
     let model = spso::model(mission).map_err(PipelineError::InvalidMission)?;
     let decoder = Decoder::new(mission, mission.theta_pso.encoding);
     let p = &mission.theta_pso;

@@ -106,10 +106,7 @@ fn admit(
 ) -> Result<(), PipelineError> {
     match revision {
         Some(r) => r.admit_rules(Kind::ThetaPso)?,
-        None => {
-            crate::pipelines::require_valid(mission)?;
-            crate::pipelines::require_within_budget(budget(mission))?;
-        }
+        None => crate::pipelines::require_admissible(mission, budget)?,
     }
     // A gate the user asked for that no formation can take: no plan keeps
     // the route as written.
