@@ -70,11 +70,17 @@ pub struct FlyArgs {
     /// Flights per level of `--rare` (at least 10; more: a tighter interval).
     #[arg(long, value_name = "N", default_value_t = 1000, requires = "rare")]
     pub per_level: usize,
+    /// Independent runs of `--rare`, each seeded apart (run 0 with the
+    /// seed itself), reported as their mean: K runs give an interval about
+    /// √K times narrower, and `--shard I/N` splits them between machines.
+    #[arg(long, value_name = "K", default_value_t = 1, requires = "rare")]
+    pub runs: usize,
     /// Fly only shard I of N of the check (I from 0: a contiguous share of
-    /// the flight numbers) and write its flights to the --json file, a part
-    /// for `skyform merge`: the merged parts give the report one process
-    /// gives, bit for bit, whichever machines ran them.
-    #[arg(long, value_name = "I/N", requires = "json", conflicts_with_all = ["target", "rare", "flight"])]
+    /// the flight numbers; with `--rare`, of the `--runs`) and write them
+    /// to the --json file, a part for `skyform merge`: the merged parts
+    /// give the report one process gives, bit for bit, whichever machines
+    /// ran them.
+    #[arg(long, value_name = "I/N", requires = "json", conflicts_with_all = ["target", "flight"])]
     pub shard: Option<String>,
     /// A Rerun recording of the check: the plan as written, the p99
     /// envelope of each UAV as a tube, the worst flights as flown.
@@ -128,7 +134,7 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
         return replay(&setup, seed, k);
     }
     if args.rare {
-        return rare(&setup, args, seed, &cancel);
+        return rare(&setup, &mission, args, seed, &cancel);
     }
     if let Some(shard) = &args.shard {
         return super::merge_cmd::fly_shard(&setup, &mission, args, seed, shard, &cancel);
@@ -493,85 +499,114 @@ fn replay(setup: &Setup, seed: u64, k: usize) -> u8 {
     if broke { exit::INFEASIBLE } else { exit::OK }
 }
 
-/// `--rare`: each limit's probability by subset simulation, printed and
-/// (`--json`) written as `{"separation": {estimate, low, high, method,
-/// flights, …}, "clearance": {…}}`. Exit 2 when either estimate is at
-/// least one in a million.
-fn rare(setup: &Setup, args: &FlyArgs, seed: u64, cancel: &CancelToken) -> u8 {
-    use flight::rare::{self, Limit, RareOptions};
+/// `--rare`: each limit's probability by subset simulation (the mean of
+/// `--runs` independent runs), printed and (`--json`) written as
+/// `{"separation": {estimate, low, high, method, flights, …, runs: […]},
+/// "clearance": {…}}`; with `--shard I/N`, this shard's runs written as a
+/// part for `skyform merge`. Exit 2 when either estimate is at least one in
+/// a million.
+fn rare(setup: &Setup, mission: &Mission, args: &FlyArgs, seed: u64, cancel: &CancelToken) -> u8 {
+    use flight::odds::{self, OddsReport};
+    use flight::rare::{self, RareOptions};
     let terminal = std::io::stderr().is_terminal();
     let options = RareOptions {
         per_level: args.per_level.max(10),
         seed,
         threads: args.threads,
     };
+    if !(1..=odds::MAX_RUNS).contains(&args.runs) {
+        eprintln!("error: --runs {}: from 1 to {}", args.runs, odds::MAX_RUNS);
+        return exit::ERROR;
+    }
+    let progress = |run: usize, limit: rare::Limit, done: usize, level: usize| {
+        if terminal && done.is_multiple_of(50) {
+            eprint!(
+                "\rrun {run}: {}: level {level}, {done} flights",
+                limit.words()
+            );
+        }
+    };
+    if let Some(shard) = &args.shard {
+        return super::merge_cmd::rare_shard(
+            setup, mission, args, options, shard, &progress, cancel,
+        );
+    }
     println!(
-        "rare-event odds of {} ({}, {} flights a level, seed {seed})",
+        "rare-event odds of {} ({}, {} flights a level, {} run(s), seed {seed})",
         setup.mission.name,
         rare::METHOD,
-        options.per_level
+        options.per_level,
+        args.runs
     );
-    let mut estimates = Vec::new();
-    for limit in [Limit::Separation, Limit::Clearance] {
-        let progress = |done: usize, level: usize| {
-            if terminal && done.is_multiple_of(50) {
-                eprint!("\r{}: level {level}, {done} flights", limit.words());
-            }
-        };
-        let e = match rare::estimate(setup, limit, options, &progress, cancel) {
-            Ok(e) => e,
-            Err(e) => return said(&e),
-        };
-        if terminal {
-            eprintln!();
-        }
-        print!("{}", rare_text(&e));
-        estimates.push(e);
+    let runs = odds::fly_runs(setup, options, 0..args.runs, &progress, cancel);
+    if terminal {
+        eprintln!();
     }
-    if let Some(path) = &args.json {
-        let json = serde_json::json!({
-            "mission": setup.mission.name,
-            "seed": seed,
-            "per_level": options.per_level,
-            "separation": estimates[0],
-            "clearance": estimates[1],
-        });
-        if let Err(status) = json_written(&json, "the estimate", path, true) {
-            return status;
-        }
+    let runs = match runs {
+        Ok(r) => r,
+        Err(e) => return said(&e),
+    };
+    odds_written(
+        &OddsReport::new(&setup.mission.name, seed, options.per_level, runs),
+        args.json.as_deref(),
+    )
+}
+
+/// A rare-event report printed and written as JSON to `json`
+/// (atomically), and the exit status it gives: 2 when either estimate is at
+/// least 10⁻⁶, 0 when both are below.
+pub(super) fn odds_written(
+    report: &flight::odds::OddsReport,
+    json: Option<&std::path::Path>,
+) -> u8 {
+    print!("{}", odds_text(&report.separation));
+    print!("{}", odds_text(&report.clearance));
+    if let Some(path) = json
+        && let Err(status) = json_written(report, "the estimate", path, true)
+    {
+        return status;
     }
-    if estimates.iter().any(|e| e.estimate >= 1e-6) {
+    if report.separation.estimate >= 1e-6 || report.clearance.estimate >= 1e-6 {
         exit::INFEASIBLE
     } else {
         exit::OK
     }
 }
 
-/// One limit's estimate in words.
-pub fn rare_text(e: &flight::rare::Estimate) -> String {
-    let mut out = if e.bound {
+/// One limit's odds in words.
+pub fn odds_text(o: &flight::odds::Odds) -> String {
+    let runs = o.runs.len();
+    let how = if runs == 1 {
+        format!("{} level(s)", o.runs.first().map_or(0, |e| e.levels.len()))
+    } else {
+        format!("{runs} runs")
+    };
+    let mut out = if o.bound {
         format!(
-            "  {:<24} below {:.1e}: no flight broke it in {} levels ({} flights)\n",
-            e.limit.words(),
-            e.high,
-            e.levels.len(),
-            e.flights
+            "  {:<24} below {:.1e}: no flight broke it in {how} ({} flights)\n",
+            o.limit.words(),
+            o.high,
+            o.flights
         )
     } else {
         format!(
-            "  {:<24} P = {:.2e} (95 % {:.2e} to {:.2e}, c.o.v. {:.2}), {} flights, {} level(s)\n",
-            e.limit.words(),
-            e.estimate,
-            e.low,
-            e.high,
-            e.cov,
-            e.flights,
-            e.levels.len()
+            "  {:<24} P = {:.2e} (95 % {:.2e} to {:.2e}, c.o.v. {:.2}), {} flights, {how}\n",
+            o.limit.words(),
+            o.estimate,
+            o.low,
+            o.high,
+            o.cov,
+            o.flights,
         )
     };
-    if let Some(f) = &e.most_likely {
+    if let Some(f) = &o.most_likely {
+        let run = if runs > 1 {
+            format!("run {}, ", f.run)
+        } else {
+            String::new()
+        };
         out += &format!(
-            "    most likely failure: {} at t = {:.1} s, {:.2} m past the limit ({})\n",
+            "    most likely failure: {} at t = {:.1} s, {:.2} m past the limit ({run}{})\n",
             f.what,
             f.t,
             -f.room,

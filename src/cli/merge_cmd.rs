@@ -77,11 +77,86 @@ pub fn fly_shard(
     exit::OK
 }
 
+/// `--rare --shard I/N`: this shard's runs of the rare-event estimate
+/// written as a part for `skyform merge`.
+pub fn rare_shard(
+    setup: &Setup,
+    mission: &Mission,
+    args: &FlyArgs,
+    options: flight::rare::RareOptions,
+    shard: &str,
+    progress: &(dyn Fn(usize, flight::rare::Limit, usize, usize) + Sync),
+    cancel: &CancelToken,
+) -> u8 {
+    use flight::odds;
+    let shard = match flight::shard::Shard::parse(shard) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: --shard {e}");
+            return exit::ERROR;
+        }
+    };
+    let Some(path) = &args.json else {
+        eprintln!("error: --shard writes its runs to --json FILE");
+        return exit::ERROR;
+    };
+    let toml = match crate::mission::to_toml_string(mission) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return exit::ERROR;
+        }
+    };
+    let range = shard.range(args.runs);
+    let done = match odds::fly_runs(setup, options, range.clone(), progress, cancel) {
+        Ok(d) => d,
+        Err(e) => return said(&e),
+    };
+    if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        eprintln!();
+    }
+    let flights: usize = done
+        .iter()
+        .map(|r| r.separation.flights + r.clearance.flights)
+        .sum();
+    let part = odds::Part {
+        format: odds::PART_FORMAT.to_owned(),
+        mission: toml,
+        name: setup.mission.name.clone(),
+        pipeline: args.pipeline,
+        seed: options.seed,
+        per_level: options.per_level,
+        runs: args.runs,
+        shard,
+        done,
+    };
+    if let Err(status) = super::fly_cmd::json_written(&part, "the part", path, false) {
+        return status;
+    }
+    let which = if range.is_empty() {
+        "no run".to_owned()
+    } else {
+        format!("runs {}-{}", range.start, range.end - 1)
+    };
+    println!(
+        "shard {}/{} of {} rare-event runs of \"{}\" (seed {}): {which}, {flights} flights; \
+         written to {} (merge the parts with `skyform merge`)",
+        shard.index,
+        shard.count,
+        args.runs,
+        setup.mission.name,
+        options.seed,
+        path.display()
+    );
+    exit::OK
+}
+
 /// The arguments of `skyform merge`.
 #[derive(Debug, clap::Args)]
 pub struct MergeArgs {
-    /// The parts written by `skyform fly … --shard I/N --json PART`, one
-    /// per shard, in any order.
+    /// The parts written by `skyform fly … --shard I/N --json PART` (a
+    /// check's, or with `--rare` an estimate's), one per shard, in any
+    /// order.
     #[arg(required = true)]
     pub parts: Vec<PathBuf>,
     /// Write the merged report as JSON to FILE (as `skyform fly --json`).
@@ -92,19 +167,30 @@ pub struct MergeArgs {
     pub verbose: bool,
 }
 
-/// `skyform merge`: the parts of a sharded check into its report. Exit
-/// status as `skyform fly`: 0 no flight broke a limit, 2 some did, 1 error.
+/// `skyform merge`: the parts of a sharded check, or of a sharded
+/// rare-event estimate, into its report. Exit status as `skyform fly`: 0 no
+/// flight broke a limit (no estimate at 10⁻⁶ or more), 2 some did, 1 error.
 pub fn merge_command(args: &MergeArgs) -> u8 {
-    let mut parts = Vec::with_capacity(args.parts.len());
+    let mut texts = Vec::with_capacity(args.parts.len());
     for path in &args.parts {
-        let text = match std::fs::read_to_string(path) {
-            Ok(t) => t,
+        match std::fs::read_to_string(path) {
+            Ok(t) => texts.push(t),
             Err(e) => {
                 eprintln!("error: {}: {e}", path.display());
                 return exit::ERROR;
             }
-        };
-        match serde_json::from_str::<flight::shard::Part>(&text) {
+        }
+    }
+    // The first part's format says which kind of parts these are.
+    let format = texts
+        .first()
+        .and_then(|t| serde_json::from_str::<Format>(t).ok());
+    if format.is_some_and(|f| f.format == flight::odds::PART_FORMAT) {
+        return merge_odds(args, &texts);
+    }
+    let mut parts = Vec::with_capacity(texts.len());
+    for (path, text) in args.parts.iter().zip(&texts) {
+        match serde_json::from_str::<flight::shard::Part>(text) {
             Ok(p) => parts.push(p),
             Err(e) => {
                 eprintln!(
@@ -149,4 +235,34 @@ pub fn merge_command(args: &MergeArgs) -> u8 {
     let report = flight::Report::new(&setup, options, &flown, &flight::as_written(&setup));
     print!("{}", report.text(args.verbose));
     super::fly_cmd::report_written(&report, args.json.as_deref())
+}
+
+/// A part's `format`, read before the rest says which part it is.
+#[derive(serde::Deserialize)]
+struct Format {
+    format: String,
+}
+
+/// The parts of a sharded rare-event estimate into its report.
+fn merge_odds(args: &MergeArgs, texts: &[String]) -> u8 {
+    let mut parts = Vec::with_capacity(texts.len());
+    for (path, text) in args.parts.iter().zip(texts) {
+        match serde_json::from_str::<flight::odds::Part>(text) {
+            Ok(p) => parts.push(p),
+            Err(e) => {
+                eprintln!(
+                    "error: {}: not a part of `skyform fly --rare --shard` ({e})",
+                    path.display()
+                );
+                return exit::ERROR;
+            }
+        }
+    }
+    match flight::odds::merge(parts) {
+        Ok(report) => super::fly_cmd::odds_written(&report, args.json.as_deref()),
+        Err(e) => {
+            eprintln!("error: {e}");
+            exit::ERROR
+        }
+    }
 }

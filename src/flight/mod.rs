@@ -15,6 +15,7 @@
 pub mod air;
 pub mod autopilot;
 mod margin;
+pub mod odds;
 pub mod rare;
 mod report;
 pub mod shard;

@@ -34,7 +34,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use rand::SeedableRng;
 use rand::rngs::ChaCha8Rng;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::air::Normals;
 use super::{FlightError, Flown, Setup, fly_on, on_threads, vehicle_pairs};
@@ -50,7 +50,7 @@ pub const MAX_LEVELS: usize = 12;
 pub const METHOD: &str = "subset simulation (Au & Beck 2001), pCN moves (Cotter et al. 2013)";
 
 /// A limit a flight may break.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Limit {
     /// Two vehicles closer than 2 r_Q.
@@ -79,7 +79,7 @@ pub struct RareOptions {
 }
 
 /// One level of the estimate.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Level {
     /// The room below which a flight counts for this level's share
     /// (metres; the last level's is 0: the limit itself).
@@ -93,7 +93,7 @@ pub struct Level {
 }
 
 /// The most likely failing flight found: where it broke the limit.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Failure {
     /// Its room, metres (negative: past the limit).
     pub room: f64,
@@ -106,13 +106,16 @@ pub struct Failure {
     pub spread: f64,
     /// Where it is in the estimate: (level, chain, move).
     pub at: (usize, usize, usize),
+    /// The independent run it is in (`odds.rs`; 0 for a single estimate).
+    #[serde(default)]
+    pub run: usize,
 }
 
 /// The probability that a flight breaks one limit.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Estimate {
     pub limit: Limit,
-    pub method: &'static str,
+    pub method: String,
     pub estimate: f64,
     /// The 95 % interval, P·e^{±1.96 δ}.
     pub low: f64,
@@ -450,6 +453,7 @@ pub fn estimate(
                     t,
                     spread: (sample.norm2 / d as f64).sqrt(),
                     at: (level, at.0, at.1),
+                    run: 0,
                 }
             });
             let bound = breaks == 0;
@@ -466,7 +470,7 @@ pub fn estimate(
             };
             return Ok(Estimate {
                 limit,
-                method: METHOD,
+                method: METHOD.to_owned(),
                 estimate,
                 low,
                 high,

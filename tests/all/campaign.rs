@@ -138,6 +138,7 @@ fn a_campaign_runs_its_shards_on_a_ray_cluster_and_merges_to_one_process() {
         .arg("--mission")
         .arg(root.join("missions/bridge-inspection.toml"))
         .args(["--flights", "100", "--shards", "4"])
+        .args(["--rare-runs", "3", "--per-level", "20"])
         .env("RAY_USAGE_STATS_ENABLED", "0")
         .stdout(file(&dir.path().join("stdout")))
         .stderr(file(&dir.path().join("stderr")))
@@ -160,9 +161,76 @@ fn a_campaign_runs_its_shards_on_a_ray_cluster_and_merges_to_one_process() {
     assert!(stdout.contains("ray cluster: 1 node(s)"), "{stdout}");
     assert_eq!(
         stdout
-            .matches("4 shards on Ray merged == one process")
+            .matches("check, 4 shards on Ray merged == one process")
             .count(),
         2,
         "{stdout}"
+    );
+    assert_eq!(
+        stdout
+            .matches("rare, 3 shards on Ray merged == one process")
+            .count(),
+        2,
+        "{stdout}"
+    );
+}
+
+/// A rare-event estimate of 4 independent runs split into 3 shards (one
+/// of them empty: shards may outnumber nothing but runs), each written and
+/// read back as JSON, merged in another order: the report of one process
+/// to the byte. Its runs are independent (run 0 is the single estimate of
+/// the seed itself, the others differ), and a missing run is refused.
+#[test]
+fn a_rare_estimate_in_shards_of_runs_merges_to_one_process_bit_for_bit() {
+    use skyform::flight::odds::{self, OddsReport};
+    use skyform::flight::rare::{self, Limit, RareOptions};
+    let mut m = bridge();
+    m.flight.gnss_sigma_horizontal = 0.3;
+    let planned = planned(&m);
+    let setup = Setup::new(&m, &planned).unwrap_or_else(|e| panic!("{e}"));
+    let options = RareOptions {
+        per_level: 20,
+        seed: 5,
+        threads: None,
+    };
+    let cancel = CancelToken::new();
+    let runs = |r: std::ops::Range<usize>| {
+        odds::fly_runs(&setup, options, r, &|_, _, _, _| {}, &cancel)
+            .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let one = OddsReport::new(&m.name, 5, 20, runs(0..4));
+    let single = rare::estimate(&setup, Limit::Separation, options, &|_, _| {}, &cancel)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(one.separation.runs[0].estimate, single.estimate);
+    assert_ne!(one.separation.runs[1].levels, one.separation.runs[0].levels);
+    let mean = one.separation.runs.iter().map(|e| e.estimate).sum::<f64>() / 4.0;
+    assert!((one.separation.estimate - mean).abs() <= 1e-15 * mean.max(1.0));
+
+    let toml = mission::to_toml_string(&m).unwrap_or_else(|e| panic!("{e}"));
+    let mut parts: Vec<odds::Part> = (0..3)
+        .map(|index| {
+            let shard = Shard { index, count: 3 };
+            let part = odds::Part {
+                format: odds::PART_FORMAT.to_owned(),
+                mission: toml.clone(),
+                name: m.name.clone(),
+                pipeline: Kind::ThetaPso,
+                seed: 5,
+                per_level: 20,
+                runs: 4,
+                shard,
+                done: runs(shard.range(4)),
+            };
+            let text = serde_json::to_string(&part).unwrap_or_else(|e| panic!("{e}"));
+            serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}"))
+        })
+        .collect();
+    parts.reverse();
+    let merged = odds::merge(parts.clone()).unwrap_or_else(|e| panic!("{e}"));
+    let json = |r: &OddsReport| serde_json::to_string_pretty(r).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(json(&merged), json(&one));
+    assert_eq!(
+        odds::merge(parts[1..].to_vec()).map(|_| ()),
+        Err(odds::MergeError::Missing(2))
     );
 }
