@@ -19,6 +19,7 @@ use crate::run::Run;
 
 pub mod eval_cmd;
 pub mod export_cmd;
+pub mod fly_again;
 pub mod fly_cmd;
 pub mod import_cmd;
 pub mod merge_cmd;

@@ -75,6 +75,16 @@ pub struct FlyArgs {
     /// √K times narrower, and `--shard I/N` splits them between machines.
     #[arg(long, value_name = "K", default_value_t = 1, requires = "rare")]
     pub runs: usize,
+    /// With `--rare`: write each limit's most likely failing flight (its
+    /// inputs, the mission and the seed) to FILE, for `--inputs` to fly
+    /// again anywhere.
+    #[arg(long, value_name = "FILE", requires = "rare")]
+    pub failure: Option<PathBuf>,
+    /// Fly again the failing flights FILE holds (written by `--rare
+    /// --failure`) on this mission's plan: each printed as `--flight K`
+    /// prints a flight, and recorded with `--rrd`, `--connect` or `--spawn`.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["rare", "target", "shard", "flight"])]
+    pub inputs: Option<PathBuf>,
     /// Fly only shard I of N of the check (I from 0: a contiguous share of
     /// the flight numbers; with `--rare`, of the `--runs`) and write them
     /// to the --json file, a part for `skyform merge`: the merged parts
@@ -131,7 +141,10 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
         }
     };
     if let Some(k) = args.flight {
-        return replay(&setup, seed, k);
+        return super::fly_again::flight(&setup, seed, k);
+    }
+    if let Some(path) = &args.inputs {
+        return super::fly_again::inputs(&setup, &mission, args, seed, path);
     }
     if args.rare {
         return rare(&setup, &mission, args, seed, &cancel);
@@ -441,64 +454,6 @@ fn format_share(share: f64) -> String {
     format!("{:.1} %", 100.0 * (1.0 - share))
 }
 
-/// Flight `k` alone: its take-off times and, per vehicle, its closest
-/// approaches and its tightest obstacle.
-fn replay(setup: &Setup, seed: u64, k: usize) -> u8 {
-    let f = flight::fly(setup, seed, k, false);
-    println!(
-        "flight {k} of the {} plan for \"{}\" (seed {seed})",
-        setup.pipeline, setup.mission.name
-    );
-    let n = setup.plans.len();
-    let vehicle = |v: usize| setup.plans[v].vehicle + 1;
-    let mut broke = false;
-    for ((i, j), c) in flight::vehicle_pairs(n).zip(&f.pairs) {
-        let mark = if c.distance < setup.closest {
-            "BREAKS"
-        } else {
-            "ok"
-        };
-        broke |= c.distance < setup.closest;
-        println!(
-            "  {mark:<6} UAV {} - UAV {}: closest {:.2} m at t = {:.1} s (2 r_Q = {:.2} m)",
-            vehicle(i),
-            vehicle(j),
-            c.distance,
-            c.t,
-            setup.closest
-        );
-    }
-    for (v, near) in setup.near.iter().enumerate() {
-        let tightest = near
-            .iter()
-            .zip(&f.obstacles[v])
-            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance));
-        if let Some((&o, c)) = tightest {
-            let mark = if c.distance < setup.clearance {
-                "BREAKS"
-            } else {
-                "ok"
-            };
-            broke |= c.distance < setup.clearance;
-            println!(
-                "  {mark:<6} UAV {} took off {:+.2} s late; nearest '{}' at {:.2} m, t = {:.1} s \
-                 (r_Q = {:.2} m); cross-track at most {:.2} m",
-                vehicle(v),
-                f.takeoff[v],
-                setup.mission.obstacles[o].name,
-                c.distance,
-                c.t,
-                setup.clearance,
-                f.cross_track[v]
-            );
-        }
-    }
-    if !f.finished {
-        println!("  a vehicle had not reached its last waypoint at the horizon");
-    }
-    if broke { exit::INFEASIBLE } else { exit::OK }
-}
-
 /// `--rare`: each limit's probability by subset simulation (the mean of
 /// `--runs` independent runs), printed and (`--json`) written as
 /// `{"separation": {estimate, low, high, method, flights, …, runs: […]},
@@ -546,10 +501,17 @@ fn rare(setup: &Setup, mission: &Mission, args: &FlyArgs, seed: u64, cancel: &Ca
         Ok(r) => r,
         Err(e) => return said(&e),
     };
-    odds_written(
-        &OddsReport::new(&setup.mission.name, seed, options.per_level, runs),
-        args.json.as_deref(),
-    )
+    let report = OddsReport::new(&setup.mission.name, seed, options.per_level, runs);
+    let status = odds_written(&report, args.json.as_deref());
+    if let Some(path) = &args.failure {
+        let odds = [&report.separation, &report.clearance];
+        if let Err(code) =
+            super::fly_again::write_failing(path, mission, args.pipeline, seed, &odds)
+        {
+            return code;
+        }
+    }
+    status
 }
 
 /// A rare-event report printed and written as JSON to `json`

@@ -115,6 +115,19 @@ pub fn rare_shard(
     if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         eprintln!();
     }
+    if let Some(path) = &args.failure {
+        let runs = |pick: fn(&odds::Run) -> &flight::rare::Estimate| {
+            done.iter().map(|r| pick(r).clone()).collect::<Vec<_>>()
+        };
+        let separation = odds::Odds::of(flight::rare::Limit::Separation, runs(|r| &r.separation));
+        let clearance = odds::Odds::of(flight::rare::Limit::Clearance, runs(|r| &r.clearance));
+        let failing = [&separation, &clearance];
+        let written =
+            super::fly_again::write_failing(path, mission, args.pipeline, options.seed, &failing);
+        if let Err(code) = written {
+            return code;
+        }
+    }
     let flights: usize = done
         .iter()
         .map(|r| r.separation.flights + r.clearance.flights)

@@ -17,6 +17,7 @@ pub mod autopilot;
 mod margin;
 pub mod odds;
 pub mod rare;
+mod recording;
 mod report;
 pub mod shard;
 
@@ -40,6 +41,7 @@ pub use margin::{
     BetterFixes, GNSS_GRADES, MARGIN_RESOLUTION, MAX_MARGIN, MAX_SPACING, MarginLimit,
     MarginSearch, Tried, find_margin, margin_field, passing_plan, with_margin, with_spacing,
 };
+pub use recording::{RECORDED_WORST, Recording};
 pub use report::{Report, Share, Spread, Worst, wilson};
 
 use air::Normals;
@@ -499,25 +501,6 @@ pub struct Options {
     pub threads: Option<usize>,
 }
 
-/// What a recording of a check shows (`record::flight`): each vehicle's
-/// plan as written, the p99 of its cross-track error along it (the
-/// envelope: a tube of that radius), and the worst flights as flown.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Recording {
-    pub mission: String,
-    /// The instants of the samples, seconds on the plan's clock.
-    pub times: Vec<f64>,
-    /// Per vehicle (1-based number, its as-written positions at `times`).
-    pub written: Vec<(usize, Vec<Point3<f64>>)>,
-    /// Per vehicle, the p99 cross-track error at each of `times`, metres.
-    pub envelope: Vec<Vec<f64>>,
-    /// The worst flights: (flight, its vehicles' tracks).
-    pub worst: Vec<(usize, Vec<Track>)>,
-}
-
-/// The flights recorded as the worst: this many.
-pub const RECORDED_WORST: usize = 3;
-
 /// Runs `work` on `threads` worker threads (`None`: rayon's pool).
 fn on_threads<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> T {
     match threads.and_then(|n| {
@@ -528,79 +511,6 @@ fn on_threads<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) 
     }) {
         Some(pool) => pool.install(work),
         None => work(),
-    }
-}
-
-/// What a recording shows, from the flights of a check flown with their
-/// cross-track samples kept ([`check_recorded`]): the envelope, and the
-/// [`RECORDED_WORST`] worst flights' tracks (the report's worst, then the
-/// flights where the tightest pairs and obstacles were worst), flown again.
-fn recording(setup: &Setup, options: Options, report: &Report, flown: &[Flown]) -> Recording {
-    let spreads: Vec<&Vec<Vec<f32>>> = flown.iter().filter_map(|f| f.spread.as_ref()).collect();
-    let dt = setup.mission.flight.step * SAMPLE_EVERY as f64;
-    let samples = spreads
-        .iter()
-        .copied()
-        .flatten()
-        .map(Vec::len)
-        .max()
-        .unwrap_or(0);
-    let start = setup.start();
-    let times: Vec<f64> = (0..samples).map(|k| start + k as f64 * dt).collect();
-    let envelope = (0..setup.plans.len())
-        .map(|v| {
-            (0..samples)
-                .map(|k| {
-                    // A flight that finished early holds its last sample.
-                    let mut at: Vec<f64> = spreads
-                        .iter()
-                        .filter_map(|f| f[v].get(k).or(f[v].last()).map(|x| f64::from(*x)))
-                        .collect();
-                    at.sort_by(f64::total_cmp);
-                    report::quantile(&at, 0.99)
-                })
-                .collect()
-        })
-        .collect();
-    let written = setup
-        .plans
-        .iter()
-        .map(|p| {
-            let schedule = Flight::new(p);
-            (
-                p.vehicle + 1,
-                times.iter().map(|&t| schedule.at(t).0).collect(),
-            )
-        })
-        .collect();
-    let mut chosen: Vec<usize> = Vec::new();
-    let candidates = report.worst.iter().map(|w| w.flight).chain(
-        report
-            .pairs
-            .iter()
-            .map(|p| p.closest.worst_flight)
-            .chain(report.obstacles.iter().map(|o| o.clearance.worst_flight)),
-    );
-    for k in candidates {
-        if chosen.len() < RECORDED_WORST && !chosen.contains(&k) {
-            chosen.push(k);
-        }
-    }
-    let worst = chosen
-        .into_iter()
-        .map(|k| {
-            (
-                k,
-                fly(setup, options.seed, k, true).tracks.unwrap_or_default(),
-            )
-        })
-        .collect();
-    Recording {
-        mission: setup.mission.name.clone(),
-        times,
-        written,
-        envelope,
-        worst,
     }
 }
 
@@ -626,7 +536,7 @@ pub fn check_recorded(
 ) -> Result<(Report, Recording), FlightError> {
     let flown = fly_all(setup, options, true, progress, cancel)?;
     let report = Report::new(setup, options, &flown, &as_written(setup));
-    let recording = recording(setup, options, &report, &flown);
+    let recording = recording::recording(setup, options, &report, &flown);
     Ok((report, recording))
 }
 

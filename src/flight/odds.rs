@@ -189,6 +189,59 @@ pub fn fly_runs(
     .collect()
 }
 
+/// What a failing-flight file says it is.
+pub const FAILING_FORMAT: &str = "skyform failing flights 1";
+
+/// The most likely failing flights of an estimate, with everything needed
+/// to fly them again anywhere (`skyform fly MISSION --inputs FILE`): the
+/// mission and the plan's seed, and each flight's inputs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailingFile {
+    pub format: String,
+    /// The mission flown, as TOML (a replay refuses another).
+    pub mission: String,
+    pub pipeline: Kind,
+    /// The seed of the plan (and of the estimate).
+    pub seed: u64,
+    /// Each limit's most likely failing flight, where one was seen.
+    pub flights: Vec<FailingFlight>,
+}
+
+/// One limit's most likely failing flight.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailingFlight {
+    pub limit: Limit,
+    /// What it broke, where and when, as the report said.
+    pub failure: Failure,
+    /// Its standard normal inputs, in the order the flight draws them.
+    pub inputs: Vec<f32>,
+}
+
+impl FailingFile {
+    /// The failing flights of `odds` (each limit's most likely, with its
+    /// inputs: only a report made in this process has them).
+    pub fn new(mission_toml: String, pipeline: Kind, seed: u64, odds: &[&Odds]) -> FailingFile {
+        let flights = odds
+            .iter()
+            .filter_map(|o| {
+                let f = o.most_likely.as_ref()?;
+                (!f.inputs.is_empty()).then(|| FailingFlight {
+                    limit: o.limit,
+                    failure: f.clone(),
+                    inputs: f.inputs.clone(),
+                })
+            })
+            .collect();
+        FailingFile {
+            format: FAILING_FORMAT.to_owned(),
+            mission: mission_toml,
+            pipeline,
+            seed,
+            flights,
+        }
+    }
+}
+
 /// One shard's runs and what they belong to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Part {

@@ -109,6 +109,11 @@ pub struct Failure {
     /// The independent run it is in (`odds.rs`; 0 for a single estimate).
     #[serde(default)]
     pub run: usize,
+    /// Its inputs (the standard normals it drew, in order): flown again by
+    /// [`fly_failure`]. Not in the report's JSON (about 10⁵ numbers); a
+    /// failing-flight file (`odds::FailingFile`) carries them.
+    #[serde(skip)]
+    pub inputs: Vec<f32>,
 }
 
 /// The probability that a flight breaks one limit.
@@ -228,6 +233,11 @@ fn fly_inputs(setup: &Setup, u: &[f32], limit: Limit) -> f64 {
         Limit::Separation => flown.separation_room(setup),
         Limit::Clearance => flown.clearance_room(setup),
     }
+}
+
+/// Flies a failing flight's inputs again, keeping every vehicle's track.
+pub fn fly_failure(setup: &Setup, inputs: &[f32]) -> Flown {
+    fly_on(setup, &mut Reading { u: inputs, at: 0 }, 0, true, false)
 }
 
 /// One sample of a level: its room and |u|².
@@ -454,6 +464,7 @@ pub fn estimate(
                     spread: (sample.norm2 / d as f64).sqrt(),
                     at: (level, at.0, at.1),
                     run: 0,
+                    inputs: u,
                 }
             });
             let bound = breaks == 0;

@@ -1,7 +1,7 @@
 //! A flight check in a recording (`skyform fly --rrd`): each vehicle's plan
 //! as written, the p99 envelope of its cross-track error as a tube (a ball
 //! of that radius every fifth of a second along the plan), the worst flights
-//! as flown, and the report.
+//! as flown (and flights flown again from their inputs), and the report.
 
 use rerun::RecordingStream;
 
@@ -51,6 +51,18 @@ pub fn log_flights(
                 &rerun::LineStrips3D::new([line])
                     .with_colors([rerun::Color::from_rgb(230, 60, 60)])
                     .with_labels([format!("flight {flight}, UAV {vehicle}")]),
+            )?;
+        }
+    }
+    for (name, tracks) in &rec.failing {
+        for (v, track) in tracks.iter().enumerate() {
+            let vehicle = rec.written.get(v).map_or(v + 1, |w| w.0);
+            let line: Vec<[f32; 3]> = track.iter().map(|(_, p)| f32x3(p)).collect();
+            stream.log_static(
+                at::failing(name, vehicle),
+                &rerun::LineStrips3D::new([line])
+                    .with_colors([rerun::Color::from_rgb(240, 150, 30)])
+                    .with_labels([format!("{name}, UAV {vehicle}")]),
             )?;
         }
     }

@@ -74,6 +74,12 @@ pub mod flight {
     pub fn worst(flight: usize, vehicle: usize) -> String {
         format!("flight/worst/flight_{flight}/uav_{vehicle}")
     }
+
+    /// A flight flown again from its inputs (`name`: a rare-event
+    /// estimate's most likely failure of a limit).
+    pub fn failing(name: &str, vehicle: usize) -> String {
+        format!("flight/failing/{name}/uav_{vehicle}")
+    }
 }
 
 #[cfg(test)]

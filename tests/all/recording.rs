@@ -643,3 +643,82 @@ fn a_flight_check_recording_holds_the_worst_flights_and_the_envelope() {
     );
     assert!(paths.contains(&"/flight/report".to_owned()));
 }
+
+/// Issue 52, item 1: the most likely failing flight of `--rare` is
+/// replayable. `--failure F` writes its inputs with the mission and seed;
+/// `--inputs F` flies it again (the same pair, the same closest distance to
+/// the centimetre as the estimate said) and records it as flown beside the
+/// plan as written; a replay on another seed's plan is refused, naming the
+/// seed to use.
+#[test]
+fn the_most_likely_failing_flight_is_written_flown_again_and_recorded() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let failing = dir.path().join("failing.json");
+    let rrd = dir.path().join("failing.rrd");
+    let f = failing.display().to_string();
+    let out = skyform(&[
+        "fly",
+        "missions/bridge-inspection.toml",
+        "--seed",
+        "1",
+        "--rare",
+        "--per-level",
+        "30",
+        "--failure",
+        &f,
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(2), "{stdout}");
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&failing).expect("written")).expect("json");
+    let separation = file["flights"]
+        .as_array()
+        .and_then(|a| a.iter().find(|f| f["limit"] == "separation"))
+        .unwrap_or_else(|| panic!("no separation failure in {stdout}"));
+    assert!(
+        separation["inputs"]
+            .as_array()
+            .is_some_and(|u| u.len() > 1000)
+    );
+    // "UAV 2 and UAV 3 0.98 m apart": the pair and its distance.
+    let what = separation["failure"]["what"].as_str().expect("what");
+    let words: Vec<&str> = what.split_whitespace().collect();
+    let (a, b, d) = (words[1], words[4], words[5]);
+    assert!(stdout.contains(what), "{stdout}");
+
+    let again = skyform(&[
+        "fly",
+        "missions/bridge-inspection.toml",
+        "--seed",
+        "1",
+        "--inputs",
+        &f,
+        "--rrd",
+        &rrd.display().to_string(),
+    ]);
+    let replayed = String::from_utf8_lossy(&again.stdout);
+    assert_eq!(again.status.code(), Some(2), "{replayed}");
+    let line = format!("BREAKS UAV {a} - UAV {b}: closest {d} m");
+    assert!(replayed.contains(&line), "{line} not in {replayed}");
+    let paths = entity_paths(&chunks(&rrd));
+    for uav in 1..=3 {
+        for path in [
+            format!("/flight/written/uav_{uav}"),
+            format!("/flight/failing/most_likely_separation/uav_{uav}"),
+        ] {
+            assert!(paths.contains(&path), "{path} not in {paths:?}");
+        }
+    }
+
+    let refused = skyform(&[
+        "fly",
+        "missions/bridge-inspection.toml",
+        "--seed",
+        "2",
+        "--inputs",
+        &f,
+    ]);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("add --seed 1"), "{stderr}");
+}
