@@ -3,7 +3,7 @@
 //! Metres, ENU (z up), ground at z = 0. This module is a leaf: it knows nothing
 //! of missions or pipelines.
 
-use nalgebra::{Point2, Point3, Vector3};
+use nalgebra::{Point2, Point3, Vector2, Vector3};
 
 /// Signed distance from `q` to the simple polygon `vertices`: the distance
 /// to its nearest edge, negative inside (even-odd rule).
@@ -107,6 +107,25 @@ pub fn farthest_offset(offsets: &[Vector3<f64>]) -> f64 {
 /// Length of the polyline through `points`.
 pub fn polyline_length(points: &[Point3<f64>]) -> f64 {
     points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+/// The edge of the anticlockwise `outline` whose outward normal is nearest
+/// `normal` (the face an `inspect_side` names); the longer of two as near.
+pub fn facing_edge(outline: &[Point2<f64>], normal: Vector2<f64>) -> usize {
+    let n = outline.len();
+    (0..n)
+        .map(|i| {
+            let d = outline[(i + 1) % n] - outline[i];
+            let length = d.norm().max(1e-12);
+            let outward = Vector2::new(d.y, -d.x) / length;
+            (i, outward.dot(&normal), length)
+        })
+        .max_by(|a, b| {
+            (a.1, a.2)
+                .partial_cmp(&(b.1, b.2))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })
+        .map_or(0, |(i, _, _)| i)
 }
 
 #[cfg(test)]

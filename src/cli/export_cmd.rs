@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use super::{StderrProgress, cancel_on_ctrl_c, exit, load_reporting};
 use crate::export::{self, ExportError, Exported, Format, Options, Planned};
 use crate::mission::Mission;
-use crate::pipelines::theta_pso::verify::figure;
+use crate::pipelines::verify::figure;
 use crate::pipelines::{Completion, Kind};
 use crate::run::Run;
 
@@ -222,7 +222,7 @@ pub fn summary(done: &Exported) -> String {
 }
 
 /// The verification table, in the pipeline's words.
-fn checks(v: &crate::pipelines::theta_pso::verify::Verification, noun: &str) -> String {
+fn checks(v: &crate::pipelines::verify::Verification, noun: &str) -> String {
     let mut out = String::new();
     for c in &v.checks {
         out.push_str(&format!(

@@ -7,10 +7,9 @@
 //! ([`super::legs`]), between the positions the file stores (1e-7°,
 //! float32). The CSV: its samples as written, in straight lines between
 //! them. The flights are sampled at the planned tracks' instants and handed
-//! to θ-PSO's verification
-//! ([`crate::pipelines::theta_pso::verify::verify_within`], for every
-//! pipeline's files: issue 53 would give this floor a verification of its
-//! own) with the hard limits the plan was held to. Also measured: the largest distance between where a vehicle flies
+//! to the shared verification ([`crate::pipelines::verify::verify_within`],
+//! the one θ-PSO's plans pass too, for every pipeline's files) with the hard
+//! limits the plan was held to. Also measured: the largest distance between where a vehicle flies
 //! and where its track has it at the same instant (the deviation), the
 //! largest difference between when a vehicle reaches a waypoint and when
 //! the plan says (the timing error), and every leg's commanded speed and
@@ -30,8 +29,9 @@ use serde::Serialize;
 use super::{LegLimits, Placement, Planned, VehiclePlan, csv, noun};
 use crate::mission::Mission;
 use crate::outcome::tracks::{Track, TrackSample};
-use crate::pipelines::theta_pso::verify::{Verification, verify_within};
-use crate::pipelines::theta_pso::{Sample, Trajectory};
+use crate::pipelines::TrackSample as Sample;
+use crate::pipelines::verify::Trajectory;
+use crate::pipelines::verify::{Verification, verify_within};
 use crate::pipelines::{Kind, Limits};
 
 /// Which files a check flew.

@@ -24,7 +24,7 @@ use crate::base::ode::rk4_step;
 use crate::export::VehiclePlan;
 use crate::export::reverify::Flight;
 use crate::mission::VehicleLimits;
-use crate::pipelines::fleet::quadrotor::{self, Body, State};
+use crate::pipelines::quadrotor::{self, Body, State};
 
 /// PX4's multicopter position and velocity gains (MPC_XY_P, MPC_Z_P,
 /// MPC_XY_VEL_P/I/D_ACC, MPC_Z_VEL_P/I/D_ACC, their defaults).

@@ -35,7 +35,7 @@ use crate::export::reverify::Flight;
 use crate::export::{Placement, Planned, VehiclePlan, reduce};
 use crate::mission::Mission;
 use crate::pipelines::CancelToken;
-use crate::pipelines::fleet::quadrotor::Body;
+use crate::pipelines::quadrotor::Body;
 
 pub use margin::{
     BetterFixes, GNSS_GRADES, MARGIN_RESOLUTION, MAX_MARGIN, MAX_SPACING, MarginLimit,
@@ -316,7 +316,7 @@ fn fly_on(
     keep_spread: bool,
 ) -> Flown {
     let p = &setup.mission.flight;
-    let body = Body::from_params(&setup.mission.fleet);
+    let body = Body::of(setup.mission);
     let gains = autopilot::Gains::of(&setup.mission.vehicle);
     let n = setup.plans.len();
     let mut takeoff = Vec::with_capacity(n);

@@ -159,6 +159,8 @@ pub struct Words {
     pub slug: &'static str,
     /// What it calls a vehicle: `UAV`.
     pub noun: &'static str,
+    /// And more than one: `UAVs`.
+    pub nouns: &'static str,
     /// Its vehicles fly with fixed wings.
     pub fixed_wing: bool,
     /// The sweep's figure column.
@@ -201,6 +203,12 @@ pub trait Pipeline: Sync {
     fn noun(&self) -> &'static str {
         self.words().noun
     }
+    /// What it calls its vehicles: `UAVs`.
+    fn nouns(&self) -> &'static str {
+        self.words().nouns
+    }
+    /// How many vehicles a run of it flies in `mission`.
+    fn vehicles(&self, mission: &Mission) -> usize;
     /// Its vehicles fly with fixed wings.
     fn fixed_wing(&self) -> bool {
         self.words().fixed_wing

@@ -22,7 +22,7 @@ pub struct TrackSample {
 }
 
 /// The thresholds a verification holds tracks to, whichever pipeline flew
-/// them: θ-PSO's are `Limits::theta_pso` (`theta_pso::verify`); the exports
+/// them: θ-PSO's are `Limits::theta_pso` (`pipelines::verify`); the exports
 /// re-verify FLATLO and fleet plans with their own pipeline's thresholds
 /// through the same checks.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -11,9 +11,11 @@
 pub mod chart;
 pub mod face;
 pub mod interface;
+pub mod quadrotor;
 pub mod revision;
 pub mod sketch;
 pub mod table;
+pub mod verify;
 
 pub mod flatlo;
 pub mod fleet;

@@ -231,7 +231,7 @@ fn the_pair_queries_find_the_passage_beside_a_new_shape() {
 
 #[test]
 fn the_face_an_inspection_looks_at_is_the_new_shapes_own() {
-    use skyform::pipelines::theta_pso::verify::{face_bearing, on_side};
+    use skyform::pipelines::verify::{face_bearing, on_side};
     let prism = Prism::new(Footprint::new(hedge()), 0.0, 4.0);
     // North of its side it faces north; past its east end, east.
     let north = face_bearing(&prism, &Point3::new(10.0, 4.0, 2.0));

@@ -1217,7 +1217,7 @@ fn pass_at(d: f64, arc: f64) -> (Mission, Vec<skyform::pipelines::theta_pso::Tra
 #[test]
 fn eq8_a_pass_inside_the_band_long_enough_is_an_inspection() {
     let (m, flown) = pass_at(3.0, 9.0);
-    let r = &skyform::pipelines::theta_pso::verify::verify_inspections(&m, &flown)[0];
+    let r = &skyform::pipelines::verify::verify_inspections(&m, &flown)[0];
     assert!(r.ok, "{r:?}");
     // The distance travelled along the samples: chords of the circle.
     assert!((r.achieved - 9.0).abs() < 0.01, "{r:?}");
@@ -1226,7 +1226,7 @@ fn eq8_a_pass_inside_the_band_long_enough_is_an_inspection() {
     assert_eq!(r.band, [1.0, 5.0]);
     // The same distance over too short a pass breaks eq. 8's pass length.
     let (m, flown) = pass_at(3.0, 3.0);
-    let short = &skyform::pipelines::theta_pso::verify::verify_inspections(&m, &flown)[0];
+    let short = &skyform::pipelines::verify::verify_inspections(&m, &flown)[0];
     assert!(
         !short.ok && (short.achieved - 3.0).abs() < 0.01,
         "{short:?}"
@@ -1237,7 +1237,7 @@ fn eq8_a_pass_inside_the_band_long_enough_is_an_inspection() {
 fn eq8_a_pass_below_or_above_the_band_is_no_inspection() {
     for d in [0.8, 5.5] {
         let (m, flown) = pass_at(d, 9.0);
-        let r = &skyform::pipelines::theta_pso::verify::verify_inspections(&m, &flown)[0];
+        let r = &skyform::pipelines::verify::verify_inspections(&m, &flown)[0];
         assert!(
             !r.ok && r.achieved == 0.0 && r.distance.is_none(),
             "d = {d}: {r:?}"
@@ -1246,7 +1246,7 @@ fn eq8_a_pass_below_or_above_the_band_is_no_inspection() {
     // An obstacle's own band overrides the formation's.
     let (mut m, flown) = pass_at(5.5, 9.0);
     m.obstacles[0].stand_off = Some([4.0, 6.0]);
-    assert!(skyform::pipelines::theta_pso::verify::verify_inspections(&m, &flown)[0].ok);
+    assert!(skyform::pipelines::verify::verify_inspections(&m, &flown)[0].ok);
 }
 
 #[test]

@@ -22,6 +22,7 @@ static WORDS: Words = Words {
     name: "FLATLO",
     slug: "flatlo",
     noun: "aircraft",
+    nouns: "aircraft",
     fixed_wing: true,
     figure_name: "closest pair (m)",
     tallies: ("finished", "passed"),
@@ -44,6 +45,10 @@ static WORDS: Words = Words {
 impl Pipeline for Flatlo {
     fn words(&self) -> &'static Words {
         &WORDS
+    }
+
+    fn vehicles(&self, mission: &Mission) -> usize {
+        mission.flatlo.aircraft
     }
 
     fn plots(&self) -> &'static [&'static [Plot]] {

@@ -22,6 +22,7 @@ static WORDS: Words = Words {
     name: "fleet",
     slug: "fleet",
     noun: "agent",
+    nouns: "agents",
     fixed_wing: false,
     figure_name: "closest agents (m)",
     tallies: ("finished", "passed"),
@@ -44,6 +45,10 @@ static WORDS: Words = Words {
 impl Pipeline for Fleet {
     fn words(&self) -> &'static Words {
         &WORDS
+    }
+
+    fn vehicles(&self, mission: &Mission) -> usize {
+        mission.fleet.agents
     }
 
     /// The safety distance c, which every agent keeps from the others and

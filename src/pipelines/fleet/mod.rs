@@ -9,8 +9,9 @@
 //!
 //! Here: the scenario, the run's predicted size (`budget`) and the outcome
 //! types; the round loop with its named stages (observe, decide, fly,
-//! record) is `simulation.rs`, the per-agent pieces `agent.rs`, `cost.rs`
-//! and `quadrotor.rs`.
+//! record) is `simulation.rs`, the per-agent pieces `agent.rs` and
+//! `cost.rs`; the quadrotor they fly is shared (`pipelines::quadrotor`), as
+//! the flight check flies it too.
 
 pub mod agent;
 pub mod chart;
@@ -19,7 +20,6 @@ pub mod face;
 pub mod judge;
 pub mod network;
 pub mod numbering;
-pub mod quadrotor;
 pub mod recording;
 pub mod scenario;
 pub mod simulation;

@@ -24,7 +24,6 @@ use super::agent::Planner;
 use super::cost::{Neighbour, Observation};
 use super::judge::{formation_error, tolerance_of};
 use super::network::{Message, Network};
-use super::quadrotor::{self, Body, State};
 use super::{
     AgentOutcome, AgentSample, Closest, DistanceSeries, FleetOutcome, FormationError,
     MAX_SERIES_AGENTS, Other, SAMPLE_RATE, Scenario, Shortfall, TargetOutcome, neighbourhoods,
@@ -33,6 +32,7 @@ use super::{
 use crate::base::ode::rk4_step;
 use crate::base::shape::Footprint;
 use crate::mission::{FleetParams, FleetPush, Mission};
+use crate::pipelines::quadrotor::{self, Body, State};
 use crate::pipelines::{CancelToken, Completion, Event, Level, Observer};
 
 /// What carries each step's messages between the processes that fly the

@@ -33,7 +33,8 @@ pub fn chart(o: &ThetaPsoOutcome, view: &ChartView, out: &mut dyn Chart) {
             out.line(centroid_between(o, pass.time[0], pass.time[1]), Ink::Pass);
         }
     }
-    let at = |v: &super::verify::Violation| [v.location.position.x, v.location.position.y];
+    let at =
+        |v: &crate::pipelines::verify::Violation| [v.location.position.x, v.location.position.y];
     for v in o.verification.violations.iter().take(50) {
         out.mark(at(v), "✗".into(), Ink::Fault);
     }

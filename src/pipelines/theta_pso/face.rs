@@ -27,6 +27,7 @@ static WORDS: Words = Words {
     name: "θ-PSO",
     slug: "theta-pso",
     noun: "UAV",
+    nouns: "UAVs",
     fixed_wing: false,
     figure_name: "best J",
     tallies: ("J finite", "feasible"),
@@ -43,6 +44,10 @@ static WORDS: Words = Words {
 impl Pipeline for ThetaPso {
     fn words(&self) -> &'static Words {
         &WORDS
+    }
+
+    fn vehicles(&self, mission: &Mission) -> usize {
+        mission.formation.slots.len()
     }
 
     fn scene(&self, mission: &Mission, out: &mut dyn Sketch) {

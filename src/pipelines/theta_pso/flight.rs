@@ -25,9 +25,9 @@ use super::iwp::Iwp;
 use super::path::CentroidPath;
 use super::path::rounding::corners;
 use super::trajectory::{self, Flight};
-use super::verify::{self, Verification};
 use crate::mission::Mission;
 use crate::pipelines::PipelineError;
+use crate::pipelines::verify::{self, Verification};
 use nalgebra::{Point2, Point3};
 
 /// Times a corner's tolerance is cut (to a quarter, then to nothing).

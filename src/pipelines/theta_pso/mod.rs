@@ -24,8 +24,6 @@ pub mod summary;
 pub mod timing;
 pub mod trajectory;
 pub mod unusable;
-pub mod verify;
-pub mod vias;
 
 use std::f64::consts::FRAC_PI_2;
 
@@ -35,13 +33,13 @@ use serde::{Deserialize, Serialize};
 use crate::base::swarm::SearchSpace;
 use crate::mission::{Diagnostic, FieldPath, Mission};
 
+pub use crate::pipelines::verify::{Check, InspectionResult, Verification};
 pub use cost::{CostModel, CostTerms};
 pub use inspection::PassGeometry;
 pub use iwp::{Iwp, Shape, find_iwps};
 pub use path::{CentroidPath, PathBuilder};
 pub use plan::{PlanSource, passed_by_altitude, plan, plan_warm};
 pub use trajectory::{Reconfiguration, Sample, Trajectory};
-pub use verify::{Check, InspectionResult, Verification};
 
 pub use crate::pipelines::PlanOptions;
 

@@ -17,10 +17,11 @@ use super::{
     CentroidPath, CostTerms, Iwp, PlanOptions, PlannedPass, Problem, ThetaPsoOutcome, Trajectory,
     USABLE_LOGGED, Verification, WARM_STALL, WARM_SWARM, WARM_TOLERANCE, WarmStart, benchmark,
     budget, cost, flight, reference, repair, route, seeding, trajectory, trajectory_samples,
-    unusable, verify,
+    unusable,
 };
 use crate::base::swarm::{self, SwarmConfig};
 use crate::mission::Mission;
+use crate::pipelines::verify;
 use crate::pipelines::{
     CancelToken, Completion, Event, Kind, Level, Observer, PipelineError, Revision,
 };

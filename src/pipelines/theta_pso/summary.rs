@@ -133,10 +133,9 @@ pub struct VerificationRow {
 pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
     let mut rows = Vec::new();
     for check in &o.verification.checks {
-        let worst = check.worst.map_or_else(
-            || "n/a".to_owned(),
-            crate::pipelines::theta_pso::verify::figure,
-        );
+        let worst = check
+            .worst
+            .map_or_else(|| "n/a".to_owned(), crate::pipelines::verify::figure);
         let at = check.at.as_ref().map_or_else(String::new, |a| {
             let other = a
                 .other
@@ -150,7 +149,7 @@ pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
                 "{:<32} worst {worst:>9} {} {}{at}",
                 check.name,
                 check.relation,
-                crate::pipelines::theta_pso::verify::limit_figure(check.limit)
+                crate::pipelines::verify::limit_figure(check.limit)
             ),
         });
     }

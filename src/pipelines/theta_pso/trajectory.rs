@@ -25,13 +25,9 @@ use crate::pipelines::PipelineError;
 /// One sample of a UAV's trajectory: the shared timed sample.
 pub use crate::pipelines::TrackSample as Sample;
 
-/// The timed trajectory T_n of one UAV (eq. 15).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Trajectory {
-    /// 0-based slot index.
-    pub uav: usize,
-    pub samples: Vec<Sample>,
-}
+/// The timed trajectory T_n of one UAV (eq. 15): the shared timed track
+/// that verification judges.
+pub use crate::pipelines::verify::Trajectory;
 
 /// A reconfiguration as flown: which IWP (or squeezed stretch), which
 /// shape, and when.

@@ -8,6 +8,7 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, BorderType, Borders, Paragraph, Wrap};
 
 use crate::mission::Severity;
+use crate::pipelines::Kind;
 use crate::tui::app::{App, Focus};
 use crate::tui::fields::{self, Item, Place};
 
@@ -113,13 +114,15 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
                 String::new()
             }),
         ]));
-        // Each pipeline flies its own vehicles: all three counts.
-        lines.push(Line::raw(format!(
-            "θ-PSO {} UAVs · FLATLO {} aircraft · fleet {} agents",
-            m.formation.slots.len(),
-            m.flatlo.aircraft,
-            m.fleet.agents
-        )));
+        // Each pipeline flies its own vehicles: every count.
+        let counts: Vec<String> = Kind::ALL
+            .iter()
+            .map(|k| {
+                let face = k.face();
+                format!("{} {} {}", face.name(), face.vehicles(m), face.nouns())
+            })
+            .collect();
+        lines.push(Line::raw(counts.join(" · ")));
         for d in diagnostics.iter().take(6) {
             lines.push(Line::from(severity_span(
                 d.severity,

@@ -420,7 +420,7 @@ impl PathBuilder {
             let (edge, at) = match ins.side {
                 // On the chosen face, `phi` places the pass along it.
                 Some(normal) => {
-                    let i = facing_edge(outline, normal);
+                    let i = crate::base::geometry::facing_edge(outline, normal);
                     let n = outline.len();
                     let length = (outline[(i + 1) % n] - outline[i]).norm();
                     (
@@ -917,25 +917,6 @@ fn perimeter_place(outline: &[Point2<f64>], phi: f64) -> (usize, f64) {
         i += 1;
     }
     (i, at)
-}
-
-/// The edge of the anticlockwise `outline` whose outward normal is nearest
-/// `normal` (the face an `inspect_side` names); the longer of two as near.
-pub fn facing_edge(outline: &[Point2<f64>], normal: Vector2<f64>) -> usize {
-    let n = outline.len();
-    (0..n)
-        .map(|i| {
-            let d = outline[(i + 1) % n] - outline[i];
-            let length = d.norm().max(1e-12);
-            let outward = Vector2::new(d.y, -d.x) / length;
-            (i, outward.dot(&normal), length)
-        })
-        .max_by(|a, b| {
-            (a.1, a.2)
-                .partial_cmp(&(b.1, b.2))
-                .unwrap_or(std::cmp::Ordering::Equal)
-        })
-        .map_or(0, |(i, _, _)| i)
 }
 
 /// Puts `via` into leg `leg` (after its first point), locking the via's own legs.

@@ -1,5 +1,9 @@
-//! The quadrotor of the fleet paper: rigid-body dynamics (eq. 10) under the
-//! quaternion position and attitude laws (eqs. 11-13).
+//! The multicopter every multicopter of a mission is: the fleet paper's
+//! quadrotor, rigid-body dynamics (eq. 10) under the quaternion position and
+//! attitude laws (eqs. 11-13). The fleet's agents fly it, and the flight
+//! check (`flight`) flies every multicopter plan's vehicles on it, whichever
+//! pipeline planned them: so it is shared, not the fleet's own. Its
+//! parameters are read from the mission ([`Body::of`]).
 //!
 //! State: position p and velocity ṗ (m, m/s, ENU), attitude q (body → world)
 //! and body rate ω (rad/s). Thrust F along body z (b = [0 0 1]), torque τ.
@@ -11,7 +15,7 @@
 
 use nalgebra::{Matrix3, Point3, Quaternion, SVector, UnitQuaternion, Vector3};
 
-use crate::mission::FleetParams;
+use crate::mission::{FleetParams, Mission};
 
 /// Standard gravity, m/s².
 pub const G: f64 = crate::mission::GRAVITY;
@@ -41,6 +45,13 @@ pub struct Command {
 }
 
 impl Body {
+    /// The airframe of `mission`'s multicopters: the body the `[fleet]`
+    /// section describes (mass, inertia, gains, thrust and tilt limits), the
+    /// one quadrotor the file states.
+    pub fn of(mission: &Mission) -> Self {
+        Self::from_params(&mission.fleet)
+    }
+
     pub fn from_params(p: &FleetParams) -> Self {
         let inertia = Matrix3::from_diagonal(&p.inertia_diag);
         Body {

@@ -14,9 +14,21 @@
 use nalgebra::Point3;
 use serde::Serialize;
 
-use super::trajectory::Trajectory;
 use crate::mission::Mission;
-use crate::pipelines::Limits;
+use crate::pipelines::{Limits, TrackSample};
+
+mod vias;
+
+pub use vias::ViaResult;
+
+/// One UAV's timed track as verification judges it (θ-PSO's T_n, eq.
+/// 15; an export's flown schedule).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trajectory {
+    /// 0-based slot index.
+    pub uav: usize,
+    pub samples: Vec<TrackSample>,
+}
 
 /// Where a worst value happens.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -89,7 +101,7 @@ pub struct Verification {
     pub inspections: Vec<InspectionResult>,
     /// The route's vias (`[[route.via]]`), one row each, in order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub vias: Vec<super::vias::ViaResult>,
+    pub vias: Vec<ViaResult>,
 }
 
 impl Verification {
@@ -312,7 +324,7 @@ pub fn verify_within(
     let (inspections, vias) = if limits.inspections {
         (
             verify_inspections(mission, trajectories),
-            super::vias::verify_vias(mission, trajectories),
+            vias::verify_vias(mission, trajectories),
         )
     } else {
         (Vec::new(), Vec::new())
@@ -541,7 +553,7 @@ pub fn on_side(o: &crate::base::shape::Prism, p: &Point3<f64>, side: f64) -> boo
     if area < 0.0 {
         outline.reverse();
     }
-    let i = super::path::facing_edge(&outline, normal);
+    let i = crate::base::geometry::facing_edge(&outline, normal);
     crate::base::geometry::segment_point_distance(&outline[i], &outline[(i + 1) % n], &q) < 1e-6
 }
 

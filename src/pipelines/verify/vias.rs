@@ -7,7 +7,7 @@
 use nalgebra::Point3;
 use serde::Serialize;
 
-use super::trajectory::Trajectory;
+use super::Trajectory;
 use crate::mission::Mission;
 
 /// Whether the flight kept one `[[route.via]]`.
