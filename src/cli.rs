@@ -135,7 +135,9 @@ pub enum Command {
     /// Job, a Ray cluster) into the report one process gives, bit for bit.
     /// Checks the parts are one check's and cover every flight once, plans
     /// the mission they carry again, and prints (and with --json writes)
-    /// the report. Exit status as `skyform fly`. See docs/flight-check.md.
+    /// the report. The parts of a sharded rare-event estimate (`--rare
+    /// --runs K --shard I/N`) merge the same way into its odds, no flight
+    /// flown again. Exit status as `skyform fly`. See docs/flight-check.md.
     Merge(merge_cmd::MergeArgs),
     /// Bring a site survey's obstacles into a mission: GeoJSON (RFC 7946),
     /// KML or KMZ, as Google Earth, QGIS or OpenStreetMap draw them.

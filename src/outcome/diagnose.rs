@@ -16,23 +16,6 @@ pub fn diagnose(mission: &Mission) -> Vec<Diagnostic> {
     crate::pipelines::Revision::of(mission).diagnostics()
 }
 
-/// What the pipelines say of a mission that follows the rules: their budgets
-/// first (a run too large to start), then θ-PSO's IWPs and inspections,
-/// then FLATLO's airspeeds and bounds predicted from its references
-/// (`Pipeline::findings`).
-fn pipeline_findings(mission: &Mission) -> Vec<Diagnostic> {
-    use crate::pipelines::Kind;
-    // Every registered pipeline's predicted size, then its findings, each
-    // in the order of `Kind`.
-    let budgets = Kind::ALL
-        .into_iter()
-        .flat_map(|kind| kind.face().budget(mission));
-    let findings = Kind::ALL
-        .into_iter()
-        .flat_map(|kind| kind.face().findings(mission, None));
-    budgets.chain(findings).collect()
-}
-
 /// `mission::check_str` with the pipelines' findings, located in `text`.
 pub fn check_text(text: &str, file: Option<&str>) -> Checked {
     let mut checked = mission::check_str(text, file);
@@ -40,20 +23,13 @@ pub fn check_text(text: &str, file: Option<&str>) -> Checked {
         && !checked.report.has_errors()
     {
         let source = SourceMap::new(text);
-        // The pipelines' own sections' rules; their findings only on a
-        // mission that follows every rule, as in `diagnose`.
-        let sections: Vec<Diagnostic> = crate::pipelines::Kind::ALL
+        // The sections' rules, then (on a mission that follows every rule,
+        // as in `diagnose`) the pipelines' budgets and findings: the
+        // revision the designer finds, less the file's rules, which
+        // `check_str` has located already.
+        let extra: Vec<Diagnostic> = crate::pipelines::Revision::of(m)
+            .beyond_the_file()
             .into_iter()
-            .flat_map(|kind| kind.face().validate(m))
-            .collect();
-        let findings = if sections.iter().any(Diagnostic::is_error) {
-            Vec::new()
-        } else {
-            pipeline_findings(m)
-        };
-        let extra: Vec<Diagnostic> = sections
-            .into_iter()
-            .chain(findings)
             .map(|d| d.locate(file, &source))
             .collect();
         if !extra.is_empty() {

@@ -157,10 +157,16 @@ pub enum PipelineError {
 /// hold a mission to.
 pub fn validate(mission: &crate::mission::Mission) -> Vec<crate::mission::Diagnostic> {
     let mut all = crate::mission::validate(mission);
-    for kind in super::Kind::ALL {
-        all.extend(kind.face().validate(mission));
-    }
+    all.extend(section_rules(mission));
     all
+}
+
+/// The rules of every pipeline's own section, in `Kind::ALL`'s order.
+pub fn section_rules(mission: &crate::mission::Mission) -> Vec<crate::mission::Diagnostic> {
+    super::Kind::ALL
+        .into_iter()
+        .flat_map(|kind| kind.face().validate(mission))
+        .collect()
 }
 
 /// Every pipeline's first step: a mission with errors is refused, naming

@@ -21,6 +21,8 @@ pub type Prepared = Arc<dyn Any + Send + Sync>;
 pub struct Revision {
     /// The file's and the sections' rules (`pipelines::validate`).
     rules: Vec<Diagnostic>,
+    /// How many of `rules` are the file's own (`mission::validate`), first.
+    file_rules: usize,
     /// Per pipeline, in `Kind::ALL`'s order: its predicted size against the
     /// limits, its findings, what it prepared. Empty when a rule is broken
     /// (a pipeline's findings mean nothing then).
@@ -45,10 +47,13 @@ struct Own {
 impl Revision {
     /// Everything skyform says of `mission` before a run, found once.
     pub fn of(mission: &Mission) -> Self {
-        let rules = super::validate(mission);
+        let mut rules = crate::mission::validate(mission);
+        let file_rules = rules.len();
+        rules.extend(super::interface::section_rules(mission));
         if rules.iter().any(Diagnostic::is_error) {
             return Revision {
                 rules,
+                file_rules,
                 own: Vec::new(),
             };
         }
@@ -65,7 +70,11 @@ impl Revision {
                 }
             })
             .collect();
-        Revision { rules, own }
+        Revision {
+            rules,
+            file_rules,
+            own,
+        }
     }
 
     /// Every diagnostic, as `check` and the designer list them: the rules,
@@ -79,6 +88,15 @@ impl Revision {
             .chain(findings)
             .cloned()
             .collect()
+    }
+
+    /// What the pipelines say beyond the file's own rules: their sections'
+    /// rules, then their predicted sizes and findings (`check` locates these
+    /// in the text after the file's rules, which the reading of the file
+    /// reports itself).
+    pub fn beyond_the_file(&self) -> Vec<Diagnostic> {
+        let diagnostics = self.diagnostics();
+        diagnostics[self.file_rules.min(diagnostics.len())..].to_vec()
     }
 
     /// What `kind` prepared (for its own run to read back).
@@ -150,5 +168,43 @@ mod tests {
                 (a, b) => panic!("{what}: {:?} vs {:?}", a.err(), b.err()),
             }
         }
+    }
+
+    /// What `check` adds after the file's rules is the revision's
+    /// diagnostics less those rules, in the same order: on a valid mission
+    /// the budgets and findings, on a broken one only the sections' rules
+    /// (no findings), and never the file's own rules twice.
+    #[test]
+    fn beyond_the_file_is_the_revision_less_the_files_rules() {
+        let bridge = crate::mission::default_mission().mission;
+        let mut section_broken = bridge.clone();
+        section_broken.theta_pso.swarm_size = 0;
+        let mut too_big = bridge.clone();
+        too_big.theta_pso.swarm_size = 1_000_000;
+        for m in [&bridge, &section_broken, &too_big] {
+            let revision = Revision::of(m);
+            let file = crate::mission::validate(m);
+            let all = revision.diagnostics();
+            assert_eq!(all[..file.len()], file[..]);
+            assert_eq!(revision.beyond_the_file(), all[file.len()..]);
+        }
+        // A broken rule: only the sections' rules beyond the file's, no
+        // budget, no finding.
+        assert!(
+            crate::mission::validate(&section_broken)
+                .iter()
+                .any(Diagnostic::is_error)
+        );
+        assert_eq!(
+            Revision::of(&section_broken).beyond_the_file(),
+            crate::pipelines::section_rules(&section_broken)
+        );
+        let big = Revision::of(&too_big).beyond_the_file();
+        assert!(big.iter().any(Diagnostic::is_error), "{big:?}");
+        assert!(
+            crate::mission::validate(&too_big)
+                .iter()
+                .all(|d| !d.is_error())
+        );
     }
 }
