@@ -46,6 +46,17 @@ Modelling differences (why the numbers are not expected to match closely):
   * Vehicle. skyform's body is `[fleet]`'s; RotorPy's is the chosen params file, with
     motor dynamics (tau_m) and attitude loop.
 
+Turbulence (`--turbulence light --flights N`): a third case, the same 5 m/s wind with
+Dryden gusts (MIL-F-8785C low altitude, the same scales and filters as skyform's
+src/flight/air.rs: u first order, v and w second order, exactly discretised, time
+constants L/V at the vehicle's airspeed), N flights on each side, each RotorPy flight
+on a gust series of its own. skyform reports each vehicle's per-flight maximum
+cross-track error as p50 / p99 / max over its N flights; RotorPy's "air-only" maxima
+(schedule + turbulent flight - calm flight) give the same figures. `--se3-gains` also
+flies skyform with [vehicle] gains that match SE3Control's loop (position 1.625 /s, velocity
+4.0 /s horizontally: s^2 + 4.0 s + 6.5, SE3's kd and kp; 1.667 and 9.0 vertically), so the
+comparison is of the air and the airframe, not of two autopilots' stiffness.
+
 Run with the venv of requirements.txt (see README.md); about a minute a case.
 """
 import argparse
@@ -238,6 +249,77 @@ def fly_rotorpy(sched, wind_enu, params_module, t_end, dt=0.01, sample_every=5):
     return np.array(xs)
 
 
+FOOT, KNOT = 0.3048, 0.514444
+W20 = {"light": 15.0 * KNOT, "moderate": 30.0 * KNOT, "severe": 45.0 * KNOT}
+
+
+def dryden_scales(h, w20):
+    """src/flight/air.rs `dryden_scales`: (L_uv, L_w, sigma_uv, sigma_w)."""
+    h_ft = min(max(h / FOOT, 10.0), 1000.0)
+    k = 0.177 + 0.000823 * h_ft
+    sigma_w = 0.1 * w20
+    return h_ft / k ** 1.2 * FOOT, h_ft * FOOT, sigma_w / k ** 0.4, sigma_w
+
+
+class Dryden:
+    """src/flight/air.rs `Air`: the mean wind plus u (along it, first order), v (across,
+    second order) and w (up, second order), each exactly discretised in units of its sigma."""
+
+    P = np.array([[1.0, 0.5], [0.5, 0.5]])
+
+    def __init__(self, mean, w20, rng):
+        self.mean = np.array(mean, float)
+        speed = np.linalg.norm(self.mean)
+        self.along = self.mean / speed if speed > 0 else np.array([1.0, 0.0, 0.0])
+        self.across = np.array([-self.along[1], self.along[0], 0.0])
+        self.w20, self.rng = w20, rng
+        self.u = rng.standard_normal()
+        a, b = rng.standard_normal(2)
+        self.v = np.array([a, 0.5 * a + 0.5 * b])
+        a, b = rng.standard_normal(2)
+        self.w = np.array([a, 0.5 * a + 0.5 * b])
+
+    def _second(self, x, dt, tau):
+        phi = math.exp(-dt / tau)
+        T = np.array([[phi, 0.0], [phi * dt / tau, phi]])
+        L = np.linalg.cholesky(self.P - T @ self.P @ T.T + 1e-15 * np.eye(2))
+        x = T @ x + L @ self.rng.standard_normal(2)
+        return x, (math.sqrt(3) * x[0] + (1 - math.sqrt(3)) * x[1]) / math.sqrt(2)
+
+    def step(self, dt, h, velocity):
+        luv, lw, suv, sw = dryden_scales(h, self.w20)
+        airspeed = max(np.linalg.norm(np.asarray(velocity) - self.mean), 1.0)
+        phi = math.exp(-dt * airspeed / luv)
+        self.u = phi * self.u + math.sqrt(max(0.0, 1 - phi * phi)) * self.rng.standard_normal()
+        self.v, v = self._second(self.v, dt, luv / airspeed)
+        self.w, w = self._second(self.w, dt, lw / airspeed)
+        return self.mean + self.along * self.u * suv + self.across * v * suv + np.array([0, 0, w * sw])
+
+
+def fly_rotorpy_turbulent(sched, wind_enu, w20, seed, params_module, t_end, dt=0.01, sample_every=5):
+    """`fly_rotorpy` in Dryden gusts on the mean wind (one gust series, seeded)."""
+    from rotorpy.vehicles.multirotor import Multirotor
+    from rotorpy.controllers.quadrotor_control import SE3Control
+
+    qp = importlib.import_module(f"rotorpy.vehicles.{params_module}").quad_params
+    hover = math.sqrt(qp["mass"] * 9.81 / (qp["num_rotors"] * qp["k_eta"]))
+    state = dict(x=np.array(sched.p[0], float), v=np.zeros(3), q=np.array([0.0, 0, 0, 1]),
+                 w=np.zeros(3), wind=np.zeros(3), rotor_speeds=np.full(qp["num_rotors"], hover))
+    vehicle = Multirotor(qp, initial_state=state, aero=True)
+    ctrl = SE3Control(qp)
+    air = Dryden(wind_enu, w20, np.random.default_rng(seed))
+    xs = []
+    for k in range(int(round(t_end / dt)) + 1):
+        t = k * dt
+        if k % sample_every == 0:
+            xs.append(np.array(state["x"], float))
+        state["wind"] = air.step(dt, float(state["x"][2]), state["v"])
+        state = vehicle.step(state, ctrl.update(t, state, sched.update(t)), dt)
+        if not np.all(np.isfinite(state["x"])):
+            raise RuntimeError(f"RotorPy diverged at t = {t:.2f} s")
+    return np.array(xs)
+
+
 def cross_track(sched, xs, dt=0.05):
     """skyform's measure at each sample: distance from the leg the schedule is on."""
     return np.array([segment_distance(*sched.line(k * dt), x) for k, x in enumerate(xs)])
@@ -260,6 +342,10 @@ def main():
     ap.add_argument("--params", default="hummingbird_params",
                     help="rotorpy.vehicles module with quad_params (hummingbird_params, crazyflie_params, ...)")
     ap.add_argument("--keep", help="keep the edited missions, reports and exports in this folder")
+    ap.add_argument("--turbulence", choices=sorted(W20), help="add a case in this Dryden turbulence")
+    ap.add_argument("--flights", type=int, default=8, help="flights a side in turbulence")
+    ap.add_argument("--se3-gains", action="store_true",
+                    help="in turbulence, also fly skyform with [vehicle] gains matching SE3Control's loop")
     args = ap.parse_args()
     if not os.access(args.skyform, os.X_OK):
         sys.exit(f"no skyform binary at {args.skyform} (cargo build --release, or --skyform)")
@@ -319,8 +405,81 @@ def main():
         print(f"{name:<14}{v:>4}{n:>5}{sk:>13.3f}{p50:>13.3f}{mx:>13.3f}{r1:>7}{sup:>22.3f}{r2:>7}")
     print("ratio = RotorPy / skyform maximum. air-only: the schedule + (RotorPy in this air - RotorPy in calm air),\n"
           "skyform's own construction (its calm flight is the schedule exactly), so RotorPy's corner-tracking\n"
-          "error drops out. skyform's p50 = p99 = max over one flight; its per-sample median is not in the report.\n"
-          f"total {time.time() - t0:.0f} s; files in {work}")
+          "error drops out. skyform's p50 = p99 = max over one flight; its per-sample median is not in the report.")
+    if args.turbulence:
+        turbulent(args, text, frame, limits, work, calm)
+    print(f"total {time.time() - t0:.0f} s; files in {work}")
+
+
+SE3_GAINS = dict(position_gain_xy=6.5 / 4.0, velocity_gain_xy=4.0, position_gain_z=15.0 / 9.0, velocity_gain_z=9.0)
+
+
+def edit_vehicle(text, gains):
+    """The mission text with `[vehicle]`'s gains set (the section added if missing)."""
+    lines = text.splitlines()
+    start = next((i for i, l in enumerate(lines) if re.match(r"\s*\[vehicle\]", l)), None)
+    if start is None:
+        lines += ["", "[vehicle]"]
+        start = len(lines) - 1
+    end = next((i for i in range(start + 1, len(lines)) if re.match(r"\s*\[", lines[i])), len(lines))
+    lines = [l for i, l in enumerate(lines)
+             if not (start < i < end and re.match(r"\s*(\w+)\s*=", l)
+                     and re.match(r"\s*(\w+)", l).group(1) in gains)]
+    lines[start + 1:start + 1] = [f"{k} = {v!r}" for k, v in gains.items()]
+    return "\n".join(lines) + "\n"
+
+
+def turbulent(args, text, frame, limits, work, calm):
+    """The wind case in Dryden gusts, `args.flights` flights a side: per vehicle, p50 / p99 /
+    max over the flights of each flight's largest cross-track error."""
+    air = dict(wind_speed=5.0, wind_from_deg=270.0, turbulence=args.turbulence)
+    base = edit_flight(text, {**air, **QUIET})
+    variants = [("skyform, PX4 default gains", base)]
+    if args.se3_gains:
+        variants.append(("skyform, SE3-matched gains", edit_vehicle(base, SE3_GAINS)))
+    rows = []
+    scheds = None
+    for label, mission_text in variants:
+        tag = "turbulent" + ("-se3" if "SE3" in label else "")
+        path = os.path.join(work, f"{tag}.toml")
+        open(path, "w").write(mission_text)
+        report_path = os.path.join(work, f"{tag}.json")
+        run([args.skyform, "fly", path, "--seed", str(args.seed), "--flights", str(args.flights),
+             "--json", report_path])
+        report = json.load(open(report_path))
+        for c in report["cross_track"]:
+            rows.append((label, c["vehicle"], c["p50"], c["p99"], c["max"]))
+        if scheds is None:
+            out = os.path.join(work, f"export-{tag}")
+            run([args.skyform, "export", path, "--seed", str(args.seed), "--format", "plan", "--out", out])
+            plans = sorted(glob.glob(os.path.join(out, "*.plan")),
+                           key=lambda p: int(re.search(r"uav(\d+)\.plan$", p).group(1)))
+            scheds = [Schedule(*read_plan(p, frame), limits) for p in plans]
+    t_end = max(s.end for s in scheds)
+    wind = (5.0, 0.0, 0.0)  # from the west: towards +x (east)
+    for v, s in enumerate(scheds, start=1):
+        key = (s.p.tobytes(), tuple(s.arrive), t_end)
+        if key not in calm:
+            calm[key] = fly_rotorpy(s, (0.0, 0.0, 0.0), args.params, t_end)
+        nominal = np.array([s.at(k * 0.05)[0] for k in range(len(calm[key]))])
+        raw, only = [], []
+        for k in range(args.flights):
+            tv = time.time()
+            xs = fly_rotorpy_turbulent(s, wind, W20[args.turbulence], 1000 * args.seed + 100 * v + k,
+                                       args.params, t_end)
+            raw.append(cross_track(s, xs).max())
+            only.append(cross_track(s, nominal + xs - calm[key]).max())
+            print(f"  {args.turbulence} turbulence: UAV {v} flight {k} in RotorPy in {time.time() - tv:.1f} s",
+                  file=sys.stderr)
+        for label, values in (("RotorPy, air-only", only), ("RotorPy, as flown", raw)):
+            values = np.sort(values)
+            rows.append((label, v, float(np.percentile(values, 50, method="inverted_cdf")),
+                         float(np.percentile(values, 99, method="inverted_cdf")), float(values[-1])))
+    print(f"\nwind 5 m/s W, {args.turbulence} turbulence (Dryden), {args.flights} flights a side; per vehicle, "
+          "each flight's largest cross-track error (m), over the flights:")
+    print(f"{'who':<30}{'UAV':>4}{'p50':>9}{'p99':>9}{'max':>9}")
+    for label, v, p50, p99, mx in sorted(rows, key=lambda r: (r[1], r[0])):
+        print(f"{label:<30}{v:>4}{p50:>9.3f}{p99:>9.3f}{mx:>9.3f}")
 
 if __name__ == "__main__":
     main()
