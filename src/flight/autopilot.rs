@@ -43,15 +43,15 @@ impl Default for Gains {
 }
 
 impl Gains {
-    /// The proportional gains `[vehicle]` states (PX4's by default); the
-    /// integral and derivative terms stay PX4's (MPC_XY_VEL_I/D_ACC 0.4,
-    /// 0.2; MPC_Z_VEL_I/D_ACC 2, 0).
+    /// The proportional and integral gains `[vehicle]` states (PX4's by
+    /// default: MPC_XY_VEL_I_ACC 0.4, MPC_Z_VEL_I_ACC 2); the derivative
+    /// terms stay PX4's (MPC_XY_VEL_D_ACC 0.2, MPC_Z_VEL_D_ACC 0).
     pub fn of(v: &crate::mission::Vehicle) -> Self {
         Gains {
             position_xy: v.position_gain_xy,
             position_z: v.position_gain_z,
-            velocity_xy: [v.velocity_gain_xy, 0.4, 0.2],
-            velocity_z: [v.velocity_gain_z, 2.0, 0.0],
+            velocity_xy: [v.velocity_gain_xy, v.velocity_integral_xy, 0.2],
+            velocity_z: [v.velocity_gain_z, v.velocity_integral_z, 0.0],
         }
     }
 }
@@ -330,5 +330,32 @@ mod tests {
         eprintln!("pushed off {worst:.3} m at most, {settled:.4} m after 30 s");
         assert!(worst > 0.1, "the gust of wind moved it: {worst}");
         assert!(settled < 0.02, "{settled}");
+    }
+
+    /// Without an integral (`vehicle.velocity_integral_xy = 0`, a PD loop
+    /// such as RotorPy's SE3Control) a steady wind's drag is held off by
+    /// the position error alone: it settles at drag · wind / (K_p K_v) =
+    /// 0.3 · 8 / (0.95 · 1.8) = 1.40 m downwind, and stays there.
+    #[test]
+    fn without_an_integral_a_steady_wind_leaves_its_offset() {
+        let vehicle = Vehicle {
+            velocity_integral_xy: 0.0,
+            ..Vehicle::default()
+        };
+        let limits = vehicle.limits(0);
+        let plan = hovering(limits);
+        let body = Body::from_params(&FleetParams::default());
+        let mut pilot = Autopilot::new(&plan, limits, Gains::of(&vehicle), body, 2.0, 0.0);
+        let (dt, wind) = (0.01, Vector3::new(8.0, 0.0, 0.0));
+        for k in 0..3000 {
+            pilot.step(k as f64 * dt, dt, &Vector3::zeros(), &wind, 0.3);
+        }
+        let offset = quadrotor::position(&pilot.state).x;
+        let expected = 0.3 * 8.0 / (vehicle.position_gain_xy * vehicle.velocity_gain_xy);
+        eprintln!("settled {offset:.3} m downwind, expected {expected:.3} m");
+        assert!(
+            (offset - expected).abs() < 0.05 * expected,
+            "{offset} vs {expected}"
+        );
     }
 }

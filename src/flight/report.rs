@@ -454,8 +454,9 @@ fn conditions(setup: &Setup) -> String {
     format!(
         "wind {:.1} m/s from {:.0}°, {turbulence}; GNSS σ {:.2} m horizontal, {:.2} m vertical, \
          τ {:.0} s; take-off skew σ {:.2} s; acceptance radius {:.1} m (written in the files); \
-         autopilot gains: position {:.2} /s xy, {:.2} /s z, velocity {:.2} /s xy, {:.2} /s z \
-         ([vehicle], PX4's MPC_*_P by default), drag {:.2} /s; step {} s",
+         autopilot gains: position {:.2} /s xy, {:.2} /s z, velocity {:.2} /s xy, {:.2} /s z, \
+         velocity integral {:.2} /s² xy, {:.2} /s² z ([vehicle], PX4's MPC_* by default), drag \
+         {:.2} /s; step {} s",
         p.wind_speed,
         p.wind_from_deg,
         p.gnss_sigma_horizontal,
@@ -467,6 +468,8 @@ fn conditions(setup: &Setup) -> String {
         v.position_gain_z,
         v.velocity_gain_xy,
         v.velocity_gain_z,
+        v.velocity_integral_xy,
+        v.velocity_integral_z,
         p.drag,
         p.step
     )

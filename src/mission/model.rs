@@ -388,6 +388,13 @@ pub struct Vehicle {
     pub velocity_gain_xy: f64,
     /// Vertical velocity gain, 1/s (PX4 MPC_Z_VEL_P_ACC: 4).
     pub velocity_gain_z: f64,
+    /// The horizontal velocity loop's integral gain, 1/s² (PX4
+    /// MPC_XY_VEL_I_ACC: 0.4): what takes a steady wind's offset, and a
+    /// slow gust's, out of the track; 0 for none (a PD controller).
+    pub velocity_integral_xy: f64,
+    /// The vertical velocity loop's integral gain, 1/s² (PX4
+    /// MPC_Z_VEL_I_ACC: 2).
+    pub velocity_integral_z: f64,
     /// UAVs with limits of their own (a heavier camera ship, say):
     /// `uavs = [{ uav = 2, max_speed = 8.0 }]`, UAVs numbered from 1; a
     /// limit not given is the formation's.
@@ -408,6 +415,8 @@ impl Default for Vehicle {
             position_gain_z: 1.0,
             velocity_gain_xy: 1.8,
             velocity_gain_z: 4.0,
+            velocity_integral_xy: 0.4,
+            velocity_integral_z: 2.0,
             uavs: Vec::new(),
         }
     }

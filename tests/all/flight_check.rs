@@ -129,12 +129,13 @@ fn early_take_offs_fly_early_and_late_ones_late() {
 
 /// Issue 52, item 0: the files write the acceptance radius the check
 /// flies (`flight.acceptance_radius`), one number in both; the report's
-/// conditions state it and the autopilot's gains.
+/// conditions state it and the autopilot's gains, its integrals too.
 #[test]
 fn the_files_write_the_acceptance_radius_the_check_flies() {
     let mut m = bridge();
     m.flight.acceptance_radius = 1.25;
     m.vehicle.velocity_gain_xy = 2.5;
+    m.vehicle.velocity_integral_xy = 0.0;
     let planned = planned(&m, 1);
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
     let options = skyform::export::Options {
@@ -172,7 +173,8 @@ fn the_files_write_the_acceptance_radius_the_check_flies() {
     let text = report.text(false);
     assert!(
         text.contains("acceptance radius 1.2 m (written in the files)")
-            && text.contains("velocity 2.50 /s xy"),
+            && text.contains("velocity 2.50 /s xy")
+            && text.contains("velocity integral 0.00 /s² xy, 2.00 /s² z"),
         "{text}"
     );
 }

@@ -542,3 +542,30 @@ fn a_footprint_must_be_a_simple_polygon_with_an_area_in_the_bounds() {
     assert_eq!(hall.center, nalgebra::Point2::new(50.0, 50.0));
     assert!((hall.radius - 200f64.sqrt()).abs() < 1e-12);
 }
+
+/// Issue 52, item 0: the autopilot's velocity integrals are `[vehicle]`
+/// fields; 0 is a PD loop (no integral), a negative one is refused at its
+/// line, and so is one no multicopter follows.
+#[test]
+fn the_velocity_integrals_may_be_zero_never_negative() {
+    let zero = mission_with("[vehicle]\nvelocity_integral_xy = 0.0\nvelocity_integral_z = 0.0\n");
+    assert!(
+        diagnostics(&zero).iter().all(|d| !d.is_error()),
+        "{:?}",
+        diagnostics(&zero)
+    );
+    let negative = mission_with("[vehicle]\nvelocity_integral_xy = -0.4\n");
+    assert_error(
+        &negative,
+        "vehicle.velocity_integral_xy",
+        "velocity_integral_xy",
+        "-0.4",
+    );
+    let huge = mission_with("[vehicle]\nvelocity_integral_z = 80.0\n");
+    assert_error(
+        &huge,
+        "vehicle.velocity_integral_z",
+        "velocity_integral_z",
+        "50",
+    );
+}

@@ -54,8 +54,9 @@ on a gust series of its own. skyform reports each vehicle's per-flight maximum
 cross-track error as p50 / p99 / max over its N flights; RotorPy's "air-only" maxima
 (schedule + turbulent flight - calm flight) give the same figures. `--se3-gains` also
 flies skyform with [vehicle] gains that match SE3Control's loop (position 1.625 /s, velocity
-4.0 /s horizontally: s^2 + 4.0 s + 6.5, SE3's kd and kp; 1.667 and 9.0 vertically), so the
-comparison is of the air and the airframe, not of two autopilots' stiffness.
+4.0 /s horizontally: s^2 + 4.0 s + 6.5, SE3's kd and kp; 1.667 and 9.0 vertically; no velocity
+integral, as SE3 has none), so the comparison is of the air and the airframe, not of two
+autopilots' tuning.
 
 Run with the venv of requirements.txt (see README.md); about a minute a case.
 """
@@ -411,7 +412,10 @@ def main():
     print(f"total {time.time() - t0:.0f} s; files in {work}")
 
 
-SE3_GAINS = dict(position_gain_xy=6.5 / 4.0, velocity_gain_xy=4.0, position_gain_z=15.0 / 9.0, velocity_gain_z=9.0)
+# SE3Control's loop as PX4's cascade: kd and kp (6.5, 4.0 /s horizontally; 15, 9 vertically)
+# are s^2 + K_v s + K_v K_p, and SE3 has no integral.
+SE3_GAINS = dict(position_gain_xy=6.5 / 4.0, velocity_gain_xy=4.0, position_gain_z=15.0 / 9.0,
+                 velocity_gain_z=9.0, velocity_integral_xy=0.0, velocity_integral_z=0.0)
 
 
 def edit_vehicle(text, gains):

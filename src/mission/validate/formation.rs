@@ -88,6 +88,20 @@ impl Checker {
                 "a gain above 50 /s is faster than a multicopter's attitude loop follows",
             );
         }
+        // An integral may be 0 (none: a PD loop), never negative.
+        for (key, gain) in [
+            ("velocity_integral_xy", v.velocity_integral_xy),
+            ("velocity_integral_z", v.velocity_integral_z),
+        ] {
+            self.non_negative(path.key(key), gain, " /s²");
+            self.at_most(
+                path.key(key),
+                gain,
+                physical::GAIN,
+                " /s²",
+                "an integral gain above 50 /s² winds up faster than a multicopter follows",
+            );
+        }
         for (i, own) in v.uavs.iter().enumerate() {
             let at = path.key("uavs").index(i);
             if own.uav == 0 || own.uav > f.slots.len() {

@@ -194,6 +194,8 @@ static FORMATION: Table = Table { base: &[], derived: &[
     Spec { name: "position gain z", unit: "/s", keys: &["vehicle", "position_gain_z"], get: |m, _| num(m.vehicle.position_gain_z), set: |m, _, t| put(&mut m.vehicle.position_gain_z, number(t)) },
     Spec { name: "velocity gain xy", unit: "/s", keys: &["vehicle", "velocity_gain_xy"], get: |m, _| num(m.vehicle.velocity_gain_xy), set: |m, _, t| put(&mut m.vehicle.velocity_gain_xy, number(t)) },
     Spec { name: "velocity gain z", unit: "/s", keys: &["vehicle", "velocity_gain_z"], get: |m, _| num(m.vehicle.velocity_gain_z), set: |m, _, t| put(&mut m.vehicle.velocity_gain_z, number(t)) },
+    Spec { name: "velocity I xy", unit: "/s²", keys: &["vehicle", "velocity_integral_xy"], get: |m, _| num(m.vehicle.velocity_integral_xy), set: |m, _, t| put(&mut m.vehicle.velocity_integral_xy, number(t)) },
+    Spec { name: "velocity I z", unit: "/s²", keys: &["vehicle", "velocity_integral_z"], get: |m, _| num(m.vehicle.velocity_integral_z), set: |m, _, t| put(&mut m.vehicle.velocity_integral_z, number(t)) },
     Spec { name: "surface d min", unit: "m", keys: &["formation", "surface_distance"], get: |m, _| num(m.formation.surface_distance[0]), set: |m, _, t| put(&mut m.formation.surface_distance[0], number(t)) },
     Spec { name: "surface d max", unit: "m", keys: &["formation", "surface_distance"], get: |m, _| num(m.formation.surface_distance[1]), set: |m, _, t| put(&mut m.formation.surface_distance[1], number(t)) },
     Spec { name: "inspection pass", unit: "m", keys: &["formation", "inspection_pass"], get: |m, _| num(m.formation.inspection_pass), set: |m, _, t| put(&mut m.formation.inspection_pass, number(t)) },
