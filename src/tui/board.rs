@@ -238,8 +238,12 @@ impl JobBoard {
         match action {
             Run(kind) => self.run(crate::run::Run::new(kind, seed), doc, cwd, status),
             RunDistributed(kind) => {
+                // One process a vehicle of the pipeline that flies them.
                 let processes = crate::pipelines::Processes {
-                    count: doc.mission().fleet.agents.clamp(1, DESIGNER_PROCESSES),
+                    count: kind
+                        .face()
+                        .vehicles(doc.mission())
+                        .clamp(1, DESIGNER_PROCESSES),
                     realtime: false,
                 };
                 match kind.request().in_processes(processes) {

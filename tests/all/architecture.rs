@@ -423,10 +423,6 @@ const NAMES_A_PIPELINE_OR_ITS_SECTION: &[(&str, &str)] = &[
     ),
     ("src/tui/app.rs", "the formation editor lists θ-PSO's IWPs"),
     (
-        "src/tui/board.rs",
-        "a distributed fleet job's process count",
-    ),
-    (
         "src/tui/editor.rs",
         "moving the fleet's targets; θ-PSO's IWPs",
     ),
