@@ -10,6 +10,30 @@ use crate::flight::{self, Options, Setup};
 use crate::mission::Mission;
 use crate::pipelines::CancelToken;
 
+/// What every shard starts from: its `I/N`, the `--json` file its part
+/// goes to (`pieces`: what the part holds, for the error), and the mission
+/// as TOML for the part; or the exit status, said.
+fn shard_start<'a>(
+    args: &'a FlyArgs,
+    mission: &Mission,
+    shard: &str,
+    pieces: &str,
+) -> Result<(flight::shard::Shard, &'a std::path::Path, String), u8> {
+    let shard = flight::shard::Shard::parse(shard).map_err(|e| {
+        eprintln!("error: --shard {e}");
+        exit::ERROR
+    })?;
+    let Some(path) = &args.json else {
+        eprintln!("error: --shard writes its {pieces} to --json FILE");
+        return Err(exit::ERROR);
+    };
+    let toml = crate::mission::to_toml_string(mission).map_err(|e| {
+        eprintln!("error: {e}");
+        exit::ERROR
+    })?;
+    Ok((shard, path, toml))
+}
+
 /// `--shard I/N`: this shard's flights written as a part for `skyform merge`.
 pub fn fly_shard(
     setup: &Setup,
@@ -19,23 +43,9 @@ pub fn fly_shard(
     shard: &str,
     cancel: &CancelToken,
 ) -> u8 {
-    let shard = match flight::shard::Shard::parse(shard) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: --shard {e}");
-            return exit::ERROR;
-        }
-    };
-    let Some(path) = &args.json else {
-        eprintln!("error: --shard writes its flights to --json FILE");
-        return exit::ERROR;
-    };
-    let toml = match crate::mission::to_toml_string(mission) {
-        Ok(t) => t,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return exit::ERROR;
-        }
+    let (shard, path, toml) = match shard_start(args, mission, shard, "flights") {
+        Ok(start) => start,
+        Err(code) => return code,
     };
     let options = Options {
         flights: mission.flight.flights,
@@ -89,23 +99,9 @@ pub fn rare_shard(
     cancel: &CancelToken,
 ) -> u8 {
     use flight::odds;
-    let shard = match flight::shard::Shard::parse(shard) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: --shard {e}");
-            return exit::ERROR;
-        }
-    };
-    let Some(path) = &args.json else {
-        eprintln!("error: --shard writes its runs to --json FILE");
-        return exit::ERROR;
-    };
-    let toml = match crate::mission::to_toml_string(mission) {
-        Ok(t) => t,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return exit::ERROR;
-        }
+    let (shard, path, toml) = match shard_start(args, mission, shard, "runs") {
+        Ok(start) => start,
+        Err(code) => return code,
     };
     let range = shard.range(args.runs);
     let done = match odds::fly_runs(setup, options, range.clone(), progress, cancel) {
@@ -116,12 +112,14 @@ pub fn rare_shard(
         eprintln!();
     }
     if let Some(path) = &args.failure {
-        let runs = |pick: fn(&odds::Run) -> &flight::rare::Estimate| {
-            done.iter().map(|r| pick(r).clone()).collect::<Vec<_>>()
-        };
-        let separation = odds::Odds::of(flight::rare::Limit::Separation, runs(|r| &r.separation));
-        let clearance = odds::Odds::of(flight::rare::Limit::Clearance, runs(|r| &r.clearance));
-        let failing = [&separation, &clearance];
+        // This shard's runs as one report: its most likely failures.
+        let own = odds::OddsReport::new(
+            &setup.mission.name,
+            options.seed,
+            options.per_level,
+            done.clone(),
+        );
+        let failing = [&own.separation, &own.clearance];
         let written =
             super::fly_again::write_failing(path, mission, args.pipeline, options.seed, &failing);
         if let Err(code) = written {

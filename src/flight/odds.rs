@@ -23,7 +23,7 @@ use std::ops::Range;
 use serde::{Deserialize, Serialize};
 
 use super::rare::{self, Estimate, Failure, Limit, RareOptions};
-use super::shard::Shard;
+use super::shard::{Misfit, Shard, Slots};
 use super::{FlightError, Setup};
 use crate::pipelines::{CancelToken, Kind};
 
@@ -287,7 +287,7 @@ pub fn merge(parts: Vec<Part>) -> Result<OddsReport, MergeError> {
     if first.runs > MAX_RUNS {
         return Err(MergeError::TooMany(first.runs));
     }
-    let mut slots: Vec<Option<Run>> = vec![None; first.runs];
+    let mut slots = Slots::new(first.runs);
     for (i, part) in parts.into_iter().enumerate() {
         if part.format != PART_FORMAT {
             return Err(MergeError::Format(i + 1, part.format));
@@ -303,23 +303,17 @@ pub fn merge(parts: Vec<Part>) -> Result<OddsReport, MergeError> {
             return Err(MergeError::Mismatch { part: i + 1, what });
         }
         for run in part.done {
-            let Some(slot) = slots.get_mut(run.run) else {
-                return Err(MergeError::Mismatch {
+            let r = run.run;
+            slots.put(r, run).map_err(|misfit| match misfit {
+                Misfit::Outside => MergeError::Mismatch {
                     part: i + 1,
                     what: "number of runs",
-                });
-            };
-            if slot.is_some() {
-                return Err(MergeError::Twice(run.run));
-            }
-            *slot = Some(run);
+                },
+                Misfit::Twice => MergeError::Twice(r),
+            })?;
         }
     }
-    let runs = slots
-        .into_iter()
-        .enumerate()
-        .map(|(r, run)| run.ok_or(MergeError::Missing(r)))
-        .collect::<Result<Vec<_>, _>>()?;
+    let runs = slots.complete().map_err(MergeError::Missing)?;
     Ok(OddsReport::new(
         &first.name,
         first.seed,

@@ -75,6 +75,46 @@ pub struct Part {
     pub flown: Vec<Flown>,
 }
 
+/// Numbered pieces gathered from parts into their order, each exactly
+/// once: a check's flights here, a rare-event estimate's runs
+/// (`odds::merge`).
+pub(super) struct Slots<T>(Vec<Option<T>>);
+
+/// Why a piece does not go into its slot.
+pub(super) enum Misfit {
+    /// Its number is past the count the first part gave.
+    Outside,
+    /// Another part holds it already.
+    Twice,
+}
+
+impl<T> Slots<T> {
+    /// `count` empty slots (a count read from a part: checked against its
+    /// limit before).
+    pub(super) fn new(count: usize) -> Self {
+        Slots(std::iter::repeat_with(|| None).take(count).collect())
+    }
+
+    /// Puts piece number `k`.
+    pub(super) fn put(&mut self, k: usize, piece: T) -> Result<(), Misfit> {
+        let slot = self.0.get_mut(k).ok_or(Misfit::Outside)?;
+        if slot.is_some() {
+            return Err(Misfit::Twice);
+        }
+        *slot = Some(piece);
+        Ok(())
+    }
+
+    /// Every piece in order, or the number of the first missing.
+    pub(super) fn complete(self) -> Result<Vec<T>, usize> {
+        self.0
+            .into_iter()
+            .enumerate()
+            .map(|(k, piece)| piece.ok_or(k))
+            .collect()
+    }
+}
+
 /// Flies shard `shard` of the check `options` of `setup`: its part.
 pub fn fly_shard(
     setup: &Setup,
@@ -133,7 +173,7 @@ pub fn merge(parts: Vec<Part>) -> Result<(Part, Vec<Flown>), MergeError> {
     if first.flights > crate::mission::MAX_FLIGHTS {
         return Err(MergeError::TooMany(first.flights));
     }
-    let mut slots: Vec<Option<Flown>> = vec![None; first.flights];
+    let mut slots = Slots::new(first.flights);
     for (i, part) in parts.into_iter().enumerate() {
         if part.format != PART_FORMAT {
             return Err(MergeError::Format(i + 1, part.format));
@@ -148,23 +188,17 @@ pub fn merge(parts: Vec<Part>) -> Result<(Part, Vec<Flown>), MergeError> {
             return Err(MergeError::Mismatch { part: i + 1, what });
         }
         for f in part.flown {
-            let Some(slot) = slots.get_mut(f.flight) else {
-                return Err(MergeError::Mismatch {
+            let k = f.flight;
+            slots.put(k, f).map_err(|misfit| match misfit {
+                Misfit::Outside => MergeError::Mismatch {
                     part: i + 1,
                     what: "number of flights",
-                });
-            };
-            if slot.is_some() {
-                return Err(MergeError::Twice(f.flight));
-            }
-            *slot = Some(f);
+                },
+                Misfit::Twice => MergeError::Twice(k),
+            })?;
         }
     }
-    let flown = slots
-        .into_iter()
-        .enumerate()
-        .map(|(k, f)| f.ok_or(MergeError::Missing(k)))
-        .collect::<Result<Vec<_>, _>>()?;
+    let flown = slots.complete().map_err(MergeError::Missing)?;
     Ok((
         Part {
             flown: Vec::new(),
