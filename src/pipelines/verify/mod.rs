@@ -557,6 +557,25 @@ pub fn on_side(o: &crate::base::shape::Prism, p: &Point3<f64>, side: f64) -> boo
     crate::base::geometry::segment_point_distance(&outline[i], &outline[(i + 1) % n], &q) < 1e-6
 }
 
+/// The formation's centre (the mean of its UAVs) at each sample all the
+/// tracks have: what the inspections and the vias are judged on.
+fn centres(trajectories: &[Trajectory]) -> Vec<Point3<f64>> {
+    let samples = trajectories
+        .iter()
+        .map(|t| t.samples.len())
+        .min()
+        .unwrap_or(0);
+    (0..samples)
+        .map(|k| {
+            let sum: nalgebra::Vector3<f64> = trajectories
+                .iter()
+                .map(|t| t.samples[k].position.coords)
+                .sum();
+            Point3::from(sum / trajectories.len().max(1) as f64)
+        })
+        .collect()
+}
+
 /// Checks eq. 8 on the flown trajectories for every inspected obstacle:
 /// the longest run of samples where the nearest UAV is within the band must
 /// cover the pass, measured as the distance the formation's centre (the
@@ -565,25 +584,15 @@ pub fn on_side(o: &crate::base::shape::Prism, p: &Point3<f64>, side: f64) -> boo
 /// the distance is travelled, not time times a speed.
 pub fn verify_inspections(mission: &Mission, trajectories: &[Trajectory]) -> Vec<InspectionResult> {
     let f = &mission.formation;
-    let samples = trajectories
-        .iter()
-        .map(|t| t.samples.len())
-        .min()
-        .unwrap_or(0);
     // Distance travelled by the formation's centre up to each sample.
-    let centre = |k: usize| {
-        let sum: nalgebra::Vector3<f64> = trajectories
-            .iter()
-            .map(|t| t.samples[k].position.coords)
-            .sum();
-        sum / trajectories.len().max(1) as f64
-    };
+    let centres = centres(trajectories);
+    let samples = centres.len();
     let mut travelled = Vec::with_capacity(samples);
     for k in 0..samples {
         let step = if k == 0 {
             0.0
         } else {
-            (centre(k) - centre(k - 1)).norm()
+            (centres[k] - centres[k - 1]).norm()
         };
         travelled.push(travelled.last().copied().unwrap_or(0.0) + step);
     }

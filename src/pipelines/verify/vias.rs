@@ -34,19 +34,7 @@ pub struct ViaResult {
 /// nearest points) at an altitude where both stand, or passes a point
 /// within its radius, and the vias are kept in their order.
 pub fn verify_vias(mission: &Mission, trajectories: &[Trajectory]) -> Vec<ViaResult> {
-    let samples = trajectories
-        .iter()
-        .map(|t| t.samples.len())
-        .min()
-        .unwrap_or(0);
-    let centre = |k: usize| {
-        let sum: nalgebra::Vector3<f64> = trajectories
-            .iter()
-            .map(|t| t.samples[k].position.coords)
-            .sum();
-        Point3::from(sum / trajectories.len().max(1) as f64)
-    };
-    let centres: Vec<Point3<f64>> = (0..samples).map(centre).collect();
+    let centres = super::centres(trajectories);
     let time = |k: usize| trajectories[0].samples[k].t;
     let ground = mission.ground_model();
     let above = |p: &Point3<f64>| p.z - ground.as_ref().map_or(0.0, |g| g.at(p.x, p.y));
