@@ -60,17 +60,17 @@ pub fn write_failing(
     Ok(())
 }
 
-/// `--inputs FILE`: each failing flight of FILE flown again on `setup`'s
-/// plan (refused when FILE is of another mission or seed), printed, and
-/// recorded when a sink is asked.
-pub fn inputs(setup: &Setup, mission: &Mission, args: &FlyArgs, seed: u64, path: &Path) -> u8 {
-    let file = match read(path, mission, args.pipeline, seed) {
-        Ok(f) => f,
-        Err(e) => {
-            eprintln!("error: {}: {e}", path.display());
-            return exit::ERROR;
-        }
-    };
+/// `--inputs FILE`: each failing flight of `file` (read from `path` by
+/// [`read`]) flown again on `setup`'s plan, printed, and recorded when a
+/// sink is asked.
+pub fn inputs(
+    setup: &Setup,
+    mission: &Mission,
+    args: &FlyArgs,
+    seed: u64,
+    path: &Path,
+    file: &FailingFile,
+) -> u8 {
     let mut broke = false;
     let mut failing = Vec::new();
     for f in &file.flights {
@@ -112,9 +112,22 @@ pub fn inputs(setup: &Setup, mission: &Mission, args: &FlyArgs, seed: u64, path:
     if broke { exit::INFEASIBLE } else { exit::OK }
 }
 
-/// FILE read and checked to be of `mission` (its flight count aside),
-/// `pipeline` and `seed`.
-fn read(path: &Path, mission: &Mission, pipeline: Kind, seed: u64) -> Result<FailingFile, String> {
+/// `--inputs FILE` read and checked to be of `mission` (its flight count
+/// aside), `pipeline` and `seed`; or the exit status, the refusal said.
+pub fn read(path: &Path, mission: &Mission, pipeline: Kind, seed: u64) -> Result<FailingFile, u8> {
+    checked(path, mission, pipeline, seed).map_err(|e| {
+        eprintln!("error: {}: {e}", path.display());
+        exit::ERROR
+    })
+}
+
+/// [`read`], the refusal in words.
+fn checked(
+    path: &Path,
+    mission: &Mission,
+    pipeline: Kind,
+    seed: u64,
+) -> Result<FailingFile, String> {
     let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
     let file: FailingFile = serde_json::from_str(&text).map_err(|e| {
         format!("not a failing-flight file of `skyform fly --rare --failure` ({e})")
@@ -159,13 +172,10 @@ fn read(path: &Path, mission: &Mission, pipeline: Kind, seed: u64) -> Result<Fai
 fn printed(setup: &Setup, f: &Flown) -> bool {
     let n = setup.plans.len();
     let vehicle = |v: usize| setup.plans[v].vehicle + 1;
+    let mark = |breaks: bool| if breaks { "BREAKS" } else { "ok" };
     let mut broke = false;
     for ((i, j), c) in flight::vehicle_pairs(n).zip(&f.pairs) {
-        let mark = if c.distance < setup.closest {
-            "BREAKS"
-        } else {
-            "ok"
-        };
+        let mark = mark(c.distance < setup.closest);
         broke |= c.distance < setup.closest;
         println!(
             "  {mark:<6} UAV {} - UAV {}: closest {:.2} m at t = {:.1} s (2 r_Q = {:.2} m)",
@@ -182,11 +192,7 @@ fn printed(setup: &Setup, f: &Flown) -> bool {
             .zip(&f.obstacles[v])
             .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance));
         if let Some((&o, c)) = tightest {
-            let mark = if c.distance < setup.clearance {
-                "BREAKS"
-            } else {
-                "ok"
-            };
+            let mark = mark(c.distance < setup.clearance);
             broke |= c.distance < setup.clearance;
             println!(
                 "  {mark:<6} UAV {} took off {:+.2} s late; nearest '{}' at {:.2} m, t = {:.1} s \

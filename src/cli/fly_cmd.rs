@@ -124,6 +124,15 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
         }
     }
     let seed = args.seed.unwrap_or(mission.seed);
+    // A file of failing flights is read and checked before the plan is
+    // made: one of another mission or seed is refused at once.
+    let failing = match &args.inputs {
+        Some(path) => match super::fly_again::read(path, &mission, args.pipeline, seed) {
+            Ok(file) => Some((path, file)),
+            Err(code) => return code,
+        },
+        None => None,
+    };
     let cancel = cancel_on_ctrl_c();
     // The margin search plans for itself, from no margin up.
     if let Some(target) = args.target {
@@ -143,8 +152,8 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
     if let Some(k) = args.flight {
         return super::fly_again::flight(&setup, seed, k);
     }
-    if let Some(path) = &args.inputs {
-        return super::fly_again::inputs(&setup, &mission, args, seed, path);
+    if let Some((path, file)) = failing {
+        return super::fly_again::inputs(&setup, &mission, args, seed, path, &file);
     }
     if args.rare {
         return rare(&setup, &mission, args, seed, &cancel);
