@@ -80,14 +80,7 @@ impl Revision {
     /// Every diagnostic, as `check` and the designer list them: the rules,
     /// then every pipeline's predicted size, then every pipeline's findings.
     pub fn diagnostics(&self) -> Vec<Diagnostic> {
-        let budgets = self.own.iter().flat_map(|o| o.budget.iter());
-        let findings = self.own.iter().flat_map(|o| o.findings.iter());
-        self.rules
-            .iter()
-            .chain(budgets)
-            .chain(findings)
-            .cloned()
-            .collect()
+        self.listed_from(0)
     }
 
     /// What the pipelines say beyond the file's own rules: their sections'
@@ -95,8 +88,20 @@ impl Revision {
     /// in the text after the file's rules, which the reading of the file
     /// reports itself).
     pub fn beyond_the_file(&self) -> Vec<Diagnostic> {
-        let diagnostics = self.diagnostics();
-        diagnostics[self.file_rules.min(diagnostics.len())..].to_vec()
+        self.listed_from(self.file_rules)
+    }
+
+    /// The rules from number `first` on, then every pipeline's predicted
+    /// size, then every pipeline's findings.
+    fn listed_from(&self, first: usize) -> Vec<Diagnostic> {
+        let budgets = self.own.iter().flat_map(|o| o.budget.iter());
+        let findings = self.own.iter().flat_map(|o| o.findings.iter());
+        self.rules[first.min(self.rules.len())..]
+            .iter()
+            .chain(budgets)
+            .chain(findings)
+            .cloned()
+            .collect()
     }
 
     /// What `kind` prepared (for its own run to read back).
