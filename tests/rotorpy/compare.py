@@ -93,12 +93,12 @@ def toml_value(v):
     return f'"{v}"' if isinstance(v, str) else repr(float(v))
 
 
-def edit_flight(text, overrides):
-    """The mission text with `[flight]`'s keys set (the section added if missing)."""
+def edit_section(text, section, overrides):
+    """The mission text with `[section]`'s keys set (the section added if missing)."""
     lines = text.splitlines()
-    start = next((i for i, l in enumerate(lines) if re.match(r"\s*\[flight\]", l)), None)
+    start = next((i for i, l in enumerate(lines) if re.match(rf"\s*\[{section}\]", l)), None)
     if start is None:
-        lines += ["", "[flight]"]
+        lines += ["", f"[{section}]"]
         start = len(lines) - 1
     end = next((i for i in range(start + 1, len(lines)) if re.match(r"\s*\[", lines[i])), len(lines))
     todo = dict(overrides)
@@ -108,9 +108,14 @@ def edit_flight(text, overrides):
             lines[i] = f"{m.group(1)} = {toml_value(todo.pop(m.group(1)))}"
     lines[start + 1:start + 1] = [f"{k} = {toml_value(v)}" for k, v in todo.items()]
     out = "\n".join(lines) + "\n"
-    flight = tomllib.loads(out)["flight"]
-    assert all(flight[k] == v for k, v in overrides.items()), flight
+    table = tomllib.loads(out)[section]
+    assert all(table[k] == v for k, v in overrides.items()), table
     return out
+
+
+def edit_flight(text, overrides):
+    """The mission text with `[flight]`'s keys set."""
+    return edit_section(text, "flight", overrides)
 
 
 # ---------------------------------------------------------------- WGS-84 -> ENU
@@ -418,21 +423,6 @@ SE3_GAINS = dict(position_gain_xy=6.5 / 4.0, velocity_gain_xy=4.0, position_gain
                  velocity_gain_z=9.0, velocity_integral_xy=0.0, velocity_integral_z=0.0)
 
 
-def edit_vehicle(text, gains):
-    """The mission text with `[vehicle]`'s gains set (the section added if missing)."""
-    lines = text.splitlines()
-    start = next((i for i, l in enumerate(lines) if re.match(r"\s*\[vehicle\]", l)), None)
-    if start is None:
-        lines += ["", "[vehicle]"]
-        start = len(lines) - 1
-    end = next((i for i in range(start + 1, len(lines)) if re.match(r"\s*\[", lines[i])), len(lines))
-    lines = [l for i, l in enumerate(lines)
-             if not (start < i < end and re.match(r"\s*(\w+)\s*=", l)
-                     and re.match(r"\s*(\w+)", l).group(1) in gains)]
-    lines[start + 1:start + 1] = [f"{k} = {v!r}" for k, v in gains.items()]
-    return "\n".join(lines) + "\n"
-
-
 def turbulent(args, text, frame, limits, work, calm):
     """The wind case in Dryden gusts, `args.flights` flights a side: per vehicle, p50 / p99 /
     max over the flights of each flight's largest cross-track error."""
@@ -440,7 +430,7 @@ def turbulent(args, text, frame, limits, work, calm):
     base = edit_flight(text, {**air, **QUIET})
     variants = [("skyform, PX4 default gains", base)]
     if args.se3_gains:
-        variants.append(("skyform, SE3-matched gains", edit_vehicle(base, SE3_GAINS)))
+        variants.append(("skyform, SE3-matched gains", edit_section(base, "vehicle", SE3_GAINS)))
     rows = []
     scheds = None
     for label, mission_text in variants:
