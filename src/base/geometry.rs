@@ -109,6 +109,20 @@ pub fn polyline_length(points: &[Point3<f64>]) -> f64 {
     points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
 
+/// `corners` in anticlockwise order (reversed when written clockwise): the
+/// winding [`facing_edge`] and the passes along a face read.
+pub fn anticlockwise(corners: &[Point2<f64>]) -> Vec<Point2<f64>> {
+    let n = corners.len();
+    let area: f64 = (0..n)
+        .map(|i| corners[i].coords.perp(&corners[(i + 1) % n].coords))
+        .sum();
+    let mut ring = corners.to_vec();
+    if area < 0.0 {
+        ring.reverse();
+    }
+    ring
+}
+
 /// The edge of the anticlockwise `outline` whose outward normal is nearest
 /// `normal` (the face an `inspect_side` names); the longer of two as near.
 pub fn facing_edge(outline: &[Point2<f64>], normal: Vector2<f64>) -> usize {

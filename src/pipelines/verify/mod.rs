@@ -545,14 +545,8 @@ pub fn on_side(o: &crate::base::shape::Prism, p: &Point3<f64>, side: f64) -> boo
         let d = (face - side).rem_euclid(360.0);
         return d.min(360.0 - d) <= 45.0 + 1e-9;
     }
-    let mut outline: Vec<nalgebra::Point2<f64>> = o.outline.corners().to_vec();
+    let outline = crate::base::geometry::anticlockwise(o.outline.corners());
     let n = outline.len();
-    let area: f64 = (0..n)
-        .map(|i| outline[i].coords.perp(&outline[(i + 1) % n].coords))
-        .sum();
-    if area < 0.0 {
-        outline.reverse();
-    }
     let i = crate::base::geometry::facing_edge(&outline, normal);
     crate::base::geometry::segment_point_distance(&outline[i], &outline[(i + 1) % n], &q) < 1e-6
 }

@@ -864,18 +864,7 @@ fn altitude_along(a: Point3<f64>, b: Point3<f64>, p: Point2<f64>) -> f64 {
 
 /// A footprint's vertices anticlockwise (`None` for a cylinder).
 fn anticlockwise(outline: &[Point2<f64>]) -> Option<std::sync::Arc<[Point2<f64>]>> {
-    if outline.len() < 3 {
-        return None;
-    }
-    let n = outline.len();
-    let area: f64 = (0..n)
-        .map(|i| outline[i].coords.perp(&outline[(i + 1) % n].coords))
-        .sum();
-    let mut v = outline.to_vec();
-    if area < 0.0 {
-        v.reverse();
-    }
-    Some(v.into())
+    (outline.len() >= 3).then(|| crate::base::geometry::anticlockwise(outline).into())
 }
 
 /// The ends of a pass along edge `i` of the anticlockwise `outline`,
