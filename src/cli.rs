@@ -311,8 +311,8 @@ struct PlainRunArgs {
 /// is an error that lists the pipelines.
 fn run_other(args: &[String]) -> u8 {
     let name = args.first().map_or("", String::as_str);
-    let Some(kind) = Kind::ALL.into_iter().find(|k| k.slug() == name) else {
-        let known: Vec<&str> = Kind::ALL.iter().map(|k| k.slug()).collect();
+    let Some(kind) = Kind::ALL.into_iter().find(|k| k.words().slug == name) else {
+        let known: Vec<&str> = Kind::ALL.iter().map(|k| k.words().slug).collect();
         eprintln!(
             "error: no pipeline '{name}' to run: {} (skyform run --help)",
             known.join(", ")

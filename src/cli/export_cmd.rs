@@ -83,8 +83,8 @@ pub fn planned(mission: &Mission, pipeline: Kind, seed: u64) -> Result<Planned, 
     if !ok {
         eprintln!(
             "warning: the {} result itself fails its verification (see `skyform run {}`)",
-            pipeline.slug(),
-            pipeline.slug()
+            pipeline.words().slug,
+            pipeline.words().slug
         );
     }
     Ok(planned)
@@ -161,7 +161,7 @@ pub fn summary(done: &Exported) -> String {
     let noun = export::noun(done.pipeline);
     let mut out = format!(
         "export {}: tolerance {:.3} m ({})\n",
-        done.pipeline.slug(),
+        done.pipeline.words().slug,
         done.tolerance,
         done.tolerance_source
     );

@@ -154,8 +154,8 @@ fn checked(
     if file.pipeline != pipeline {
         return Err(format!(
             "its flights are of {}'s plan: add --pipeline {}",
-            file.pipeline.name(),
-            file.pipeline.name()
+            file.pipeline.words().name,
+            file.pipeline.words().name
         ));
     }
     if file.seed != seed {

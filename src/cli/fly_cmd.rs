@@ -19,7 +19,7 @@ fn flown_pipelines() -> impl clap::builder::TypedValueParser<Value = Kind> {
     use clap::builder::TypedValueParser;
     let names: Vec<clap::builder::PossibleValue> = Kind::value_variants()
         .iter()
-        .filter(|k| !k.fixed_wing())
+        .filter(|k| !k.words().fixed_wing)
         .filter_map(|k| k.to_possible_value())
         .collect();
     clap::builder::PossibleValuesParser::new(names)
@@ -104,11 +104,11 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
     let Some(mut mission) = load_reporting(&args.mission) else {
         return exit::ERROR;
     };
-    if args.pipeline.fixed_wing() {
+    if args.pipeline.words().fixed_wing {
         eprintln!(
             "error: {}'s aircraft fly on their own model; the flight check flies multicopters \
              (--pipeline theta-pso or fleet)",
-            args.pipeline.name()
+            args.pipeline.words().name
         );
         return exit::ERROR;
     }
@@ -272,7 +272,7 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
     let Some((field, now)) = flight::margin_field(mission, pipeline) else {
         eprintln!(
             "error: --target: {} has no margin to widen",
-            pipeline.name()
+            pipeline.words().name
         );
         return exit::ERROR;
     };
@@ -306,7 +306,11 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
             }
         })
         .collect();
-    let spacing_field = pipeline.face().spacing_field().unwrap_or("the spacing");
+    let spacing_field = pipeline
+        .face()
+        .words()
+        .spacing_field
+        .unwrap_or("the spacing");
     let highest_margin = search
         .limit
         .as_ref()
@@ -351,7 +355,7 @@ fn margin(args: &FlyArgs, mission: &Mission, seed: u64, target: f64, cancel: &Ca
                 100.0 * target
             );
             let widest = search.spacing_limit.as_ref().map_or(
-                if pipeline.face().spacing_field().is_some() {
+                if pipeline.face().words().spacing_field.is_some() {
                     flight::MAX_SPACING
                 } else {
                     1.0

@@ -214,7 +214,7 @@ pub struct Words {
 
 impl Words {
     pub fn of(pipeline: Kind) -> Words {
-        let (completed, verdict) = pipeline.tally_words();
+        let (completed, verdict) = pipeline.words().tallies;
         Words { completed, verdict }
     }
 

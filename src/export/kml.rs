@@ -54,7 +54,7 @@ pub fn render(
     let mut elements = vec![
         text(
             "name",
-            &format!("{} — {}", mission.name, planned.pipeline.slug()),
+            &format!("{} — {}", mission.name, planned.pipeline.words().slug),
         ),
         text("open", "1"),
         text("description", &description(mission, planned)),
@@ -151,7 +151,7 @@ fn description(mission: &Mission, planned: &Planned) -> String {
         "{} plan, seed {}: {}\n\nAltitudes are absolute: [origin].altitude plus the \
          mission's z (its height above the mission's ground), as the exported waypoint \
          files' homes and relative heights add up to.",
-        planned.pipeline.slug(),
+        planned.pipeline.words().slug,
         planned.seed,
         planned.verdict
     );

@@ -97,7 +97,7 @@ pub const MIN_TOLERANCE: f64 = 0.01;
 /// How each pipeline names its vehicles: θ-PSO's UAVs, FLATLO's
 /// aircraft, the fleet's agents.
 pub fn noun(pipeline: Kind) -> &'static str {
-    pipeline.face().noun()
+    pipeline.face().words().noun
 }
 
 /// What a pipeline's outcome gives the export: each vehicle's track, the
@@ -405,7 +405,7 @@ pub enum ExportError {
 pub fn file_name(stem: &str, pipeline: Kind, vehicle: usize, format: Format) -> String {
     format!(
         "{stem}-{}-{}{}.{}",
-        pipeline.slug(),
+        pipeline.words().slug,
         noun(pipeline).to_lowercase(),
         vehicle + 1,
         format.extension()
@@ -414,7 +414,7 @@ pub fn file_name(stem: &str, pipeline: Kind, vehicle: usize, format: Format) -> 
 
 /// File name of the KML of the whole plan: `<mission-stem>-<pipeline>.kml`.
 pub fn kml_file_name(stem: &str, pipeline: Kind) -> String {
-    format!("{stem}-{}.kml", pipeline.slug())
+    format!("{stem}-{}.kml", pipeline.words().slug)
 }
 
 /// Reduces, re-verifies and (unless refused) writes one file per vehicle and
@@ -436,7 +436,7 @@ pub fn export(
         return Err(ExportError::NoOrigin(f.name()));
     }
     if planned.tracks.iter().all(|t| t.samples.is_empty()) {
-        return Err(ExportError::Empty(planned.pipeline.slug()));
+        return Err(ExportError::Empty(planned.pipeline.words().slug));
     }
     let (mut tolerance, mut tolerance_source) = match options.tolerance {
         Some(t) if t.is_finite() && t >= MIN_TOLERANCE => (t, "--tolerance".to_owned()),
@@ -603,7 +603,7 @@ pub fn items(
         placement.home(&first.xy())
     });
     let stored = |p: &Point3<f64>| placement.stored(p, &home);
-    let fixed_wing = planned.pipeline.fixed_wing();
+    let fixed_wing = planned.pipeline.words().fixed_wing;
     // Ground speed for multicopters, airspeed for fixed wing (still air).
     let speed_type = if fixed_wing { 0.0 } else { 1.0 };
     let accept = planned.acceptance.unwrap_or(tolerance.max(0.1));

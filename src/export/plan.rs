@@ -20,12 +20,20 @@ use crate::mission::Mission;
 /// MAV_AUTOPILOT: PX4 for the quadrotor pipelines, ArduPilot for FLATLO's
 /// fixed-wing aircraft (ArduPlane).
 pub fn firmware_type(planned: &Planned) -> u8 {
-    if planned.pipeline.fixed_wing() { 3 } else { 12 }
+    if planned.pipeline.words().fixed_wing {
+        3
+    } else {
+        12
+    }
 }
 
 /// MAV_TYPE: 1 fixed wing, 2 quadrotor.
 pub fn vehicle_type(planned: &Planned) -> u8 {
-    if planned.pipeline.fixed_wing() { 1 } else { 2 }
+    if planned.pipeline.words().fixed_wing {
+        1
+    } else {
+        2
+    }
 }
 
 fn item_json(item: &Item, jump: usize) -> Value {

@@ -191,10 +191,10 @@ impl Reverification {
 
 /// The advice for one failure.
 fn advice(f: &Failure, pipeline: Kind, tolerance: f64, deviation: f64) -> String {
-    let (name, slug) = (pipeline.name(), pipeline.slug());
+    let (name, slug) = (pipeline.words().name, pipeline.words().slug);
     let c = f.constraint.as_str();
     if f.unit == "m/s" {
-        let field = match (pipeline.speed_field(), c) {
+        let field = match (pipeline.words().speed_field, c) {
             (Some(field), _) => field,
             (None, "climb rate") => "vehicle.max_climb_rate",
             (None, "descent rate") => "vehicle.max_descent_rate",
@@ -216,7 +216,8 @@ fn advice(f: &Failure, pipeline: Kind, tolerance: f64, deviation: f64) -> String
     }
     let fix = if c.starts_with("distance inside the x-y bounds") {
         pipeline
-            .bounds_advice()
+            .words()
+            .bounds_advice
             .unwrap_or("widen bounds.x and bounds.y, or move the route inside them")
     } else if c.starts_with("altitude") {
         "widen bounds.z, or plan the heights inside it"

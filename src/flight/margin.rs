@@ -476,7 +476,7 @@ pub fn find_margin(
     match found {
         Some((_, report)) if keeps_all(&report) => search.report = Some(report),
         // Then the pairs: 2 r_Q, at that margin.
-        Some((m, _)) if pipeline.face().spacing_field().is_some() => {
+        Some((m, _)) if pipeline.face().words().spacing_field.is_some() => {
             let spacing_cap = valid_up_to(mission, pipeline, 1.0, MAX_SPACING, &|changed, s| {
                 with_margin(changed, pipeline, m);
                 with_spacing(changed, pipeline, s);

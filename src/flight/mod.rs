@@ -86,7 +86,7 @@ pub enum FlightError {
 #[derive(Debug, Clone)]
 pub struct Setup<'m> {
     pub mission: &'m Mission,
-    /// The pipeline that planned it (`Kind::name`).
+    /// The pipeline that planned it (`Words::name`).
     pub pipeline: &'static str,
     pub plans: Vec<VehiclePlan>,
     /// Least clearance to an obstacle's surface (r_Q) and between two
@@ -152,7 +152,7 @@ impl<'m> Setup<'m> {
         Ok(Setup {
             inspected,
             mission,
-            pipeline: planned.pipeline.name(),
+            pipeline: planned.pipeline.words().name,
             clearance: planned.limits.clearance,
             closest: planned.limits.closest,
             plans,

@@ -26,7 +26,7 @@ use tracks::Track;
 
 /// What [`Outcome::figure`] is for `kind`, as a sweep's table heads it.
 pub fn figure_name(kind: Kind) -> &'static str {
-    kind.face().figure_name()
+    kind.face().words().figure_name
 }
 
 /// Whether a run of `kind` on `mission` is small enough to plan live, after
@@ -121,7 +121,7 @@ impl Outcome {
     /// One line for the status bar and the job list.
     pub fn headline(&self) -> String {
         let verdict = match self.verdict() {
-            Verdict::Passed => self.kind().face().passed_phrase().to_owned(),
+            Verdict::Passed => self.kind().face().words().passed.to_owned(),
             Verdict::Failed(reason) => format!("FAILED: {reason}"),
             Verdict::Cancelled => "no verdict on a partial run".to_owned(),
         };
@@ -165,7 +165,7 @@ impl Outcome {
     /// The verdict in one word for the job list: a θ-PSO plan is feasible or
     /// not, a flown run passes or fails; `None` for a partial run.
     pub fn verdict_word(&self) -> Option<&'static str> {
-        let (passed, failed) = self.kind().face().verdict_words();
+        let (passed, failed) = self.kind().face().words().verdicts;
         match self.verdict() {
             Verdict::Passed => Some(passed),
             Verdict::Failed(_) => Some(failed),

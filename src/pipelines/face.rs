@@ -183,80 +183,22 @@ pub struct Words {
     pub bounds_advice: Option<&'static str>,
     /// The field a flight check widens to space its vehicles apart.
     pub spacing_field: Option<&'static str>,
+    /// Its flights span kilometres (FLATLO's): the designer leaves the
+    /// site's labels and the formation's slots off the map under one, where
+    /// they would be letters piled on a few cells.
+    pub dwarfs_the_site: bool,
 }
 
 /// A pipeline: its words, its limits and its run. One unit value per
 /// pipeline (`Kind::face`).
 pub trait Pipeline: Sync {
-    /// Its fixed words and flags, as data ([`Words`]); the methods below
-    /// read them.
+    /// Its fixed words and flags, as data ([`Words`]).
     fn words(&self) -> &'static Words;
-    /// For people: `θ-PSO`.
-    fn name(&self) -> &'static str {
-        self.words().name
-    }
-    /// On the command line and in file names: `theta-pso`.
-    fn slug(&self) -> &'static str {
-        self.words().slug
-    }
-    /// What it calls a vehicle in files and messages: `UAV`.
-    fn noun(&self) -> &'static str {
-        self.words().noun
-    }
-    /// What it calls its vehicles: `UAVs`.
-    fn nouns(&self) -> &'static str {
-        self.words().nouns
-    }
     /// How many vehicles a run of it flies in `mission`.
     fn vehicles(&self, mission: &Mission) -> usize;
-    /// Its vehicles fly with fixed wings.
-    fn fixed_wing(&self) -> bool {
-        self.words().fixed_wing
-    }
-    /// The one figure a sweep tabulates, as its column is headed.
-    fn figure_name(&self) -> &'static str {
-        self.words().figure_name
-    }
-    /// What a run's two tallies are called (a sweep's columns): complete
-    /// and good.
-    fn tally_words(&self) -> (&'static str, &'static str) {
-        self.words().tallies
-    }
-    /// The verdict in one word, passed and failed (the job list).
-    fn verdict_words(&self) -> (&'static str, &'static str) {
-        self.words().verdicts
-    }
-    /// The headline's verdict when every hard constraint holds.
-    fn passed_phrase(&self) -> &'static str {
-        self.words().passed
-    }
-    /// The designer may re-plan it after every edit.
-    fn live(&self) -> bool {
-        self.words().live
-    }
-    /// Its run key in the designer and what the key table (the help, the
-    /// README) says it does.
-    fn run_key(&self) -> (char, &'static str) {
-        self.words().run_key
-    }
-    /// The designer's key that runs it as agent processes, and its words,
-    /// for one that [`Pipeline::flies_as_processes`].
-    fn processes_key(&self) -> Option<(char, &'static str)> {
-        self.words().processes_key
-    }
-    /// The mission field that limits its vehicles' speed, when that is not
-    /// the `[vehicle]` section's.
-    fn speed_field(&self) -> Option<&'static str> {
-        self.words().speed_field
-    }
-    /// What to change when its flight leaves the bounds, where its own
-    /// fields set the flight's extent; `None`: the route sets it.
-    fn bounds_advice(&self) -> Option<&'static str> {
-        self.words().bounds_advice
-    }
     /// The run in a few words for a sweep's first line (`θ-PSO`).
     fn describe(&self, _mission: &Mission) -> String {
-        self.name().to_owned()
+        self.words().name.to_owned()
     }
     /// The mission field a flight check's margin is added to (`skyform fly
     /// --target`: what its verification holds as the least clearance), and
@@ -267,15 +209,8 @@ pub trait Pipeline: Sync {
     }
     /// `mission` asked to keep `m` more (the field of [`Pipeline::margin_field`]).
     fn add_margin(&self, _mission: &mut Mission, _m: f64) {}
-    /// The mission field that spaces its vehicles apart (θ-PSO: the
-    /// slots), when a flight check may widen it: what `skyform fly
-    /// --target` scales when the pairs break more often than the target
-    /// however far the obstacles are kept. `None`: it cannot.
-    fn spacing_field(&self) -> Option<&'static str> {
-        self.words().spacing_field
-    }
     /// `mission` with its vehicles spaced `scale` times as far apart (the
-    /// field of [`Pipeline::spacing_field`]).
+    /// field of [`Words::spacing_field`]).
     fn widen_spacing(&self, _mission: &mut Mission, _scale: f64) {}
     /// The plots its viewer layout puts beside the scene, a column of
     /// panels (a panel of several plots is a set of tabs).
@@ -348,7 +283,7 @@ pub trait PipelineOutcome {
     }
     /// The run gave a result to judge.
     fn judged(&self) -> bool;
-    /// The one figure a sweep tabulates (`Pipeline::figure_name`); NaN
+    /// The one figure a sweep tabulates (`Words::figure_name`); NaN
     /// when there is none.
     fn figure(&self) -> f64;
     /// Cost evaluations made.
@@ -377,17 +312,6 @@ pub trait PipelineOutcome {
     }
     /// Charts the outcome in the side view, along [`PipelineOutcome::flown_path`].
     fn chart_side(&self, _view: &ChartView, _out: &mut dyn Chart) {}
-    /// Where the formation heads from its start, when the plan says (θ-PSO:
-    /// its first waypoint); the designer turns the slots it draws there.
-    fn heading_from_start(&self) -> Option<Point3<f64>> {
-        None
-    }
-    /// Its flight spans kilometres (FLATLO's): the designer leaves the
-    /// site's labels and the formation's slots off the map under it, where
-    /// they would be letters piled on a few cells.
-    fn dwarfs_the_site(&self) -> bool {
-        false
-    }
     /// What a live plan adds to its vehicles' tracks in a recording, under
     /// `root` (θ-PSO: its centroid path).
     fn sketch_live(&self, _root: &str, _out: &mut dyn Sketch) {}
@@ -406,11 +330,6 @@ pub trait PipelineOutcome {
     fn warm_request(&self, _from: &str) -> Option<super::Request> {
         None
     }
-    /// Its vehicles still flying at the end, of how many (the fleet's agents
-    /// not lost); `None` for a pipeline that loses none.
-    fn vehicles_alive(&self) -> Option<(usize, usize)> {
-        None
-    }
     /// How long a flight the designer can replay on the map runs, seconds
     /// (the fleet's); `None`: nothing to replay.
     fn replay(&self) -> Option<f64> {
@@ -418,41 +337,11 @@ pub trait PipelineOutcome {
     }
 }
 
-/// A kind's words and rules, read from its face.
+/// A kind's words, read from its face.
 impl Kind {
-    /// For people: `θ-PSO`, `FLATLO`, `fleet`.
-    pub fn name(self) -> &'static str {
-        self.face().name()
-    }
-
-    /// As on the command line and in file names: `theta-pso`, `flatlo`, `fleet`.
-    pub fn slug(self) -> &'static str {
-        self.face().slug()
-    }
-
-    /// The vehicles it plans fly with fixed wings (FLATLO's aircraft).
-    pub fn fixed_wing(self) -> bool {
-        self.face().fixed_wing()
-    }
-
-    /// What a run's two tallies are called (a sweep's columns).
-    pub fn tally_words(self) -> (&'static str, &'static str) {
-        self.face().tally_words()
-    }
-
-    /// The designer can re-plan it after every edit.
-    pub fn live(self) -> bool {
-        self.face().live()
-    }
-
-    /// The mission field that limits its vehicles' speed, when that is not
-    /// the `[vehicle]` section's (FLATLO's airspeed range).
-    pub fn speed_field(self) -> Option<&'static str> {
-        self.face().speed_field()
-    }
-
-    /// What to change when its flight leaves the bounds ([`Pipeline::bounds_advice`]).
-    pub fn bounds_advice(self) -> Option<&'static str> {
-        self.face().bounds_advice()
+    /// Its fixed words and flags ([`Words`]): `Kind::Flatlo.words().name`
+    /// is `FLATLO`.
+    pub fn words(self) -> &'static Words {
+        self.face().words()
     }
 }

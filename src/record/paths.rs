@@ -32,7 +32,7 @@ pub const MISSION: &str = "mission";
 /// The root of a pipeline's entities (and the name of its recording
 /// property): its slug as an entity name, `theta_pso`, `flatlo`, `fleet`.
 pub fn root(kind: Kind) -> String {
-    kind.slug().replace('-', "_")
+    kind.words().slug.replace('-', "_")
 }
 
 /// Where a pipeline's log lines (its `Event::Log`s) go: under its own root,

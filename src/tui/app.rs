@@ -217,7 +217,7 @@ impl App {
         if let Some(o) = self
             .shown()
             .and_then(|j| j.outcome.as_ref())
-            .filter(|o| o.kind().fixed_wing())
+            .filter(|o| o.kind().words().fixed_wing)
         {
             for p in o
                 .reference_tracks()

@@ -88,7 +88,7 @@ impl JobBoard {
     }
 
     /// Turns live planning on for the pipeline shown when it can plan live
-    /// (`Kind::live`), otherwise for the default one (θ-PSO), or off.
+    /// (`Words::live`), otherwise for the default one (θ-PSO), or off.
     pub fn toggle_live(&mut self, now: Instant, status: &mut StatusLine) {
         if self.live.is_on() {
             self.live.stop();
@@ -98,12 +98,12 @@ impl JobBoard {
         let pipeline = self
             .shown()
             .map(|j| j.pipeline)
-            .filter(|k| k.live())
+            .filter(|k| k.words().live)
             .unwrap_or_default();
         match self.live.start(pipeline, now) {
             Ok(()) => status.say(format!(
                 "live planning on: {} re-plans after every edit (L turns it off)",
-                pipeline.name()
+                pipeline.words().name
             )),
             Err(e) => status.error(e),
         }
@@ -250,9 +250,10 @@ impl JobBoard {
                     Some(request) => {
                         self.run(crate::run::Run::asking(request, seed), doc, cwd, status);
                     }
-                    None => {
-                        status.error(format!("{} does not fly as agent processes", kind.name()))
-                    }
+                    None => status.error(format!(
+                        "{} does not fly as agent processes",
+                        kind.words().name
+                    )),
                 }
             }
             RunNewSeed => {
@@ -341,7 +342,7 @@ impl JobBoard {
             status.error(format!("flight check: job {id} has no plan"));
             return;
         };
-        if job.pipeline.fixed_wing() {
+        if job.pipeline.words().fixed_wing {
             status.error("flight check: FLATLO's aircraft fly on their own model; G flies θ-PSO and fleet plans");
             return;
         }
@@ -412,7 +413,7 @@ impl JobBoard {
         let taken: Vec<&Path> = self.jobs.iter().filter_map(|j| j.rrd.as_deref()).collect();
         job.rrd = self
             .record_rrd
-            .then(|| rrd_path(doc, cwd, pipeline.slug(), seed, &taken));
+            .then(|| rrd_path(doc, cwd, pipeline.words().slug, seed, &taken));
         let record = RecordSettings {
             rrd: job.rrd.clone(),
             viewer: self.viewer,
@@ -436,7 +437,7 @@ impl JobBoard {
         self.cursor = self.jobs.len() - 1;
         status.say(format!(
             "job {id}: {}{how} started with seed {seed}{recording} (x cancels)",
-            pipeline.name()
+            pipeline.words().name
         ));
     }
 

@@ -107,8 +107,8 @@ pub fn keys_for(action: &Action) -> Option<&'static str> {
 pub static KEYS: LazyLock<Vec<KeyRow>> = LazyLock::new(table);
 
 /// The table: the designer's own keys, and each pipeline's run keys where
-/// the Run group lists them (from its face: `Pipeline::run_key`,
-/// `Pipeline::processes_key`).
+/// the Run group lists them (from its face: `Words::run_key`,
+/// `Words::processes_key`).
 ///
 /// Long (~380 lines) because it is the key table itself, as data: one row of
 /// four short fields per key, in the order the help shows them.
@@ -500,7 +500,7 @@ fn table() -> Vec<KeyRow> {
 
 /// `kind`'s run key: runs it with the mission's seed.
 fn run_row(kind: Kind) -> KeyRow {
-    let (key, help) = kind.face().run_key();
+    let (key, help) = kind.face().words().run_key;
     KeyRow {
         group: "Run",
         keys: key.to_string().into(),
@@ -511,7 +511,7 @@ fn run_row(kind: Kind) -> KeyRow {
 
 /// `kind`'s key that runs it as agent processes, for one that flies so.
 fn processes_row(kind: Kind) -> Option<KeyRow> {
-    let (key, help) = kind.face().processes_key()?;
+    let (key, help) = kind.face().words().processes_key?;
     Some(KeyRow {
         group: "Run",
         keys: key.to_string().into(),

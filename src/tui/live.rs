@@ -140,12 +140,12 @@ impl Live {
     /// Turns live planning on for `pipeline` (θ-PSO or FLATLO; the fleet,
     /// which simulates for seconds, is never live); a run is due at once.
     pub fn start(&mut self, pipeline: Kind, now: Instant) -> Result<(), String> {
-        if !pipeline.live() {
+        if !pipeline.words().live {
             let key = crate::tui::keys::keys_for(&crate::tui::action::Action::Run(pipeline))
                 .map_or_else(String::new, |k| format!(" with {k}"));
             return Err(format!(
                 "the {} is not planned live: run it{key}",
-                pipeline.name()
+                pipeline.words().name
             ));
         }
         self.on = true;

@@ -461,7 +461,7 @@ fn plan_json(path: &Path) -> Value {
 
 fn check_plan_file(m: &Mission, p: &Planned, path: &Path) {
     let v = plan_json(path);
-    let fixed_wing = p.pipeline.fixed_wing();
+    let fixed_wing = p.pipeline.words().fixed_wing;
     assert_eq!(v["fileType"], "Plan");
     assert_eq!(v["version"], 1);
     assert!(v["groundStation"].is_string());
@@ -592,7 +592,7 @@ fn every_written_speed_is_within_the_vehicle_limits() {
         for plan in &done.plans {
             let n = plan.vehicle;
             let limits = m.vehicle.limits(n);
-            let multicopter = !p.pipeline.fixed_wing();
+            let multicopter = !p.pipeline.words().fixed_wing;
             let v = plan_json(&file_of(&done, n, Format::Plan));
             let mut speeds: Vec<f64> = v["mission"]["items"]
                 .as_array()
@@ -1358,7 +1358,7 @@ fn expectations(m: &Mission, p: &Planned, done: &Exported, dir: &Path) -> (PathB
         let home_item = json!({"command": 16, "lat": home.latitude_deg(), "lon": home.longitude_deg(), "alt": home.altitude});
         let path_of = |format: Format| file_of(done, plan.vehicle, format).display().to_string();
         let mut plan_items = expected(false, &|f| f);
-        if p.pipeline.fixed_wing() {
+        if p.pipeline.words().fixed_wing {
             // MAVSDK puts plannedHomePosition first for ArduPilot.
             plan_items.insert(0, home_item.clone());
         }
@@ -1503,7 +1503,7 @@ fn flight_expectation(m: &Mission, p: &Planned, done: &Exported, dir: &Path) -> 
         "clearance": p.limits.clearance,
         "flat_ground": m.terrain.is_none(),
         "obstacles": obstacles,
-        "fixed_wing": p.pipeline.fixed_wing(),
+        "fixed_wing": p.pipeline.words().fixed_wing,
         "kml": kml,
         "vehicles": vehicles,
     });

@@ -39,6 +39,7 @@ static WORDS: Words = Words {
         "widen bounds.x and bounds.y to hold the squadron's manoeuvre (flatlo.spacing, \
          flatlo.turn_radius and flatlo.start set its extent)",
     ),
+    dwarfs_the_site: true,
     spacing_field: None,
 };
 
@@ -92,11 +93,6 @@ impl Pipeline for Flatlo {
 impl PipelineOutcome for FlatloOutcome {
     fn chart(&self, view: &ChartView, out: &mut dyn Chart) {
         chart::chart(self, view, out);
-    }
-
-    /// The transition flies kilometres.
-    fn dwarfs_the_site(&self) -> bool {
-        true
     }
 
     fn header(&self) -> &crate::pipelines::Header {

@@ -42,7 +42,7 @@ pub fn sketch(o: &FlatloOutcome, out: &mut dyn Sketch) {
              arrival: {:.1} s\nduration: {:.1} s\nclosest: {}\nspacing error: {}\n\
              passed: {}\nskyform: {}",
             o.header.mission,
-            o.header.pipeline.slug(),
+            o.header.pipeline.words().slug,
             o.header.seed,
             o.header.completion,
             o.aircraft.len(),

@@ -39,6 +39,7 @@ static WORDS: Words = Words {
     )),
     speed_field: None,
     bounds_advice: None,
+    dwarfs_the_site: false,
     spacing_field: None,
 };
 
@@ -240,10 +241,6 @@ impl PipelineOutcome for FleetOutcome {
             limits_note: None,
             loiter_radius: 0.0,
         }
-    }
-
-    fn vehicles_alive(&self) -> Option<(usize, usize)> {
-        Some((self.agents.len() - self.lost.len(), self.agents.len()))
     }
 
     /// The flight, replayed on the map (`,` `.` `>`).

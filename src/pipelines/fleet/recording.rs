@@ -44,7 +44,7 @@ pub fn sketch(o: &FleetOutcome, out: &mut dyn Sketch) {
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\nagents: {}\n\
              kept apart: {}\nconverged: {}\nskyform: {}",
             o.header.mission,
-            o.header.pipeline.slug(),
+            o.header.pipeline.words().slug,
             o.header.seed,
             o.header.completion,
             o.agents.len(),

@@ -38,6 +38,7 @@ static WORDS: Words = Words {
     processes_key: None,
     speed_field: None,
     bounds_advice: None,
+    dwarfs_the_site: false,
     spacing_field: Some("formation.slots"),
 };
 
@@ -63,7 +64,7 @@ impl Pipeline for ThetaPso {
                 p.encoding, p.swarm_size, p.iterations
             )
         } else {
-            self.name().to_owned()
+            self.words().name.to_owned()
         }
     }
 
@@ -168,10 +169,6 @@ impl PipelineOutcome for ThetaPsoOutcome {
 
     fn chart_side(&self, view: &ChartView, out: &mut dyn Chart) {
         chart::chart_side(self, view, out);
-    }
-
-    fn heading_from_start(&self) -> Option<nalgebra::Point3<f64>> {
-        self.centroid_path.get(1).copied()
     }
 
     fn header(&self) -> &crate::pipelines::Header {

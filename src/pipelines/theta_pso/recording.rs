@@ -109,7 +109,7 @@ pub fn sketch(o: &ThetaPsoOutcome, scene: Option<&Mission>, out: &mut dyn Sketch
             "mission: {}\npipeline: {}\nseed: {}\ncompletion: {:?}\niterations: {}\n\
              feasible: {}\ncost J: {:.4}\nlength: {:.2} m\nduration: {:.2} s\nskyform: {}",
             o.header.mission,
-            o.header.pipeline.slug(),
+            o.header.pipeline.words().slug,
             o.header.seed,
             o.header.completion,
             o.iterations,

@@ -119,7 +119,12 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect) {
             .iter()
             .map(|k| {
                 let face = k.face();
-                format!("{} {} {}", face.name(), face.vehicles(m), face.nouns())
+                format!(
+                    "{} {} {}",
+                    face.words().name,
+                    face.vehicles(m),
+                    face.words().nouns
+                )
             })
             .collect();
         lines.push(Line::raw(counts.join(" · ")));

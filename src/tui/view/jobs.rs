@@ -54,7 +54,7 @@ fn live_line(app: &App, job: &Job) -> Line<'static> {
         format!(
             "{} · {} · {ms:.0} ms · {warm} · {state}",
             crate::tui::live::label(job.id),
-            job.pipeline.name()
+            job.pipeline.words().name
         ),
         Style::default().cyan(),
     )
@@ -63,8 +63,8 @@ fn live_line(app: &App, job: &Job) -> Line<'static> {
 /// A distributed fleet's agents alive, of how many (red once one is lost).
 fn agents_span(job: &Job) -> Option<Span<'static>> {
     job.distributed?;
-    let lost = job.outcome.as_ref().and_then(|o| o.face().vehicles_alive());
-    let (alive, total) = lost.or(job.agents)?;
+    // The run reports each loss as it happens (`Event::Vehicles`).
+    let (alive, total) = job.agents?;
     let style = if alive < total {
         Style::default().red().bold()
     } else {
@@ -184,7 +184,7 @@ pub fn draw(frame: &mut Frame, app: &App, area: Rect, now: Instant) {
                 if cursor { "▶" } else { " " },
                 if shown { "◉" } else { " " },
                 job.id,
-                job.pipeline.name(),
+                job.pipeline.words().name,
                 job.seed
             );
             let style = if cursor && focused {

@@ -363,7 +363,7 @@ fn running_line(app: &App) -> Vec<Line<'static>> {
         .jobs()
         .iter()
         .filter(|j| j.is_running())
-        .map(|j| format!("job {} {} s{}", j.id, j.pipeline.name(), j.seed))
+        .map(|j| format!("job {} {} s{}", j.id, j.pipeline.words().name, j.seed))
         .collect();
     match running.len() {
         0 => Vec::new(),

@@ -95,7 +95,7 @@ pub(super) fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewp
     // A result drawn at kilometre scale (FLATLO's): the θ-PSO route, IWPs
     // and obstacle names would be letters piled on a few cells (the
     // selected obstacle's name is still drawn).
-    let kilometres = shown_chart(app).is_some_and(|(o, _)| o.face().dwarfs_the_site());
+    let kilometres = shown_chart(app).is_some_and(|(o, _)| o.kind().words().dwarfs_the_site);
     let scale = vp.metres_per_column();
     let mut labels = Labels {
         vp,

@@ -136,7 +136,7 @@ fn result_part(app: &App, job: &Job, outcome: &Outcome) -> Part<'static> {
     let what = if job.pipeline == Kind::default() {
         String::new()
     } else {
-        format!("{} ", job.pipeline.name())
+        format!("{} ", job.pipeline.words().name)
     };
     let yellow = Style::default().black().on_yellow();
     let (long, short, style) = if Live::owns(job.id) {
@@ -281,7 +281,7 @@ pub fn draw_map(frame: &mut Frame, app: &App, area: Rect, vp: &Viewport, folded:
                     format!(
                         " {} {} running… {:.0}% ",
                         crate::tui::live::label(job.id),
-                        job.pipeline.name(),
+                        job.pipeline.words().name,
                         job.progress * 100.0
                     ),
                     Style::default().cyan(),
@@ -512,7 +512,7 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
         o.face().chart(view, &mut canvas);
     }
     paint_flight_check(ctx, app, dot);
-    if shown.is_none_or(|(o, _)| !o.face().dwarfs_the_site()) {
+    if shown.is_none_or(|(o, _)| !o.kind().words().dwarfs_the_site) {
         draw_formation_at_start(ctx, app, m, dot);
     }
 }
@@ -597,7 +597,14 @@ fn paint_flight_check(ctx: &mut Context, app: &App, dot: f64) {
 fn draw_formation_at_start(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
     let start = m.route.start;
     let toward = shown_chart(app)
-        .and_then(|(o, _)| o.face().heading_from_start())
+        .and_then(|(o, _)| {
+            // The plan's first step off the start, where it has a path.
+            o.face()
+                .flown_path()?
+                .iter()
+                .find(|p| (p.xy() - start.xy()).norm() > 1e-6)
+                .copied()
+        })
         .unwrap_or(m.route.goal);
     let d = (toward - start).xy();
     let heading = if d.norm() > 1e-9 { d.y.atan2(d.x) } else { 0.0 };
