@@ -192,7 +192,9 @@ fn flatlo(c: &mut Criterion) {
         .map(|l| l.mission)
         .unwrap_or_else(|e| panic!("{e}"));
     let mut app = App::new(Document::new(m, None), std::env::temp_dir());
-    app.update(Action::Select(Item::Squadron));
+    app.update(Action::Select(Item::Section(
+        skyform::pipelines::Kind::Flatlo,
+    )));
     assert!(app.start_live(Kind::Flatlo).is_ok());
     assert!(app.settle_live(SETTLE));
     let cold = app

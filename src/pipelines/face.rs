@@ -183,6 +183,9 @@ pub struct Words {
     pub bounds_advice: Option<&'static str>,
     /// The field a flight check widens to space its vehicles apart.
     pub spacing_field: Option<&'static str>,
+    /// Its mission section: the TOML key and the designer's title
+    /// (`("theta_pso", "θ-PSO parameters")`).
+    pub section: (&'static str, &'static str),
     /// Its flights span kilometres (FLATLO's): the designer leaves the
     /// site's labels and the formation's slots off the map under one, where
     /// they would be letters piled on a few cells.
@@ -212,6 +215,11 @@ pub trait Pipeline: Sync {
     /// `mission` with its vehicles spaced `scale` times as far apart (the
     /// field of [`Words::spacing_field`]).
     fn widen_spacing(&self, _mission: &mut Mission, _scale: f64) {}
+    /// The points of its own section the designer draws on the map and
+    /// lets the operator move, add and delete (the fleet's targets).
+    fn points(&self) -> &'static [super::points::PointKind] {
+        &[]
+    }
     /// The plots its viewer layout puts beside the scene, a column of
     /// panels (a panel of several plots is a set of tabs).
     fn plots(&self) -> &'static [&'static [Plot]];

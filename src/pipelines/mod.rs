@@ -11,6 +11,7 @@
 pub mod chart;
 pub mod face;
 pub mod interface;
+pub mod points;
 pub mod quadrotor;
 pub mod revision;
 pub mod sketch;

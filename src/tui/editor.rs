@@ -21,9 +21,8 @@ use super::action::{Action, Pane};
 use super::document::Document;
 use super::fields::{self, Field, Item};
 use super::status::StatusLine;
-use crate::mission::{
-    self, FleetTarget, Mission, MissionError, PathSegment, Preset, Severity, ShapeChoice,
-};
+use crate::mission::{self, Mission, MissionError, PathSegment, Preset, Severity, ShapeChoice};
+use crate::pipelines::points::{self, PointRef};
 use crate::pipelines::theta_pso::{Iwp, find_iwps};
 
 /// A line of text being typed into an inspector field.
@@ -350,27 +349,28 @@ impl Editor {
         status.say(format!("added '{name}' at ({:.1}, {:.1})", p.x, p.y));
     }
 
-    /// A copy of the selected obstacle beside it, or a new fleet target
-    /// after the last.
+    /// A copy of the selected obstacle beside it, or a new point of the
+    /// selected point's kind (or of its section's first kind) after the
+    /// last.
     fn duplicate(&mut self, status: &mut StatusLine) {
+        let kind = match &self.selected {
+            Item::Point(p) => Some((p.pipeline, p.kind)),
+            Item::Section(k) => points::kinds_of(*k).next().map(|(i, _)| (*k, i)),
+            _ => None,
+        };
+        if let Some((pipeline, kind)) = kind
+            && let Some(k) = pipeline.face().points().get(kind)
+        {
+            self.edit(status, |m| (k.add)(m));
+            let index = (k.count)(self.mission()).saturating_sub(1);
+            self.select(Item::Point(PointRef {
+                pipeline,
+                kind,
+                index,
+            }));
+            return;
+        }
         match self.selected {
-            Item::Fleet | Item::FleetTarget(_) => {
-                // A new target 10 s after the last, 1 m east of it.
-                let next = match self.mission().fleet.targets.last() {
-                    Some(t) => {
-                        let mut next = t.clone();
-                        next.time = t.time + 10.0;
-                        next.move_to(t.centre() + Vector2::new(1.0, 0.0));
-                        next
-                    }
-                    None => FleetTarget::around(
-                        0.0,
-                        crate::pipelines::fleet::default_target(self.mission()),
-                    ),
-                };
-                self.edit(status, |m| m.fleet.targets.push(next));
-                self.select(Item::FleetTarget(self.mission().fleet.targets.len() - 1));
-            }
             Item::Obstacle(i) => {
                 if let Some(o) = self.mission().obstacles.get(i) {
                     let copy = fields::duplicate_obstacle(self.mission(), o);
@@ -690,7 +690,7 @@ impl Editor {
             | Item::Start
             | Item::Goal
             | Item::Via(_)
-            | Item::FleetTarget(_) => {
+            | Item::Point(_) => {
                 if let Some(p) = self.position_of(&item) {
                     let to = p + Vector2::new(dx * s, dy * s);
                     self.edit(status, |m| set_position(m, &item, to));
@@ -722,7 +722,7 @@ impl Editor {
             Item::Start => Some(m.route.start.xy()),
             Item::Goal => Some(m.route.goal.xy()),
             Item::Slot(i) => m.formation.slots.get(*i).map(|s| Point2::new(s.x, s.y)),
-            Item::FleetTarget(i) => m.fleet.targets.get(*i).map(|t| t.centre()),
+            Item::Point(p) => p.centre(m),
             // A via point moves; a gate is where its obstacles are.
             Item::Via(i) => m.route.via.get(*i)?.point.map(|p| p.xy()),
             _ => None,
@@ -773,13 +773,11 @@ impl Editor {
                     }
                 });
             }
-            Item::FleetTarget(i) => {
-                self.edit(status, |m| {
-                    if i < m.fleet.targets.len() {
-                        m.fleet.targets.remove(i);
-                    }
-                });
-                status.say("fleet target deleted (u to undo)");
+            Item::Point(p) => {
+                if let Some(k) = p.kind() {
+                    self.edit(status, |m| (k.remove)(m, p.index));
+                    status.say(format!("{} deleted (u to undo)", k.noun.to_lowercase()));
+                }
             }
             Item::Via(i) => {
                 self.edit(status, |m| {
@@ -954,9 +952,9 @@ fn set_position(m: &mut Mission, item: &Item, p: Point2<f64>) {
                 s.y = p.y;
             }
         }
-        Item::FleetTarget(i) => {
-            if let Some(t) = m.fleet.targets.get_mut(*i) {
-                t.move_to(p);
+        Item::Point(q) => {
+            if let Some(k) = q.kind() {
+                (k.move_to)(m, q.index, p);
             }
         }
         Item::Via(i) => {

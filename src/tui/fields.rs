@@ -13,6 +13,8 @@
 use nalgebra::Point2;
 
 use crate::mission::{FieldPath, Mission, Obstacle, PathSegment, ShapeChoice, WaypointChoice};
+use crate::pipelines::Kind;
+use crate::pipelines::points::{self, PointRef};
 use crate::pipelines::theta_pso::Iwp;
 
 mod table;
@@ -37,13 +39,10 @@ pub enum Item {
     Slot(usize),
     /// The IWP between these two obstacles (eq. 9): its reconfiguration choice.
     Waypoint([String; 2]),
-    ThetaPso,
-    /// The FLATLO squadron and its aircraft model.
-    Squadron,
-    /// The distributed fleet's parameters.
-    Fleet,
-    /// One target of the fleet's timed sequence.
-    FleetTarget(usize),
+    /// A pipeline's own section (`[theta_pso]`, `[flatlo]`, `[fleet]`).
+    Section(Kind),
+    /// A point of a pipeline's section the map draws (a fleet target).
+    Point(PointRef),
     /// The air and autopilots of the flight check (`[flight]`).
     Flight,
 }
@@ -71,10 +70,8 @@ impl Item {
             Item::Formation => "Formation".into(),
             Item::Slot(i) => format!("Slot {} (UAV {})", i + 1, i + 1),
             Item::Waypoint([a, b]) => format!("IWP {a} ↔ {b}"),
-            Item::ThetaPso => "θ-PSO parameters".into(),
-            Item::Squadron => "Squadron (FLATLO)".into(),
-            Item::Fleet => "Fleet".into(),
-            Item::FleetTarget(i) => format!("Fleet target {}", i + 1),
+            Item::Section(k) => k.words().section.1.into(),
+            Item::Point(p) => p.title(),
             Item::Flight => "Flight check (air, GNSS)".into(),
         }
     }
@@ -88,7 +85,7 @@ impl Item {
                 .get(*i)
                 .is_some_and(|o| *v < o.footprint.len()),
             Item::Slot(i) => *i < mission.formation.slots.len(),
-            Item::FleetTarget(i) => *i < mission.fleet.targets.len(),
+            Item::Point(p) => p.exists(mission),
             Item::Via(i) => *i < mission.route.via.len(),
             Item::Terrain => mission.terrain.is_some(),
             Item::Waypoint([a, b]) => {
@@ -118,11 +115,12 @@ impl Item {
             Item::Terrain => root.key("terrain"),
             Item::Formation => root.key("formation"),
             Item::Slot(i) => root.key("formation").key("slots").index(*i),
-            Item::ThetaPso => root.key("theta_pso"),
-            Item::Squadron => root.key("flatlo"),
-            Item::Fleet => root.key("fleet"),
+            Item::Section(k) => root.key(k.words().section.0),
             Item::Flight => root.key("flight"),
-            Item::FleetTarget(i) => root.key("fleet").key("targets").index(*i),
+            Item::Point(p) => {
+                let [section, list] = p.kind()?.path;
+                root.key(section).key(list).index(p.index)
+            }
             Item::Mission => return None,
         })
     }
@@ -131,11 +129,8 @@ impl Item {
     /// `reconfiguration.waypoints`, if it has one yet).
     fn index(&self, m: &Mission) -> Option<usize> {
         match self {
-            Item::Obstacle(i)
-            | Item::Slot(i)
-            | Item::FleetTarget(i)
-            | Item::Via(i)
-            | Item::Vertex(i, _) => Some(*i),
+            Item::Obstacle(i) | Item::Slot(i) | Item::Via(i) | Item::Vertex(i, _) => Some(*i),
+            Item::Point(p) => Some(p.index),
             Item::Waypoint([a, b]) => m.reconfiguration.position(a, b),
             _ => None,
         }
@@ -150,10 +145,10 @@ pub fn map_items(mission: &Mission) -> Vec<Item> {
         items.push(Item::Terrain);
     }
     items.extend((0..mission.obstacles.len()).map(Item::Obstacle));
-    items.push(Item::ThetaPso);
-    items.push(Item::Squadron);
-    items.push(Item::Fleet);
-    items.extend((0..mission.fleet.targets.len()).map(Item::FleetTarget));
+    for k in Kind::ALL {
+        items.push(Item::Section(k));
+        items.extend(points::points_of(mission, k).into_iter().map(Item::Point));
+    }
     items.push(Item::Flight);
     items
 }
@@ -179,7 +174,7 @@ pub fn formation_items(mission: &Mission, iwps: &[Iwp]) -> Vec<Item> {
 
 /// A step of a table's base path: a key, or the selected item's index in
 /// its list.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 enum Step {
     Key(&'static str),
     Index,

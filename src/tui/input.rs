@@ -269,10 +269,11 @@ fn hit(
                     }
                 }
             }
-            for (i, t) in m.fleet.targets.iter().enumerate() {
-                let d = (t.centre() - p).norm();
-                if d <= tolerance * 1.5 {
-                    consider(d - tolerance * 2.0, Item::FleetTarget(i));
+            for point in crate::pipelines::points::every_point(m) {
+                if let Some(d) = point.centre(m).map(|c| (c - p).norm())
+                    && d <= tolerance * 1.5
+                {
+                    consider(d - tolerance * 2.0, Item::Point(point));
                 }
             }
         }

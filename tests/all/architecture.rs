@@ -422,10 +422,7 @@ const NAMES_A_PIPELINE_OR_ITS_SECTION: &[(&str, &str)] = &[
         "θ-PSO's clearance margin in the site's rules",
     ),
     ("src/tui/app.rs", "the formation editor lists θ-PSO's IWPs"),
-    (
-        "src/tui/editor.rs",
-        "moving the fleet's targets; θ-PSO's IWPs",
-    ),
+    ("src/tui/editor.rs", "θ-PSO's IWPs"),
     ("src/tui/fields.rs", "the sections' items in the inspector"),
     ("src/tui/fields/table.rs", "the sections' inspector rows"),
     ("src/tui/find.rs", "θ-PSO's IWPs in the item finder"),
@@ -433,9 +430,6 @@ const NAMES_A_PIPELINE_OR_ITS_SECTION: &[(&str, &str)] = &[
         "src/tui/fixtures.rs",
         "test fixtures that shorten θ-PSO's runs",
     ),
-    ("src/tui/input.rs", "clicking a fleet target on the map"),
-    ("src/tui/view/map/labels.rs", "the fleet's targets' labels"),
-    ("src/tui/view/map/mod.rs", "the fleet's targets on the map"),
 ];
 
 /// Lines of `file` outside comments and its `#[cfg(test)]` module that name

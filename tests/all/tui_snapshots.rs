@@ -906,7 +906,9 @@ fn a_flatlo_result_turns_stale_after_an_edit() {
         "{fresh}"
     );
     assert!(!fresh.contains("STALE"), "{fresh}");
-    app.update(Action::Select(Item::Squadron));
+    app.update(Action::Select(Item::Section(
+        skyform::pipelines::Kind::Flatlo,
+    )));
     type_into(&mut app, "airspeed (m/s)", "35");
     app.update(Action::FocusOn(Focus::Jobs));
     let stale = render(&app, started);
@@ -941,7 +943,13 @@ fn a_fleet_result_turns_stale_after_an_edit() {
     let fresh = map_title(&render(&app, started));
     assert!(fresh.contains("job 1 fleet seed 1: "), "{fresh}");
     assert!(!fresh.contains("STALE"), "{fresh}");
-    app.update(Action::Select(Item::FleetTarget(0)));
+    app.update(Action::Select(Item::Point(
+        skyform::pipelines::points::PointRef {
+            pipeline: skyform::pipelines::Kind::Fleet,
+            kind: 0,
+            index: 0,
+        },
+    )));
     app.update(Action::FocusOn(Focus::Map));
     app.update(Action::Nudge(1.0, 0.0));
     app.update(Action::FocusOn(Focus::Jobs));

@@ -181,7 +181,9 @@ fn cancel_keeps_the_best_so_far() {
     let dir = tempfile::tempdir().unwrap();
     let mut app = app_in(dir.path());
     type_into(&mut app, "seed", "3"); // any edit; then a long run
-    app.update(Action::Select(Item::ThetaPso));
+    app.update(Action::Select(Item::Section(
+        skyform::pipelines::Kind::ThetaPso,
+    )));
     // Long, but inside the budget (100 × 40,000 × 4 runs = 1.6e7 evaluations).
     type_into(&mut app, "iterations", "40000");
     app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
@@ -239,7 +241,9 @@ fn a_run_over_its_budget_is_not_started() {
         status.text
     );
     type_into(&mut app, "ground speed (m/s)", "3");
-    app.update(Action::Select(Item::ThetaPso));
+    app.update(Action::Select(Item::Section(
+        skyform::pipelines::Kind::ThetaPso,
+    )));
     type_into(&mut app, "swarm size", "100000000");
     app.update(Action::Run(skyform::pipelines::Kind::ThetaPso));
     assert!(app.jobs().is_empty());
@@ -608,7 +612,13 @@ fn a_fleet_run_replays_on_the_map() {
     assert_eq!(app.replay_time(), Some(6.0));
     assert!(!app.is_playing(), "stops at the end");
     // Fleet targets are items: select, move, add, delete.
-    app.update(Action::Select(Item::FleetTarget(0)));
+    app.update(Action::Select(Item::Point(
+        skyform::pipelines::points::PointRef {
+            pipeline: skyform::pipelines::Kind::Fleet,
+            kind: 0,
+            index: 0,
+        },
+    )));
     app.update(Action::FocusOn(Focus::Map));
     app.update(Action::Nudge(1.0, 0.0));
     assert_eq!(

@@ -39,6 +39,7 @@ static WORDS: Words = Words {
         "widen bounds.x and bounds.y to hold the squadron's manoeuvre (flatlo.spacing, \
          flatlo.turn_radius and flatlo.start set its extent)",
     ),
+    section: ("flatlo", "Squadron (FLATLO)"),
     dwarfs_the_site: true,
     spacing_field: None,
 };

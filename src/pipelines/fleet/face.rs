@@ -1,11 +1,12 @@
 //! The fleet's face: what every front end reads of it (`pipelines::face`).
 
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector2};
 
 use super::{FleetOutcome, chart, recording, summary};
-use crate::mission::{Diagnostic, Mission};
+use crate::mission::{Diagnostic, FleetTarget, Mission};
 use crate::pipelines::chart::{Chart, ChartView};
 use crate::pipelines::face::Words;
+use crate::pipelines::points::PointKind;
 use crate::pipelines::sketch::{Plot, Sketch};
 use crate::pipelines::{Airframe, ExportRules, Limits};
 use crate::pipelines::{
@@ -39,13 +40,57 @@ static WORDS: Words = Words {
     )),
     speed_field: None,
     bounds_advice: None,
+    section: ("fleet", "Fleet"),
     dwarfs_the_site: false,
     spacing_field: None,
 };
 
+/// The fleet's targets, on the designer's map.
+static POINTS: [PointKind; 1] = [PointKind {
+    noun: "Fleet target",
+    glyph: "◎",
+    path: ["fleet", "targets"],
+    count: |m| m.fleet.targets.len(),
+    centre: |m, i| m.fleet.targets.get(i).map(|t| t.centre()),
+    spots: |m, i| {
+        m.fleet
+            .targets
+            .get(i)
+            .map_or(Vec::new(), |t| t.positions.clone())
+    },
+    move_to: |m, i, p| {
+        if let Some(t) = m.fleet.targets.get_mut(i) {
+            t.move_to(p);
+        }
+    },
+    add: |m| {
+        // 10 s after the last, 1 m east of it; the first where the fleet
+        // has room to form.
+        let next = match m.fleet.targets.last() {
+            Some(t) => {
+                let mut next = t.clone();
+                next.time = t.time + 10.0;
+                next.move_to(t.centre() + Vector2::new(1.0, 0.0));
+                next
+            }
+            None => FleetTarget::around(0.0, super::default_target(m)),
+        };
+        m.fleet.targets.push(next);
+    },
+    remove: |m, i| {
+        if i < m.fleet.targets.len() {
+            m.fleet.targets.remove(i);
+        }
+    },
+}];
+
 impl Pipeline for Fleet {
     fn words(&self) -> &'static Words {
         &WORDS
+    }
+
+    fn points(&self) -> &'static [PointKind] {
+        &POINTS
     }
 
     fn vehicles(&self, mission: &Mission) -> usize {

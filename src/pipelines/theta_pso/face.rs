@@ -38,6 +38,7 @@ static WORDS: Words = Words {
     processes_key: None,
     speed_field: None,
     bounds_advice: None,
+    section: ("theta_pso", "θ-PSO parameters"),
     dwarfs_the_site: false,
     spacing_field: Some("formation.slots"),
 };

@@ -3,7 +3,7 @@
 //! values as text. The tables keep one field a line (`rustfmt::skip`) so
 //! they read as tables: name, unit, keys, read, write.
 //!
-//! Long (~825 lines) because it is the field tables of every item kind (some 300 lines, one
+//! Long (~910 lines) because it is the field tables of every item kind (some 300 lines, one
 //! field a line) with the parsers, names and setters their cells call, read together.
 
 use nalgebra::{Point2, Vector3};
@@ -16,6 +16,7 @@ use crate::mission::{
     CostKind, Encoding, FleetTarget, GeoOrigin, Mission, Obstacle, Preset, ShapeChoice, Terrain,
     Turbulence, WaypointChoice, spacing_of,
 };
+use crate::pipelines::points::PointRef;
 
 /// The table of `item`'s kind.
 pub(super) fn of(item: &Item) -> &'static Table {
@@ -31,12 +32,38 @@ pub(super) fn of(item: &Item) -> &'static Table {
         Item::Formation => &FORMATION,
         Item::Slot(_) => &SLOT,
         Item::Waypoint(_) => &WAYPOINT,
-        Item::ThetaPso => &THETA_PSO,
-        Item::Squadron => &SQUADRON,
-        Item::Fleet => &FLEET,
-        Item::FleetTarget(_) => &FLEET_TARGET,
+        Item::Section(k) => section_table(&[Key(k.words().section.0)]),
+        Item::Point(p) => p.kind().map_or(&NO_FIELDS, |k| {
+            section_table(&[Key(k.path[0]), Key(k.path[1]), Index])
+        }),
         Item::Flight => &FLIGHT,
     }
+}
+
+/// The pipelines' sections and their points, found by where they are in
+/// the file (a section's key, a point list's path).
+static SECTIONS: [&Table; 4] = [&THETA_PSO, &SQUADRON, &FLEET, &FLEET_TARGET];
+
+/// The table of `SECTIONS` at `base`; none (no fields) for a section
+/// without rows here.
+fn section_table(base: &[super::Step]) -> &'static Table {
+    SECTIONS
+        .iter()
+        .find(|t| t.base == base)
+        .copied()
+        .unwrap_or(&NO_FIELDS)
+}
+
+/// An item whose section has no rows here.
+static NO_FIELDS: Table = Table {
+    base: &[],
+    derived: &[],
+    fields: &[],
+};
+
+/// A fleet target: a point whose rows are the targets'.
+fn is_target(p: &PointRef) -> bool {
+    std::ptr::eq(of(&Item::Point(*p)), &FLEET_TARGET)
 }
 
 /// `[flight]`: the air, the fixes and the autopilot of `skyform fly`.
@@ -344,7 +371,7 @@ fn ground_xy(m: &Mission, item: &Item) -> Option<Point2<f64>> {
         Item::Start => Some(m.route.start.xy()),
         Item::Goal => Some(m.route.goal.xy()),
         Item::Obstacle(_) => obstacle_at(m, item).map(|o| o.center),
-        Item::FleetTarget(_) => target_at(m, item).map(|t| t.position),
+        Item::Point(_) => target_at(m, item).map(|t| t.position),
         _ => None,
     }
 }
@@ -388,7 +415,7 @@ fn set_geo(m: &mut Mission, item: &Item, text: &str, lat: bool) -> Result<(), St
         Item::Start => (m.route.start.x, m.route.start.y) = (p.x, p.y),
         Item::Goal => (m.route.goal.x, m.route.goal.y) = (p.x, p.y),
         Item::Obstacle(_) => obstacle(m, item)?.move_to(p),
-        Item::FleetTarget(_) => target(m, item)?.position = p,
+        Item::Point(_) => target(m, item)?.position = p,
         _ => return Err("this item has no position".into()),
     }
     Ok(())
@@ -793,14 +820,18 @@ fn slot<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut Vector3<f64>, Str
 
 fn target_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m FleetTarget> {
     match item {
-        Item::FleetTarget(i) => m.fleet.targets.get(*i),
+        Item::Point(p) if is_target(p) => m.fleet.targets.get(p.index),
         _ => None,
     }
 }
 
 fn target<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut FleetTarget, String> {
     match item {
-        Item::FleetTarget(i) => m.fleet.targets.get_mut(*i).ok_or("no such target".into()),
+        Item::Point(p) if is_target(p) => m
+            .fleet
+            .targets
+            .get_mut(p.index)
+            .ok_or("no such target".into()),
         _ => Err("not a fleet target".into()),
     }
 }

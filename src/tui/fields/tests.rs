@@ -10,7 +10,7 @@ fn every_field_reads_back_what_it_writes() {
         Item::Obstacle(0),
         Item::Formation,
         Item::Slot(1),
-        Item::ThetaPso,
+        Item::Section(Kind::ThetaPso),
     ];
     for item in items {
         for (k, f) in fields(&item, &m).into_iter().enumerate() {

@@ -105,8 +105,10 @@ pub(super) fn paint_labels(ctx: &mut Context, app: &App, m: &Mission, vp: &Viewp
     if !kilometres {
         labels.reserve(s.x, s.y, 1);
         labels.reserve(g.x, g.y, 1);
-        for t in &m.fleet.targets {
-            let c = t.centre();
+        for c in crate::pipelines::points::every_point(m)
+            .iter()
+            .filter_map(|p| p.centre(m))
+        {
             labels.reserve(c.x, c.y, 2);
         }
         for (_, at) in super::via_marks(m) {

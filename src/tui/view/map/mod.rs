@@ -488,19 +488,25 @@ fn paint_map(ctx: &mut Context, app: &App, m: &Mission, dot: f64) {
         };
         ctx.print(at.x, at.y, Span::styled(format!("{glyph}{}", k + 1), style));
     }
-    for (k, t) in m.fleet.targets.iter().enumerate() {
-        let style = if *app.selected() == Item::FleetTarget(k) {
+    for point in crate::pipelines::points::every_point(m) {
+        let (Some(kind), Some(c)) = (point.kind(), point.centre(m)) else {
+            continue;
+        };
+        let style = if *app.selected() == Item::Point(point) {
             Style::default().black().on_yellow().bold()
         } else {
             Style::default().fg(Color::Yellow).bold()
         };
-        // A target of one point per agent: each point a dot, the target's
-        // number at their middle.
-        for q in &t.positions {
+        // A point of several spots (a target of one per agent): each spot
+        // a dot, the point's number at their middle.
+        for q in (kind.spots)(m, point.index) {
             ctx.print(q.x, q.y, Span::styled("·", style));
         }
-        let c = t.centre();
-        ctx.print(c.x, c.y, Span::styled(format!("◎{}", k + 1), style));
+        ctx.print(
+            c.x,
+            c.y,
+            Span::styled(format!("{}{}", kind.glyph, point.index + 1), style),
+        );
     }
     let shown = shown_chart(app);
     if let Some((o, view)) = &shown {
