@@ -417,10 +417,6 @@ const NAMES_A_PIPELINE_OR_ITS_SECTION: &[(&str, &str)] = &[
         "src/mission/validate/mod.rs",
         "each section's rules, called by name",
     ),
-    (
-        "src/mission/validate/site.rs",
-        "θ-PSO's clearance margin in the site's rules",
-    ),
     ("src/tui/app.rs", "the formation editor lists θ-PSO's IWPs"),
     ("src/tui/editor.rs", "θ-PSO's IWPs"),
     ("src/tui/fields.rs", "the sections' items in the inspector"),

@@ -43,7 +43,11 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
         &mission.reconfiguration,
         mission,
     );
-    c.theta_pso(&root.key("theta_pso"), &mission.theta_pso);
+    c.theta_pso(
+        &root.key("theta_pso"),
+        &mission.theta_pso,
+        mission.terrain.is_some(),
+    );
     c.flatlo(&root.key("flatlo"), &mission.flatlo);
     c.fleet(&root.key("fleet"), &mission.fleet, mission);
     c.flight(&root.key("flight"), &mission.flight);

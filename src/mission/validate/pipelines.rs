@@ -4,7 +4,30 @@
 use super::*;
 
 impl Checker {
-    pub(super) fn theta_pso(&mut self, path: &FieldPath, p: &ThetaPsoParams) {
+    /// `[theta_pso]`, and what `cost = "spso"` and the spherical encoding
+    /// need of the rest of the mission (a `[terrain]`: `has_terrain`).
+    pub(super) fn theta_pso(&mut self, path: &FieldPath, p: &ThetaPsoParams, has_terrain: bool) {
+        use crate::mission::model::{CostKind, Encoding};
+        if p.cost == CostKind::Spso {
+            if !has_terrain {
+                self.error(
+                    path.key("cost"),
+                    "\"spso\" needs a [terrain] height map (its J3 and J4 read the ground)",
+                );
+            }
+            let most = crate::mission::SPSO_MAX_NODES;
+            if p.waypoints > most {
+                self.error(
+                    path.key("waypoints"),
+                    format!("the SPSO cost takes at most {most} free nodes"),
+                );
+            }
+        } else if p.encoding == Encoding::Spherical {
+            self.error(
+                path.key("encoding"),
+                "\"spherical\" encodes the SPSO benchmark's paths: it needs cost = \"spso\"",
+            );
+        }
         self.at_least_one(path.key("swarm_size"), p.swarm_size, "particle");
         self.at_least_one(path.key("waypoints"), p.waypoints, "waypoint");
         self.at_least_one(path.key("iterations"), p.iterations, "iteration");

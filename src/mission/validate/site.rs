@@ -542,32 +542,8 @@ impl Checker {
         }
     }
 
-    /// `[terrain]`: the file loaded, its pixels placed, the bounds on it; and
-    /// what `cost = "spso"` and the spherical encoding need.
+    /// `[terrain]`: the file loaded, its pixels placed, the bounds on it.
     pub(super) fn terrain(&mut self, path: &FieldPath, mission: &Mission) {
-        use crate::mission::model::{CostKind, Encoding};
-        let p = &mission.theta_pso;
-        let at = FieldPath::root().key("theta_pso");
-        if p.cost == CostKind::Spso {
-            if mission.terrain.is_none() {
-                self.error(
-                    at.key("cost"),
-                    "\"spso\" needs a [terrain] height map (its J3 and J4 read the ground)",
-                );
-            }
-            let most = crate::mission::SPSO_MAX_NODES;
-            if p.waypoints > most {
-                self.error(
-                    at.key("waypoints"),
-                    format!("the SPSO cost takes at most {most} free nodes"),
-                );
-            }
-        } else if p.encoding == Encoding::Spherical {
-            self.error(
-                at.key("encoding"),
-                "\"spherical\" encodes the SPSO benchmark's paths: it needs cost = \"spso\"",
-            );
-        }
         let Some(t) = &mission.terrain else { return };
         for (i, v) in t.pixel_size.iter().enumerate() {
             if *v == 0.0 {
