@@ -23,7 +23,7 @@ use std::ops::Range;
 use serde::{Deserialize, Serialize};
 
 use super::rare::{self, Estimate, Failure, Limit, RareOptions};
-use super::shard::{Misfit, Shard, Slots};
+use super::shard::{MergeError, PartWords, Shard, Sharded, merge_parts};
 use super::{FlightError, Setup};
 use crate::pipelines::{CancelToken, Kind};
 
@@ -260,60 +260,53 @@ pub struct Part {
     pub done: Vec<Run>,
 }
 
-/// Why rare-event parts do not merge.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum MergeError {
-    #[error("no part to merge")]
-    Empty,
-    #[error("part {0}: not a skyform rare-event part (format '{1}')")]
-    Format(usize, String),
-    #[error(
-        "part {part} is of another estimate than part 1: its {what} differs \
-         (merge the parts of one `skyform fly --rare --shard` run)"
-    )]
-    Mismatch { part: usize, what: &'static str },
-    #[error("part 1 says the estimate has {0} runs, over the limit of {MAX_RUNS}")]
-    TooMany(usize),
-    #[error("run {0} is in no part: a shard is missing")]
-    Missing(usize),
-    #[error("run {0} is in two parts: a shard is given twice")]
-    Twice(usize),
+/// A rare-event estimate's parts: its runs.
+static ESTIMATE_PARTS: PartWords = PartWords {
+    kind: "rare-event",
+    whole: "estimate",
+    piece: "run",
+    count: "number of runs",
+    command: "skyform fly --rare --shard",
+    most: MAX_RUNS,
+};
+
+impl Sharded for Part {
+    type Piece = Run;
+    const WORDS: &'static PartWords = &ESTIMATE_PARTS;
+    const FORMAT: &'static str = PART_FORMAT;
+
+    fn format(&self) -> &str {
+        &self.format
+    }
+
+    fn count(&self) -> usize {
+        self.runs
+    }
+
+    fn differs(&self, first: &Self) -> Option<&'static str> {
+        [
+            ("mission", self.mission != first.mission),
+            ("pipeline", self.pipeline != first.pipeline),
+            ("seed", self.seed != first.seed),
+            ("flights per level", self.per_level != first.per_level),
+            ("number of runs", self.runs != first.runs),
+        ]
+        .into_iter()
+        .find_map(|(what, differs)| differs.then_some(what))
+    }
+
+    fn take(&mut self) -> Vec<(usize, Run)> {
+        std::mem::take(&mut self.done)
+            .into_iter()
+            .map(|r| (r.run, r))
+            .collect()
+    }
 }
 
 /// The report of `parts`, checked to be one estimate's and to hold every
 /// run once. Parts are numbered from 1 in errors, in the order given.
 pub fn merge(parts: Vec<Part>) -> Result<OddsReport, MergeError> {
-    let first = parts.first().cloned().ok_or(MergeError::Empty)?;
-    if first.runs > MAX_RUNS {
-        return Err(MergeError::TooMany(first.runs));
-    }
-    let mut slots = Slots::new(first.runs);
-    for (i, part) in parts.into_iter().enumerate() {
-        if part.format != PART_FORMAT {
-            return Err(MergeError::Format(i + 1, part.format));
-        }
-        let differs = [
-            ("mission", part.mission != first.mission),
-            ("pipeline", part.pipeline != first.pipeline),
-            ("seed", part.seed != first.seed),
-            ("flights per level", part.per_level != first.per_level),
-            ("number of runs", part.runs != first.runs),
-        ];
-        if let Some((what, _)) = differs.iter().find(|(_, d)| *d) {
-            return Err(MergeError::Mismatch { part: i + 1, what });
-        }
-        for run in part.done {
-            let r = run.run;
-            slots.put(r, run).map_err(|misfit| match misfit {
-                Misfit::Outside => MergeError::Mismatch {
-                    part: i + 1,
-                    what: "number of runs",
-                },
-                Misfit::Twice => MergeError::Twice(r),
-            })?;
-        }
-    }
-    let runs = slots.complete().map_err(MergeError::Missing)?;
+    let (first, runs) = merge_parts(parts)?;
     Ok(OddsReport::new(
         &first.name,
         first.seed,

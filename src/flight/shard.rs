@@ -78,10 +78,10 @@ pub struct Part {
 /// Numbered pieces gathered from parts into their order, each exactly
 /// once: a check's flights here, a rare-event estimate's runs
 /// (`odds::merge`).
-pub(super) struct Slots<T>(Vec<Option<T>>);
+struct Slots<T>(Vec<Option<T>>);
 
 /// Why a piece does not go into its slot.
-pub(super) enum Misfit {
+enum Misfit {
     /// Its number is past the count the first part gave.
     Outside,
     /// Another part holds it already.
@@ -91,12 +91,12 @@ pub(super) enum Misfit {
 impl<T> Slots<T> {
     /// `count` empty slots (a count read from a part: checked against its
     /// limit before).
-    pub(super) fn new(count: usize) -> Self {
+    fn new(count: usize) -> Self {
         Slots(std::iter::repeat_with(|| None).take(count).collect())
     }
 
     /// Puts piece number `k`.
-    pub(super) fn put(&mut self, k: usize, piece: T) -> Result<(), Misfit> {
+    fn put(&mut self, k: usize, piece: T) -> Result<(), Misfit> {
         let slot = self.0.get_mut(k).ok_or(Misfit::Outside)?;
         if slot.is_some() {
             return Err(Misfit::Twice);
@@ -106,7 +106,7 @@ impl<T> Slots<T> {
     }
 
     /// Every piece in order, or the number of the first missing.
-    pub(super) fn complete(self) -> Result<Vec<T>, usize> {
+    fn complete(self) -> Result<Vec<T>, usize> {
         self.0
             .into_iter()
             .enumerate()
@@ -140,72 +140,181 @@ pub fn fly_shard(
     })
 }
 
-/// Why parts do not merge.
+/// What a kind of part is called in a merge's errors, and its limit: a
+/// check's flights, a rare-event estimate's runs.
+#[derive(Debug, PartialEq, Eq)]
+pub struct PartWords {
+    /// `flight-check` (its format's words).
+    pub kind: &'static str,
+    /// What the parts are parts of: `check`.
+    pub whole: &'static str,
+    /// One numbered piece of it: `flight`.
+    pub piece: &'static str,
+    /// The field that counts the pieces, as a mismatch names it.
+    pub count: &'static str,
+    /// The command whose shards merge: `skyform fly --shard`.
+    pub command: &'static str,
+    /// Most pieces a whole may have.
+    pub most: usize,
+}
+
+/// Why parts do not merge, in the words of their kind.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum MergeError {
-    #[error("no part to merge")]
+#[error("{}", self.words())]
+pub struct MergeError {
+    pub kind: &'static PartWords,
+    pub why: Misjoin,
+}
+
+/// What is wrong with the parts handed to a merge.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Misjoin {
     Empty,
-    #[error("part {0}: not a skyform flight-check part (format '{1}')")]
+    /// Part `.0` (from 1) is of format `.1`.
     Format(usize, String),
-    #[error(
-        "part {part} is of another check than part 1: its {what} differs \
-         (merge the parts of one `skyform fly --shard` run)"
-    )]
-    Mismatch { part: usize, what: &'static str },
-    #[error(
-        "part 1 says the check has {0} flights, over the limit of {max} a check may fly",
-        max = crate::mission::MAX_FLIGHTS
-    )]
+    /// Part `part` differs from the first in `what`.
+    Mismatch {
+        part: usize,
+        what: &'static str,
+    },
+    /// The first part counts this many pieces, over the limit.
     TooMany(usize),
-    #[error("flight {0} is in no part: a shard is missing")]
+    /// Piece `.0` is in no part.
     Missing(usize),
-    #[error("flight {0} is in two parts: a shard is given twice")]
+    /// Piece `.0` is in two parts.
     Twice(usize),
+}
+
+impl MergeError {
+    fn words(&self) -> String {
+        let PartWords {
+            kind,
+            whole,
+            piece,
+            command,
+            most,
+            ..
+        } = self.kind;
+        match &self.why {
+            Misjoin::Empty => "no part to merge".to_owned(),
+            Misjoin::Format(part, format) => {
+                format!("part {part}: not a skyform {kind} part (format '{format}')")
+            }
+            Misjoin::Mismatch { part, what } => format!(
+                "part {part} is of another {whole} than part 1: its {what} differs \
+                 (merge the parts of one `{command}` run)"
+            ),
+            Misjoin::TooMany(n) => {
+                format!("part 1 says the {whole} has {n} {piece}s, over the limit of {most}")
+            }
+            Misjoin::Missing(k) => format!("{piece} {k} is in no part: a shard is missing"),
+            Misjoin::Twice(k) => format!("{piece} {k} is in two parts: a shard is given twice"),
+        }
+    }
+}
+
+/// A part of a sharded whole, as [`merge_parts`] reads it.
+pub(super) trait Sharded: Clone {
+    type Piece;
+    /// Its kind's words and limit.
+    const WORDS: &'static PartWords;
+    /// The format it says it is; [`Sharded::FORMAT`] when it is one.
+    const FORMAT: &'static str;
+    fn format(&self) -> &str;
+    /// How many pieces the whole has.
+    fn count(&self) -> usize;
+    /// What makes it another whole's than `first`, in a word.
+    fn differs(&self, first: &Self) -> Option<&'static str>;
+    /// Its pieces, each with its number, taken out of it.
+    fn take(&mut self) -> Vec<(usize, Self::Piece)>;
+}
+
+/// Every piece of `parts` in order, checked to be one whole's and to hold
+/// every piece once; and the first part, emptied. Parts are numbered from 1
+/// in errors, in the order given.
+pub(super) fn merge_parts<P: Sharded>(parts: Vec<P>) -> Result<(P, Vec<P::Piece>), MergeError> {
+    let refuse = |why| MergeError {
+        kind: P::WORDS,
+        why,
+    };
+    let mut first = parts.first().cloned().ok_or(refuse(Misjoin::Empty))?;
+    // A part is a file anyone may hand in: its count is checked before it
+    // sizes anything.
+    if first.count() > P::WORDS.most {
+        return Err(refuse(Misjoin::TooMany(first.count())));
+    }
+    let mut slots = Slots::new(first.count());
+    for (i, mut part) in parts.into_iter().enumerate() {
+        if part.format() != P::FORMAT {
+            return Err(refuse(Misjoin::Format(i + 1, part.format().to_owned())));
+        }
+        if let Some(what) = part.differs(&first) {
+            return Err(refuse(Misjoin::Mismatch { part: i + 1, what }));
+        }
+        for (k, piece) in part.take() {
+            slots.put(k, piece).map_err(|misfit| {
+                refuse(match misfit {
+                    Misfit::Outside => Misjoin::Mismatch {
+                        part: i + 1,
+                        what: P::WORDS.count,
+                    },
+                    Misfit::Twice => Misjoin::Twice(k),
+                })
+            })?;
+        }
+    }
+    let pieces = slots.complete().map_err(|k| refuse(Misjoin::Missing(k)))?;
+    first.take();
+    Ok((first, pieces))
+}
+
+/// A check's parts: its flights.
+static CHECK_PARTS: PartWords = PartWords {
+    kind: "flight-check",
+    whole: "check",
+    piece: "flight",
+    count: "number of flights",
+    command: "skyform fly --shard",
+    most: crate::mission::MAX_FLIGHTS,
+};
+
+impl Sharded for Part {
+    type Piece = Flown;
+    const WORDS: &'static PartWords = &CHECK_PARTS;
+    const FORMAT: &'static str = PART_FORMAT;
+
+    fn format(&self) -> &str {
+        &self.format
+    }
+
+    fn count(&self) -> usize {
+        self.flights
+    }
+
+    fn differs(&self, first: &Self) -> Option<&'static str> {
+        [
+            ("mission", self.mission != first.mission),
+            ("pipeline", self.pipeline != first.pipeline),
+            ("seed", self.seed != first.seed),
+            ("number of flights", self.flights != first.flights),
+        ]
+        .into_iter()
+        .find_map(|(what, differs)| differs.then_some(what))
+    }
+
+    fn take(&mut self) -> Vec<(usize, Flown)> {
+        std::mem::take(&mut self.flown)
+            .into_iter()
+            .map(|f| (f.flight, f))
+            .collect()
+    }
 }
 
 /// The flights of `parts`, checked to be one check's and complete, in
 /// flight order; and the first part (its mission, pipeline, seed,
 /// flights). Parts are numbered from 1 in errors, in the order given.
 pub fn merge(parts: Vec<Part>) -> Result<(Part, Vec<Flown>), MergeError> {
-    let first = parts.first().cloned().ok_or(MergeError::Empty)?;
-    // A part is a file anyone may hand in: its count is checked before it
-    // sizes anything.
-    if first.flights > crate::mission::MAX_FLIGHTS {
-        return Err(MergeError::TooMany(first.flights));
-    }
-    let mut slots = Slots::new(first.flights);
-    for (i, part) in parts.into_iter().enumerate() {
-        if part.format != PART_FORMAT {
-            return Err(MergeError::Format(i + 1, part.format));
-        }
-        let differs = [
-            ("mission", part.mission != first.mission),
-            ("pipeline", part.pipeline != first.pipeline),
-            ("seed", part.seed != first.seed),
-            ("number of flights", part.flights != first.flights),
-        ];
-        if let Some((what, _)) = differs.iter().find(|(_, d)| *d) {
-            return Err(MergeError::Mismatch { part: i + 1, what });
-        }
-        for f in part.flown {
-            let k = f.flight;
-            slots.put(k, f).map_err(|misfit| match misfit {
-                Misfit::Outside => MergeError::Mismatch {
-                    part: i + 1,
-                    what: "number of flights",
-                },
-                Misfit::Twice => MergeError::Twice(k),
-            })?;
-        }
-    }
-    let flown = slots.complete().map_err(MergeError::Missing)?;
-    Ok((
-        Part {
-            flown: Vec::new(),
-            ..first
-        },
-        flown,
-    ))
+    merge_parts(parts)
 }
 
 #[cfg(test)]

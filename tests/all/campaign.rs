@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use skyform::export::Planned;
-use skyform::flight::shard::{self, MergeError, Part, Shard};
+use skyform::flight::shard::{self, Misjoin, Part, Shard};
 use skyform::flight::{self, Options, Report, Setup};
 use skyform::mission::{self, Mission};
 use skyform::outcome;
@@ -74,24 +74,35 @@ fn four_shards_merged_are_one_process_bit_for_bit() {
 
     // A shard missing, a shard twice, a part of another check: refused.
     assert_eq!(
-        shard::merge(parts[1..].to_vec()).map(|_| ()),
-        Err(MergeError::Missing(90))
+        shard::merge(parts[1..].to_vec())
+            .map(|_| ())
+            .map_err(|e| e.why),
+        Err(Misjoin::Missing(90))
+    );
+    assert_eq!(
+        shard::merge(parts[1..].to_vec())
+            .err()
+            .map(|e| e.to_string()),
+        Some("flight 90 is in no part: a shard is missing".to_owned())
     );
     let mut twice = parts.clone();
     twice.push(parts[0].clone());
-    assert_eq!(shard::merge(twice).map(|_| ()), Err(MergeError::Twice(90)));
+    assert_eq!(
+        shard::merge(twice).map(|_| ()).map_err(|e| e.why),
+        Err(Misjoin::Twice(90))
+    );
     // A part that claims more flights than a check may fly sizes nothing.
     let mut huge = parts.clone();
     huge[0].flights = usize::MAX;
     assert_eq!(
-        shard::merge(huge).map(|_| ()),
-        Err(MergeError::TooMany(usize::MAX))
+        shard::merge(huge).map(|_| ()).map_err(|e| e.why),
+        Err(Misjoin::TooMany(usize::MAX))
     );
     let mut other = parts.clone();
     other[2].seed = 2;
     assert_eq!(
-        shard::merge(other).map(|_| ()),
-        Err(MergeError::Mismatch {
+        shard::merge(other).map(|_| ()).map_err(|e| e.why),
+        Err(Misjoin::Mismatch {
             part: 3,
             what: "seed"
         })
@@ -230,7 +241,15 @@ fn a_rare_estimate_in_shards_of_runs_merges_to_one_process_bit_for_bit() {
     let json = |r: &OddsReport| serde_json::to_string_pretty(r).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(json(&merged), json(&one));
     assert_eq!(
-        odds::merge(parts[1..].to_vec()).map(|_| ()),
-        Err(odds::MergeError::Missing(2))
+        odds::merge(parts[1..].to_vec())
+            .map(|_| ())
+            .map_err(|e| e.why),
+        Err(Misjoin::Missing(2))
+    );
+    assert_eq!(
+        odds::merge(parts[1..].to_vec())
+            .err()
+            .map(|e| e.to_string()),
+        Some("run 2 is in no part: a shard is missing".to_owned())
     );
 }
