@@ -13,7 +13,10 @@ use skyform::tui::fixtures::{app_with_result, crowded_mission};
 use skyform::tui::{Action, App, Document, view};
 
 fn full_frame(c: &mut Criterion) {
-    let app = app_with_result(crowded_mission(200), 3, 20);
+    // A plan on the map, not the best one: 20 iterations of the swarm.
+    let mut mission = crowded_mission(200);
+    mission.theta_pso.iterations = 20;
+    let app = app_with_result(mission, 3);
     assert!(
         app.shown().and_then(|j| j.outcome.as_ref()).is_some(),
         "the frame must show a result"

@@ -118,9 +118,8 @@ pub fn app_with_run(kind: Kind, mission: Mission, seed: u64, file: &str) -> App 
 }
 
 /// An app on `mission` whose map shows a finished run of the designer's
-/// default pipeline (θ-PSO: `iterations` swarm iterations, seed `seed`).
-pub fn app_with_result(mut mission: Mission, seed: u64, iterations: usize) -> App {
-    mission.theta_pso.iterations = iterations;
+/// default pipeline with seed `seed`.
+pub fn app_with_result(mission: Mission, seed: u64) -> App {
     app_with_run(Kind::default(), mission, seed, "mission.toml")
 }
 

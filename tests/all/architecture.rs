@@ -422,10 +422,6 @@ const NAMES_A_PIPELINE_OR_ITS_SECTION: &[(&str, &str)] = &[
     ("src/tui/fields.rs", "the sections' items in the inspector"),
     ("src/tui/fields/table.rs", "the sections' inspector rows"),
     ("src/tui/find.rs", "θ-PSO's IWPs in the item finder"),
-    (
-        "src/tui/fixtures.rs",
-        "test fixtures that shorten θ-PSO's runs",
-    ),
 ];
 
 /// Lines of `file` outside comments and its `#[cfg(test)]` module that name

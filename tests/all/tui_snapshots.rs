@@ -101,7 +101,7 @@ fn jobs_panel_mid_run() {
 
 #[test]
 fn jobs_panel_with_a_finished_result() {
-    let mut app = app_with_result(default_mission().mission, 7, 150);
+    let mut app = app_with_result(crate::common::quick(default_mission().mission, 150), 7);
     app.update(Action::FocusOn(Focus::Jobs));
     let started = app.jobs()[0].started;
     let screen = render(&app, started);
@@ -125,7 +125,7 @@ fn jobs_panel_with_a_finished_result() {
 
 #[test]
 fn a_stale_result_is_marked_on_the_map() {
-    let mut app = app_with_result(default_mission().mission, 7, 20);
+    let mut app = app_with_result(crate::common::quick(default_mission().mission, 20), 7);
     app.update(Action::Select(Item::Goal));
     app.update(Action::FocusOn(Focus::Map));
     app.update(Action::Nudge(-1.0, 0.0));
@@ -457,7 +457,7 @@ fn jobs_panel(screen: &str) -> Vec<String> {
 /// count by reason with the nearest named, not a dozen lines.
 #[test]
 fn the_jobs_panel_groups_unusable_iwps_and_names_the_nearest_at_80_by_24() {
-    let mut app = app_with_result(bridge_with_post_clusters(), 7, 20);
+    let mut app = app_with_result(crate::common::quick(bridge_with_post_clusters(), 20), 7);
     app.update(Action::FocusOn(Focus::Jobs));
     let screen = render_at(&app, app.jobs()[0].started, (80, 24));
     let panel = jobs_panel(&screen).join(" ");
@@ -579,7 +579,7 @@ fn the_iwp_table_does_not_say_none_while_the_mission_has_errors() {
 /// whole ("STALE" was cut to "STAL" behind the scale), the scale after it.
 #[test]
 fn a_stale_result_is_marked_on_the_map_at_80_by_24() {
-    let mut app = app_with_result(default_mission().mission, 7, 20);
+    let mut app = app_with_result(crate::common::quick(default_mission().mission, 20), 7);
     app.update(Action::Select(Item::Goal));
     app.update(Action::FocusOn(Focus::Map));
     let fresh = render_at(&app, app.jobs()[0].started, (80, 24));
@@ -970,7 +970,7 @@ fn a_fleet_result_turns_stale_after_an_edit() {
 /// verdict whole.
 #[test]
 fn at_80_by_24_the_map_has_the_width_and_no_title_is_cut_mid_word() {
-    let mut app = app_with_result(default_mission().mission, 7, 20);
+    let mut app = app_with_result(crate::common::quick(default_mission().mission, 20), 7);
     app.update(Action::FocusOn(Focus::Map));
     let started = app.jobs()[0].started;
     let screen = render_at(&app, started, (80, 24));

@@ -137,7 +137,7 @@ fn validation_follows_the_typing() {
 
 #[test]
 fn an_edit_after_a_run_marks_the_result_stale_and_undo_makes_it_fresh() {
-    let app = &mut app_with_result(default_mission().mission, 7, 20);
+    let app = &mut app_with_result(crate::common::quick(default_mission().mission, 20), 7);
     let job = app.shown().expect("a shown result");
     assert!(!app.is_stale(job));
     app.update(Action::Select(Item::Goal));
@@ -871,7 +871,7 @@ fn the_formation_title_follows_undo_back_to_the_original_shape() {
 
 #[test]
 fn opening_another_mission_drops_the_jobs_of_the_first() {
-    let mut app = app_with_result(default_mission().mission, 7, 5);
+    let mut app = app_with_result(crate::common::quick(default_mission().mission, 5), 7);
     assert_eq!(app.jobs().len(), 1);
     let b = mission::BUILTIN
         .iter()

@@ -13,3 +13,13 @@ pub fn skyform(args: &[&str]) -> Output {
         .unwrap_or_else(|e| panic!("cannot start skyform: {e}"))
 }
 pub mod oracle;
+
+/// `mission` with θ-PSO's swarm cut to `iterations` (a designer's test
+/// needs a plan on the map, not the best one).
+pub fn quick(
+    mut mission: skyform::mission::Mission,
+    iterations: usize,
+) -> skyform::mission::Mission {
+    mission.theta_pso.iterations = iterations;
+    mission
+}
