@@ -2023,6 +2023,40 @@ fn the_viaduct_plans_with_an_obstacle_margin_up_to_3_9_m() {
     }
 }
 
+/// Issue 51: pier 5's east face is 3 m long under a 6 m pass. A straight
+/// pass keeps the facing UAV within the band's 5 m only at √(5² − 1.5²) =
+/// 4.77 m from the face or nearer; with `obstacle_margin = 4.0` it must keep
+/// 4.45 m, which leaves 0.32 m, and `check` warns, naming the face, the
+/// figures and what would give room. At 3.5 m (0.87 m left) it says nothing.
+#[test]
+fn a_pass_longer_than_a_thin_face_is_warned_of_with_its_figures() {
+    let warnings = |margin: f64| -> Vec<String> {
+        let mut m = viaduct();
+        m.formation.obstacle_margin = margin;
+        skyform::pipelines::theta_pso::diagnostics(&m)
+            .into_iter()
+            .filter(|d| !d.is_error() && d.to_string().contains("hard to inspect"))
+            .map(|d| d.to_string())
+            .collect()
+    };
+    assert_eq!(warnings(3.5), Vec::<String>::new());
+    let at_4 = warnings(4.0);
+    assert_eq!(at_4.len(), 1, "{at_4:?}");
+    for words in [
+        "obstacles[4].stand_off",
+        "'pier 5'",
+        "its east face is 3.0 m long",
+        "only 4.77 m from the face",
+        "0.32 m above the 4.45 m",
+        "shorten formation.inspection_pass to 4.4 m",
+        "lower formation.obstacle_margin to 3.81 m",
+    ] {
+        assert!(at_4[0].contains(words), "{words:?} not in {}", at_4[0]);
+    }
+    // 3.81 m, the margin it names, leaves the 0.5 m: no warning.
+    assert_eq!(warnings(3.81), Vec::<String>::new());
+}
+
 /// Issue 50: a gate no formation can take is `NO PLAN` naming it and why;
 /// a `[[reconfiguration.waypoints]]` entry that names no IWP says why in
 /// the summary (and `check` warns of it), never silently ignored.

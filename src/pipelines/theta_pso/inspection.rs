@@ -181,6 +181,88 @@ fn flown_band([d_min, d_max]: [f64; 2], f: &Formation) -> Result<[f64; 2], Strin
 /// quarter either side of the pass's line.
 pub const LEAST_FLOWN_BAND: f64 = 0.5;
 
+/// The inspected footprints whose face is shorter than the pass and leaves
+/// a straight pass less than [`LEAST_FLOWN_BAND`] to be held in, each with
+/// why and what would give it room: `check` warns of them.
+///
+/// Reading of eq. 8 on a footprint: past the face's ends the facing UAV's
+/// distance is to the face's corners, √(d² + s²) at s metres past an end
+/// for a pass d from the face. A straight pass of L metres along a face w
+/// metres long reaches at least (L − w)/2 past an end, so it keeps the UAV
+/// within d_max only when d ≤ √(d_max² − ((L − w)/2)²). (Issue 51: the
+/// viaduct's pier 5 has a 3 m east face under a 6 m pass; with
+/// `obstacle_margin = 4.0` that leaves 4.45-4.77 m, and the plan failed its
+/// inspection after 12 s.) A warning, not a refusal: the band rule's
+/// 0.5 m is a judgement, and the viaduct plans with 0.42 m (margin 3.9).
+pub fn thin_face_passes(mission: &Mission) -> Vec<(usize, String)> {
+    let f = &mission.formation;
+    let length = f.inspection_pass;
+    let mut out = Vec::new();
+    for (k, o) in mission.obstacles.iter().enumerate() {
+        let corners = o.outline().corners().to_vec();
+        if !o.inspect || corners.len() < 3 {
+            continue;
+        }
+        let ring = crate::base::geometry::anticlockwise(&corners);
+        let n = ring.len();
+        let edge = |i: usize| (ring[(i + 1) % n] - ring[i]).norm();
+        let (face, side) = match o.inspect_side.as_ref().and_then(|s| s.normal()) {
+            Some(normal) => (
+                edge(crate::base::geometry::facing_edge(&ring, normal)),
+                o.inspect_side
+                    .as_ref()
+                    .map_or_else(String::new, |s| format!("{} ", s.words())),
+            ),
+            None => ((0..n).map(edge).fold(0.0, f64::max), "longest ".to_owned()),
+        };
+        let overhang = (length - face) / 2.0;
+        // A band `check` refuses already is not warned of again.
+        let Ok([lower, d_max]) = flown_band(o.stand_off_band(f), f) else {
+            continue;
+        };
+        if overhang <= 0.0 {
+            continue;
+        }
+        let upper = (d_max.powi(2) - overhang.powi(2)).max(0.0).sqrt();
+        if upper - lower >= LEAST_FLOWN_BAND - 1e-9 {
+            continue;
+        }
+        let reach = d_max.powi(2) - (lower + LEAST_FLOWN_BAND).powi(2);
+        let shorten = if reach > 0.0 {
+            format!(
+                "shorten formation.inspection_pass to {:.1} m",
+                ((face + 2.0 * reach.sqrt()) * 10.0).floor() / 10.0
+            )
+        } else {
+            "widen the band".to_owned()
+        };
+        let margin = if lower > f.least_clearance() - 1e-9 && f.obstacle_margin > 0.0 {
+            // Down to the centimetre: the margin named leaves the band.
+            let most = f.obstacle_margin - (lower + LEAST_FLOWN_BAND - upper);
+            format!(
+                " or lower formation.obstacle_margin to {:.2} m",
+                ((most * 100.0).floor() / 100.0).max(0.0)
+            )
+        } else {
+            String::new()
+        };
+        out.push((
+            k,
+            format!(
+                "its {side}face is {face:.1} m long, shorter than the {length} m pass \
+                 (formation.inspection_pass): past the face's ends the facing UAV's distance is \
+                 to its corners, so a straight pass keeps it within {} m only {upper:.2} m from \
+                 the face or nearer, {:.2} m above the {lower:.2} m it keeps, less than the \
+                 {LEAST_FLOWN_BAND} m a pass is held in; the plan may fail its inspection: \
+                 {shorten}{margin}",
+                short(d_max),
+                (upper - lower).max(0.0)
+            ),
+        ));
+    }
+    out
+}
+
 /// The pass geometry of every inspected obstacle, or the first reason one
 /// cannot be flown, with its obstacle index.
 pub fn pass_geometries(mission: &Mission) -> Result<Vec<(usize, PassGeometry)>, (usize, String)> {

@@ -382,6 +382,15 @@ pub fn diagnostics_given(mission: &Mission, iwps: &[Iwp]) -> Vec<Diagnostic> {
             ),
         ));
     }
+    for (k, reason) in inspection::thin_face_passes(mission) {
+        out.push(Diagnostic::warning(
+            FieldPath::root().key("obstacles").index(k).key("stand_off"),
+            format!(
+                "'{}' is hard to inspect: {reason}",
+                mission.obstacles[k].name
+            ),
+        ));
+    }
     out
 }
 
