@@ -136,13 +136,10 @@ pub fn verification_rows(o: &ThetaPsoOutcome) -> Vec<VerificationRow> {
         let worst = check
             .worst
             .map_or_else(|| "n/a".to_owned(), crate::pipelines::verify::figure);
-        let at = check.at.as_ref().map_or_else(String::new, |a| {
-            let other = a
-                .other
-                .as_deref()
-                .map_or_else(String::new, |o| format!(" vs {o}"));
-            format!("  (UAV {} at t = {:.1} s{other})", a.uav + 1, a.time)
-        });
+        let at = check
+            .at
+            .as_ref()
+            .map_or_else(String::new, |a| format!("  ({})", a.words()));
         rows.push(VerificationRow {
             ok: check.ok,
             text: format!(

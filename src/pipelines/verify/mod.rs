@@ -42,6 +42,18 @@ pub struct Location {
     pub position: Point3<f64>,
 }
 
+impl Location {
+    /// `UAV 1 at t = 42.9 s vs 11 kV line #1`: where a check was worst, as
+    /// the failure line and the summary's table say it.
+    pub fn words(&self) -> String {
+        let other = self
+            .other
+            .as_deref()
+            .map_or_else(String::new, |o| format!(" vs {o}"));
+        format!("UAV {} at t = {:.1} s{other}", self.uav + 1, self.time)
+    }
+}
+
 /// One row of the verification table.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Check {
@@ -112,13 +124,9 @@ impl Verification {
     pub fn first_failure(&self) -> Option<String> {
         if let Some(c) = self.checks.iter().find(|c| !c.ok) {
             let worst = c.worst.map_or_else(|| "n/a".to_owned(), figure);
-            let at = c.at.as_ref().map_or_else(String::new, |a| {
-                let other = a
-                    .other
-                    .as_deref()
-                    .map_or_else(String::new, |o| format!(" vs {o}"));
-                format!(" (UAV {} at t = {:.1} s{other})", a.uav + 1, a.time)
-            });
+            let at =
+                c.at.as_ref()
+                    .map_or_else(String::new, |a| format!(" ({})", a.words()));
             return Some(format!(
                 "{} worst {worst} {} {}{at}",
                 c.name,
