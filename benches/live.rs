@@ -17,7 +17,7 @@
 //! - `live/flatlo_spacing`: FLATLO's paper case, Δ_d typed in alternately
 //!   18,300 and 18,400 m. Target: median ≤ 60 ms.
 //! - `live/validate_bridge`: the rules every run holds the bridge to
-//!   (`pipelines::validate`), which a live re-plan checks again after the
+//!   (`mission::validate`), which a live re-plan checks again after the
 //!   designer's own check of the edit (`outcome::diagnose`, also timed:
 //!   `live/diagnose_bridge`): what validating once per revision would save
 //!   of `bridge_nudge_1m` (issue 38).
@@ -257,7 +257,7 @@ fn validation(c: &mut Criterion) {
     let m = mission::default_mission().mission;
     let mut group = c.benchmark_group("live");
     group.bench_function("validate_bridge", |b| {
-        b.iter(|| skyform::pipelines::validate(std::hint::black_box(&m)))
+        b.iter(|| skyform::mission::validate(std::hint::black_box(&m)))
     });
     group.bench_function("diagnose_bridge", |b| {
         b.iter(|| skyform::outcome::diagnose::diagnose(std::hint::black_box(&m)))

@@ -114,7 +114,7 @@ pub fn fly_command(args: &FlyArgs) -> u8 {
     }
     if let Some(n) = args.flights {
         mission.flight.flights = n;
-        let problems: Vec<_> = crate::pipelines::validate(&mission)
+        let problems: Vec<_> = crate::mission::validate(&mission)
             .into_iter()
             .filter(|d| d.is_error() && d.path.to_string().starts_with("flight"))
             .collect();

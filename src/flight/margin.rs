@@ -175,7 +175,7 @@ fn invalid_with(
 ) -> Option<String> {
     let mut changed = mission.clone();
     change(&mut changed);
-    let rules = crate::pipelines::validate(&changed);
+    let rules = crate::mission::validate(&changed);
     let is_error = |d: &crate::mission::Diagnostic| d.severity == crate::mission::Severity::Error;
     let findings = || pipeline.face().findings(&changed, None);
     rules

@@ -63,7 +63,12 @@ pub fn check_str(text: &str, file: Option<&str>) -> Checked {
                 .filter(|p| !p.as_os_str().is_empty())
                 .unwrap_or_else(|| Path::new("."));
             mission.load_terrain(base);
-            let report = Report::new(validate(&mission).into_iter().map(locate).collect());
+            let mut found: Vec<Diagnostic> = validate(&mission).into_iter().map(locate).collect();
+            // In the order of the file: the sections' rules run in the
+            // order of their keys, not of the user's text. What the file
+            // does not write (a default) comes after what it does.
+            found.sort_by_key(|d| d.location.map_or(usize::MAX, |at| at.line));
+            let report = Report::new(found);
             Checked {
                 mission: Some(mission),
                 report,

@@ -30,4 +30,6 @@ pub use presets::{
 };
 pub use source::{FieldPath, LineCol, PathSegment, SourceMap};
 pub use template::{name_for, template, template_text};
-pub use validate::{MAX_FLIGHTS, compact, compact_digits, validate};
+pub use validate::{
+    Checker, MAX_FLIGHTS, SECTION_RULES, SectionRules, compact, compact_digits, physical, validate,
+};

@@ -1,6 +1,7 @@
 //! Everything skyform can say about a mission before running it.
 //!
-//! `mission::validate` holds the rules of the file itself; the pipelines know
+//! `mission::validate` holds the rules of the file itself, each pipeline's
+//! section's among them (registered by the pipeline); the pipelines know
 //! more (an IWP no shape can pass, an inspection pass eq. 8 cannot hold).
 //! Each pipeline also predicts the size of a run and refuses one over the
 //! documented limits (`pipeline::limits`). Every reader of a mission
@@ -23,9 +24,9 @@ pub fn check_text(text: &str, file: Option<&str>) -> Checked {
         && !checked.report.has_errors()
     {
         let source = SourceMap::new(text);
-        // The sections' rules, then (on a mission that follows every rule,
-        // as in `diagnose`) the pipelines' budgets and findings: the
-        // revision the designer finds, less the file's rules, which
+        // On a mission that follows every rule (as in `diagnose`), the
+        // pipelines' budgets and findings: the revision the designer finds,
+        // less the rules (the file's and every registered section's), which
         // `check_str` has located already.
         let extra: Vec<Diagnostic> = crate::pipelines::Revision::of(m)
             .beyond_the_file()

@@ -223,11 +223,6 @@ pub trait Pipeline: Sync {
     /// The plots its viewer layout puts beside the scene, a column of
     /// panels (a panel of several plots is a set of tabs).
     fn plots(&self) -> &'static [&'static [Plot]];
-    /// The rules of its own mission section, beyond what `mission::validate`
-    /// holds (a new pipeline's section is checked here, in its module).
-    fn validate(&self, _mission: &Mission) -> Vec<Diagnostic> {
-        Vec::new()
-    }
     /// What it says of a mission that follows the rules, before a run
     /// (θ-PSO: IWPs no shape can pass, inspections eq. 8 cannot hold;
     /// FLATLO: airspeeds and bounds predicted from its references).

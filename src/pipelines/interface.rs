@@ -152,23 +152,6 @@ pub enum PipelineError {
     Transport(String),
 }
 
-/// The rules of the file (`mission::validate`) and of every pipeline's own
-/// section (`Pipeline::validate`): what `check`, the designer and every run
-/// hold a mission to.
-pub fn validate(mission: &crate::mission::Mission) -> Vec<crate::mission::Diagnostic> {
-    let mut all = crate::mission::validate(mission);
-    all.extend(section_rules(mission));
-    all
-}
-
-/// The rules of every pipeline's own section, in `Kind::ALL`'s order.
-pub fn section_rules(mission: &crate::mission::Mission) -> Vec<crate::mission::Diagnostic> {
-    super::Kind::ALL
-        .into_iter()
-        .flat_map(|kind| kind.face().validate(mission))
-        .collect()
-}
-
 /// Every pipeline's first step: a mission with errors is refused, naming
 /// them; then a run whose predicted size (`budget`, read only of a valid
 /// mission) is over its documented limit.
@@ -176,7 +159,10 @@ pub fn require_admissible(
     mission: &crate::mission::Mission,
     budget: fn(&crate::mission::Mission) -> Vec<crate::mission::Diagnostic>,
 ) -> Result<(), PipelineError> {
-    refuse_errors(&validate(mission), PipelineError::InvalidMission)?;
+    refuse_errors(
+        &crate::mission::validate(mission),
+        PipelineError::InvalidMission,
+    )?;
     refuse_errors(&budget(mission), PipelineError::OverBudget)
 }
 

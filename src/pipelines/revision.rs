@@ -19,10 +19,9 @@ pub type Prepared = Arc<dyn Any + Send + Sync>;
 /// What was found of one revision of a mission.
 #[derive(Default)]
 pub struct Revision {
-    /// The file's and the sections' rules (`pipelines::validate`).
+    /// The rules of the file and of every registered section
+    /// (`mission::validate`), which the reading of the file reports too.
     rules: Vec<Diagnostic>,
-    /// How many of `rules` are the file's own (`mission::validate`), first.
-    file_rules: usize,
     /// Per pipeline, in `Kind::ALL`'s order: its predicted size against the
     /// limits, its findings, what it prepared. Empty when a rule is broken
     /// (a pipeline's findings mean nothing then).
@@ -47,13 +46,10 @@ struct Own {
 impl Revision {
     /// Everything skyform says of `mission` before a run, found once.
     pub fn of(mission: &Mission) -> Self {
-        let mut rules = crate::mission::validate(mission);
-        let file_rules = rules.len();
-        rules.extend(super::interface::section_rules(mission));
+        let rules = crate::mission::validate(mission);
         if rules.iter().any(Diagnostic::is_error) {
             return Revision {
                 rules,
-                file_rules,
                 own: Vec::new(),
             };
         }
@@ -70,38 +66,24 @@ impl Revision {
                 }
             })
             .collect();
-        Revision {
-            rules,
-            file_rules,
-            own,
-        }
+        Revision { rules, own }
     }
 
     /// Every diagnostic, as `check` and the designer list them: the rules,
     /// then every pipeline's predicted size, then every pipeline's findings.
     pub fn diagnostics(&self) -> Vec<Diagnostic> {
-        self.listed_from(0)
+        let mut all = self.rules.clone();
+        all.extend(self.beyond_the_file());
+        all
     }
 
-    /// What the pipelines say beyond the file's own rules: their sections'
-    /// rules, then their predicted sizes and findings (`check` locates these
-    /// in the text after the file's rules, which the reading of the file
-    /// reports itself).
+    /// What the pipelines say beyond the rules: their predicted sizes, then
+    /// their findings (`check` locates these in the text after the rules,
+    /// which the reading of the file reports itself).
     pub fn beyond_the_file(&self) -> Vec<Diagnostic> {
-        self.listed_from(self.file_rules)
-    }
-
-    /// The rules from number `first` on, then every pipeline's predicted
-    /// size, then every pipeline's findings.
-    fn listed_from(&self, first: usize) -> Vec<Diagnostic> {
         let budgets = self.own.iter().flat_map(|o| o.budget.iter());
         let findings = self.own.iter().flat_map(|o| o.findings.iter());
-        self.rules[first.min(self.rules.len())..]
-            .iter()
-            .chain(budgets)
-            .chain(findings)
-            .cloned()
-            .collect()
+        budgets.chain(findings).cloned().collect()
     }
 
     /// What `kind` prepared (for its own run to read back).
@@ -177,8 +159,9 @@ mod tests {
 
     /// What `check` adds after the file's rules is the revision's
     /// diagnostics less those rules, in the same order: on a valid mission
-    /// the budgets and findings, on a broken one only the sections' rules
-    /// (no findings), and never the file's own rules twice.
+    /// the budgets and findings, on a broken one nothing (no findings), and
+    /// never the rules twice. A pipeline's section's rules are the file's:
+    /// θ-PSO's registered rule on its swarm is among `mission::validate`'s.
     #[test]
     fn beyond_the_file_is_the_revision_less_the_files_rules() {
         let bridge = crate::mission::default_mission().mission;
@@ -193,17 +176,13 @@ mod tests {
             assert_eq!(all[..file.len()], file[..]);
             assert_eq!(revision.beyond_the_file(), all[file.len()..]);
         }
-        // A broken rule: only the sections' rules beyond the file's, no
-        // budget, no finding.
+        let file = crate::mission::validate(&section_broken);
         assert!(
-            crate::mission::validate(&section_broken)
-                .iter()
-                .any(Diagnostic::is_error)
+            file.iter()
+                .any(|d| d.is_error() && d.path.to_string() == "theta_pso.swarm_size"),
+            "{file:?}"
         );
-        assert_eq!(
-            Revision::of(&section_broken).beyond_the_file(),
-            crate::pipelines::section_rules(&section_broken)
-        );
+        assert!(Revision::of(&section_broken).beyond_the_file().is_empty());
         let big = Revision::of(&too_big).beyond_the_file();
         assert!(big.iter().any(Diagnostic::is_error), "{big:?}");
         assert!(

@@ -413,10 +413,6 @@ const NAMES_A_PIPELINE_OR_ITS_SECTION: &[(&str, &str)] = &[
         "src/mission/model.rs",
         "the sections themselves, and θ-PSO's clearance margin in the passing altitudes",
     ),
-    (
-        "src/mission/validate/mod.rs",
-        "each section's rules, called by name",
-    ),
     ("src/tui/app.rs", "the formation editor lists θ-PSO's IWPs"),
     ("src/tui/editor.rs", "θ-PSO's IWPs"),
     ("src/tui/fields.rs", "the sections' items in the inspector"),

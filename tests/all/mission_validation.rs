@@ -569,3 +569,38 @@ fn the_velocity_integrals_may_be_zero_never_negative() {
         "50",
     );
 }
+
+/// Issue 53: a pipeline's section's rules live in its own module and are
+/// registered with the file's (`mission::SECTION_RULES`); reading a file
+/// runs every registered section's, and lists what they find in the order
+/// of the file, whichever order the sections are written in.
+#[test]
+fn the_sections_rules_run_when_a_file_is_read_in_the_order_of_the_file() {
+    let theta = "[theta_pso]\nswarm_size = 0\n";
+    let fleet = "[fleet]\nagents = 0\n";
+    let flatlo = "[flatlo]\naircraft = 1\n";
+    for sections in [
+        [theta, fleet, flatlo],
+        [fleet, flatlo, theta],
+        [flatlo, theta, fleet],
+    ] {
+        let text = mission_with(&sections.concat());
+        let paths: Vec<String> = diagnostics(&text)
+            .iter()
+            .filter(|d| d.severity == Severity::Error)
+            .map(|d| d.path.to_string())
+            .collect();
+        let mut by_line: Vec<(usize, &str)> = [
+            ("swarm_size = 0", "theta_pso.swarm_size"),
+            ("agents = 0", "fleet.agents"),
+            ("aircraft = 1", "flatlo.aircraft"),
+        ]
+        .into_iter()
+        .map(|(needle, path)| (line_of(&text, needle), path))
+        .collect();
+        by_line.sort();
+        let expected: Vec<&str> = by_line.iter().map(|(_, p)| *p).collect();
+        assert_eq!(paths, expected, "{text}");
+        assert!(parse_str(&text, FILE).is_err(), "{text}");
+    }
+}

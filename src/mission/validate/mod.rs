@@ -10,18 +10,28 @@ use nalgebra::Point3;
 use super::diagnostic::Diagnostic;
 use super::source::FieldPath;
 use crate::mission::model::{
-    Bounds, FlatloParams, FleetParams, Formation, GeoOrigin, Mission, Reconfiguration, Route,
-    ThetaPsoParams, Vehicle,
+    Bounds, Formation, GeoOrigin, Mission, Reconfiguration, Route, Vehicle,
 };
 
-use crate::mission::model::GRAVITY as G;
-
-mod fleet;
 mod flight;
 pub use flight::MAX_FLIGHTS;
 mod formation;
-mod pipelines;
 mod site;
+
+/// A pipeline's own section's rules, registered by the pipeline's module
+/// (`#[linkme::distributed_slice(SECTION_RULES)]`): the file's rules run
+/// every registered section's, so a new pipeline's section is checked
+/// wherever a mission is read, and this floor names none of them.
+pub struct SectionRules {
+    /// The section's TOML key (`[key]`): the root of its fields' paths.
+    pub key: &'static str,
+    /// Its rules, on the section at `path` of `mission`.
+    pub check: fn(&mut Checker, &FieldPath, &Mission),
+}
+
+/// Every registered section's rules.
+#[linkme::distributed_slice]
+pub static SECTION_RULES: [SectionRules];
 
 /// Checks every rule; errors and warnings in the order of the file.
 pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
@@ -43,13 +53,13 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
         &mission.reconfiguration,
         mission,
     );
-    c.theta_pso(
-        &root.key("theta_pso"),
-        &mission.theta_pso,
-        mission.terrain.is_some(),
-    );
-    c.flatlo(&root.key("flatlo"), &mission.flatlo);
-    c.fleet(&root.key("fleet"), &mission.fleet, mission);
+    // Sections in the order of their keys: the order of the registry is
+    // the linker's.
+    let mut sections: Vec<&SectionRules> = SECTION_RULES.iter().collect();
+    sections.sort_by_key(|s| s.key);
+    for section in sections {
+        (section.check)(&mut c, &root.key(section.key), mission);
+    }
     c.flight(&root.key("flight"), &mission.flight);
     c.obstacles(&root.key("obstacles"), mission);
     c.terrain(&root.key("terrain"), mission);
@@ -61,7 +71,7 @@ pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
 /// mistake, and the pipelines would spend minutes or gigabytes on it. The
 /// ENU frame is a local tangent plane: a few hundred km across is already
 /// far from flat, so a span of 1,000 km is refused.
-mod physical {
+pub mod physical {
     /// Metres across any axis of the bounds, and the FLATLO distances.
     pub const SPAN: f64 = 1e6;
     /// Metres above the ground: far above any UAV's ceiling (~20 km).
@@ -79,17 +89,19 @@ mod physical {
     pub const UAV_RADIUS: f64 = 50.0;
 }
 
+/// The rules' findings as they are found: each rule says what is wrong
+/// with the field at a path, in words for the operator.
 #[derive(Default)]
-struct Checker {
+pub struct Checker {
     out: Vec<Diagnostic>,
 }
 
 impl Checker {
-    fn error(&mut self, path: FieldPath, message: impl Into<String>) {
+    pub fn error(&mut self, path: FieldPath, message: impl Into<String>) {
         self.out.push(Diagnostic::error(path, message));
     }
 
-    fn warning(&mut self, path: FieldPath, message: impl Into<String>) {
+    pub fn warning(&mut self, path: FieldPath, message: impl Into<String>) {
         self.out.push(Diagnostic::warning(path, message));
     }
 
@@ -132,7 +144,7 @@ impl Checker {
     }
 
     /// An error when `value` exceeds what any UAV mission uses (`physical`).
-    fn at_most(&mut self, path: FieldPath, value: f64, max: f64, unit: &str, why: &str) {
+    pub fn at_most(&mut self, path: FieldPath, value: f64, max: f64, unit: &str, why: &str) {
         if value.is_finite() && value > max {
             self.error(
                 path,
@@ -202,46 +214,10 @@ impl Checker {
             " m",
             "no formation link reaches that far",
         );
-        let p = &mission.flatlo;
-        let flatlo = root.key("flatlo");
-        self.at_most(
-            flatlo.key("airspeed"),
-            p.airspeed,
-            SPEED,
-            " m/s",
-            "faster than sound",
-        );
-        for (key, value) in [
-            ("spacing", p.spacing),
-            ("turn_radius", p.turn_radius),
-            ("final_leg", p.final_leg),
-        ] {
-            self.at_most(
-                flatlo.key(key),
-                value,
-                SPAN,
-                " m",
-                "the ENU frame is a local plane and no squadron spans more",
-            );
-        }
-        self.at_most(
-            flatlo.key("altitude"),
-            p.altitude,
-            CEILING,
-            " m",
-            "far above any aircraft's ceiling",
-        );
-        self.at_most(
-            root.key("fleet").key("altitude"),
-            mission.fleet.altitude,
-            CEILING,
-            " m",
-            "far above any UAV's ceiling",
-        );
     }
 
     /// `value > 0`; non-finite values are reported once, by `finite_everywhere`.
-    fn positive(&mut self, path: FieldPath, value: f64, unit: &str) {
+    pub fn positive(&mut self, path: FieldPath, value: f64, unit: &str) {
         if value.is_finite() && value <= 0.0 {
             self.error(
                 path,
@@ -250,7 +226,7 @@ impl Checker {
         }
     }
 
-    fn non_negative(&mut self, path: FieldPath, value: f64, unit: &str) {
+    pub fn non_negative(&mut self, path: FieldPath, value: f64, unit: &str) {
         if value.is_finite() && value < 0.0 {
             self.error(
                 path,
@@ -259,14 +235,14 @@ impl Checker {
         }
     }
 
-    fn at_least_one(&mut self, path: FieldPath, value: usize, what: &str) {
+    pub fn at_least_one(&mut self, path: FieldPath, value: usize, what: &str) {
         if value == 0 {
             self.error(path, format!("needs at least one {what}, got 0"));
         }
     }
 
     /// `[lo, hi]` with lo < hi.
-    fn range(&mut self, path: FieldPath, range: [f64; 2], unit: &str) -> bool {
+    pub fn range(&mut self, path: FieldPath, range: [f64; 2], unit: &str) -> bool {
         let [lo, hi] = range;
         if !(lo.is_finite() && hi.is_finite()) {
             return false;
@@ -289,7 +265,7 @@ impl Checker {
     }
 
     /// An open interval (lo, hi].
-    fn in_half_open(&mut self, path: FieldPath, value: f64, lo: f64, hi: f64) {
+    pub fn in_half_open(&mut self, path: FieldPath, value: f64, lo: f64, hi: f64) {
         if value.is_finite() && !(value > lo && value <= hi) {
             self.error(
                 path,

@@ -1,10 +1,17 @@
-//! Each pipeline's parameters: θ-PSO's swarm, FLATLO's squadron and
-//! controller (the fleet's are `fleet.rs`).
+//! `[flatlo]`'s rules: the squadron, its aircraft and its controller.
+//! Registered with the file's rules (`mission::SECTION_RULES`), which run
+//! them whenever a mission is read or checked, naming no pipeline.
 
-use super::*;
+use crate::mission::{Checker, FieldPath, FlatloParams, SECTION_RULES, SectionRules, compact};
+
+#[linkme::distributed_slice(SECTION_RULES)]
+static RULES: SectionRules = SectionRules {
+    key: "flatlo",
+    check: |c, path, mission| c.flatlo(path, &mission.flatlo),
+};
 
 impl Checker {
-    pub(super) fn flatlo(&mut self, path: &FieldPath, p: &FlatloParams) {
+    fn flatlo(&mut self, path: &FieldPath, p: &FlatloParams) {
         if p.aircraft < 2 {
             self.error(
                 path.key("aircraft"),
@@ -118,5 +125,38 @@ impl Checker {
                 ),
             );
         }
+        self.flatlo_physical(path, p);
+    }
+
+    /// Physically absurd values (`mission::physical`): errors that say why.
+    fn flatlo_physical(&mut self, path: &FieldPath, p: &FlatloParams) {
+        use crate::mission::physical::{CEILING, SPAN, SPEED};
+        self.at_most(
+            path.key("airspeed"),
+            p.airspeed,
+            SPEED,
+            " m/s",
+            "faster than sound",
+        );
+        for (key, value) in [
+            ("spacing", p.spacing),
+            ("turn_radius", p.turn_radius),
+            ("final_leg", p.final_leg),
+        ] {
+            self.at_most(
+                path.key(key),
+                value,
+                SPAN,
+                " m",
+                "the ENU frame is a local plane and no squadron spans more",
+            );
+        }
+        self.at_most(
+            path.key("altitude"),
+            p.altitude,
+            CEILING,
+            " m",
+            "far above any aircraft's ceiling",
+        );
     }
 }

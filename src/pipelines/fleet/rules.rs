@@ -1,13 +1,31 @@
-//! The fleet's parameters: its agents and their PSO, the formation they
-//! form (d_ij^d that a plane can hold), its targets (a point to form
-//! around, or one per agent), its network.
+//! `[fleet]`'s rules: its agents and their PSO, the formation they form
+//! (d_ij^d that a plane can hold), its targets (a point to form around, or
+//! one per agent), its network. Registered with the file's rules
+//! (`mission::SECTION_RULES`), which run them whenever a mission is read or
+//! checked, naming no pipeline.
 
-use super::*;
+use crate::mission::GRAVITY as G;
+use crate::mission::{
+    Checker, FieldPath, FleetParams, Mission, SECTION_RULES, SectionRules, compact,
+};
+
+#[linkme::distributed_slice(SECTION_RULES)]
+static RULES: SectionRules = SectionRules {
+    key: "fleet",
+    check: |c, path, mission| c.fleet(path, &mission.fleet, mission),
+};
 
 impl Checker {
     /// Long (~130 lines): one rule per key of `[fleet]`, in the order of the section.
-    pub(super) fn fleet(&mut self, path: &FieldPath, p: &FleetParams, mission: &Mission) {
+    fn fleet(&mut self, path: &FieldPath, p: &FleetParams, mission: &Mission) {
         let bounds = &mission.bounds;
+        self.at_most(
+            path.key("altitude"),
+            p.altitude,
+            crate::mission::physical::CEILING,
+            " m",
+            "far above any UAV's ceiling",
+        );
         self.at_least_one(path.key("agents"), p.agents, "agent");
         self.at_least_one(path.key("swarm_size"), p.swarm_size, "particle");
         self.at_least_one(path.key("iterations"), p.iterations, "iteration");
@@ -209,7 +227,7 @@ impl Checker {
     /// formation must be able to stand: the agents in the plane, each d_ip^d
     /// from the target (eq. 6), every distance within `fleet.tolerance` of
     /// its value ([`Self::fleet_formable`]).
-    pub(super) fn fleet_distances(&mut self, path: &FieldPath, p: &FleetParams) {
+    fn fleet_distances(&mut self, path: &FieldPath, p: &FleetParams) {
         let n = p.agents;
         let at = path.key("distances");
         if p.distances.is_empty() {
@@ -327,7 +345,7 @@ impl Checker {
 
     /// `[fleet.network]`: a range that carries, a latency within the run, a
     /// loss that leaves some messages, links and own clocks of real agents.
-    pub(super) fn fleet_network(&mut self, path: &FieldPath, p: &FleetParams) {
+    fn fleet_network(&mut self, path: &FieldPath, p: &FleetParams) {
         let n = &p.network;
         if let Some(range) = n.range {
             self.positive(path.key("range"), range, " m");

@@ -1,13 +1,21 @@
-//! Each pipeline's parameters: θ-PSO's swarm, FLATLO's squadron and
-//! controller (the fleet's are `fleet.rs`).
+//! `[theta_pso]`'s rules: the swarm's sizes and weights, and what
+//! `cost = "spso"` and the spherical encoding need of the rest of the
+//! mission. Registered with the file's rules (`mission::SECTION_RULES`),
+//! which run them whenever a mission is read or checked, naming no pipeline.
 
-use super::*;
+use crate::mission::{Checker, FieldPath, SECTION_RULES, SectionRules, ThetaPsoParams};
+
+#[linkme::distributed_slice(SECTION_RULES)]
+static RULES: SectionRules = SectionRules {
+    key: "theta_pso",
+    check: |c, path, mission| c.theta_pso(path, &mission.theta_pso, mission.terrain.is_some()),
+};
 
 impl Checker {
     /// `[theta_pso]`, and what `cost = "spso"` and the spherical encoding
     /// need of the rest of the mission (a `[terrain]`: `has_terrain`).
-    pub(super) fn theta_pso(&mut self, path: &FieldPath, p: &ThetaPsoParams, has_terrain: bool) {
-        use crate::mission::model::{CostKind, Encoding};
+    fn theta_pso(&mut self, path: &FieldPath, p: &ThetaPsoParams, has_terrain: bool) {
+        use crate::mission::{CostKind, Encoding};
         if p.cost == CostKind::Spso {
             if !has_terrain {
                 self.error(
@@ -71,122 +79,6 @@ impl Checker {
             self.warning(
                 path.key("weight_obstacle"),
                 "is 0: the planner will ignore obstacles (the result is still verified)",
-            );
-        }
-    }
-
-    pub(super) fn flatlo(&mut self, path: &FieldPath, p: &FlatloParams) {
-        if p.aircraft < 2 {
-            self.error(
-                path.key("aircraft"),
-                format!(
-                    "a squadron transition needs at least 2 aircraft, got {}",
-                    p.aircraft
-                ),
-            );
-        }
-        for (key, value, unit) in [
-            ("spacing", p.spacing, " m"),
-            ("airspeed", p.airspeed, " m/s"),
-            ("turn_radius", p.turn_radius, " m"),
-            ("altitude", p.altitude, " m"),
-            ("final_leg", p.final_leg, " m"),
-            ("sample_period", p.sample_period, " s"),
-            ("sim_step", p.sim_step, " s"),
-            ("mass", p.mass, " kg"),
-            ("wing_area", p.wing_area, " m²"),
-            ("air_density", p.air_density, " kg/m³"),
-            ("max_thrust", p.max_thrust, " N"),
-            ("max_bank_deg", p.max_bank_deg, "°"),
-        ] {
-            self.positive(path.key(key), value, unit);
-        }
-        for (key, value) in [
-            ("drag_cd0", p.drag_cd0),
-            ("drag_k", p.drag_k),
-            ("noise", p.noise),
-            ("min_separation", p.min_separation),
-        ] {
-            self.non_negative(path.key(key), value, "");
-        }
-        for (i, gain) in p.pid.iter().enumerate() {
-            self.non_negative(path.key("pid").index(i), *gain, "");
-        }
-        if self.range(path.key("load_factor"), p.load_factor, "") && p.load_factor[1] <= 1.0 {
-            self.error(
-                path.key("load_factor"),
-                format!(
-                    "n_max = {} cannot hold level flight (needs n > 1 to turn)",
-                    p.load_factor[1]
-                ),
-            );
-        }
-        let speeds = path.key("airspeed_range");
-        for (i, v) in p.airspeed_range.iter().enumerate() {
-            self.positive(speeds.index(i), *v, " m/s");
-        }
-        if self.range(speeds.clone(), p.airspeed_range, " m/s") {
-            let [lo, hi] = p.airspeed_range;
-            if p.airspeed.is_finite() && !(lo..=hi).contains(&p.airspeed) {
-                self.error(
-                    path.key("airspeed"),
-                    format!(
-                        "the nominal airspeed {} m/s is outside airspeed_range [{}, {}] m/s \
-                         (every aircraft flies it after the transition)",
-                        compact(p.airspeed),
-                        compact(lo),
-                        compact(hi)
-                    ),
-                );
-            }
-        }
-        if p.max_bank_deg >= 90.0 {
-            self.error(
-                path.key("max_bank_deg"),
-                format!("must be below 90°, got {}°", p.max_bank_deg),
-            );
-        }
-        if p.climb_deg.abs() >= 90.0 {
-            self.error(
-                path.key("climb_deg"),
-                format!("must be within ±90°, got {}°", p.climb_deg),
-            );
-        }
-        if p.sim_step > p.sample_period {
-            self.warning(
-                path.key("sim_step"),
-                format!(
-                    "the RK4 step {} s is longer than the reference period {} s",
-                    p.sim_step, p.sample_period
-                ),
-            );
-        }
-        // Algorithm 1, line 41: Δ2 = √2 (Δ − 2r(1 − cos π/4)) must not be
-        // negative for the smallest lateral offset Δ that is not zero.
-        let smallest_offset = if p.aircraft.is_multiple_of(2) {
-            p.spacing / 2.0
-        } else {
-            p.spacing
-        };
-        let needed = 2.0 * p.turn_radius * (1.0 - std::f64::consts::FRAC_PI_4.cos());
-        if smallest_offset < needed {
-            self.error(
-                path.key("turn_radius"),
-                format!(
-                    "a turn radius of {} m needs a lateral offset of at least {needed:.1} m \
-                     (Algorithm 1, line 41), but the innermost aircraft is {smallest_offset} m \
-                     from the longitudinal line",
-                    p.turn_radius
-                ),
-            );
-        }
-        if p.noise > 0.05 {
-            self.warning(
-                path.key("noise"),
-                format!(
-                    "{} % noise is far above the paper's 0.25 %",
-                    p.noise * 100.0
-                ),
             );
         }
     }
