@@ -1,7 +1,8 @@
 //! Latitude/longitude positions in mission files.
 //!
-//! The start and goal, obstacle centres, fleet targets and initial positions
-//! and FLATLO's start may be written as WGS-84 latitude/longitude instead of
+//! The start and goal, obstacle centres and the positions a pipeline's
+//! section registers (`SECTION_POSITIONS`: the fleet's targets and initial
+//! positions, FLATLO's start) may be written as WGS-84 latitude/longitude instead of
 //! ENU metres:
 //!
 //! ```toml
@@ -41,7 +42,7 @@ pub enum Form {
 
 /// A step of a position's place in the file.
 #[derive(Debug, Clone, Copy)]
-enum Step {
+pub enum Step {
     Key(&'static str),
     /// Every element of an array.
     Each,
@@ -49,12 +50,46 @@ enum Step {
 
 /// Where positions are, and whether they are in the air (x, y, z) or on
 /// the ground (x, y).
-struct Slot {
-    steps: &'static [Step],
-    air: bool,
+pub struct Slot {
+    pub steps: &'static [Step],
+    pub air: bool,
 }
 
-const SLOTS: [Slot; 6] = [
+/// The positions of a pipeline's own section that a file may write as
+/// latitude/longitude (FLATLO's start, the fleet's targets), registered by
+/// the pipeline's module (`#[linkme::distributed_slice(SECTION_POSITIONS)]`):
+/// loading converts them and saving writes them back as every other
+/// position, and this floor names no pipeline.
+pub struct SectionPositions {
+    /// Where they are in the file.
+    pub slots: &'static [Slot],
+    /// Each one of a mission in memory, at its path.
+    pub positions: fn(&Mission) -> Vec<(FieldPath, Position)>,
+}
+
+/// Every registered section's positions.
+#[linkme::distributed_slice]
+pub static SECTION_POSITIONS: [SectionPositions];
+
+/// The file's own slots, then every registered section's, in the order of
+/// their sections' keys (the registry's order is the linker's).
+fn slots() -> impl Iterator<Item = &'static Slot> {
+    SLOTS.iter().chain(sections().flat_map(|s| s.slots.iter()))
+}
+
+/// The registered sections, in the order of their first slot's key.
+fn sections() -> impl Iterator<Item = &'static SectionPositions> {
+    let mut all: Vec<&SectionPositions> = SECTION_POSITIONS.iter().collect();
+    all.sort_by_key(
+        |s| match s.slots.first().and_then(|slot| slot.steps.first()) {
+            Some(Step::Key(key)) => *key,
+            _ => "",
+        },
+    );
+    all.into_iter()
+}
+
+const SLOTS: [Slot; 3] = [
     Slot {
         steps: &[Step::Key("route"), Step::Key("start")],
         air: true,
@@ -65,27 +100,6 @@ const SLOTS: [Slot; 6] = [
     },
     Slot {
         steps: &[Step::Key("obstacles"), Step::Each, Step::Key("center")],
-        air: false,
-    },
-    Slot {
-        steps: &[
-            Step::Key("fleet"),
-            Step::Key("targets"),
-            Step::Each,
-            Step::Key("position"),
-        ],
-        air: false,
-    },
-    Slot {
-        steps: &[
-            Step::Key("fleet"),
-            Step::Key("initial_positions"),
-            Step::Each,
-        ],
-        air: false,
-    },
-    Slot {
-        steps: &[Step::Key("flatlo"), Step::Key("start")],
         air: false,
     },
 ];
@@ -165,7 +179,7 @@ pub fn convert(root: &Spanned<DeTable<'_>>) -> Result<Conversions, Vec<Diagnosti
     let mut found = Vec::new();
     let mut problems = Vec::new();
     let mut out = Conversions::default();
-    for slot in &SLOTS {
+    for slot in slots() {
         visit(
             root.get_ref(),
             slot.steps,
@@ -491,7 +505,7 @@ fn value_at_mut<'t, 'i>(
 }
 
 /// A position of the mission in memory (ENU metres), at its path.
-enum Position {
+pub enum Position {
     Ground(Point2<f64>),
     Air(Point3<f64>),
 }
@@ -502,22 +516,13 @@ fn positions(m: &Mission) -> Vec<(FieldPath, Position)> {
     let mut out = vec![
         (root.key("route").key("start"), Position::Air(m.route.start)),
         (root.key("route").key("goal"), Position::Air(m.route.goal)),
-        (
-            root.key("flatlo").key("start"),
-            Position::Ground(m.flatlo.start),
-        ),
     ];
     for (i, o) in m.obstacles.iter().enumerate() {
         let path = root.key("obstacles").index(i).key("center");
         out.push((path, Position::Ground(o.center)));
     }
-    for (i, t) in m.fleet.targets.iter().enumerate() {
-        let path = root.key("fleet").key("targets").index(i).key("position");
-        out.push((path, Position::Ground(t.position)));
-    }
-    for (i, p) in m.fleet.initial_positions.iter().enumerate() {
-        let path = root.key("fleet").key("initial_positions").index(i);
-        out.push((path, Position::Ground(*p)));
+    for section in sections() {
+        out.extend((section.positions)(m));
     }
     out
 }

@@ -406,10 +406,6 @@ const NAMES_A_PIPELINE_OR_ITS_SECTION: &[(&str, &str)] = &[
         "the fleet's transport: the fleet's wire format",
     ),
     (
-        "src/mission/geodetic.rs",
-        "FLATLO's start and the fleet's targets and positions as latitude/longitude",
-    ),
-    (
         "src/mission/model.rs",
         "the sections themselves, and θ-PSO's clearance margin in the passing altitudes",
     ),

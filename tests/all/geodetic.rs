@@ -358,3 +358,57 @@ fn the_inspector_shows_and_edits_positions_in_latitude_longitude() {
     let status = app.status().expect("the refusal on the status line");
     assert!(status.text.contains("[origin]"), "{}", status.text);
 }
+
+/// Issue 53: the positions a pipeline's section registers
+/// (`mission::geodetic::SECTION_POSITIONS`: FLATLO's start, the fleet's
+/// initial positions) are read from latitude/longitude and saved back in
+/// that form, as the file's own are.
+#[test]
+fn a_sections_registered_positions_read_and_save_as_latitude_longitude() {
+    let text = shipped("bridge-inspection.toml");
+    let m = load(&text);
+    let frame = Frame::new(m.origin.as_ref().unwrap_or_else(|| panic!("origin")));
+    let (start, first) = (Point2::new(20.0, 30.0), Point2::new(40.0, 50.0));
+    let mut doc: DocumentMut = text.parse().unwrap_or_else(|e| panic!("{e}"));
+    doc["flatlo"] = toml_edit::table();
+    doc["flatlo"]["start"] = ground(&frame, start);
+    let mut starts = toml_edit::Array::new();
+    for p in [first, Point2::new(42.0, 50.0), Point2::new(44.0, 50.0)] {
+        starts.push(toml_edit::Value::Array(toml_edit::Array::from_iter([
+            p.x, p.y,
+        ])));
+    }
+    doc["fleet"]["initial_positions"] = toml_edit::value(starts);
+    doc["fleet"]["initial_positions"][0] = ground(&frame, first);
+    let text = doc.to_string();
+    let read = load(&text);
+    assert!(
+        (read.flatlo.start - start).norm() < 1e-6,
+        "{}",
+        read.flatlo.start
+    );
+    assert!((read.fleet.initial_positions[0] - first).norm() < 1e-6);
+
+    let mut edited = read.clone();
+    edited.flatlo.start.x += 5.0;
+    edited.fleet.initial_positions[0].y -= 3.0;
+    let saved = edit_in_place(&edited, &text).unwrap_or_else(|| panic!("not a mission"));
+    let back = load(&saved);
+    assert!((back.flatlo.start - edited.flatlo.start).norm() < 1e-6);
+    assert!((back.fleet.initial_positions[0] - edited.fleet.initial_positions[0]).norm() < 1e-6);
+    let doc: DocumentMut = saved.parse().unwrap_or_else(|e| panic!("{e}"));
+    let written = |item: &Item| {
+        item.as_inline_table()
+            .is_some_and(|t| t.contains_key("latitude"))
+            || item
+                .as_value()
+                .and_then(Value::as_inline_table)
+                .is_some_and(|t| t.contains_key("latitude"))
+    };
+    assert!(written(&doc["flatlo"]["start"]), "{saved}");
+    assert!(written(&doc["fleet"]["initial_positions"][0]), "{saved}");
+    assert!(
+        doc["fleet"]["initial_positions"][1].as_array().is_some(),
+        "the second stays in metres:\n{saved}"
+    );
+}

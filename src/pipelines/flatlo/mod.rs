@@ -18,7 +18,7 @@ pub mod envelope;
 pub mod face;
 pub mod maneuver;
 pub mod recording;
-mod rules;
+mod section;
 pub mod summary;
 
 use nalgebra::{Point3, Vector3};

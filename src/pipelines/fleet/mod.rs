@@ -21,8 +21,8 @@ pub mod judge;
 pub mod network;
 pub mod numbering;
 pub mod recording;
-mod rules;
 pub mod scenario;
+mod section;
 pub mod simulation;
 pub mod summary;
 

@@ -18,7 +18,7 @@ pub mod recording;
 pub mod reference;
 pub mod repair;
 pub mod route;
-mod rules;
+mod section;
 pub mod seeding;
 pub mod spso;
 pub mod summary;

@@ -1,10 +1,13 @@
-//! `[fleet]`'s rules: its agents and their PSO, the formation they form
-//! (d_ij^d that a plane can hold), its targets (a point to form around, or
-//! one per agent), its network. Registered with the file's rules
-//! (`mission::SECTION_RULES`), which run them whenever a mission is read or
-//! checked, naming no pipeline.
+//! `[fleet]` as a unit of the mission: its rules (its agents and their PSO,
+//! the formation they form, d_ij^d that a plane can hold, its targets, a
+//! point to form around or one per agent, its network), registered with the
+//! file's (`mission::SECTION_RULES`), and its targets and initial positions,
+//! which a file may write as latitude/longitude
+//! (`mission::geodetic::SECTION_POSITIONS`). The mission's floor runs and
+//! converts them whenever a mission is read, naming no pipeline.
 
 use crate::mission::GRAVITY as G;
+use crate::mission::geodetic::{Position, SECTION_POSITIONS, SectionPositions, Slot, Step};
 use crate::mission::{
     Checker, FieldPath, FleetParams, Mission, SECTION_RULES, SectionRules, compact,
 };
@@ -13,6 +16,41 @@ use crate::mission::{
 static RULES: SectionRules = SectionRules {
     key: "fleet",
     check: |c, path, mission| c.fleet(path, &mission.fleet, mission),
+};
+
+#[linkme::distributed_slice(SECTION_POSITIONS)]
+static POSITIONS: SectionPositions = SectionPositions {
+    slots: &[
+        Slot {
+            steps: &[
+                Step::Key("fleet"),
+                Step::Key("targets"),
+                Step::Each,
+                Step::Key("position"),
+            ],
+            air: false,
+        },
+        Slot {
+            steps: &[
+                Step::Key("fleet"),
+                Step::Key("initial_positions"),
+                Step::Each,
+            ],
+            air: false,
+        },
+    ],
+    positions: |m| {
+        let fleet = FieldPath::root().key("fleet");
+        let targets = m.fleet.targets.iter().enumerate().map(|(i, t)| {
+            let path = fleet.key("targets").index(i).key("position");
+            (path, Position::Ground(t.position))
+        });
+        let starts = m.fleet.initial_positions.iter().enumerate().map(|(i, p)| {
+            let path = fleet.key("initial_positions").index(i);
+            (path, Position::Ground(*p))
+        });
+        targets.chain(starts).collect()
+    },
 };
 
 impl Checker {

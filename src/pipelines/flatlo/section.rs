@@ -1,13 +1,28 @@
-//! `[flatlo]`'s rules: the squadron, its aircraft and its controller.
-//! Registered with the file's rules (`mission::SECTION_RULES`), which run
-//! them whenever a mission is read or checked, naming no pipeline.
+//! `[flatlo]` as a unit of the mission: its rules (the squadron, its aircraft
+//! and its controller), registered with the file's (`mission::SECTION_RULES`),
+//! and its start, which a file may write as latitude/longitude
+//! (`mission::geodetic::SECTION_POSITIONS`). The mission's floor runs and
+//! converts them whenever a mission is read, naming no pipeline.
 
+use crate::mission::geodetic::{Position, SECTION_POSITIONS, SectionPositions, Slot, Step};
 use crate::mission::{Checker, FieldPath, FlatloParams, SECTION_RULES, SectionRules, compact};
 
 #[linkme::distributed_slice(SECTION_RULES)]
 static RULES: SectionRules = SectionRules {
     key: "flatlo",
     check: |c, path, mission| c.flatlo(path, &mission.flatlo),
+};
+
+#[linkme::distributed_slice(SECTION_POSITIONS)]
+static POSITIONS: SectionPositions = SectionPositions {
+    slots: &[Slot {
+        steps: &[Step::Key("flatlo"), Step::Key("start")],
+        air: false,
+    }],
+    positions: |m| {
+        let start = FieldPath::root().key("flatlo").key("start");
+        vec![(start, Position::Ground(m.flatlo.start))]
+    },
 };
 
 impl Checker {

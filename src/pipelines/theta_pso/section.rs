@@ -1,6 +1,6 @@
-//! `[theta_pso]`'s rules: the swarm's sizes and weights, and what
-//! `cost = "spso"` and the spherical encoding need of the rest of the
-//! mission. Registered with the file's rules (`mission::SECTION_RULES`),
+//! `[theta_pso]` as a unit of the mission: its rules (the swarm's sizes and
+//! weights, and what `cost = "spso"` and the spherical encoding need of the
+//! rest of the mission), registered with the file's (`mission::SECTION_RULES`),
 //! which run them whenever a mission is read or checked, naming no pipeline.
 
 use crate::mission::{Checker, FieldPath, SECTION_RULES, SectionRules, ThetaPsoParams};
