@@ -215,6 +215,11 @@ pub trait Pipeline: Sync {
     /// `mission` with its vehicles spaced `scale` times as far apart (the
     /// field of [`Words::spacing_field`]).
     fn widen_spacing(&self, _mission: &mut Mission, _scale: f64) {}
+    /// Its own section's fields, as the designer's inspector shows and
+    /// edits them (kept in the pipeline's `section.rs`).
+    fn rows(&self) -> &'static [super::rows::Row] {
+        &[]
+    }
     /// The points of its own section the designer draws on the map and
     /// lets the operator move, add and delete (the fleet's targets).
     fn points(&self) -> &'static [super::points::PointKind] {

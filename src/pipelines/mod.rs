@@ -14,6 +14,7 @@ pub mod interface;
 pub mod points;
 pub mod quadrotor;
 pub mod revision;
+pub mod rows;
 pub mod sketch;
 pub mod table;
 pub mod verify;

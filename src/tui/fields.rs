@@ -15,6 +15,8 @@ use nalgebra::Point2;
 use crate::mission::{FieldPath, Mission, Obstacle, PathSegment, ShapeChoice, WaypointChoice};
 use crate::pipelines::Kind;
 use crate::pipelines::points::{self, PointRef};
+use crate::pipelines::rows::Row;
+pub use crate::pipelines::rows::{fmt_num, number};
 use crate::pipelines::theta_pso::Iwp;
 
 mod table;
@@ -241,11 +243,19 @@ impl Table {
     }
 }
 
+/// Where a field is declared: a row of the inspector's own tables, or a
+/// row of a pipeline's section (`Pipeline::rows`).
+#[derive(Clone, Copy)]
+enum Source {
+    Spec(&'static Spec),
+    Row(&'static Row),
+}
+
 /// One editable line of the inspector: a field of the table, with the path
 /// and value it has for the selected item.
 #[derive(Clone)]
 pub struct Field {
-    spec: &'static Spec,
+    source: Source,
     label: String,
     path: FieldPath,
     value: String,
@@ -265,7 +275,10 @@ impl Field {
 
     /// The unit alone (`m`, `m/s`, `°`); empty for none.
     pub fn unit(&self) -> &'static str {
-        self.spec.unit
+        match self.source {
+            Source::Spec(spec) => spec.unit,
+            Source::Row(row) => row.unit,
+        }
     }
 
     /// Where the field is in the mission; [`place`] says which
@@ -281,30 +294,65 @@ impl Field {
 
     /// Parses `text` and writes it into `mission`; the error says what is expected.
     pub fn set(&self, mission: &mut Mission, item: &Item, text: &str) -> Result<(), String> {
-        (self.spec.set)(mission, item, text.trim())
+        match self.source {
+            Source::Spec(spec) => (spec.set)(mission, item, text.trim()),
+            Source::Row(row) => (row.set)(mission, text.trim()),
+        }
     }
 }
 
 /// The inspector's fields for `item`, with the values they have in
 /// `mission` (none for an item that is not in it).
 pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
+    if let Item::Section(kind) = item {
+        return section_fields(kind.face().rows(), kind.words().section.0, mission);
+    }
     let table = table::of(item);
     table
         .derived
         .iter()
         .chain(table.fields)
         .filter_map(|spec| {
-            let value = (spec.get)(mission, item)?;
-            let label = if spec.unit.is_empty() {
-                spec.name.to_owned()
-            } else {
-                format!("{} ({})", spec.name, spec.unit)
+            Some(Field {
+                source: Source::Spec(spec),
+                label: label(spec.name, spec.unit),
+                path: table.path(spec, item, mission),
+                value: (spec.get)(mission, item)?,
+            })
+        })
+        .collect()
+}
+
+/// The name with its unit: `radius (m)`.
+fn label(name: &str, unit: &str) -> String {
+    if unit.is_empty() {
+        name.to_owned()
+    } else {
+        format!("{name} ({unit})")
+    }
+}
+
+/// A pipeline's section's fields: its `rows` below `[key]`; rows that
+/// share their keys are that array's elements, in order, as the validator
+/// indexes them (`flatlo.start[1]`).
+fn section_fields(rows: &'static [Row], key: &str, mission: &Mission) -> Vec<Field> {
+    rows.iter()
+        .filter_map(|row| {
+            let path = row
+                .keys
+                .iter()
+                .fold(FieldPath::root().key(key), |p, k| p.key(k));
+            let mut siblings = rows.iter().filter(|r| r.keys == row.keys);
+            let element = siblings.clone().position(|r| std::ptr::eq(r, row));
+            let path = match (siblings.nth(1), element) {
+                (Some(_), Some(i)) => path.index(i),
+                _ => path,
             };
             Some(Field {
-                spec,
-                label,
-                path: table.path(spec, item, mission),
-                value,
+                source: Source::Row(row),
+                label: label(row.name, row.unit),
+                path,
+                value: (row.get)(mission)?,
             })
         })
         .collect()
@@ -387,19 +435,6 @@ pub fn place(
         .map(|_| (Place::Item, false))
 }
 
-/// Metres, degrees, gains: any finite number.
-pub fn number(text: &str) -> Result<f64, String> {
-    match text.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        // `1e400` is a number, one too large for any field (Rust reads it
-        // as infinity); `inf` and `nan` are not numbers a field takes.
-        Ok(v) if v.is_infinite() && text.chars().any(|c| c.is_ascii_digit()) => Err(format!(
-            "'{text}' is too large: the largest number a field holds is about 1.8e308"
-        )),
-        _ => Err(format!("'{text}' is not a number")),
-    }
-}
-
 pub fn shape_name(choice: ShapeChoice) -> &'static str {
     match choice {
         ShapeChoice::Auto => "auto",
@@ -417,27 +452,6 @@ pub fn next_shape(choice: ShapeChoice) -> ShapeChoice {
         ShapeChoice::Rotation => ShapeChoice::Shrink,
         ShapeChoice::Shrink => ShapeChoice::Auto,
     }
-}
-
-/// Formats a number the way it would be typed: exactly when that is short
-/// (so opening a field and applying it changes nothing), else to 4 decimals.
-pub fn fmt_num(v: f64) -> String {
-    // Huge and tiny values in scientific notation: `1e300`, not 301 digits
-    // (it reads back as typed).
-    if v.is_finite() && v != 0.0 && !(1e-4..1e9).contains(&v.abs()) {
-        return format!("{v:e}");
-    }
-    let exact = format!("{v}");
-    let s = if exact.len() <= 12 {
-        exact
-    } else {
-        let rounded = format!("{v:.4}");
-        rounded
-            .trim_end_matches('0')
-            .trim_end_matches('.')
-            .to_owned()
-    };
-    if s == "-0" { "0".into() } else { s }
 }
 
 /// The reconfiguration entry for an IWP, created with the defaults when the

@@ -53,6 +53,10 @@ impl Pipeline for Flatlo {
         mission.flatlo.aircraft
     }
 
+    fn rows(&self) -> &'static [crate::pipelines::rows::Row] {
+        super::section::ROWS
+    }
+
     fn plots(&self) -> &'static [&'static [Plot]] {
         recording::PLOTS
     }

@@ -6,6 +6,7 @@
 
 use crate::mission::geodetic::{Position, SECTION_POSITIONS, SectionPositions, Slot, Step};
 use crate::mission::{Checker, FieldPath, FlatloParams, SECTION_RULES, SectionRules, compact};
+use crate::pipelines::rows::{Row, count, num, number, put, text};
 
 #[linkme::distributed_slice(SECTION_RULES)]
 static RULES: SectionRules = SectionRules {
@@ -24,6 +25,40 @@ static POSITIONS: SectionPositions = SectionPositions {
         vec![(start, Position::Ground(m.flatlo.start))]
     },
 };
+
+/// The inspector's rows of `[flatlo]`, the squadron and its aircraft model:
+/// every key (`Pipeline::rows`).
+#[rustfmt::skip]
+pub(super) static ROWS: &[Row] = &[
+    Row { name: "aircraft N", unit: "", keys: &["aircraft"], get: |m| text(m.flatlo.aircraft), set: |m, t| put(&mut m.flatlo.aircraft, count(t)) },
+    Row { name: "spacing Δd", unit: "m", keys: &["spacing"], get: |m| num(m.flatlo.spacing), set: |m, t| put(&mut m.flatlo.spacing, number(t)) },
+    Row { name: "airspeed", unit: "m/s", keys: &["airspeed"], get: |m| num(m.flatlo.airspeed), set: |m, t| put(&mut m.flatlo.airspeed, number(t)) },
+    Row { name: "turn radius r", unit: "m", keys: &["turn_radius"], get: |m| num(m.flatlo.turn_radius), set: |m, t| put(&mut m.flatlo.turn_radius, number(t)) },
+    Row { name: "heading φ", unit: "°", keys: &["heading_deg"], get: |m| num(m.flatlo.heading_deg), set: |m, t| put(&mut m.flatlo.heading_deg, number(t)) },
+    Row { name: "climb β", unit: "°", keys: &["climb_deg"], get: |m| num(m.flatlo.climb_deg), set: |m, t| put(&mut m.flatlo.climb_deg, number(t)) },
+    Row { name: "altitude", unit: "m", keys: &["altitude"], get: |m| num(m.flatlo.altitude), set: |m, t| put(&mut m.flatlo.altitude, number(t)) },
+    Row { name: "start x", unit: "m", keys: &["start"], get: |m| num(m.flatlo.start.x), set: |m, t| put(&mut m.flatlo.start.x, number(t)) },
+    Row { name: "start y", unit: "m", keys: &["start"], get: |m| num(m.flatlo.start.y), set: |m, t| put(&mut m.flatlo.start.y, number(t)) },
+    Row { name: "final leg K2", unit: "m", keys: &["final_leg"], get: |m| num(m.flatlo.final_leg), set: |m, t| put(&mut m.flatlo.final_leg, number(t)) },
+    Row { name: "noise σ", unit: "", keys: &["noise"], get: |m| num(m.flatlo.noise), set: |m, t| put(&mut m.flatlo.noise, number(t)) },
+    Row { name: "min separation", unit: "m", keys: &["min_separation"], get: |m| num(m.flatlo.min_separation), set: |m, t| put(&mut m.flatlo.min_separation, number(t)) },
+    Row { name: "sample period T", unit: "s", keys: &["sample_period"], get: |m| num(m.flatlo.sample_period), set: |m, t| put(&mut m.flatlo.sample_period, number(t)) },
+    Row { name: "RK4 step", unit: "s", keys: &["sim_step"], get: |m| num(m.flatlo.sim_step), set: |m, t| put(&mut m.flatlo.sim_step, number(t)) },
+    Row { name: "mass", unit: "kg", keys: &["mass"], get: |m| num(m.flatlo.mass), set: |m, t| put(&mut m.flatlo.mass, number(t)) },
+    Row { name: "wing area", unit: "m²", keys: &["wing_area"], get: |m| num(m.flatlo.wing_area), set: |m, t| put(&mut m.flatlo.wing_area, number(t)) },
+    Row { name: "air density", unit: "kg/m³", keys: &["air_density"], get: |m| num(m.flatlo.air_density), set: |m, t| put(&mut m.flatlo.air_density, number(t)) },
+    Row { name: "drag C_D0", unit: "", keys: &["drag_cd0"], get: |m| num(m.flatlo.drag_cd0), set: |m, t| put(&mut m.flatlo.drag_cd0, number(t)) },
+    Row { name: "drag k", unit: "", keys: &["drag_k"], get: |m| num(m.flatlo.drag_k), set: |m, t| put(&mut m.flatlo.drag_k, number(t)) },
+    Row { name: "max thrust", unit: "N", keys: &["max_thrust"], get: |m| num(m.flatlo.max_thrust), set: |m, t| put(&mut m.flatlo.max_thrust, number(t)) },
+    Row { name: "load factor min", unit: "", keys: &["load_factor"], get: |m| num(m.flatlo.load_factor[0]), set: |m, t| put(&mut m.flatlo.load_factor[0], number(t)) },
+    Row { name: "load factor max", unit: "", keys: &["load_factor"], get: |m| num(m.flatlo.load_factor[1]), set: |m, t| put(&mut m.flatlo.load_factor[1], number(t)) },
+    Row { name: "max bank", unit: "°", keys: &["max_bank_deg"], get: |m| num(m.flatlo.max_bank_deg), set: |m, t| put(&mut m.flatlo.max_bank_deg, number(t)) },
+    Row { name: "airspeed min", unit: "m/s", keys: &["airspeed_range"], get: |m| num(m.flatlo.airspeed_range[0]), set: |m, t| put(&mut m.flatlo.airspeed_range[0], number(t)) },
+    Row { name: "airspeed max", unit: "m/s", keys: &["airspeed_range"], get: |m| num(m.flatlo.airspeed_range[1]), set: |m, t| put(&mut m.flatlo.airspeed_range[1], number(t)) },
+    Row { name: "PID kp", unit: "", keys: &["pid"], get: |m| num(m.flatlo.pid[0]), set: |m, t| put(&mut m.flatlo.pid[0], number(t)) },
+    Row { name: "PID ki", unit: "", keys: &["pid"], get: |m| num(m.flatlo.pid[1]), set: |m, t| put(&mut m.flatlo.pid[1], number(t)) },
+    Row { name: "PID kd", unit: "", keys: &["pid"], get: |m| num(m.flatlo.pid[2]), set: |m, t| put(&mut m.flatlo.pid[2], number(t)) },
+];
 
 impl Checker {
     fn flatlo(&mut self, path: &FieldPath, p: &FlatloParams) {

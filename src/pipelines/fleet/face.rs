@@ -107,6 +107,10 @@ impl Pipeline for Fleet {
         mission.fleet.safety_distance += m;
     }
 
+    fn rows(&self) -> &'static [crate::pipelines::rows::Row] {
+        super::section::ROWS
+    }
+
     fn plots(&self) -> &'static [&'static [Plot]] {
         recording::PLOTS
     }

@@ -11,6 +11,9 @@ use crate::mission::geodetic::{Position, SECTION_POSITIONS, SectionPositions, Sl
 use crate::mission::{
     Checker, FieldPath, FleetParams, Mission, SECTION_RULES, SectionRules, compact,
 };
+use crate::pipelines::rows::{
+    Row, auto_or_number, count, fmt_num, in_the_file, listed, num, number, put, text,
+};
 
 #[linkme::distributed_slice(SECTION_RULES)]
 static RULES: SectionRules = SectionRules {
@@ -52,6 +55,43 @@ static POSITIONS: SectionPositions = SectionPositions {
         targets.chain(starts).collect()
     },
 };
+
+/// The inspector's rows of `[fleet]` (Table 1, the scenario, the quadrotor);
+/// its matrices and lists are shown, edited in the file (`Pipeline::rows`).
+#[rustfmt::skip]
+pub(super) static ROWS: &[Row] = &[
+    Row { name: "agents n", unit: "", keys: &["agents"], get: |m| text(m.fleet.agents), set: |m, t| put(&mut m.fleet.agents, count(t)) },
+    Row { name: "ρ target weight", unit: "", keys: &["rho"], get: |m| num(m.fleet.rho), set: |m, t| put(&mut m.fleet.rho, number(t)) },
+    Row { name: "σ steepness", unit: "", keys: &["sigma"], get: |m| num(m.fleet.sigma), set: |m, t| put(&mut m.fleet.sigma, number(t)) },
+    Row { name: "c safety", unit: "m", keys: &["safety_distance"], get: |m| num(m.fleet.safety_distance), set: |m, t| put(&mut m.fleet.safety_distance, number(t)) },
+    Row { name: "l neighbourhood", unit: "m", keys: &["neighbourhood"], get: |m| num(m.fleet.neighbourhood), set: |m, t| put(&mut m.fleet.neighbourhood, number(t)) },
+    Row { name: "d_obs detection", unit: "m", keys: &["detection_range"], get: |m| num(m.fleet.detection_range), set: |m, t| put(&mut m.fleet.detection_range, number(t)) },
+    Row { name: "h_max step", unit: "m", keys: &["step_max"], get: |m| num(m.fleet.step_max), set: |m, t| put(&mut m.fleet.step_max, number(t)) },
+    Row { name: "τ replan", unit: "s", keys: &["replan_period"], get: |m| num(m.fleet.replan_period), set: |m, t| put(&mut m.fleet.replan_period, number(t)) },
+    Row { name: "d_ip to target", unit: "m", keys: &["target_distance"], get: |m| num(m.fleet.target_distance), set: |m, t| put(&mut m.fleet.target_distance, number(t)) },
+    Row { name: "altitude", unit: "m", keys: &["altitude"], get: |m| num(m.fleet.altitude), set: |m, t| put(&mut m.fleet.altitude, number(t)) },
+    Row { name: "duration", unit: "s", keys: &["duration"], get: |m| text(m.fleet.duration.map_or_else(|| "auto".to_owned(), fmt_num)), set: |m, t| put(&mut m.fleet.duration, auto_or_number(t)) },
+    Row { name: "tolerance", unit: "", keys: &["tolerance"], get: |m| num(m.fleet.tolerance), set: |m, t| put(&mut m.fleet.tolerance, number(t)) },
+    Row { name: "PSO particles", unit: "", keys: &["swarm_size"], get: |m| text(m.fleet.swarm_size), set: |m, t| put(&mut m.fleet.swarm_size, count(t)) },
+    Row { name: "PSO iterations", unit: "", keys: &["iterations"], get: |m| text(m.fleet.iterations), set: |m, t| put(&mut m.fleet.iterations, count(t)) },
+    Row { name: "PSO inertia w", unit: "", keys: &["inertia"], get: |m| num(m.fleet.inertia), set: |m, t| put(&mut m.fleet.inertia, number(t)) },
+    Row { name: "PSO cognitive c1", unit: "", keys: &["cognitive"], get: |m| num(m.fleet.cognitive), set: |m, t| put(&mut m.fleet.cognitive, number(t)) },
+    Row { name: "PSO social c2", unit: "", keys: &["social"], get: |m| num(m.fleet.social), set: |m, t| put(&mut m.fleet.social, number(t)) },
+    Row { name: "dynamics step", unit: "s", keys: &["sim_step"], get: |m| num(m.fleet.sim_step), set: |m, t| put(&mut m.fleet.sim_step, number(t)) },
+    Row { name: "mass", unit: "kg", keys: &["mass"], get: |m| num(m.fleet.mass), set: |m, t| put(&mut m.fleet.mass, number(t)) },
+    Row { name: "inertia J x", unit: "kg·m²", keys: &["inertia_diag"], get: |m| num(m.fleet.inertia_diag.x), set: |m, t| put(&mut m.fleet.inertia_diag.x, number(t)) },
+    Row { name: "inertia J y", unit: "kg·m²", keys: &["inertia_diag"], get: |m| num(m.fleet.inertia_diag.y), set: |m, t| put(&mut m.fleet.inertia_diag.y, number(t)) },
+    Row { name: "inertia J z", unit: "kg·m²", keys: &["inertia_diag"], get: |m| num(m.fleet.inertia_diag.z), set: |m, t| put(&mut m.fleet.inertia_diag.z, number(t)) },
+    Row { name: "K_pos position", unit: "", keys: &["position_gains"], get: |m| num(m.fleet.position_gains[0]), set: |m, t| put(&mut m.fleet.position_gains[0], number(t)) },
+    Row { name: "K_pos velocity", unit: "", keys: &["position_gains"], get: |m| num(m.fleet.position_gains[1]), set: |m, t| put(&mut m.fleet.position_gains[1], number(t)) },
+    Row { name: "K_att attitude", unit: "", keys: &["attitude_gains"], get: |m| num(m.fleet.attitude_gains[0]), set: |m, t| put(&mut m.fleet.attitude_gains[0], number(t)) },
+    Row { name: "K_att rate", unit: "", keys: &["attitude_gains"], get: |m| num(m.fleet.attitude_gains[1]), set: |m, t| put(&mut m.fleet.attitude_gains[1], number(t)) },
+    Row { name: "max thrust", unit: "N", keys: &["max_thrust"], get: |m| num(m.fleet.max_thrust), set: |m, t| put(&mut m.fleet.max_thrust, number(t)) },
+    Row { name: "max tilt", unit: "°", keys: &["max_tilt_deg"], get: |m| num(m.fleet.max_tilt_deg), set: |m, t| put(&mut m.fleet.max_tilt_deg, number(t)) },
+    Row { name: "distances d^d", unit: "", keys: &["distances"], get: |m| text(listed(m.fleet.distances.len(), "rows", "a uniform polygon")), set: in_the_file },
+    Row { name: "initial positions", unit: "", keys: &["initial_positions"], get: |m| text(listed(m.fleet.initial_positions.len(), "positions", "seeded random")), set: in_the_file },
+    Row { name: "pushes", unit: "", keys: &["pushes"], get: |m| text(listed(m.fleet.pushes.len(), "pushes", "none")), set: in_the_file },
+];
 
 impl Checker {
     /// Long (~130 lines): one rule per key of `[fleet]`, in the order of the section.

@@ -93,6 +93,10 @@ impl Pipeline for ThetaPso {
         }
     }
 
+    fn rows(&self) -> &'static [crate::pipelines::rows::Row] {
+        super::section::ROWS
+    }
+
     fn plots(&self) -> &'static [&'static [Plot]] {
         recording::PLOTS
     }

@@ -3,20 +3,25 @@
 //! values as text. The tables keep one field a line (`rustfmt::skip`) so
 //! they read as tables: name, unit, keys, read, write.
 //!
-//! Long (~910 lines) because it is the field tables of every item kind (some 300 lines, one
-//! field a line) with the parsers, names and setters their cells call, read together.
+//! A pipeline's own section's rows are its face's (`Pipeline::rows`, in
+//! the pipeline's `section.rs`); its points' rows (the fleet's targets) are
+//! still here.
+//!
+//! Long (~750 lines) because it is the field tables of every other item kind (one field a
+//! line) with the parsers, names and setters their cells call, read together.
 
 use nalgebra::{Point2, Vector3};
 
 use super::Step::{Index, Key, Vertex};
-use super::{Item, Spec, Table, fmt_num, number, shape_name, waypoint_choice};
+use super::{Item, Spec, Table, shape_name, waypoint_choice};
 use crate::base::terrain::Lookup;
 use crate::mission::geodesy::Frame;
 use crate::mission::{
-    CostKind, Encoding, FleetTarget, GeoOrigin, Mission, Obstacle, Preset, ShapeChoice, Terrain,
-    Turbulence, WaypointChoice, spacing_of,
+    FleetTarget, GeoOrigin, Mission, Obstacle, Preset, ShapeChoice, Terrain, Turbulence,
+    WaypointChoice, spacing_of,
 };
 use crate::pipelines::points::PointRef;
+use crate::pipelines::rows::{count, fmt_num, num, number, put, text};
 
 /// The table of `item`'s kind.
 pub(super) fn of(item: &Item) -> &'static Table {
@@ -32,7 +37,8 @@ pub(super) fn of(item: &Item) -> &'static Table {
         Item::Formation => &FORMATION,
         Item::Slot(_) => &SLOT,
         Item::Waypoint(_) => &WAYPOINT,
-        Item::Section(k) => section_table(&[Key(k.words().section.0)]),
+        // A section's rows are its pipeline's (`Pipeline::rows`).
+        Item::Section(_) => &NO_FIELDS,
         Item::Point(p) => p.kind().map_or(&NO_FIELDS, |k| {
             section_table(&[Key(k.path[0]), Key(k.path[1]), Index])
         }),
@@ -40,9 +46,9 @@ pub(super) fn of(item: &Item) -> &'static Table {
     }
 }
 
-/// The pipelines' sections and their points, found by where they are in
-/// the file (a section's key, a point list's path).
-static SECTIONS: [&Table; 4] = [&THETA_PSO, &SQUADRON, &FLEET, &FLEET_TARGET];
+/// The pipelines' points, found by where they are in the file (a point
+/// list's path).
+static SECTIONS: [&Table; 1] = [&FLEET_TARGET];
 
 /// The table of `SECTIONS` at `base`; none (no fields) for a section
 /// without rows here.
@@ -54,7 +60,7 @@ fn section_table(base: &[super::Step]) -> &'static Table {
         .unwrap_or(&NO_FIELDS)
 }
 
-/// An item whose section has no rows here.
+/// An item whose fields are not in these tables.
 static NO_FIELDS: Table = Table {
     base: &[],
     derived: &[],
@@ -250,99 +256,6 @@ static WAYPOINT: Table = Table { base: &[Key("reconfiguration"), Key("waypoints"
 ]};
 
 #[rustfmt::skip]
-static THETA_PSO: Table = Table { base: &[Key("theta_pso")], derived: &[], fields: &[
-    Spec { name: "swarm size", unit: "", keys: &["swarm_size"], get: |m, _| text(m.theta_pso.swarm_size), set: |m, _, t| put(&mut m.theta_pso.swarm_size, count(t)) },
-    Spec { name: "waypoints", unit: "", keys: &["waypoints"], get: |m, _| text(m.theta_pso.waypoints), set: |m, _, t| put(&mut m.theta_pso.waypoints, count(t)) },
-    Spec { name: "iterations", unit: "", keys: &["iterations"], get: |m, _| text(m.theta_pso.iterations), set: |m, _, t| put(&mut m.theta_pso.iterations, count(t)) },
-    Spec { name: "restarts", unit: "", keys: &["restarts"], get: |m, _| text(m.theta_pso.restarts), set: |m, _, t| put(&mut m.theta_pso.restarts, count(t)) },
-    Spec { name: "seeded particles", unit: "", keys: &["seeded_particles"], get: |m, _| text(m.theta_pso.seeded_particles), set: |m, _, t| put(&mut m.theta_pso.seeded_particles, count(t)) },
-    Spec { name: "clearance margin", unit: "m", keys: &["clearance_margin"], get: |m, _| num(m.theta_pso.clearance_margin), set: |m, _, t| put(&mut m.theta_pso.clearance_margin, number(t)) },
-    Spec { name: "inertia w", unit: "", keys: &["inertia"], get: |m, _| num(m.theta_pso.inertia), set: |m, _, t| put(&mut m.theta_pso.inertia, number(t)) },
-    Spec { name: "cognitive c1", unit: "", keys: &["cognitive"], get: |m, _| num(m.theta_pso.cognitive), set: |m, _, t| put(&mut m.theta_pso.cognitive, number(t)) },
-    Spec { name: "social c2", unit: "", keys: &["social"], get: |m, _| num(m.theta_pso.social), set: |m, _, t| put(&mut m.theta_pso.social, number(t)) },
-    Spec { name: "segments L", unit: "", keys: &["segments"], get: |m, _| text(m.theta_pso.segments), set: |m, _, t| put(&mut m.theta_pso.segments, count(t)) },
-    Spec { name: "β1 length", unit: "", keys: &["weight_length"], get: |m, _| num(m.theta_pso.weight_length), set: |m, _, t| put(&mut m.theta_pso.weight_length, number(t)) },
-    Spec { name: "β2 obstacle", unit: "", keys: &["weight_obstacle"], get: |m, _| num(m.theta_pso.weight_obstacle), set: |m, _, t| put(&mut m.theta_pso.weight_obstacle, number(t)) },
-    Spec { name: "β3 altitude", unit: "", keys: &["weight_altitude"], get: |m, _| num(m.theta_pso.weight_altitude), set: |m, _, t| put(&mut m.theta_pso.weight_altitude, number(t)) },
-    Spec { name: "βR waypoints", unit: "", keys: &["weight_waypoints"], get: |m, _| num(m.theta_pso.weight_waypoints), set: |m, _, t| put(&mut m.theta_pso.weight_waypoints, number(t)) },
-    Spec { name: "J_B bounds weight", unit: "", keys: &["weight_bounds"], get: |m, _| num(m.theta_pso.weight_bounds), set: |m, _, t| put(&mut m.theta_pso.weight_bounds, number(t)) },
-    Spec { name: "J_T turning weight", unit: "", keys: &["weight_turning"], get: |m, _| num(m.theta_pso.weight_turning), set: |m, _, t| put(&mut m.theta_pso.weight_turning, number(t)) },
-    Spec { name: "ground penalty", unit: "", keys: &["ground_penalty"], get: |m, _| num(m.theta_pso.ground_penalty), set: |m, _, t| put(&mut m.theta_pso.ground_penalty, number(t)) },
-    Spec { name: "cost", unit: "", keys: &["cost"], get: |m, _| text(cost_name(m.theta_pso.cost)), set: |m, _, t| put(&mut m.theta_pso.cost, cost(t)) },
-    Spec { name: "encoding", unit: "", keys: &["encoding"], get: |m, _| text(encoding_name(m.theta_pso.encoding)), set: |m, _, t| put(&mut m.theta_pso.encoding, encoding(t)) },
-]};
-
-/// FLATLO's squadron and its aircraft model: every `[flatlo]` key.
-#[rustfmt::skip]
-static SQUADRON: Table = Table { base: &[Key("flatlo")], derived: &[], fields: &[
-    Spec { name: "aircraft N", unit: "", keys: &["aircraft"], get: |m, _| text(m.flatlo.aircraft), set: |m, _, t| put(&mut m.flatlo.aircraft, count(t)) },
-    Spec { name: "spacing Δd", unit: "m", keys: &["spacing"], get: |m, _| num(m.flatlo.spacing), set: |m, _, t| put(&mut m.flatlo.spacing, number(t)) },
-    Spec { name: "airspeed", unit: "m/s", keys: &["airspeed"], get: |m, _| num(m.flatlo.airspeed), set: |m, _, t| put(&mut m.flatlo.airspeed, number(t)) },
-    Spec { name: "turn radius r", unit: "m", keys: &["turn_radius"], get: |m, _| num(m.flatlo.turn_radius), set: |m, _, t| put(&mut m.flatlo.turn_radius, number(t)) },
-    Spec { name: "heading φ", unit: "°", keys: &["heading_deg"], get: |m, _| num(m.flatlo.heading_deg), set: |m, _, t| put(&mut m.flatlo.heading_deg, number(t)) },
-    Spec { name: "climb β", unit: "°", keys: &["climb_deg"], get: |m, _| num(m.flatlo.climb_deg), set: |m, _, t| put(&mut m.flatlo.climb_deg, number(t)) },
-    Spec { name: "altitude", unit: "m", keys: &["altitude"], get: |m, _| num(m.flatlo.altitude), set: |m, _, t| put(&mut m.flatlo.altitude, number(t)) },
-    Spec { name: "start x", unit: "m", keys: &["start"], get: |m, _| num(m.flatlo.start.x), set: |m, _, t| put(&mut m.flatlo.start.x, number(t)) },
-    Spec { name: "start y", unit: "m", keys: &["start"], get: |m, _| num(m.flatlo.start.y), set: |m, _, t| put(&mut m.flatlo.start.y, number(t)) },
-    Spec { name: "final leg K2", unit: "m", keys: &["final_leg"], get: |m, _| num(m.flatlo.final_leg), set: |m, _, t| put(&mut m.flatlo.final_leg, number(t)) },
-    Spec { name: "noise σ", unit: "", keys: &["noise"], get: |m, _| num(m.flatlo.noise), set: |m, _, t| put(&mut m.flatlo.noise, number(t)) },
-    Spec { name: "min separation", unit: "m", keys: &["min_separation"], get: |m, _| num(m.flatlo.min_separation), set: |m, _, t| put(&mut m.flatlo.min_separation, number(t)) },
-    Spec { name: "sample period T", unit: "s", keys: &["sample_period"], get: |m, _| num(m.flatlo.sample_period), set: |m, _, t| put(&mut m.flatlo.sample_period, number(t)) },
-    Spec { name: "RK4 step", unit: "s", keys: &["sim_step"], get: |m, _| num(m.flatlo.sim_step), set: |m, _, t| put(&mut m.flatlo.sim_step, number(t)) },
-    Spec { name: "mass", unit: "kg", keys: &["mass"], get: |m, _| num(m.flatlo.mass), set: |m, _, t| put(&mut m.flatlo.mass, number(t)) },
-    Spec { name: "wing area", unit: "m²", keys: &["wing_area"], get: |m, _| num(m.flatlo.wing_area), set: |m, _, t| put(&mut m.flatlo.wing_area, number(t)) },
-    Spec { name: "air density", unit: "kg/m³", keys: &["air_density"], get: |m, _| num(m.flatlo.air_density), set: |m, _, t| put(&mut m.flatlo.air_density, number(t)) },
-    Spec { name: "drag C_D0", unit: "", keys: &["drag_cd0"], get: |m, _| num(m.flatlo.drag_cd0), set: |m, _, t| put(&mut m.flatlo.drag_cd0, number(t)) },
-    Spec { name: "drag k", unit: "", keys: &["drag_k"], get: |m, _| num(m.flatlo.drag_k), set: |m, _, t| put(&mut m.flatlo.drag_k, number(t)) },
-    Spec { name: "max thrust", unit: "N", keys: &["max_thrust"], get: |m, _| num(m.flatlo.max_thrust), set: |m, _, t| put(&mut m.flatlo.max_thrust, number(t)) },
-    Spec { name: "load factor min", unit: "", keys: &["load_factor"], get: |m, _| num(m.flatlo.load_factor[0]), set: |m, _, t| put(&mut m.flatlo.load_factor[0], number(t)) },
-    Spec { name: "load factor max", unit: "", keys: &["load_factor"], get: |m, _| num(m.flatlo.load_factor[1]), set: |m, _, t| put(&mut m.flatlo.load_factor[1], number(t)) },
-    Spec { name: "max bank", unit: "°", keys: &["max_bank_deg"], get: |m, _| num(m.flatlo.max_bank_deg), set: |m, _, t| put(&mut m.flatlo.max_bank_deg, number(t)) },
-    Spec { name: "airspeed min", unit: "m/s", keys: &["airspeed_range"], get: |m, _| num(m.flatlo.airspeed_range[0]), set: |m, _, t| put(&mut m.flatlo.airspeed_range[0], number(t)) },
-    Spec { name: "airspeed max", unit: "m/s", keys: &["airspeed_range"], get: |m, _| num(m.flatlo.airspeed_range[1]), set: |m, _, t| put(&mut m.flatlo.airspeed_range[1], number(t)) },
-    Spec { name: "PID kp", unit: "", keys: &["pid"], get: |m, _| num(m.flatlo.pid[0]), set: |m, _, t| put(&mut m.flatlo.pid[0], number(t)) },
-    Spec { name: "PID ki", unit: "", keys: &["pid"], get: |m, _| num(m.flatlo.pid[1]), set: |m, _, t| put(&mut m.flatlo.pid[1], number(t)) },
-    Spec { name: "PID kd", unit: "", keys: &["pid"], get: |m, _| num(m.flatlo.pid[2]), set: |m, _, t| put(&mut m.flatlo.pid[2], number(t)) },
-]};
-
-/// The fleet's parameters (Table 1, the scenario, the quadrotor); its
-/// matrices and lists are shown (edited in the file).
-#[rustfmt::skip]
-static FLEET: Table = Table { base: &[Key("fleet")], derived: &[], fields: &[
-    Spec { name: "agents n", unit: "", keys: &["agents"], get: |m, _| text(m.fleet.agents), set: |m, _, t| put(&mut m.fleet.agents, count(t)) },
-    Spec { name: "ρ target weight", unit: "", keys: &["rho"], get: |m, _| num(m.fleet.rho), set: |m, _, t| put(&mut m.fleet.rho, number(t)) },
-    Spec { name: "σ steepness", unit: "", keys: &["sigma"], get: |m, _| num(m.fleet.sigma), set: |m, _, t| put(&mut m.fleet.sigma, number(t)) },
-    Spec { name: "c safety", unit: "m", keys: &["safety_distance"], get: |m, _| num(m.fleet.safety_distance), set: |m, _, t| put(&mut m.fleet.safety_distance, number(t)) },
-    Spec { name: "l neighbourhood", unit: "m", keys: &["neighbourhood"], get: |m, _| num(m.fleet.neighbourhood), set: |m, _, t| put(&mut m.fleet.neighbourhood, number(t)) },
-    Spec { name: "d_obs detection", unit: "m", keys: &["detection_range"], get: |m, _| num(m.fleet.detection_range), set: |m, _, t| put(&mut m.fleet.detection_range, number(t)) },
-    Spec { name: "h_max step", unit: "m", keys: &["step_max"], get: |m, _| num(m.fleet.step_max), set: |m, _, t| put(&mut m.fleet.step_max, number(t)) },
-    Spec { name: "τ replan", unit: "s", keys: &["replan_period"], get: |m, _| num(m.fleet.replan_period), set: |m, _, t| put(&mut m.fleet.replan_period, number(t)) },
-    Spec { name: "d_ip to target", unit: "m", keys: &["target_distance"], get: |m, _| num(m.fleet.target_distance), set: |m, _, t| put(&mut m.fleet.target_distance, number(t)) },
-    Spec { name: "altitude", unit: "m", keys: &["altitude"], get: |m, _| num(m.fleet.altitude), set: |m, _, t| put(&mut m.fleet.altitude, number(t)) },
-    Spec { name: "duration", unit: "s", keys: &["duration"], get: |m, _| text(m.fleet.duration.map_or_else(|| "auto".to_owned(), fmt_num)), set: |m, _, t| put(&mut m.fleet.duration, auto_or_number(t)) },
-    Spec { name: "tolerance", unit: "", keys: &["tolerance"], get: |m, _| num(m.fleet.tolerance), set: |m, _, t| put(&mut m.fleet.tolerance, number(t)) },
-    Spec { name: "PSO particles", unit: "", keys: &["swarm_size"], get: |m, _| text(m.fleet.swarm_size), set: |m, _, t| put(&mut m.fleet.swarm_size, count(t)) },
-    Spec { name: "PSO iterations", unit: "", keys: &["iterations"], get: |m, _| text(m.fleet.iterations), set: |m, _, t| put(&mut m.fleet.iterations, count(t)) },
-    Spec { name: "PSO inertia w", unit: "", keys: &["inertia"], get: |m, _| num(m.fleet.inertia), set: |m, _, t| put(&mut m.fleet.inertia, number(t)) },
-    Spec { name: "PSO cognitive c1", unit: "", keys: &["cognitive"], get: |m, _| num(m.fleet.cognitive), set: |m, _, t| put(&mut m.fleet.cognitive, number(t)) },
-    Spec { name: "PSO social c2", unit: "", keys: &["social"], get: |m, _| num(m.fleet.social), set: |m, _, t| put(&mut m.fleet.social, number(t)) },
-    Spec { name: "dynamics step", unit: "s", keys: &["sim_step"], get: |m, _| num(m.fleet.sim_step), set: |m, _, t| put(&mut m.fleet.sim_step, number(t)) },
-    Spec { name: "mass", unit: "kg", keys: &["mass"], get: |m, _| num(m.fleet.mass), set: |m, _, t| put(&mut m.fleet.mass, number(t)) },
-    Spec { name: "inertia J x", unit: "kg·m²", keys: &["inertia_diag"], get: |m, _| num(m.fleet.inertia_diag.x), set: |m, _, t| put(&mut m.fleet.inertia_diag.x, number(t)) },
-    Spec { name: "inertia J y", unit: "kg·m²", keys: &["inertia_diag"], get: |m, _| num(m.fleet.inertia_diag.y), set: |m, _, t| put(&mut m.fleet.inertia_diag.y, number(t)) },
-    Spec { name: "inertia J z", unit: "kg·m²", keys: &["inertia_diag"], get: |m, _| num(m.fleet.inertia_diag.z), set: |m, _, t| put(&mut m.fleet.inertia_diag.z, number(t)) },
-    Spec { name: "K_pos position", unit: "", keys: &["position_gains"], get: |m, _| num(m.fleet.position_gains[0]), set: |m, _, t| put(&mut m.fleet.position_gains[0], number(t)) },
-    Spec { name: "K_pos velocity", unit: "", keys: &["position_gains"], get: |m, _| num(m.fleet.position_gains[1]), set: |m, _, t| put(&mut m.fleet.position_gains[1], number(t)) },
-    Spec { name: "K_att attitude", unit: "", keys: &["attitude_gains"], get: |m, _| num(m.fleet.attitude_gains[0]), set: |m, _, t| put(&mut m.fleet.attitude_gains[0], number(t)) },
-    Spec { name: "K_att rate", unit: "", keys: &["attitude_gains"], get: |m, _| num(m.fleet.attitude_gains[1]), set: |m, _, t| put(&mut m.fleet.attitude_gains[1], number(t)) },
-    Spec { name: "max thrust", unit: "N", keys: &["max_thrust"], get: |m, _| num(m.fleet.max_thrust), set: |m, _, t| put(&mut m.fleet.max_thrust, number(t)) },
-    Spec { name: "max tilt", unit: "°", keys: &["max_tilt_deg"], get: |m, _| num(m.fleet.max_tilt_deg), set: |m, _, t| put(&mut m.fleet.max_tilt_deg, number(t)) },
-    Spec { name: "distances d^d", unit: "", keys: &["distances"], get: |m, _| text(listed(m.fleet.distances.len(), "rows", "a uniform polygon")), set: in_the_file },
-    Spec { name: "initial positions", unit: "", keys: &["initial_positions"], get: |m, _| text(listed(m.fleet.initial_positions.len(), "positions", "seeded random")), set: in_the_file },
-    Spec { name: "pushes", unit: "", keys: &["pushes"], get: |m, _| text(listed(m.fleet.pushes.len(), "pushes", "none")), set: in_the_file },
-]};
-
-#[rustfmt::skip]
 static FLEET_TARGET: Table = Table { base: &[Key("fleet"), Key("targets"), Index], derived: &[], fields: &[
     Spec { name: "time", unit: "s", keys: &["time"], get: |m, i| num(target_at(m, i)?.time), set: |m, i, t| put(&mut target(m, i)?.time, number(t)) },
     Spec { name: "x", unit: "m", keys: &["position"], get: |m, i| num(around_at(m, i)?.position.x), set: |m, i, t| put(&mut target(m, i)?.position.x, number(t)) },
@@ -421,29 +334,8 @@ fn set_geo(m: &mut Mission, item: &Item, text: &str, lat: bool) -> Result<(), St
     Ok(())
 }
 
-/// Writes a parsed value (or passes its error on).
-fn put<T>(place: &mut T, value: Result<T, String>) -> Result<(), String> {
-    *place = value?;
-    Ok(())
-}
-
-/// A value shown as it is printed.
-fn text(value: impl ToString) -> Option<String> {
-    Some(value.to_string())
-}
-
-/// A number shown as it would be typed ([`fmt_num`]).
-fn num(value: f64) -> Option<String> {
-    Some(fmt_num(value))
-}
-
 fn yes(value: bool) -> Option<String> {
     text(if value { "yes" } else { "no" })
-}
-
-fn count(text: &str) -> Result<usize, String> {
-    text.parse::<usize>()
-        .map_err(|_| format!("'{text}' is not a whole number ≥ 0"))
 }
 
 fn shape(text: &str) -> Result<ShapeChoice, String> {
@@ -500,50 +392,6 @@ fn lookup_name(lookup: Lookup) -> &'static str {
         Lookup::Nearest => "nearest",
         Lookup::Bilinear => "bilinear",
     }
-}
-
-fn cost(text: &str) -> Result<CostKind, String> {
-    match text.trim().to_ascii_lowercase().as_str() {
-        "paper" => Ok(CostKind::Paper),
-        "spso" => Ok(CostKind::Spso),
-        other => Err(format!("'{other}' is not a cost: paper or spso")),
-    }
-}
-
-fn cost_name(cost: CostKind) -> &'static str {
-    match cost {
-        CostKind::Paper => "paper",
-        CostKind::Spso => "spso",
-    }
-}
-
-fn encoding(text: &str) -> Result<Encoding, String> {
-    match text.trim().to_ascii_lowercase().as_str() {
-        "angle" => Ok(Encoding::Angle),
-        "spherical" => Ok(Encoding::Spherical),
-        other => Err(format!("'{other}' is not an encoding: angle or spherical")),
-    }
-}
-
-fn encoding_name(encoding: Encoding) -> &'static str {
-    match encoding {
-        Encoding::Angle => "angle",
-        Encoding::Spherical => "spherical",
-    }
-}
-
-/// A list the file holds, as a count (or what its absence means).
-fn listed(n: usize, what: &str, none: &str) -> String {
-    if n == 0 {
-        format!("none: {none}")
-    } else {
-        format!("{n} {what} (edit them in the file)")
-    }
-}
-
-/// The write of a value shown but edited in the file.
-fn in_the_file(_: &mut Mission, _: &Item, _: &str) -> Result<(), String> {
-    Err("a list of the file: edit it there (the inspector shows its messages)".into())
 }
 
 /// The two obstacles an IWP choice names.
@@ -695,16 +543,6 @@ fn set_wire(
     p[axis] = v;
     o.settle();
     Ok(())
-}
-
-/// `auto` (or nothing) for a value the planner works out, else a number.
-fn auto_or_number(text: &str) -> Result<Option<f64>, String> {
-    let t = text.trim();
-    if t.is_empty() || t.eq_ignore_ascii_case("auto") {
-        Ok(None)
-    } else {
-        number(t).map(Some).map_err(|e| format!("{e}, or auto"))
-    }
 }
 
 /// An inspected side: `any` (or nothing) for none, a bearing in degrees,
