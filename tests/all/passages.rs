@@ -636,3 +636,78 @@ fn ompl_finds_the_open_aisles_and_no_way_through_a_closed_one() {
     }
     assert!(!answers[2].0, "OMPL went through the closed aisle");
 }
+
+/// Two rows of [`row`] in series, `apart` metres along the route, each
+/// with its own aisle (the second's at `b`'s offset): the way bends
+/// between them, past four obstacles of two rows. Same slant for both, so
+/// their walls stay apart.
+fn rows_in_series(a: &Sweep, b: &Sweep, apart: f64) -> Mission {
+    let mut m = row(a);
+    let second = row(b);
+    let slant = a.slant.to_radians();
+    let along_route = nalgebra::Vector2::new(slant.cos(), slant.sin()) * apart;
+    for o in &mut m.obstacles {
+        let c = o.center - along_route / 2.0;
+        o.move_to(c);
+        o.name = format!("first {}", o.name);
+    }
+    for mut o in second.obstacles {
+        let c = o.center + along_route / 2.0;
+        o.move_to(c);
+        o.name = format!("second {}", o.name);
+        m.obstacles.push(o);
+    }
+    m
+}
+
+/// Measures two rows in series (`SKYFORM_SERIES=N` missions): both aisles
+/// from 5 cm over the column's need, 8-30 m apart, offsets ±10 m, every
+/// site size; the planner's verdict and time, and the voxel oracle's.
+#[test]
+#[ignore = "a measurement: SKYFORM_SERIES=N cargo test --release --test all passages::series -- --ignored --nocapture"]
+fn series_rates() {
+    let n: u64 = std::env::var("SKYFORM_SERIES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(20);
+    let (mut found, mut worst) = (0, 0.0f64);
+    for i in 0..n {
+        let a = sweep(1000 + 2 * i);
+        let mut b = sweep(1001 + 2 * i);
+        b.slant = a.slant;
+        b.site = a.site;
+        b.uavs = a.uavs;
+        b.at_bound = false;
+        let a = Sweep {
+            at_bound: false,
+            ..a
+        };
+        let apart = [8.0, 15.0, 30.0][(i % 3) as usize];
+        let m = rows_in_series(&a, &b, apart);
+        if let Ok(dir) = std::env::var("SKYFORM_SWEEP_DUMP") {
+            let text = mission::to_toml_string(&m).unwrap_or_else(|e| panic!("{e}"));
+            std::fs::write(format!("{dir}/series-{i}.toml"), text)
+                .unwrap_or_else(|e| panic!("{e}"));
+        }
+        let t = std::time::Instant::now();
+        let got = feasible(&m);
+        let secs = t.elapsed().as_secs_f64();
+        worst = worst.max(secs);
+        found += usize::from(got == Ok(true));
+        println!(
+            "{i:3} apart {apart:4} site {:?} slant {:2} uavs {:2} | {:?} {:.2}{} off {:6.2} | {:?} {:.2}{} off {:6.2}: {got:?} {secs:.2} s",
+            a.site,
+            a.slant,
+            a.uavs,
+            a.sides,
+            a.excess,
+            if a.wide { "w" } else { "" },
+            a.offset,
+            b.sides,
+            b.excess,
+            if b.wide { "w" } else { "" },
+            b.offset
+        );
+    }
+    println!("found {found} of {n}; worst {worst:.2} s");
+}
