@@ -234,12 +234,24 @@ impl Table {
         if self.derived.iter().any(|s| std::ptr::eq(s, spec)) {
             return path;
         }
-        let mut siblings = self.fields.iter().filter(|s| s.keys == spec.keys);
-        let element = siblings.clone().position(|s| std::ptr::eq(s, spec));
-        match (siblings.nth(1), element) {
-            (Some(_), Some(i)) => path.index(i),
-            _ => path,
-        }
+        element(path, self.fields, spec, |s| s.keys)
+    }
+}
+
+/// `path`, indexed as an array's element when other fields of `all` share
+/// `this`'s keys: fields that share their keys are that array's elements,
+/// in order (x min, x max; x, y, z), as the validator indexes them.
+fn element<T>(
+    path: FieldPath,
+    all: &[T],
+    this: &T,
+    keys: fn(&T) -> &'static [&'static str],
+) -> FieldPath {
+    let mut siblings = all.iter().filter(|s| keys(s) == keys(this));
+    let index = siblings.clone().position(|s| std::ptr::eq(s, this));
+    match (siblings.nth(1), index) {
+        (Some(_), Some(i)) => path.index(i),
+        _ => path,
     }
 }
 
@@ -332,9 +344,7 @@ fn label(name: &str, unit: &str) -> String {
     }
 }
 
-/// A pipeline's section's fields: its `rows` below `[key]`; rows that
-/// share their keys are that array's elements, in order, as the validator
-/// indexes them (`flatlo.start[1]`).
+/// A pipeline's section's fields: its `rows` below `[key]` (`flatlo.start[1]`).
 fn section_fields(rows: &'static [Row], key: &str, mission: &Mission) -> Vec<Field> {
     rows.iter()
         .filter_map(|row| {
@@ -342,16 +352,10 @@ fn section_fields(rows: &'static [Row], key: &str, mission: &Mission) -> Vec<Fie
                 .keys
                 .iter()
                 .fold(FieldPath::root().key(key), |p, k| p.key(k));
-            let mut siblings = rows.iter().filter(|r| r.keys == row.keys);
-            let element = siblings.clone().position(|r| std::ptr::eq(r, row));
-            let path = match (siblings.nth(1), element) {
-                (Some(_), Some(i)) => path.index(i),
-                _ => path,
-            };
             Some(Field {
                 source: Source::Row(row),
                 label: label(row.name, row.unit),
-                path,
+                path: element(path, rows, row, |r| r.keys),
                 value: (row.get)(mission)?,
             })
         })

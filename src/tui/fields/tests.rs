@@ -235,3 +235,41 @@ fn numbers_are_shown_as_typed() {
     assert_eq!(fmt_num(12.345678), "12.345678");
     assert_eq!(fmt_num(0.1 + 0.2), "0.3", "long ones rounded");
 }
+
+/// A pipeline's section's rows (its face's) are at their paths in the
+/// file, an array's elements indexed as the validator indexes them, so a
+/// message on `flatlo.start[1]` is shown under "start y".
+#[test]
+fn a_sections_rows_are_at_their_paths_elements_indexed() {
+    let m = default_mission().mission;
+    let path_of = |kind: Kind, label: &str| {
+        fields(&Item::Section(kind), &m)
+            .into_iter()
+            .find(|f| f.label().starts_with(label))
+            .map(|f| f.path().to_string())
+    };
+    assert_eq!(
+        path_of(Kind::Flatlo, "start x").as_deref(),
+        Some("flatlo.start[0]")
+    );
+    assert_eq!(
+        path_of(Kind::Flatlo, "start y").as_deref(),
+        Some("flatlo.start[1]")
+    );
+    assert_eq!(
+        path_of(Kind::Flatlo, "PID kd").as_deref(),
+        Some("flatlo.pid[2]")
+    );
+    assert_eq!(
+        path_of(Kind::Fleet, "inertia J z").as_deref(),
+        Some("fleet.inertia_diag[2]")
+    );
+    assert_eq!(
+        path_of(Kind::Fleet, "agents n").as_deref(),
+        Some("fleet.agents")
+    );
+    assert_eq!(
+        path_of(Kind::ThetaPso, "swarm size").as_deref(),
+        Some("theta_pso.swarm_size")
+    );
+}
