@@ -109,22 +109,9 @@ fn four_shards_merged_are_one_process_bit_for_bit() {
     );
 }
 
-/// The Python of the venv with `tests/campaign/requirements.txt` (Ray):
-/// `SKYFORM_CAMPAIGN_VENV`; skipped without it, except under CI.
+/// The Python of the campaign's venv (`tests/campaign/requirements.txt`, Ray).
 fn campaign_python() -> Option<PathBuf> {
-    match std::env::var_os("SKYFORM_CAMPAIGN_VENV") {
-        Some(venv) => Some(PathBuf::from(venv).join("bin").join("python")),
-        None => {
-            assert!(
-                std::env::var_os("CI").is_none(),
-                "CI is set but SKYFORM_CAMPAIGN_VENV is not: .ci/run must create the campaign's venv"
-            );
-            eprintln!(
-                "skipped: set SKYFORM_CAMPAIGN_VENV to a venv with tests/campaign/requirements.txt"
-            );
-            None
-        }
-    }
+    crate::common::venv_python("SKYFORM_CAMPAIGN_VENV", "tests/campaign/requirements.txt")
 }
 
 fn file(path: &Path) -> std::fs::File {

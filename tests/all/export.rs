@@ -1387,31 +1387,12 @@ fn expectations(m: &Mission, p: &Planned, done: &Exported, dir: &Path) -> (PathB
     (plan_path, wpl_path)
 }
 
-/// The Python of a virtual environment with `tests/export_readers/requirements.txt`:
-/// `SKYFORM_EXPORT_VENV`. Without it the check is skipped, except under CI
-/// (`CI` set), where it fails: CI must run the readers.
+/// The Python of the readers' venv (`tests/export_readers/requirements.txt`).
 fn reader_python() -> Option<PathBuf> {
-    match std::env::var_os("SKYFORM_EXPORT_VENV") {
-        Some(venv) => {
-            let python = PathBuf::from(venv).join("bin").join("python");
-            assert!(
-                python.exists(),
-                "SKYFORM_EXPORT_VENV has no {}",
-                python.display()
-            );
-            Some(python)
-        }
-        None => {
-            assert!(
-                std::env::var_os("CI").is_none(),
-                "CI is set but SKYFORM_EXPORT_VENV is not: .ci/run must create the readers' venv"
-            );
-            eprintln!(
-                "skipped: set SKYFORM_EXPORT_VENV to a venv with tests/export_readers/requirements.txt"
-            );
-            None
-        }
-    }
+    crate::common::venv_python(
+        "SKYFORM_EXPORT_VENV",
+        "tests/export_readers/requirements.txt",
+    )
 }
 
 /// Runs one of `tests/export_readers`' scripts on `expect`.

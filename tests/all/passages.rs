@@ -541,22 +541,9 @@ fn a_margin_that_leaves_no_band_to_inspect_in_is_refused_at_once() {
     }
 }
 
-/// The Python of the venv with `tests/oracle_ompl/requirements.txt` (OMPL):
-/// `SKYFORM_OMPL_VENV`; skipped without it, except under CI.
+/// The Python of the OMPL oracle's venv (`tests/oracle_ompl/requirements.txt`).
 fn ompl_python() -> Option<std::path::PathBuf> {
-    match std::env::var_os("SKYFORM_OMPL_VENV") {
-        Some(venv) => Some(std::path::PathBuf::from(venv).join("bin").join("python")),
-        None => {
-            assert!(
-                std::env::var_os("CI").is_none(),
-                "CI is set but SKYFORM_OMPL_VENV is not: .ci/run must create the OMPL oracle's venv"
-            );
-            eprintln!(
-                "skipped: set SKYFORM_OMPL_VENV to a venv with tests/oracle_ompl/requirements.txt"
-            );
-            None
-        }
-    }
+    crate::common::venv_python("SKYFORM_OMPL_VENV", "tests/oracle_ompl/requirements.txt")
 }
 
 /// OMPL's answers for `missions`, each written as TOML (the oracle reads

@@ -23,3 +23,24 @@ pub fn quick(
     mission.theta_pso.iterations = iterations;
     mission
 }
+
+/// The Python of the venv that `variable` names (one `.ci/run` creates
+/// with `requirements`): `None`, and the test skipped, without it, except
+/// under CI (`CI` set), where it fails: CI must run what needs it.
+pub fn venv_python(variable: &str, requirements: &str) -> Option<std::path::PathBuf> {
+    match std::env::var_os(variable) {
+        Some(venv) => {
+            let python = std::path::PathBuf::from(venv).join("bin").join("python");
+            assert!(python.exists(), "{variable} has no {}", python.display());
+            Some(python)
+        }
+        None => {
+            assert!(
+                std::env::var_os("CI").is_none(),
+                "CI is set but {variable} is not: .ci/run must create the venv of {requirements}"
+            );
+            eprintln!("skipped: set {variable} to a venv with {requirements}");
+            None
+        }
+    }
+}
