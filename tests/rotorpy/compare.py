@@ -13,7 +13,9 @@ skew off, it
      parameters by default, RotorPy's aero on) + `SE3Control`, tracking the
      piecewise-linear, constant-speed schedule the export's re-verification and the
      fly check use (legs at their written speeds, holds waited, arrival times as
-     export::reverify::Flight), wind from `rotorpy.wind.ConstantWind`;
+     export::reverify::Flight), handed on as a setpoint generator would: smoothed
+     over `--smooth` seconds (1 s; `Smoothed`), so no step in the velocity
+     reference reaches the controller; wind from `rotorpy.wind.ConstantWind`;
   4. measures cross-track error the way skyform does (src/flight/mod.rs): at 20 Hz,
      the 3-D distance from the leg the schedule has the vehicle on (the waypoint
      itself while it holds, before take-off and after its last one), and prints
@@ -220,6 +222,42 @@ class Schedule:
         return dict(x=x, x_dot=v, x_ddot=z3, x_dddot=z3, x_ddddot=z3, yaw=0.0, yaw_dot=0.0, yaw_ddot=0.0)
 
 
+class Smoothed:
+    """The schedule as a vehicle's setpoint generator would hand it on: its positions
+    averaged twice over a centred window of `width` seconds (a triangle kernel), so the
+    velocity is continuous and the acceleration is bounded by (velocity step) / width,
+    with the acceleration fed forward. Centred, so it does not lag the schedule; a
+    corner is rounded within width / 2 of it. PX4 limits jerk and acceleration the same
+    way (MPC_JERK_AUTO, MPC_ACC_HOR); a step in the velocity reference, which the
+    schedule itself has at every waypoint, is what no autopilot is given."""
+
+    def __init__(self, sched, width, dt=0.01):
+        self.dt = dt
+        n = max(1, int(round(width / dt)))
+        self.t0 = -width
+        ts = np.arange(self.t0, sched.end + 2 * width + dt, dt)
+        raw = np.array([sched.at(t)[0] for t in ts])
+        box = np.ones(n) / n
+        x = raw
+        for _ in range(2):
+            pad = np.pad(x, ((n, n), (0, 0)), mode="edge")
+            x = np.stack([np.convolve(pad[:, i], box, mode="same") for i in range(3)], axis=1)[n:-n]
+        self.x = x
+        self.v = np.gradient(x, dt, axis=0)
+        self.a = np.gradient(self.v, dt, axis=0)
+
+    def update(self, t):
+        k = min(max(int(round((t - self.t0) / self.dt)), 0), len(self.x) - 1)
+        z3 = np.zeros(3)
+        return dict(x=self.x[k], x_dot=self.v[k], x_ddot=self.a[k], x_dddot=z3, x_ddddot=z3,
+                    yaw=0.0, yaw_dot=0.0, yaw_ddot=0.0)
+
+
+def reference(sched, smooth):
+    """What the vehicle is told to fly: the schedule itself (smooth = 0), or smoothed."""
+    return Smoothed(sched, smooth) if smooth > 0 else sched
+
+
 def segment_distance(a, b, p):
     ab = b - a
     L2 = float(ab @ ab)
@@ -229,7 +267,7 @@ def segment_distance(a, b, p):
 
 # ---------------------------------------------------------------- RotorPy
 
-def fly_rotorpy(sched, wind_enu, params_module, t_end, dt=0.01, sample_every=5):
+def fly_rotorpy(sched, wind_enu, params_module, t_end, smooth, dt=0.01, sample_every=5):
     """RotorPy's positions at 20 Hz (t = 0, 0.05, ...) flying `sched` in a constant wind."""
     from rotorpy.vehicles.multirotor import Multirotor
     from rotorpy.controllers.quadrotor_control import SE3Control
@@ -241,6 +279,7 @@ def fly_rotorpy(sched, wind_enu, params_module, t_end, dt=0.01, sample_every=5):
                  w=np.zeros(3), wind=np.zeros(3), rotor_speeds=np.full(qp["num_rotors"], hover))
     vehicle = Multirotor(qp, initial_state=state, aero=True)  # RK45 over each step
     ctrl = SE3Control(qp)
+    ref = reference(sched, smooth)
     wind = ConstantWind(*wind_enu)
     xs = []
     steps = int(round(t_end / dt))
@@ -249,7 +288,7 @@ def fly_rotorpy(sched, wind_enu, params_module, t_end, dt=0.01, sample_every=5):
         if k % sample_every == 0:
             xs.append(np.array(state["x"], float))
         state["wind"] = wind.update(t, state["x"])
-        state = vehicle.step(state, ctrl.update(t, state, sched.update(t)), dt)
+        state = vehicle.step(state, ctrl.update(t, state, ref.update(t)), dt)
         if not np.all(np.isfinite(state["x"])):
             raise RuntimeError(f"RotorPy diverged at t = {t:.2f} s")
     return np.array(xs)
@@ -302,7 +341,8 @@ class Dryden:
         return self.mean + self.along * self.u * suv + self.across * v * suv + np.array([0, 0, w * sw])
 
 
-def fly_rotorpy_turbulent(sched, wind_enu, w20, seed, params_module, t_end, dt=0.01, sample_every=5):
+def fly_rotorpy_turbulent(sched, wind_enu, w20, seed, params_module, t_end, smooth, dt=0.01,
+                          sample_every=5):
     """`fly_rotorpy` in Dryden gusts on the mean wind (one gust series, seeded)."""
     from rotorpy.vehicles.multirotor import Multirotor
     from rotorpy.controllers.quadrotor_control import SE3Control
@@ -313,6 +353,7 @@ def fly_rotorpy_turbulent(sched, wind_enu, w20, seed, params_module, t_end, dt=0
                  w=np.zeros(3), wind=np.zeros(3), rotor_speeds=np.full(qp["num_rotors"], hover))
     vehicle = Multirotor(qp, initial_state=state, aero=True)
     ctrl = SE3Control(qp)
+    ref = reference(sched, smooth)
     air = Dryden(wind_enu, w20, np.random.default_rng(seed))
     xs = []
     for k in range(int(round(t_end / dt)) + 1):
@@ -320,7 +361,7 @@ def fly_rotorpy_turbulent(sched, wind_enu, w20, seed, params_module, t_end, dt=0
         if k % sample_every == 0:
             xs.append(np.array(state["x"], float))
         state["wind"] = air.step(dt, float(state["x"][2]), state["v"])
-        state = vehicle.step(state, ctrl.update(t, state, sched.update(t)), dt)
+        state = vehicle.step(state, ctrl.update(t, state, ref.update(t)), dt)
         if not np.all(np.isfinite(state["x"])):
             raise RuntimeError(f"RotorPy diverged at t = {t:.2f} s")
     return np.array(xs)
@@ -352,6 +393,11 @@ def main():
     ap.add_argument("--flights", type=int, default=8, help="flights a side in turbulence")
     ap.add_argument("--se3-gains", action="store_true",
                     help="in turbulence, also fly skyform with [vehicle] gains matching SE3Control's loop")
+    ap.add_argument("--match-drag", action="store_true",
+                    help="in turbulence, also fly skyform with SE3-matched gains and [flight] drag set to "
+                         "the RotorPy airframe's drag, linearised about the mean wind")
+    ap.add_argument("--smooth", type=float, default=1.0,
+                    help="seconds of the setpoint smoothing window (0: fly the schedule's steps as they are)")
     args = ap.parse_args()
     if not os.access(args.skyform, os.X_OK):
         sys.exit(f"no skyform binary at {args.skyform} (cargo build --release, or --skyform)")
@@ -390,8 +436,8 @@ def main():
             tv = time.time()
             key = (s.p.tobytes(), tuple(s.arrive), t_end)
             if key not in calm:  # the same schedule flown in calm air (reused across cases)
-                calm[key] = fly_rotorpy(s, (0.0, 0.0, 0.0), args.params, t_end)
-            xs = calm[key] if not any(wind) else fly_rotorpy(s, wind, args.params, t_end)
+                calm[key] = fly_rotorpy(s, (0.0, 0.0, 0.0), args.params, t_end, args.smooth)
+            xs = calm[key] if not any(wind) else fly_rotorpy(s, wind, args.params, t_end, args.smooth)
             off = cross_track(s, xs)
             # skyform's construction: the schedule plus the departure the air causes
             # (here: wind flight - calm flight), so corner-tracking error cancels out.
@@ -423,6 +469,18 @@ SE3_GAINS = dict(position_gain_xy=6.5 / 4.0, velocity_gain_xy=4.0, position_gain
                  velocity_gain_z=9.0, velocity_integral_xy=0.0, velocity_integral_z=0.0)
 
 
+def linear_drag(params_module, airspeed):
+    """The RotorPy airframe's drag per unit mass, 1/s, as skyform's linear model
+    (force = drag x mass x (wind - velocity)) would write it: the slope of its drag
+    about `airspeed` in hover, d(a)/d(v) = 4 k_d omega_hover / m (the rotors' H-force,
+    linear in v) + 2 c_D |v| / m (the parasitic drag, quadratic)."""
+    qp = importlib.import_module(f"rotorpy.vehicles.{params_module}").quad_params
+    hover = math.sqrt(qp["mass"] * 9.81 / (qp["num_rotors"] * qp["k_eta"]))
+    rotors = qp["num_rotors"] * qp["k_d"] * hover / qp["mass"]
+    parasitic = 2.0 * qp["c_Dx"] * airspeed / qp["mass"]
+    return rotors + parasitic
+
+
 def turbulent(args, text, frame, limits, work, calm):
     """The wind case in Dryden gusts, `args.flights` flights a side: per vehicle, p50 / p99 /
     max over the flights of each flight's largest cross-track error."""
@@ -431,10 +489,14 @@ def turbulent(args, text, frame, limits, work, calm):
     variants = [("skyform, PX4 default gains", base)]
     if args.se3_gains:
         variants.append(("skyform, SE3-matched gains", edit_section(base, "vehicle", SE3_GAINS)))
+    if args.match_drag:
+        drag = linear_drag(args.params, 5.0)
+        variants.append((f"skyform, SE3 gains, drag {drag:.2f}",
+                         edit_flight(edit_section(base, "vehicle", SE3_GAINS), {"drag": round(drag, 4)})))
     rows = []
     scheds = None
     for label, mission_text in variants:
-        tag = "turbulent" + ("-se3" if "SE3" in label else "")
+        tag = "turbulent" + ("-se3" if "SE3" in label else "") + ("-drag" if "drag" in label else "")
         path = os.path.join(work, f"{tag}.toml")
         open(path, "w").write(mission_text)
         report_path = os.path.join(work, f"{tag}.json")
@@ -454,13 +516,13 @@ def turbulent(args, text, frame, limits, work, calm):
     for v, s in enumerate(scheds, start=1):
         key = (s.p.tobytes(), tuple(s.arrive), t_end)
         if key not in calm:
-            calm[key] = fly_rotorpy(s, (0.0, 0.0, 0.0), args.params, t_end)
+            calm[key] = fly_rotorpy(s, (0.0, 0.0, 0.0), args.params, t_end, args.smooth)
         nominal = np.array([s.at(k * 0.05)[0] for k in range(len(calm[key]))])
         raw, only = [], []
         for k in range(args.flights):
             tv = time.time()
             xs = fly_rotorpy_turbulent(s, wind, W20[args.turbulence], 1000 * args.seed + 100 * v + k,
-                                       args.params, t_end)
+                                       args.params, t_end, args.smooth)
             raw.append(cross_track(s, xs).max())
             only.append(cross_track(s, nominal + xs - calm[key]).max())
             print(f"  {args.turbulence} turbulence: UAV {v} flight {k} in RotorPy in {time.time() - tv:.1f} s",
