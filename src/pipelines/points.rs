@@ -33,6 +33,8 @@ pub struct PointKind {
     pub add: fn(&mut Mission),
     /// Deletes point `i`, if it exists.
     pub remove: fn(&mut Mission, usize),
+    /// Its fields, as the designer's inspector shows and edits them.
+    pub rows: &'static [super::rows::PointRow],
 }
 
 /// One point of one kind: the pipeline, its kind's index on the face, the

@@ -5,7 +5,10 @@
 //! rows of the selected section and names no pipeline. Also the words every
 //! row reads and writes a value in, which the inspector's own tables share.
 
+use nalgebra::Point2;
+
 use crate::mission::Mission;
+use crate::mission::geodesy::Frame;
 
 /// One field of a pipeline's section.
 pub struct Row {
@@ -19,6 +22,66 @@ pub struct Row {
     pub get: fn(&Mission) -> Option<String>,
     /// Writes the (trimmed) text, parsed; the error says what is expected.
     pub set: fn(&mut Mission, &str) -> Result<(), String>,
+}
+
+/// One field of a point of a pipeline's section (`PointKind::rows`: a
+/// fleet target's time, place, latitude): as a [`Row`], of the point at an
+/// index of its list.
+pub struct PointRow {
+    pub name: &'static str,
+    pub unit: &'static str,
+    /// Keys below the point's table in the list.
+    pub keys: &'static [&'static str],
+    /// The value of point `i`; `None` for a row the point does not have.
+    pub get: fn(&Mission, usize) -> Option<String>,
+    pub set: fn(&mut Mission, usize, &str) -> Result<(), String>,
+}
+
+/// Degrees to 8 decimals (about a millimetre), as typed.
+pub fn degrees(v: f64) -> String {
+    let s = format!("{v:.8}");
+    s.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+/// The latitude (or longitude) of ground point `p` through the mission's
+/// `[origin]` (the geodesy of the files and exports), as typed; empty for
+/// a mission without an origin.
+pub fn geo_text(m: &Mission, p: Point2<f64>, latitude: bool) -> String {
+    m.origin.as_ref().map_or_else(String::new, |o| {
+        let g = Frame::new(o).ground_to_geodetic(&p);
+        degrees(if latitude { g.latitude } else { g.longitude })
+    })
+}
+
+/// Where ground point `here` goes when its latitude (or longitude) is typed
+/// as `text`, the other kept. The value shown, applied again, moves nothing.
+pub fn geo_moved(
+    m: &Mission,
+    here: Point2<f64>,
+    text: &str,
+    latitude: bool,
+) -> Result<Point2<f64>, String> {
+    let Some(origin) = &m.origin else {
+        return Err(
+            "a latitude/longitude needs the mission's [origin] (Mission: origin lat, lon)".into(),
+        );
+    };
+    let frame = Frame::new(origin);
+    let g = frame.ground_to_geodetic(&here);
+    if text == degrees(if latitude { g.latitude } else { g.longitude }) {
+        return Ok(here);
+    }
+    let v = number(text)?;
+    let limit = if latitude { 90.0 } else { 180.0 };
+    if v.abs() > limit {
+        return Err(format!("must be within ±{limit}°, got {v}"));
+    }
+    let (la, lo) = if latitude {
+        (v, g.longitude)
+    } else {
+        (g.latitude, v)
+    };
+    Ok(frame.ground_to_enu(la, lo))
 }
 
 /// Metres, degrees, gains: any finite number.
@@ -131,5 +194,36 @@ mod tests {
             }
         }
         assert!(rows > 70, "{rows}");
+    }
+
+    /// Every point's rows (`PointKind::rows`), on every shipped mission's
+    /// points: the same, of the point at its index; and a row the point
+    /// does not have (a target of one point per agent has no `x`) shows
+    /// nothing.
+    #[test]
+    fn every_points_rows_show_a_value_and_write_it_back_unchanged() {
+        let mut shown = 0;
+        for builtin in crate::mission::BUILTIN {
+            let m = crate::mission::parse_str(builtin.text, builtin.file_name)
+                .unwrap_or_else(|e| panic!("{e}"))
+                .mission;
+            for point in crate::pipelines::points::every_point(&m) {
+                let kind = point.kind().unwrap_or_else(|| panic!("{point:?}"));
+                for row in kind.rows {
+                    let Some(value) = (row.get)(&m, point.index) else {
+                        continue;
+                    };
+                    shown += 1;
+                    let mut again = m.clone();
+                    match (row.set)(&mut again, point.index, &value) {
+                        Err(e) if e.contains("in the file") => {}
+                        other => assert_eq!(other, Ok(()), "{}: {}", builtin.file_name, row.name),
+                    }
+                    assert_eq!(again, m, "{}: {} = {value}", builtin.file_name, row.name);
+                }
+                assert!((kind.rows[0].get)(&m, usize::MAX).is_none());
+            }
+        }
+        assert!(shown >= 4, "{shown}");
     }
 }

@@ -14,8 +14,9 @@ use nalgebra::Point2;
 
 use crate::mission::{FieldPath, Mission, Obstacle, PathSegment, ShapeChoice, WaypointChoice};
 use crate::pipelines::Kind;
+use crate::pipelines::points::PointKind;
 use crate::pipelines::points::{self, PointRef};
-use crate::pipelines::rows::Row;
+use crate::pipelines::rows::{PointRow, Row};
 pub use crate::pipelines::rows::{fmt_num, number};
 use crate::pipelines::theta_pso::Iwp;
 
@@ -261,6 +262,8 @@ fn element<T>(
 enum Source {
     Spec(&'static Spec),
     Row(&'static Row),
+    /// A row of the point at this index of its list.
+    Point(&'static PointRow, usize),
 }
 
 /// One editable line of the inspector: a field of the table, with the path
@@ -290,6 +293,7 @@ impl Field {
         match self.source {
             Source::Spec(spec) => spec.unit,
             Source::Row(row) => row.unit,
+            Source::Point(row, _) => row.unit,
         }
     }
 
@@ -309,6 +313,7 @@ impl Field {
         match self.source {
             Source::Spec(spec) => (spec.set)(mission, item, text.trim()),
             Source::Row(row) => (row.set)(mission, text.trim()),
+            Source::Point(row, i) => (row.set)(mission, i, text.trim()),
         }
     }
 }
@@ -318,6 +323,11 @@ impl Field {
 pub fn fields(item: &Item, mission: &Mission) -> Vec<Field> {
     if let Item::Section(kind) = item {
         return section_fields(kind.face().rows(), kind.words().section.0, mission);
+    }
+    if let Item::Point(point) = item {
+        return point
+            .kind()
+            .map_or_else(Vec::new, |kind| point_fields(kind, point.index, mission));
     }
     let table = table::of(item);
     table
@@ -342,6 +352,27 @@ fn label(name: &str, unit: &str) -> String {
     } else {
         format!("{name} ({unit})")
     }
+}
+
+/// Point `i`'s fields, its kind's rows below its table in the list
+/// (`fleet.targets[1].position[0]`).
+fn point_fields(kind: &PointKind, i: usize, mission: &Mission) -> Vec<Field> {
+    let table = FieldPath::root()
+        .key(kind.path[0])
+        .key(kind.path[1])
+        .index(i);
+    kind.rows
+        .iter()
+        .filter_map(|row| {
+            let path = row.keys.iter().fold(table.clone(), |p, k| p.key(k));
+            Some(Field {
+                source: Source::Point(row, i),
+                label: label(row.name, row.unit),
+                path: element(path, kind.rows, row, |r| r.keys),
+                value: (row.get)(mission, i)?,
+            })
+        })
+        .collect()
 }
 
 /// A pipeline's section's fields: its `rows` below `[key]` (`flatlo.start[1]`).

@@ -411,11 +411,7 @@ const NAMES_A_PIPELINE_OR_ITS_SECTION: &[(&str, &str)] = &[
     ),
     ("src/tui/app.rs", "the formation editor lists θ-PSO's IWPs"),
     ("src/tui/editor.rs", "θ-PSO's IWPs"),
-    ("src/tui/fields.rs", "the sections' items in the inspector"),
-    (
-        "src/tui/fields/table.rs",
-        "the fleet targets' inspector rows (a point's rows are not yet its kind's)",
-    ),
+    ("src/tui/fields.rs", "θ-PSO's IWPs in the formation's items"),
     ("src/tui/find.rs", "θ-PSO's IWPs in the item finder"),
 ];
 

@@ -82,6 +82,7 @@ static POINTS: [PointKind; 1] = [PointKind {
             m.fleet.targets.remove(i);
         }
     },
+    rows: super::section::TARGET_ROWS,
 }];
 
 impl Pipeline for Fleet {

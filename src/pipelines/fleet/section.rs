@@ -6,14 +6,17 @@
 //! (`mission::geodetic::SECTION_POSITIONS`). The mission's floor runs and
 //! converts them whenever a mission is read, naming no pipeline.
 
+use crate::mission::FleetTarget;
 use crate::mission::GRAVITY as G;
 use crate::mission::geodetic::{Position, SECTION_POSITIONS, SectionPositions, Slot, Step};
 use crate::mission::{
     Checker, FieldPath, FleetParams, Mission, SECTION_RULES, SectionRules, compact,
 };
 use crate::pipelines::rows::{
-    Row, auto_or_number, count, fmt_num, in_the_file, listed, num, number, put, text,
+    PointRow, Row, auto_or_number, count, fmt_num, geo_moved, geo_text, in_the_file, listed, num,
+    number, put, text,
 };
+use nalgebra::Point2;
 
 #[linkme::distributed_slice(SECTION_RULES)]
 static RULES: SectionRules = SectionRules {
@@ -92,6 +95,48 @@ pub(super) static ROWS: &[Row] = &[
     Row { name: "initial positions", unit: "", keys: &["initial_positions"], get: |m| text(listed(m.fleet.initial_positions.len(), "positions", "seeded random")), set: in_the_file },
     Row { name: "pushes", unit: "", keys: &["pushes"], get: |m| text(listed(m.fleet.pushes.len(), "pushes", "none")), set: in_the_file },
 ];
+
+/// The inspector's rows of one of `[fleet]`'s targets (`PointKind::rows`):
+/// its time; a point to form around, where it is (in metres and, with an
+/// `[origin]`, in degrees); a target of one point per agent, its centre and
+/// how many points it has.
+#[rustfmt::skip]
+pub(super) static TARGET_ROWS: &[PointRow] = &[
+    PointRow { name: "time", unit: "s", keys: &["time"], get: |m, i| num(target_at(m, i)?.time), set: |m, i, t| put(&mut target(m, i)?.time, number(t)) },
+    PointRow { name: "x", unit: "m", keys: &["position"], get: |m, i| num(around_at(m, i)?.position.x), set: |m, i, t| put(&mut target(m, i)?.position.x, number(t)) },
+    PointRow { name: "y", unit: "m", keys: &["position"], get: |m, i| num(around_at(m, i)?.position.y), set: |m, i, t| put(&mut target(m, i)?.position.y, number(t)) },
+    PointRow { name: "lat", unit: "°", keys: &["position", "latitude"], get: |m, i| Some(geo_text(m, around_at(m, i)?.position, true)), set: |m, i, t| set_geo(m, i, t, true) },
+    PointRow { name: "lon", unit: "°", keys: &["position", "longitude"], get: |m, i| Some(geo_text(m, around_at(m, i)?.position, false)), set: |m, i, t| set_geo(m, i, t, false) },
+    PointRow { name: "centre x", unit: "m", keys: &["positions"], get: |m, i| num(each_at(m, i)?.centre().x), set: |m, i, t| { let x = number(t)?; let tg = target(m, i)?; let c = tg.centre(); tg.move_to(Point2::new(x, c.y)); Ok(()) } },
+    PointRow { name: "centre y", unit: "m", keys: &["positions"], get: |m, i| num(each_at(m, i)?.centre().y), set: |m, i, t| { let y = number(t)?; let tg = target(m, i)?; let c = tg.centre(); tg.move_to(Point2::new(c.x, y)); Ok(()) } },
+    PointRow { name: "points", unit: "", keys: &["positions"], get: |m, i| text(each_at(m, i)?.positions.len()), set: |_, _, _| Err("one point per agent: edit `positions` in the file (the planner assigns them)".into()) },
+];
+
+fn target_at(m: &Mission, i: usize) -> Option<&FleetTarget> {
+    m.fleet.targets.get(i)
+}
+
+/// A target of one point to form around.
+fn around_at(m: &Mission, i: usize) -> Option<&FleetTarget> {
+    target_at(m, i).filter(|t| t.positions.is_empty())
+}
+
+/// A target of one point per agent.
+fn each_at(m: &Mission, i: usize) -> Option<&FleetTarget> {
+    target_at(m, i).filter(|t| !t.positions.is_empty())
+}
+
+fn target(m: &mut Mission, i: usize) -> Result<&mut FleetTarget, String> {
+    m.fleet.targets.get_mut(i).ok_or("no such target".into())
+}
+
+/// Moves target `i` to a typed latitude or longitude (the other kept).
+fn set_geo(m: &mut Mission, i: usize, text: &str, latitude: bool) -> Result<(), String> {
+    let here = target_at(m, i).ok_or("no such target")?.position;
+    let p = geo_moved(m, here, text, latitude)?;
+    target(m, i)?.position = p;
+    Ok(())
+}
 
 impl Checker {
     /// Long (~130 lines): one rule per key of `[fleet]`, in the order of the section.

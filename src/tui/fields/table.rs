@@ -3,11 +3,10 @@
 //! values as text. The tables keep one field a line (`rustfmt::skip`) so
 //! they read as tables: name, unit, keys, read, write.
 //!
-//! A pipeline's own section's rows are its face's (`Pipeline::rows`, in
-//! the pipeline's `section.rs`); its points' rows (the fleet's targets) are
-//! still here.
+//! A pipeline's own section's rows, and its points', are its face's
+//! (`Pipeline::rows`, `PointKind::rows`, in the pipeline's `section.rs`).
 //!
-//! Long (~750 lines) because it is the field tables of every other item kind (one field a
+//! Long (~660 lines) because it is the field tables of every other item kind (one field a
 //! line) with the parsers, names and setters their cells call, read together.
 
 use nalgebra::{Point2, Vector3};
@@ -15,13 +14,11 @@ use nalgebra::{Point2, Vector3};
 use super::Step::{Index, Key, Vertex};
 use super::{Item, Spec, Table, shape_name, waypoint_choice};
 use crate::base::terrain::Lookup;
-use crate::mission::geodesy::Frame;
 use crate::mission::{
-    FleetTarget, GeoOrigin, Mission, Obstacle, Preset, ShapeChoice, Terrain, Turbulence,
-    WaypointChoice, spacing_of,
+    GeoOrigin, Mission, Obstacle, Preset, ShapeChoice, Terrain, Turbulence, WaypointChoice,
+    spacing_of,
 };
-use crate::pipelines::points::PointRef;
-use crate::pipelines::rows::{count, fmt_num, num, number, put, text};
+use crate::pipelines::rows::{count, fmt_num, geo_moved, geo_text, num, number, put, text};
 
 /// The table of `item`'s kind.
 pub(super) fn of(item: &Item) -> &'static Table {
@@ -37,27 +34,11 @@ pub(super) fn of(item: &Item) -> &'static Table {
         Item::Formation => &FORMATION,
         Item::Slot(_) => &SLOT,
         Item::Waypoint(_) => &WAYPOINT,
-        // A section's rows are its pipeline's (`Pipeline::rows`).
-        Item::Section(_) => &NO_FIELDS,
-        Item::Point(p) => p.kind().map_or(&NO_FIELDS, |k| {
-            section_table(&[Key(k.path[0]), Key(k.path[1]), Index])
-        }),
+        // A section's rows are its pipeline's (`Pipeline::rows`), its
+        // points' their kind's (`PointKind::rows`).
+        Item::Section(_) | Item::Point(_) => &NO_FIELDS,
         Item::Flight => &FLIGHT,
     }
-}
-
-/// The pipelines' points, found by where they are in the file (a point
-/// list's path).
-static SECTIONS: [&Table; 1] = [&FLEET_TARGET];
-
-/// The table of `SECTIONS` at `base`; none (no fields) for a section
-/// without rows here.
-fn section_table(base: &[super::Step]) -> &'static Table {
-    SECTIONS
-        .iter()
-        .find(|t| t.base == base)
-        .copied()
-        .unwrap_or(&NO_FIELDS)
 }
 
 /// An item whose fields are not in these tables.
@@ -66,11 +47,6 @@ static NO_FIELDS: Table = Table {
     derived: &[],
     fields: &[],
 };
-
-/// A fleet target: a point whose rows are the targets'.
-fn is_target(p: &PointRef) -> bool {
-    std::ptr::eq(of(&Item::Point(*p)), &FLEET_TARGET)
-}
 
 /// `[flight]`: the air, the fixes and the autopilot of `skyform fly`.
 #[rustfmt::skip]
@@ -255,28 +231,10 @@ static WAYPOINT: Table = Table { base: &[Key("reconfiguration"), Key("waypoints"
     Spec { name: "scale (blank: default)", unit: "", keys: &["scale"], get: |m, i| text(choice_at(m, i).and_then(|c| c.scale).map(fmt_num).unwrap_or_default()), set: |m, i, t| set_choice(m, i, blank_or(number, t), |c| &mut c.scale) },
 ]};
 
-#[rustfmt::skip]
-static FLEET_TARGET: Table = Table { base: &[Key("fleet"), Key("targets"), Index], derived: &[], fields: &[
-    Spec { name: "time", unit: "s", keys: &["time"], get: |m, i| num(target_at(m, i)?.time), set: |m, i, t| put(&mut target(m, i)?.time, number(t)) },
-    Spec { name: "x", unit: "m", keys: &["position"], get: |m, i| num(around_at(m, i)?.position.x), set: |m, i, t| put(&mut target(m, i)?.position.x, number(t)) },
-    Spec { name: "y", unit: "m", keys: &["position"], get: |m, i| num(around_at(m, i)?.position.y), set: |m, i, t| put(&mut target(m, i)?.position.y, number(t)) },
-    Spec { name: "lat", unit: "°", keys: &["position", "latitude"], get: |m, i| { around_at(m, i)?; geo(m, i, LAT) }, set: |m, i, t| set_geo(m, i, t, LAT) },
-    Spec { name: "lon", unit: "°", keys: &["position", "longitude"], get: |m, i| { around_at(m, i)?; geo(m, i, LON) }, set: |m, i, t| set_geo(m, i, t, LON) },
-    Spec { name: "centre x", unit: "m", keys: &["positions"], get: |m, i| num(each_at(m, i)?.centre().x), set: |m, i, t| { let x = number(t)?; let tg = target(m, i)?; let c = tg.centre(); tg.move_to(nalgebra::Point2::new(x, c.y)); Ok(()) } },
-    Spec { name: "centre y", unit: "m", keys: &["positions"], get: |m, i| num(each_at(m, i)?.centre().y), set: |m, i, t| { let y = number(t)?; let tg = target(m, i)?; let c = tg.centre(); tg.move_to(nalgebra::Point2::new(c.x, y)); Ok(()) } },
-    Spec { name: "points", unit: "", keys: &["positions"], get: |m, i| text(each_at(m, i)?.positions.len()), set: |_, _, _| Err("one point per agent: edit `positions` in the file (the planner assigns them)".into()) },
-]};
-
 // Reading and writing the values as text.
 
 const LAT: bool = true;
 const LON: bool = false;
-
-/// Degrees to 8 decimals (about a millimetre), as typed.
-fn degrees(v: f64) -> String {
-    let s = format!("{v:.8}");
-    s.trim_end_matches('0').trim_end_matches('.').to_owned()
-}
 
 /// Where a positioned item is on the ground plane (x, y), metres ENU.
 fn ground_xy(m: &Mission, item: &Item) -> Option<Point2<f64>> {
@@ -284,7 +242,6 @@ fn ground_xy(m: &Mission, item: &Item) -> Option<Point2<f64>> {
         Item::Start => Some(m.route.start.xy()),
         Item::Goal => Some(m.route.goal.xy()),
         Item::Obstacle(_) => obstacle_at(m, item).map(|o| o.center),
-        Item::Point(_) => target_at(m, item).map(|t| t.position),
         _ => None,
     }
 }
@@ -292,43 +249,18 @@ fn ground_xy(m: &Mission, item: &Item) -> Option<Point2<f64>> {
 /// The item's latitude or longitude through `[origin]` (the geodesy of the
 /// files and exports); empty for a mission without an origin.
 fn geo(m: &Mission, item: &Item, lat: bool) -> Option<String> {
-    let p = ground_xy(m, item)?;
-    Some(m.origin.as_ref().map_or_else(String::new, |o| {
-        let g = Frame::new(o).ground_to_geodetic(&p);
-        degrees(if lat { g.latitude } else { g.longitude })
-    }))
+    Some(geo_text(m, ground_xy(m, item)?, lat))
 }
 
 /// Moves the item to a typed latitude or longitude (the other and its
 /// height kept). The value shown, applied again, moves nothing.
 fn set_geo(m: &mut Mission, item: &Item, text: &str, lat: bool) -> Result<(), String> {
-    let Some(origin) = m.origin.clone() else {
-        return Err(
-            "a latitude/longitude needs the mission's [origin] (Mission: origin lat, lon)".into(),
-        );
-    };
-    let frame = Frame::new(&origin);
     let here = ground_xy(m, item).ok_or("the item is gone")?;
-    let g = frame.ground_to_geodetic(&here);
-    if text == degrees(if lat { g.latitude } else { g.longitude }) {
-        return Ok(());
-    }
-    let v = number(text)?;
-    let limit = if lat { 90.0 } else { 180.0 };
-    if v.abs() > limit {
-        return Err(format!("must be within ±{limit}°, got {v}"));
-    }
-    let (la, lo) = if lat {
-        (v, g.longitude)
-    } else {
-        (g.latitude, v)
-    };
-    let p = frame.ground_to_enu(la, lo);
+    let p = geo_moved(m, here, text, lat)?;
     match item {
         Item::Start => (m.route.start.x, m.route.start.y) = (p.x, p.y),
         Item::Goal => (m.route.goal.x, m.route.goal.y) = (p.x, p.y),
         Item::Obstacle(_) => obstacle(m, item)?.move_to(p),
-        Item::Point(_) => target(m, item)?.position = p,
         _ => return Err("this item has no position".into()),
     }
     Ok(())
@@ -507,16 +439,6 @@ fn set_via_point(m: &mut Mission, item: &Item, axis: usize, text: &str) -> Resul
     Ok(())
 }
 
-/// A fleet target the formation forms around.
-fn around_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m FleetTarget> {
-    target_at(m, item).filter(|t| t.positions.is_empty())
-}
-
-/// A fleet target of one point per agent.
-fn each_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m FleetTarget> {
-    target_at(m, item).filter(|t| !t.positions.is_empty())
-}
-
 /// An obstacle that is not a wire (whose box the wire's own fields set).
 fn solid_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m Obstacle> {
     obstacle_at(m, item).filter(|o| !o.is_wire())
@@ -653,24 +575,6 @@ fn slot<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut Vector3<f64>, Str
     match item {
         Item::Slot(i) => m.formation.slots.get_mut(*i).ok_or("no such slot".into()),
         _ => Err("not a slot".into()),
-    }
-}
-
-fn target_at<'m>(m: &'m Mission, item: &Item) -> Option<&'m FleetTarget> {
-    match item {
-        Item::Point(p) if is_target(p) => m.fleet.targets.get(p.index),
-        _ => None,
-    }
-}
-
-fn target<'m>(m: &'m mut Mission, item: &Item) -> Result<&'m mut FleetTarget, String> {
-    match item {
-        Item::Point(p) if is_target(p) => m
-            .fleet
-            .targets
-            .get_mut(p.index)
-            .ok_or("no such target".into()),
-        _ => Err("not a fleet target".into()),
     }
 }
 
