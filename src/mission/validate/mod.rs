@@ -2,8 +2,10 @@
 //!
 //! Every rule runs, so one pass reports every problem. Each finding names the
 //! field it concerns; `Diagnostic::locate` later adds the file and line.
-//! `validate` below is the list of every section's rules, in the order of
-//! the file; each section's rules live in a module of their own.
+//! `validate` below is the list of every section's rules; each section's
+//! rules live in a module of their own, a pipeline's section's in the
+//! pipeline's `section.rs`, registered in [`SECTION_RULES`]. Reading a
+//! file lists what they find in the order of its lines (`file.rs`).
 
 use nalgebra::Point3;
 
@@ -33,7 +35,7 @@ pub struct SectionRules {
 #[linkme::distributed_slice]
 pub static SECTION_RULES: [SectionRules];
 
-/// Checks every rule; errors and warnings in the order of the file.
+/// Checks every rule, the registered sections' among them.
 pub fn validate(mission: &Mission) -> Vec<Diagnostic> {
     let mut c = Checker::default();
     let root = FieldPath::root();
