@@ -168,9 +168,10 @@ def answer(path, args):
         """A straight motion is valid when every point of it keeps the
         clearance. The distance to the nearest obstacle changes by at most
         the distance moved, so stepping by the room to spare never steps
-        over an obstacle (conservative advancement): exact, and long steps
-        through open air. The least step, `--resolution`, bounds the work
-        where a motion grazes an obstacle."""
+        over an obstacle (conservative advancement), and steps are long
+        through open air. The least step, `--resolution` (1 mm), bounds the
+        work where a motion grazes an obstacle: that close, a motion is
+        exact to the least step, and a found path is checked again."""
 
         def __init__(self, si):
             super().__init__(si)
