@@ -21,6 +21,7 @@ pub mod judge;
 pub mod network;
 pub mod numbering;
 pub mod recording;
+mod rules;
 pub mod scenario;
 mod section;
 pub mod simulation;
