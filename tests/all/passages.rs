@@ -647,6 +647,74 @@ fn rows_in_series(a: &Sweep, b: &Sweep, apart: f64) -> Mission {
     m
 }
 
+/// The `i`th pair of rows of the series family and how far apart they
+/// stand: the same slant, site and formation for both, neither against
+/// the bounds.
+fn series(i: u64) -> (Sweep, Sweep, f64) {
+    let a = sweep(1000 + 2 * i);
+    let mut b = sweep(1001 + 2 * i);
+    b.slant = a.slant;
+    b.site = a.site;
+    b.uavs = a.uavs;
+    b.at_bound = false;
+    let a = Sweep {
+        at_bound: false,
+        ..a
+    };
+    (a, b, [8.0, 15.0, 30.0][(i % 3) as usize])
+}
+
+/// Issue 51, series #6: two rows 8 m apart on a 1 km site, their walls
+/// running 2 km on past it, the way bending from the first row's aisle
+/// along the 3.5 m between the rows to the second's. A crossing was as
+/// deep as the deeper of its two obstacles (a wall's 2 km, where a bay
+/// flanks the gap for 8 m) and one pair of walls was nearest 1.5 km
+/// outside the site: the route ran a 7,874 m corridor out of the bounds
+/// and the run ended INFEASIBLE after 20 s. Now the plan is found, its
+/// corridor near the start-goal line's length and inside the site.
+#[test]
+fn rows_in_series_plan_along_the_way_between_them_inside_the_site() {
+    let (a, b, apart) = series(6);
+    assert_eq!((apart, a.site), (8.0, (1000.0, 1000.0)), "the case moved");
+    let m = rows_in_series(&a, &b, apart);
+    let iwps = skyform::pipelines::theta_pso::find_iwps(&m);
+    for iwp in iwps.iter().filter(|i| i.is_via()) {
+        for end in [-1.0, 1.0] {
+            let p = iwp.position + iwp.normal * (end * iwp.straight);
+            assert!(
+                m.bounds.contains_xy(&p),
+                "{:?}: its straight ends at {p:?}, outside the bounds",
+                iwp.between
+            );
+        }
+    }
+    let outcome = plan(
+        &m,
+        1,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        outcome.feasible(),
+        "{}",
+        skyform::outcome::Outcome::ThetaPso(Box::new(outcome.clone())).summary()
+    );
+    let line = (m.route.goal - m.route.start).norm();
+    assert!(
+        outcome.path_length < 1.1 * line,
+        "path {:.1} m for a {line:.1} m line",
+        outcome.path_length
+    );
+    for p in &outcome.centroid_path {
+        assert!(
+            m.bounds.contains_xy(&p.xy()),
+            "the path leaves the site at {p:?}"
+        );
+    }
+}
+
 /// Measures two rows in series (`SKYFORM_SERIES=N` missions): both aisles
 /// from 5 cm over the column's need, 8-30 m apart, offsets ±10 m, every
 /// site size; the planner's verdict and time, and the voxel oracle's.
@@ -659,17 +727,7 @@ fn series_rates() {
         .unwrap_or(20);
     let (mut found, mut worst) = (0, 0.0f64);
     for i in 0..n {
-        let a = sweep(1000 + 2 * i);
-        let mut b = sweep(1001 + 2 * i);
-        b.slant = a.slant;
-        b.site = a.site;
-        b.uavs = a.uavs;
-        b.at_bound = false;
-        let a = Sweep {
-            at_bound: false,
-            ..a
-        };
-        let apart = [8.0, 15.0, 30.0][(i % 3) as usize];
+        let (a, b, apart) = series(i);
         let m = rows_in_series(&a, &b, apart);
         if let Ok(dir) = std::env::var("SKYFORM_SWEEP_DUMP") {
             let text = mission::to_toml_string(&m).unwrap_or_else(|e| panic!("{e}"));

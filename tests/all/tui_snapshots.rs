@@ -112,12 +112,12 @@ fn jobs_panel_with_a_finished_result() {
     );
     // r_Q 0.5 + the safety margin 0.1.
     assert!(
-        screen.contains("✓ obstacle clearance worst 0.687 ≥ 0.6"),
+        screen.contains("✓ obstacle clearance worst 0.750 ≥ 0.6"),
         "{screen}"
     );
     // The flight's own rows, against [vehicle]'s default 12 m/s.
     assert!(
-        screen.contains("✓ horizontal speed (m/s) worst 4.167 ≤ 12"),
+        screen.contains("✓ horizontal speed (m/s) worst 4.335 ≤ 12"),
         "{screen}"
     );
     insta::assert_snapshot!(screen);
@@ -521,7 +521,7 @@ fn the_jobs_panel_puts_the_verdict_and_the_first_failure_on_top_at_80_by_24() {
     assert!(panel[1].starts_with("✗ INFEASIBLE · "), "{screen}");
     let detail = panel[1..].join(" ");
     assert!(
-        detail.starts_with("✗ INFEASIBLE · obstacle clearance worst 0.310 ≥ 0.6 (UAV 2 at t ="),
+        detail.starts_with("✗ INFEASIBLE · obstacle clearance worst 0.310 ≥ 0.6 (UAV 3 at t ="),
         "{screen}"
     );
 }

@@ -34,7 +34,7 @@
 //! (narrower than one UAV, blocked, never in the way at a common altitude)
 //! is unusable with the reason, which refuses the plan (`NO PLAN`).
 //!
-//! Long (~960 lines) because it is eq. 9 and Fig. 2 together: the shapes, the widths they
+//! Long (~1110 lines) because it is eq. 9 and Fig. 2 together: the shapes, the widths they
 //! need, the crossing's hold against each obstacle as the crossing sees it (a disc, a
 //! footprint's edges), each pair's IWP (or gate) with why none, read as one reading.
 
@@ -494,12 +494,16 @@ fn crossing_hold(
     let r_q = f.least_clearance();
     let margin = mission.theta_pso.clearance_margin.max(0.0);
     let obstacles = &mission.obstacles;
-    // How deep the wall the gap pierces is along the crossing: its two
-    // obstacles' reach either side of the gap line.
+    // How deep the wall the gap pierces is along the crossing: as far
+    // either side of the gap line as both its obstacles flank it (the
+    // shallower one's reach). Beyond it one side is open: a post beside a
+    // wall that runs along the crossing narrows the way for the post's
+    // depth, not for the wall's kilometre (issue 51: a crossing 2 km each
+    // side led the route out of the site).
     let deepest = pair
         .iter()
         .map(|&k| Seen::of(&obstacles[k], center, normal).depth())
-        .fold(0.0, f64::max);
+        .fold(f64::INFINITY, f64::min);
     let wall_zone = deepest + f.safe_radius() + margin;
     let mut approaching = vec![f.slots.clone()];
     if let Some(shape) = shape {
@@ -804,6 +808,19 @@ fn pair_iwp(
         ),
     };
     let position = Point2::from((p_p.coords + p_q.coords) / 2.0);
+    // Two walls that run on past the site may be nearest outside it: that
+    // gap is not flown, and what lies between them inside is left to the
+    // route's grid and its exact gaps (issue 51: a crossing 2 km out of a
+    // 1 km site).
+    if !mission.bounds.contains_xy(&position) {
+        gate?;
+        refusal.get_or_insert_with(|| {
+            format!(
+                "the gap is narrowest at ({:.1}, {:.1}) m, outside the x-y bounds",
+                position.x, position.y
+            )
+        });
+    }
     let normal = Vector2::new(-u.y, u.x);
     let margin = mission.theta_pso.clearance_margin.max(0.0);
     let hold_for = |shape: Option<Shape>| {
@@ -838,6 +855,9 @@ fn pair_iwp(
         Ok((shape, hold)) => (shape, hold, None),
         Err(reason) => (None, (0.0, 0.0), Some(reason)),
     };
+    // The straight is flown inside the site: no farther either way than the
+    // bounds.
+    let straight = straight.min(room_along(&mission.bounds, position, normal));
     Some(Iwp {
         between: [a.name.clone(), b.name.clone()],
         obstacles: [p, q],
@@ -853,6 +873,20 @@ fn pair_iwp(
         window,
         gate,
     })
+}
+
+/// How far from `p` (inside `bounds`) along `±direction` the x-y bounds
+/// leave room, the nearer of the two ways.
+fn room_along(bounds: &crate::mission::Bounds, p: Point2<f64>, direction: Vector2<f64>) -> f64 {
+    let d = direction / direction.norm().max(1e-12);
+    let mut room = f64::INFINITY;
+    for (axis, range) in [bounds.x, bounds.y].into_iter().enumerate() {
+        let (at, step) = (p[axis], d[axis].abs());
+        if step > 1e-12 {
+            room = room.min((at - range[0]).min(range[1] - at).max(0.0) / step);
+        }
+    }
+    room
 }
 
 /// Two crossings in sequence whose straights overlap along the way (walls
@@ -943,6 +977,94 @@ pub mod searches {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mission::Obstacle;
+
+    /// A 100 m site on x with obstacles of the given footprints standing
+    /// from the ground to 30 m.
+    fn site_with(outlines: &[(&str, &[[f64; 2]])]) -> Mission {
+        let text = "name = \"slabs\"\n[bounds]\nx = [0.0, 100.0]\ny = [-30.0, 30.0]\n\
+                    z = [3.0, 12.0]\n[route]\nstart = [5.0, 0.0, 8.0]\ngoal = [95.0, 0.0, 8.0]\n";
+        let mut m = crate::mission::parse_str(text, "slabs.toml")
+            .unwrap_or_else(|e| panic!("{e}"))
+            .mission;
+        for (name, outline) in outlines {
+            let mut o = Obstacle::standing(name.to_string(), Point2::origin(), 0.0, 30.0);
+            o.footprint = outline.iter().map(|&[x, y]| Point2::new(x, y)).collect();
+            o.overfly = false;
+            o.settle();
+            m.obstacles.push(o);
+        }
+        m
+    }
+
+    /// `x0..x1` × `y0..y1`.
+    fn slab(x0: f64, x1: f64, y0: f64, y1: f64) -> [[f64; 2]; 4] {
+        [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+    }
+
+    /// A crossing is straight for as far as both its obstacles flank the
+    /// gap: a 2 m post beside a wall that runs 2 km along the crossing
+    /// narrows the way for the post's 2 m, not the wall's 2 km (issue 51,
+    /// series #6: the route ran its crossing out of the site).
+    #[test]
+    fn a_crossing_is_as_deep_as_the_shallower_of_its_two_obstacles() {
+        let m = site_with(&[
+            ("post", &slab(49.0, 51.0, -1.0, 1.0)),
+            ("wall", &slab(-950.0, 1050.0, 2.5, 3.5)),
+        ]);
+        let iwps = find_iwps(&m);
+        let iwp = iwps
+            .iter()
+            .find(|i| i.between == ["post", "wall"])
+            .unwrap_or_else(|| panic!("no IWP: {iwps:?}"));
+        assert!(iwp.is_via(), "{iwp:?}");
+        assert!((iwp.gap - 1.5).abs() < 1e-9, "{iwp:?}");
+        // Along x through the gap; 1 m of post each side, r_Q, the margins
+        // and the hold are a few metres, the wall's 1 km is not.
+        assert!(iwp.normal.x.abs() > 0.999, "{iwp:?}");
+        assert!(iwp.straight < 15.0 && iwp.straight > 1.0, "{iwp:?}");
+    }
+
+    fn iwps_between(m: &Mission, a: &str, b: &str) -> Vec<Iwp> {
+        let found: Vec<Iwp> = find_iwps(m)
+            .into_iter()
+            .filter(|i| i.between == [a, b])
+            .collect();
+        assert_eq!(found.len(), 1, "{a} | {b}: {found:?}");
+        found
+    }
+
+    /// Two walls nearest each other outside the site leave no IWP there, and
+    /// no crossing's straight runs past the bounds.
+    #[test]
+    fn no_crossing_lies_or_runs_outside_the_bounds() {
+        // Converging walls, nearest (1.4 m apart) at x = 600, where the site
+        // ends at x = 100; a post 1.5 m south of the wall, 1 m from the
+        // site's east end.
+        let m = site_with(&[
+            ("south", &slab(0.0, 600.0, -1.0, 0.0)),
+            (
+                "north",
+                &[[0.0, 8.0], [600.0, 1.4], [600.0, 2.4], [0.0, 9.0]],
+            ),
+            ("post", &slab(98.0, 99.0, -3.5, -2.5)),
+        ]);
+        assert!(
+            iwps_between(&m, "south", "post").iter().all(|i| i.is_via()),
+            "the post's gap is a crossing"
+        );
+        let iwps = find_iwps(&m);
+        assert!(
+            !iwps.iter().any(|i| i.between == ["south", "north"]),
+            "the walls' gap lies outside the site: {iwps:?}"
+        );
+        for iwp in iwps.iter().filter(|i| i.is_via()) {
+            for end in [-1.0, 1.0] {
+                let p = iwp.position + iwp.normal * (end * iwp.straight);
+                assert!(m.bounds.contains_xy(&p), "{iwp:?} ends at {p}");
+            }
+        }
+    }
 
     /// The capsule's cut by a line, solved exactly, against the distance to
     /// the segment sampled every millimetre along the line, for segments
