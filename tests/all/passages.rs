@@ -715,6 +715,35 @@ fn rows_in_series_plan_along_the_way_between_them_inside_the_site() {
     }
 }
 
+/// Issue 51, series #3: rows 8 m apart on a 1 km site, the way bending
+/// from the first row's aisle along the 3.5 m between the rows into the
+/// second's. At the whole site's 2.5 m cells the route found no corridor
+/// ("a way bent between three or more that fits by less than about 2.50 m
+/// may not be found"); the same rows on a 120 m site plan. The route now
+/// looks again at finer cells in the window round the start, the goal and
+/// the gaps, and plans it on the large site too.
+#[test]
+fn a_way_bent_between_two_rows_is_found_on_a_large_site() {
+    let (a, b, apart) = series(3);
+    assert_eq!((apart, a.site), (8.0, (1000.0, 1000.0)), "the case moved");
+    let m = rows_in_series(&a, &b, apart);
+    let outcome = plan(
+        &m,
+        1,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        outcome.feasible(),
+        "{}",
+        skyform::outcome::Outcome::ThetaPso(Box::new(outcome.clone())).summary()
+    );
+    let cell = outcome.corridor.coarse_cell.unwrap_or(0.0);
+    assert!(cell < 1.0, "searched at {cell} m cells");
+}
+
 /// Measures two rows in series (`SKYFORM_SERIES=N` missions): both aisles
 /// from 5 cm over the column's need, 8-30 m apart, offsets ±10 m, every
 /// site size; the planner's verdict and time, and the voxel oracle's.

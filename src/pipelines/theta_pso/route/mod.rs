@@ -292,11 +292,12 @@ impl Site {
         margin: f64,
         levels: Levels,
         stops: usize,
+        searched: Area,
     ) -> Self {
         let shape = Shape::new(mission, margin);
         let need = shape.need();
         let b = &mission.bounds;
-        let area = (b.x[1] - b.x[0]) * (b.y[1] - b.y[0]);
+        let area = (searched[0][1] - searched[0][0]) * (searched[1][1] - searched[1][0]);
         // The search holds a state per cell, layer, level and stage: the grid
         // shares its states among the stages (one more than the stops) and
         // the levels, never finer than 0.2 m. A large site gets
@@ -321,7 +322,7 @@ impl Site {
             .map(|l| {
                 let obstacles = blocking(mission, levels.span(l));
                 let discs: Vec<Footprint> = obstacles.iter().map(|(_, d)| d.clone()).collect();
-                let field = Field::new([b.x, b.y], &discs, cell, cap);
+                let field = Field::new(searched, &discs, cell, cap);
                 Level {
                     obstacles,
                     discs,
@@ -366,7 +367,7 @@ impl Site {
                 .into_iter()
                 .map(|(_, d)| d)
                 .collect();
-            let hull = Field::new([b.x, b.y], &discs, cell, cap + run);
+            let hull = Field::new(searched, &discs, cell, cap + run);
             for (i, bits) in open.iter_mut().enumerate() {
                 let (c, p) = (hull.clearance(i), hull.center(i));
                 for layer in 0..LAYERS {
@@ -425,6 +426,9 @@ impl Site {
         p: Point2<f64>,
         out: nalgebra::Vector2<f64>,
     ) -> Option<(usize, Point2<f64>, usize)> {
+        if !self.field().contains(p) {
+            return None;
+        }
         let here = self.field().index_of(p);
         if (0..LAYERS).any(|l| self.open[here] & bit(level, l) != 0) {
             return Some((here, p, 0));
@@ -499,6 +503,9 @@ fn pass_clear(site: &Site, level: usize, k: usize, ends: [Point2<f64>; 2]) -> bo
     let open = &site.open;
     let obstacle = obstacles.iter().position(|(o, _)| *o == k);
     let nominal = bit(level, 0);
+    if !ends.iter().all(|p| field.contains(*p)) {
+        return false;
+    }
     field.cells_along(ends[0], ends[1]).all(|c| {
         open[c] & nominal != 0
             || (field.nearest_disc(c) == obstacle && field.clearance(c) > site.shape.r_q)
@@ -516,7 +523,86 @@ pub fn find(
     iwps: &[Iwp],
     margin: f64,
 ) -> Result<Corridor, Blocked> {
-    let flat = find_at(mission, builder, iwps, margin, Levels::flat(mission));
+    let b = &mission.bounds;
+    let whole = find_in(mission, builder, iwps, margin, [b.x, b.y]);
+    if whole.is_ok() {
+        return whole;
+    }
+    let Some(window) = focus(mission, builder, iwps) else {
+        return whole;
+    };
+    find_in(mission, builder, iwps, margin, window).or_else(|_| {
+        whole.map_err(|mut blocked| {
+            let [x, y] = window;
+            blocked.reason.push_str(&format!(
+                "; searched again at finer cells over x {:.0} to {:.0} m, y {:.0} to {:.0} m (round \
+                 the start, the goal and every gap narrower than the formation): no corridor there \
+                 either",
+                x[0], x[1], y[0], y[1]
+            ));
+            blocked
+        })
+    })
+}
+
+/// A rectangle of the x-y plane: [x range, y range], metres.
+type Area = [[f64; 2]; 2];
+
+/// Metres the focused window reaches beyond what it must hold.
+const FOCUS_PAD: f64 = 20.0;
+
+/// Where to look again, at finer cells, when a large site's coarse grid
+/// found no corridor: the box round the start, the goal, the user's via
+/// points, the inspected obstacles and every gap eq. 9 places an IWP at
+/// (the passages narrower than the formation, where a coarse cell may close
+/// a way that bends between three obstacles), `FOCUS_PAD` beyond and
+/// within the bounds. `None` when the site is already fine or the window
+/// would not be much smaller than the site (issue 51: two rows in series
+/// on a 1 km site, the way bending along 3.5 m between them, closed at
+/// 2.5 m cells and open at 0.75 m).
+fn focus(mission: &Mission, builder: &PathBuilder, iwps: &[Iwp]) -> Option<Area> {
+    let b = &mission.bounds;
+    let size = |a: &Area| (a[0][1] - a[0][0]) * (a[1][1] - a[1][0]);
+    let whole = [b.x, b.y];
+    if (size(&whole) / MAX_CELLS).sqrt() <= 1.5 * FINEST_CELL {
+        return None;
+    }
+    let f = &mission.formation;
+    let pad = FOCUS_PAD + f.radius();
+    let mut held: Vec<(Point2<f64>, f64)> = vec![
+        (mission.route.start.xy(), pad),
+        (mission.route.goal.xy(), pad),
+    ];
+    held.extend(builder.via_points().iter().map(|(_, p)| (p.xy(), pad)));
+    held.extend(iwps.iter().map(|i| (i.position, pad)));
+    let around = f.surface_distance[1] + pad;
+    held.extend(
+        mission
+            .obstacles
+            .iter()
+            .filter(|o| o.inspect)
+            .map(|o| (o.center, o.radius + around)),
+    );
+    let mut window = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+    for (p, reach) in held {
+        for (axis, range) in window.iter_mut().enumerate() {
+            range[0] = range[0].min(p[axis] - reach).max(whole[axis][0]);
+            range[1] = range[1].max(p[axis] + reach).min(whole[axis][1]);
+        }
+    }
+    (size(&window) <= size(&whole) / 4.0).then_some(window)
+}
+
+/// The route search over `area` (the whole site, or [`focus`]'s window):
+/// flat, then over levels.
+fn find_in(
+    mission: &Mission,
+    builder: &PathBuilder,
+    iwps: &[Iwp],
+    margin: f64,
+    area: Area,
+) -> Result<Corridor, Blocked> {
+    let flat = find_at(mission, builder, iwps, margin, Levels::flat(mission), area);
     let Err(blocked) = flat else {
         return flat;
     };
@@ -530,7 +616,7 @@ pub fn find(
     if levels.len() < 2 {
         return Err(with_altitudes(mission, blocked, z_box));
     }
-    find_at(mission, builder, iwps, margin, levels).map_err(|stacked| {
+    find_at(mission, builder, iwps, margin, levels, area).map_err(|stacked| {
         // The stacked search names what closes the way at every altitude it
         // tried; when nothing does (the way closes only in combination), the
         // flat search's chain is the one to name.
@@ -616,6 +702,7 @@ fn find_at(
     iwps: &[Iwp],
     margin: f64,
     levels: Levels,
+    area: Area,
 ) -> Result<Corridor, Blocked> {
     let (start, goal) = (mission.route.start.xy(), mission.route.goal.xy());
     let overlaps = |a: [f64; 2], b: [f64; 2]| a[0] <= b[1] + 1e-9 && b[0] <= a[1] + 1e-9;
@@ -627,7 +714,7 @@ fn find_at(
     let windows = builder.crossing_windows();
     let requested = requested_crossings(mission, builder, iwps);
     let order = stop_order(builder, &crossings, &requested, start, goal);
-    let site = Site::new(mission, builder, margin, levels, order.len());
+    let site = Site::new(mission, builder, margin, levels, order.len(), area);
     let field = site.field();
     let levels = &site.levels;
     let stage_of_crossing = |c: usize| order.iter().position(|s| *s == Stop::Crossing(c));
@@ -688,7 +775,7 @@ fn find_at(
     }
 
     let via_tag = 2 * crossings.len() + candidates.len();
-    for &(stage, level, p, k) in &via_jumps {
+    for &(stage, level, p, k) in via_jumps.iter().filter(|j| field.contains(j.2)) {
         let cell = field.index_of(p);
         jumps.push(Jump {
             from: cell,

@@ -48,7 +48,15 @@ pub fn reuse(
             .filter(|r| **r)
             .count()
         + builder.via_points().len();
-    let site = Site::new(mission, builder, margin, Levels::flat(mission), stops);
+    let b = &mission.bounds;
+    let site = Site::new(
+        mission,
+        builder,
+        margin,
+        Levels::flat(mission),
+        stops,
+        [b.x, b.y],
+    );
     let field = site.field();
     let crossings = builder.crossings();
     let windows = builder.crossing_windows();
