@@ -8,8 +8,9 @@
 //! with a commanded speed per leg ([`legs`]: ground speed for multicopters,
 //! airspeed for fixed wing), so that each vehicle reaches each waypoint
 //! when the plan says. The files are then flown as an autopilot flies them
-//! and checked with the pipeline's own verification against the hard
-//! limits, every written speed against the vehicle's ([`reverify`]). Only
+//! and checked with the shared verification every pipeline's plan passes
+//! ([`crate::pipelines::verify`]) against the hard limits, every written
+//! speed against the vehicle's ([`reverify`]). Only
 //! then are they written: QGroundControl `.plan` ([`plan`]), `QGC WPL 110`
 //! ([`wpl`]) or CSV ([`csv`]), atomically. A KML of the whole plan ([`kml`]:
 //! the mission, every vehicle's home and track, the verdict) is one more
