@@ -744,6 +744,63 @@ fn a_way_bent_between_two_rows_is_found_on_a_large_site() {
     assert!(cell < 1.0, "searched at {cell} m cells");
 }
 
+/// Issue 51: a refusal after the second look. On a 1 km site a low block
+/// fills the only gap of a first wall (the formation could climb over it)
+/// and a second wall is closed from bound to bound: the whole site's
+/// search fails flat and over levels, and so does the window's. The
+/// window's explanation of what closes the way reads its own grid (it once
+/// read a grid of the whole site at the window's cells, which its search
+/// had not covered); the refusal names the closed wall and says where it
+/// looked again.
+#[test]
+fn a_closed_site_is_refused_after_the_second_look_over_levels() {
+    let text = "name = \"closed\"\nseed = 1\n[bounds]\nx = [0.0, 1000.0]\ny = [-500.0, 500.0]\n\
+                z = [3.0, 20.0]\n[route]\nstart = [5.0, 0.0, 8.0]\ngoal = [995.0, 0.0, 8.0]\n\
+                [formation]\nuav_radius = 0.33\n";
+    let mut m = mission::parse_str(text, "closed.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .mission;
+    for (name, [x0, x1, y0, y1], height, overfly) in [
+        ("first south", [300.0, 301.0, -600.0, -1.0], 30.0, false),
+        ("first north", [300.0, 301.0, 1.0, 600.0], 30.0, false),
+        ("low block", [299.5, 301.5, -1.2, 1.2], 9.0, true),
+        ("second wall", [600.0, 601.0, -600.0, 600.0], 30.0, false),
+    ] {
+        let mut o = Obstacle::standing(name.to_owned(), Point2::origin(), 0.0, height);
+        o.footprint = vec![
+            Point2::new(x0, y0),
+            Point2::new(x1, y0),
+            Point2::new(x1, y1),
+            Point2::new(x0, y1),
+        ];
+        o.overfly = overfly;
+        o.settle();
+        m.obstacles.push(o);
+    }
+    match plan(
+        &m,
+        1,
+        PlanOptions::default(),
+        &mut Silent,
+        &CancelToken::new(),
+    ) {
+        Err(PipelineError::NoRoute(no)) => {
+            assert!(
+                no.obstacles.contains(&"second wall".to_owned()),
+                "{:?}: {}",
+                no.obstacles,
+                no.reason
+            );
+            assert!(
+                no.reason.contains("searched again at finer cells"),
+                "{}",
+                no.reason
+            );
+        }
+        other => panic!("{:?}", other.map(|o| o.feasible())),
+    }
+}
+
 /// Measures two rows in series (`SKYFORM_SERIES=N` missions): both aisles
 /// from 5 cm over the column's need, 8-30 m apart, offsets ±10 m, every
 /// site size; the planner's verdict and time, and the voxel oracle's.

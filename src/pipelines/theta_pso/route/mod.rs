@@ -245,9 +245,12 @@ const CLIMB_COST: f64 = 2.0;
 
 /// Half the horizontal run of a climb between two levels `dz` apart: the
 /// ramp is flown within this of the cell the search climbed at, so that
-/// cell keeps this much more clearance over every altitude between.
+/// cell keeps this much more clearance over every altitude between. At
+/// most 2.5 m, but never under a cell and a half: on a large site's coarse
+/// cells (over 1.67 m) the cell wins (a `clamp` with its bounds crossed
+/// aborted the run there).
 fn ramp(dz: f64, cell: f64) -> f64 {
-    (0.5 * dz.abs()).clamp(1.5 * cell, 2.5)
+    (0.5 * dz.abs()).min(2.5).max(1.5 * cell)
 }
 
 /// One level of the search: what stands in the way there.
@@ -270,6 +273,9 @@ pub(crate) struct Site {
     at: Vec<Level>,
     /// Per cell, the search's bits (`search::bit`, `search::climb_bit`).
     open: Vec<u64>,
+    /// The rectangle searched: the bounds, or `focus`'s window. Every grid
+    /// of the site covers it, so their cells are the search's.
+    area: Area,
 }
 
 impl Site {
@@ -399,6 +405,7 @@ impl Site {
             need,
             levels,
             at,
+            area: searched,
             open,
         }
     }
@@ -932,10 +939,9 @@ fn explain(
             .collect();
         let discs: Vec<Footprint> = kept.iter().map(|(_, d)| d.clone()).collect();
         let geometry = site.field();
-        let b = &mission.bounds;
         everywhere = (
             Field::new(
-                [b.x, b.y],
+                site.area,
                 &discs,
                 geometry.cell(),
                 site.need[0] + 2.0 * geometry.cell(),
