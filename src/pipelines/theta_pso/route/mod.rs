@@ -34,10 +34,11 @@
 //! formation turned to just the right heading might squeeze through where
 //! the disc model says it cannot).
 //!
-//! Long (~950 lines) because it holds the stage's driver and the site it searches: the
+//! Long (~1060 lines) because it holds the stage's driver and the site it searches: the
 //! shape, layers and levels, the cells' open bits, the landings that join exact passages to
-//! the grid, the stops and the jumps; the search, the field, the gaps, the guide, the
-//! corridor's assembly, the squeeze map and the refusal's words are submodules.
+//! the grid, the stops and the jumps, the second look over a window (`focus`); the search,
+//! the field, the gaps, the guide, the corridor's assembly, the squeeze map and the refusal's
+//! words are submodules.
 
 mod blocked;
 mod corridor;
