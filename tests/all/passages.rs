@@ -664,32 +664,19 @@ fn series(i: u64) -> (Sweep, Sweep, f64) {
     (a, b, [8.0, 15.0, 30.0][(i % 3) as usize])
 }
 
-/// Issue 51, series #6: two rows 8 m apart on a 1 km site, their walls
-/// running 2 km on past it, the way bending from the first row's aisle
-/// along the 3.5 m between the rows to the second's. A crossing was as
-/// deep as the deeper of its two obstacles (a wall's 2 km, where a bay
-/// flanks the gap for 8 m) and one pair of walls was nearest 1.5 km
-/// outside the site: the route ran a 7,874 m corridor out of the bounds
-/// and the run ended INFEASIBLE after 20 s. Now the plan is found, its
-/// corridor near the start-goal line's length and inside the site.
-#[test]
-fn rows_in_series_plan_along_the_way_between_them_inside_the_site() {
-    let (a, b, apart) = series(6);
-    assert_eq!((apart, a.site), (8.0, (1000.0, 1000.0)), "the case moved");
-    let m = rows_in_series(&a, &b, apart);
-    let iwps = skyform::pipelines::theta_pso::find_iwps(&m);
-    for iwp in iwps.iter().filter(|i| i.is_via()) {
-        for end in [-1.0, 1.0] {
-            let p = iwp.position + iwp.normal * (end * iwp.straight);
-            assert!(
-                m.bounds.contains_xy(&p),
-                "{:?}: its straight ends at {p:?}, outside the bounds",
-                iwp.between
-            );
-        }
-    }
+/// The `i`th case of the series, which the tests below were written for
+/// as two rows 8 m apart on a 1 km site.
+fn series_on_a_large_site(i: u64) -> Mission {
+    let (a, b, apart) = series(i);
+    assert_eq!((apart, a.site), (8.0, (1000.0, 1000.0)), "case {i} moved");
+    rows_in_series(&a, &b, apart)
+}
+
+/// θ-PSO's plan of `m` (seed 1), which must be FEASIBLE: its summary
+/// says why not.
+fn planned_feasibly(m: &Mission) -> skyform::pipelines::theta_pso::ThetaPsoOutcome {
     let outcome = plan(
-        &m,
+        m,
         1,
         PlanOptions::default(),
         &mut Silent,
@@ -701,6 +688,31 @@ fn rows_in_series_plan_along_the_way_between_them_inside_the_site() {
         "{}",
         skyform::outcome::Outcome::ThetaPso(Box::new(outcome.clone())).summary()
     );
+    outcome
+}
+
+/// Issue 51, series #6: two rows 8 m apart on a 1 km site, their walls
+/// running 2 km on past it, the way bending from the first row's aisle
+/// along the 3.5 m between the rows to the second's. A crossing was as
+/// deep as the deeper of its two obstacles (a wall's 2 km, where a bay
+/// flanks the gap for 8 m) and one pair of walls was nearest 1.5 km
+/// outside the site: the route ran a 7,874 m corridor out of the bounds
+/// and the run ended INFEASIBLE after 20 s. Now the plan is found, its
+/// corridor near the start-goal line's length and inside the site.
+#[test]
+fn rows_in_series_plan_along_the_way_between_them_inside_the_site() {
+    let m = series_on_a_large_site(6);
+    let iwps = skyform::pipelines::theta_pso::find_iwps(&m);
+    for iwp in iwps.iter().filter(|i| i.is_via()) {
+        for p in iwp.straight_ends() {
+            assert!(
+                m.bounds.contains_xy(&p),
+                "{:?}: its straight ends at {p:?}, outside the bounds",
+                iwp.between
+            );
+        }
+    }
+    let outcome = planned_feasibly(&m);
     let line = (m.route.goal - m.route.start).norm();
     assert!(
         outcome.path_length < 1.1 * line,
@@ -724,22 +736,7 @@ fn rows_in_series_plan_along_the_way_between_them_inside_the_site() {
 /// the gaps, and plans it on the large site too.
 #[test]
 fn a_way_bent_between_two_rows_is_found_on_a_large_site() {
-    let (a, b, apart) = series(3);
-    assert_eq!((apart, a.site), (8.0, (1000.0, 1000.0)), "the case moved");
-    let m = rows_in_series(&a, &b, apart);
-    let outcome = plan(
-        &m,
-        1,
-        PlanOptions::default(),
-        &mut Silent,
-        &CancelToken::new(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    assert!(
-        outcome.feasible(),
-        "{}",
-        skyform::outcome::Outcome::ThetaPso(Box::new(outcome.clone())).summary()
-    );
+    let outcome = planned_feasibly(&series_on_a_large_site(3));
     let cell = outcome.corridor.coarse_cell.unwrap_or(0.0);
     assert!(cell < 1.0, "searched at {cell} m cells");
 }

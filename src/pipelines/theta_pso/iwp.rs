@@ -89,6 +89,13 @@ pub struct Iwp {
 }
 
 impl Iwp {
+    /// The ends of the straight crossing: `straight` either way from the
+    /// gap along its normal.
+    pub fn straight_ends(&self) -> [Point2<f64>; 2] {
+        let reach = self.normal * self.straight;
+        [self.position - reach, self.position + reach]
+    }
+
     /// The planned path goes through this IWP.
     pub fn is_via(&self) -> bool {
         self.enabled && self.unusable.is_none()
@@ -1059,8 +1066,7 @@ mod tests {
             "the walls' gap lies outside the site: {iwps:?}"
         );
         for iwp in iwps.iter().filter(|i| i.is_via()) {
-            for end in [-1.0, 1.0] {
-                let p = iwp.position + iwp.normal * (end * iwp.straight);
+            for p in iwp.straight_ends() {
                 assert!(m.bounds.contains_xy(&p), "{iwp:?} ends at {p}");
             }
         }
